@@ -1,0 +1,69 @@
+"""The condensed (dual) problem on the contact candidates.
+
+With ``W = N K⁻¹ Nᵀ`` (the Delassus operator, m × m SPD) and
+``b = N K⁻¹ f − d``, the gap of the candidates is ``g(λ) = Wλ − b`` and the
+contact forces solve the linear complementarity problem
+
+    λ ≥ 0,   Wλ − b ≥ 0,   λᵢ (Wλ − b)ᵢ = 0,
+
+i.e. the bound-constrained QP ``min ½λᵀWλ − bᵀλ`` over ``λ ≥ 0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+
+def delassus(N: sp.csr_matrix, factor) -> tuple[np.ndarray, np.ndarray]:
+    """``W = N K⁻¹ Nᵀ`` by m back-solves; also returns ``K⁻¹ Nᵀ`` (n × m)."""
+    K_inv_NT = factor.solve(N.T.toarray())
+    K_inv_NT = K_inv_NT.reshape(N.shape[1], N.shape[0])
+    W = N @ K_inv_NT
+    return 0.5 * (W + W.T), K_inv_NT
+
+
+def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
+              lam0: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """Primal-dual active set on ``min ½λᵀWλ − bᵀλ, λ ≥ 0``.
+
+    The active set is ``A = {i : λᵢ − gᵢ > 0}`` with ``g = Wλ − b``; on A the
+    gap is closed (``W_AA λ_A = b_A``), off A the force is zero. Stops when A
+    repeats; returns ``(λ, iterations)``, or raises ``ArithmeticError`` when
+    the active set keeps changing for ``max_iter`` steps.
+    """
+    m = len(b)
+    lam = np.zeros(m) if lam0 is None else np.maximum(lam0, 0.0)
+    active = None
+    for iteration in range(1, max_iter + 1):
+        gap = W @ lam - b
+        new_active = (lam - gap) > 0
+        if active is not None and np.array_equal(new_active, active):
+            return lam, iteration - 1
+        active = new_active
+        lam = np.zeros(m)
+        if active.any():
+            lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
+    raise ArithmeticError(f"active set still changing after {max_iter} PDAS steps")
+
+
+def delassus_max_eigenvalue(N: sp.csr_matrix, factor, rtol: float = 1e-6,
+                            max_iter: int = 500, seed: int = 0) -> tuple[float, int]:
+    """``λ_max(W)`` of ``W = N K⁻¹ Nᵀ`` by power iteration (one back-solve per step).
+
+    Returns the Rayleigh-quotient estimate (a lower bound of the true value)
+    and the number of steps; stops when it changes by less than ``rtol``.
+    """
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal(N.shape[0])
+    x /= np.linalg.norm(x)
+    estimate = 0.0
+    for step in range(1, max_iter + 1):
+        y = N @ factor.solve(N.T @ x)
+        new_estimate = float(x @ y)
+        x = y / np.linalg.norm(y)
+        if abs(new_estimate - estimate) <= rtol * abs(new_estimate):
+            return new_estimate, step
+        estimate = new_estimate
+    return estimate, max_iter

@@ -1,0 +1,22 @@
+"""The package's exceptions.
+
+Every error a user can cause by bad input is an :class:`InputError`: its message
+names the parameter and says how to fix it. The CLI turns it into a one-line
+message and exit code 2.
+"""
+
+
+class SignoriniError(Exception):
+    """Base class of every error raised by signorini."""
+
+
+class InputError(SignoriniError, ValueError):
+    """Bad input: a parameter, option, scene or method name the package cannot use."""
+
+
+class BackendNotInstalled(InputError):
+    """A method whose backend package is not installed."""
+
+
+class SolverError(SignoriniError):
+    """A backend failed in a way that is not the user's input (re-raised ``from`` it)."""

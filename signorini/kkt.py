@@ -1,0 +1,151 @@
+"""KKT certificates, active sets and comparisons: computed here, never by a solver.
+
+For ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with multipliers ``λ`` every residual is
+relative, so that the same threshold means the same thing in any units.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .problem import ContactProblem, ContactSolution
+
+#: normalised force and gap below which a node counts as touching with zero force
+WEAK_TOL = 1e-6
+
+
+def _inf_norm(x: np.ndarray) -> float:
+    return float(np.max(np.abs(x))) if x.size else 0.0
+
+
+def _positive(x: float) -> float:
+    return x if x > 0 else 1.0
+
+
+def gap_scale(problem: ContactProblem, u: np.ndarray) -> float:
+    """Length against which gaps are judged: ``max(‖Nu‖∞, ‖d‖∞)``."""
+    return _positive(max(_inf_norm(problem.N @ u), _inf_norm(problem.d)))
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """Relative KKT residuals of a candidate solution ``(u, λ)``.
+
+    - ``primal``: ``max((Nu − d)⁺) / max(‖Nu‖∞, ‖d‖∞)``
+    - ``stationarity``: ``‖Ku − f + Nᵀλ‖∞ / (‖f‖∞ + ‖Nᵀλ‖∞)``
+    - ``dual_sign``: ``max((−λ)⁺) / ‖λ‖∞``
+    - ``complementarity``: ``max |λᵢ (Nu − d)ᵢ| / (‖λ‖∞ · max(‖Nu‖∞, ‖d‖∞))``
+    - ``duality_gap``: ``|J(u) − D(λ)| / max(|J(u)|, |D(λ)|)`` with ``J`` the
+      energy and ``D`` the dual function (one factorisation of K, cached).
+
+    Residuals are ``inf`` when ``u`` or ``λ`` is not finite.
+    """
+
+    primal: float
+    stationarity: float
+    dual_sign: float
+    complementarity: float
+    duality_gap: float
+
+    def worst(self) -> tuple[str, float]:
+        """The largest residual and its name."""
+        items = asdict(self)
+        name = max(items, key=lambda k: items[k] if np.isfinite(items[k]) else np.inf)
+        return name, items[name]
+
+    def as_dict(self) -> dict[str, float]:
+        return asdict(self)
+
+
+def certificate(problem: ContactProblem, solution: ContactSolution,
+                duality_gap: bool = True) -> Certificate:
+    """Relative KKT residuals of ``solution`` for ``problem`` (see :class:`Certificate`)."""
+    u, lam = solution.u, solution.lam
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(lam))):
+        inf = float("inf")
+        return Certificate(inf, inf, inf, inf, inf)
+    violation = problem.N @ u - problem.d
+    scale_gap = gap_scale(problem, u)
+    NT_lam = problem.N.T @ lam
+    lam_norm = _positive(_inf_norm(lam))
+    primal = max(float(np.max(violation, initial=0.0)), 0.0) / scale_gap
+    residual = problem.K @ u - problem.f + NT_lam
+    stationarity = _inf_norm(residual) / _positive(_inf_norm(problem.f) + _inf_norm(NT_lam))
+    dual_sign = max(float(np.max(-lam, initial=0.0)), 0.0) / lam_norm
+    complementarity = _inf_norm(lam * violation) / (lam_norm * scale_gap)
+    gap = float("nan")
+    if duality_gap:
+        primal_obj = problem.energy(u)
+        dual_obj = problem.dual_objective(np.maximum(lam, 0.0))
+        gap = abs(primal_obj - dual_obj) / _positive(max(abs(primal_obj), abs(dual_obj)))
+    return Certificate(primal, stationarity, dual_sign, complementarity, gap)
+
+
+ACTIVE, WEAK, INACTIVE = "active", "weak", "inactive"
+
+
+def classify(problem: ContactProblem, solution: ContactSolution,
+             weak_tol: float = WEAK_TOL) -> np.ndarray:
+    """Label each candidate ``active``, ``inactive`` or ``weak`` (weakly active).
+
+    With ``λ̃ = λ/‖λ‖∞`` and ``g̃ = (d − Nu)⁺ / max(‖Nu‖∞, ‖d‖∞)``: a node is
+    weakly active when both are at most ``weak_tol`` (it touches with zero
+    force, so its membership of the active set is not determined); otherwise
+    it is active when ``λ̃ > g̃`` and inactive when not. For an exact solution
+    one of the two is zero; for an inexact one the larger decides.
+    """
+    u, lam = solution.u, solution.lam
+    lam_n = np.maximum(lam, 0.0) / _positive(_inf_norm(lam))
+    gap_n = np.maximum(problem.gap(u), 0.0) / gap_scale(problem, u)
+    labels = np.where(lam_n > gap_n, ACTIVE, INACTIVE).astype(object)
+    labels[(lam_n <= weak_tol) & (gap_n <= weak_tol)] = WEAK
+    return labels
+
+
+def active_set(problem: ContactProblem, solution: ContactSolution,
+               weak_tol: float = WEAK_TOL) -> np.ndarray:
+    """Boolean mask of the (strongly) active candidates."""
+    return classify(problem, solution, weak_tol) == ACTIVE
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """How far two solutions of one problem are apart.
+
+    ``u_rel`` and ``lam_rel`` are ∞-norm differences relative to the larger
+    norm; ``misclassified`` counts nodes active in one and inactive in the
+    other (weakly active nodes of either are left out and counted in ``weak``).
+    """
+
+    u_rel: float
+    lam_rel: float
+    misclassified: int
+    weak: int
+
+    @property
+    def same_active_set(self) -> bool:
+        return self.misclassified == 0
+
+    def as_dict(self) -> dict[str, float | int]:
+        return asdict(self)
+
+
+def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        return float("inf")
+    return _inf_norm(a - b) / _positive(max(_inf_norm(a), _inf_norm(b)))
+
+
+def compare(problem: ContactProblem, first: ContactSolution, second: ContactSolution,
+            weak_tol: float = WEAK_TOL) -> Comparison:
+    """Compare two solutions: displacements, multipliers and active sets."""
+    u_rel = _rel_diff(first.u, second.u)
+    lam_rel = _rel_diff(first.lam, second.lam)
+    if not np.isfinite(lam_rel) or not np.isfinite(u_rel):
+        return Comparison(u_rel, lam_rel, problem.m, 0)
+    a, b = classify(problem, first, weak_tol), classify(problem, second, weak_tol)
+    weak = (a == WEAK) | (b == WEAK)
+    misclassified = int(np.sum((a != b) & ~weak))
+    return Comparison(u_rel, lam_rel, misclassified, int(np.sum(weak)))

@@ -1,0 +1,217 @@
+"""The discrete Signorini problem and what a solver returns for it.
+
+The problem is one convex QP::
+
+    minimise   ½ uᵀ K u − fᵀ u        (K sparse SPD, n × n)
+    subject to N u ≤ d                (N sparse m × n, one row per contact candidate)
+
+with KKT conditions ``K u − f + Nᵀ λ = 0``, ``N u ≤ d``, ``λ ≥ 0``,
+``λᵢ (N u − d)ᵢ = 0``. ``λ`` is the nodal contact force (compressive positive).
+
+All arrays held by :class:`ContactProblem` are dimensionless; :class:`Scales`
+turns them back into physical units.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from .errors import InputError
+
+#: the statuses a :class:`ContactSolution` can carry
+STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed")
+
+
+@dataclass(frozen=True)
+class Scales:
+    """Units that make the problem dimensionless.
+
+    A physical quantity is its dimensionless value times its scale:
+    ``u = length · û``, ``λ = force · λ̂``, ``w = weight · ŵ`` and
+    ``p = λ / w = pressure · p̂`` with ``pressure = force / weight``.
+    In 2D (per unit thickness) ``force = E·L`` and ``weight = L``.
+    """
+
+    length: float = 1.0
+    force: float = 1.0
+    weight: float = 1.0
+
+    @property
+    def pressure(self) -> float:
+        return self.force / self.weight
+
+
+@dataclass
+class ContactProblem:
+    """Data of ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` (dimensionless).
+
+    Attributes
+    ----------
+    K : (n, n) sparse SPD stiffness on the free dofs.
+    f : (n,) load on the free dofs (includes the lift of prescribed displacements).
+    N : (m, n) sparse normal-gap rows, one per contact candidate node.
+    d : (m,) initial gaps (lifted by prescribed displacements).
+    weights : (m,) lumped boundary weights ``wᵢ = ∫ φᵢ ds`` of the candidates.
+    contact_points : (m, dim) reference coordinates of the candidates.
+    free_dofs : (n,) indices of the free dofs inside the full dof vector.
+    prescribed : (n_full,) full dof vector holding the prescribed values (zero on free dofs).
+    load_row, load_offset : the total applied load of the full body is
+        ``load_row @ u + load_offset`` (a reaction on the loaded boundary), used
+        to check force balance against ``force_multiplicity · Σ λ``.
+    force_multiplicity : how many copies of the model make the full body
+        (2 for a half model with one symmetry plane).
+    scales : the units of every array above.
+    scene, params : where the problem came from.
+    mesh : the scene's mesh (for plots and export), in dimensionless coordinates.
+    """
+
+    K: sp.csr_matrix
+    f: np.ndarray
+    N: sp.csr_matrix
+    d: np.ndarray
+    weights: np.ndarray
+    contact_points: np.ndarray
+    free_dofs: np.ndarray
+    prescribed: np.ndarray
+    load_row: np.ndarray | None = None
+    load_offset: float = 0.0
+    force_multiplicity: float = 1.0
+    scales: Scales = field(default_factory=Scales)
+    scene: str = ""
+    params: dict[str, Any] = field(default_factory=dict)
+    mesh: Any = None
+    assemble_time: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.K = sp.csr_matrix(self.K)
+        self.N = sp.csr_matrix(self.N)
+        self.f = np.asarray(self.f, dtype=float)
+        self.d = np.asarray(self.d, dtype=float)
+        self.weights = np.asarray(self.weights, dtype=float)
+        n, m = self.K.shape[0], self.N.shape[0]
+        if self.K.shape != (n, n):
+            raise InputError(f"K must be square, got shape {self.K.shape}")
+        if self.f.shape != (n,):
+            raise InputError(f"f must have shape ({n},), got {self.f.shape}")
+        if self.N.shape != (m, n):
+            raise InputError(f"N must have shape (m, {n}), got {self.N.shape}")
+        if self.d.shape != (m,):
+            raise InputError(f"d must have shape ({m},), got {self.d.shape}")
+        if self.weights.shape != (m,):
+            raise InputError(f"weights must have shape ({m},), got {self.weights.shape}")
+        if m == 0:
+            raise InputError("the problem has no contact candidates: nothing can touch the obstacle")
+        for name in ("f", "d", "weights"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise InputError(f"{name} contains non-finite values")
+        if not np.all(np.isfinite(self.K.data)) or not np.all(np.isfinite(self.N.data)):
+            raise InputError("K or N contains non-finite values")
+        if np.any(self.weights <= 0):
+            bad = int(np.argmin(self.weights))
+            raise InputError(
+                f"contact candidate {bad} has weight {self.weights[bad]:g} ≤ 0: "
+                "every candidate must lie on a boundary edge of positive length")
+        self._factor = None
+
+    @property
+    def n(self) -> int:
+        """Number of free dofs."""
+        return self.K.shape[0]
+
+    @property
+    def m(self) -> int:
+        """Number of contact candidates."""
+        return self.N.shape[0]
+
+    def expand(self, u: np.ndarray) -> np.ndarray:
+        """Full dof vector (free and prescribed) from the free-dof vector ``u``."""
+        full = self.prescribed.copy()
+        full[self.free_dofs] = u
+        return full
+
+    def gap(self, u: np.ndarray) -> np.ndarray:
+        """``d − N u``: the remaining gap at each candidate (≥ 0 when feasible)."""
+        return self.d - self.N @ u
+
+    def energy(self, u: np.ndarray) -> float:
+        """Primal objective ``½uᵀKu − fᵀu``."""
+        return float(0.5 * u @ (self.K @ u) - self.f @ u)
+
+    def factor(self):
+        """A cached factorisation of K (for certificates and dual objectives)."""
+        if self._factor is None:
+            from .linalg import factorize
+            self._factor = factorize(self.K)
+        return self._factor
+
+    def displacement_for(self, lam: np.ndarray) -> np.ndarray:
+        """``u(λ) = K⁻¹ (f − Nᵀλ)``, the minimiser of the Lagrangian."""
+        return self.factor().solve(self.f - self.N.T @ lam)
+
+    def dual_objective(self, lam: np.ndarray) -> float:
+        """``D(λ) = min_u ½uᵀKu − fᵀu + λᵀ(Nu − d)``.
+
+        Equals ``−½ (f − Nᵀλ)ᵀ K⁻¹ (f − Nᵀλ) − λᵀ d``; concave, maximised over ``λ ≥ 0``.
+        """
+        r = self.f - self.N.T @ lam
+        return float(-0.5 * r @ self.factor().solve(r) - lam @ self.d)
+
+    def total_contact_force(self, lam: np.ndarray) -> float:
+        """Total contact force of the full body (dimensionless): multiplicity · Σλ."""
+        return float(self.force_multiplicity * np.sum(lam))
+
+    def applied_load(self, u: np.ndarray) -> float:
+        """Total load the boundary conditions apply to the full body (dimensionless)."""
+        if self.load_row is None:
+            return float("nan")
+        return float(self.load_row @ u + self.load_offset)
+
+    def with_data(self, **changes: Any) -> "ContactProblem":
+        """A copy with some fields replaced (the cached factorisation is dropped)."""
+        return dataclasses.replace(self, **changes)
+
+
+@dataclass
+class ContactSolution:
+    """What a solver returns: ``u`` (free dofs), ``lam`` (contact forces), status.
+
+    ``status`` is one of :data:`STATUSES`. ``converged`` means the solver
+    claims success *and* the package's KKT certificate agrees (the wrapper in
+    :func:`signorini.solvers.solve` enforces this). ``history`` maps a name to
+    one value per iteration (``kkt``, ``primal``, ``dual``...).
+    """
+
+    method: str
+    u: np.ndarray
+    lam: np.ndarray
+    status: str
+    message: str = ""
+    iterations: int = 0
+    build_time: float = 0.0
+    solve_time: float = 0.0
+    history: dict[str, list[float]] = field(default_factory=dict)
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise ValueError(f"status {self.status!r} is not one of {STATUSES}")
+
+    @property
+    def contact_force(self) -> np.ndarray:
+        return self.lam
+
+    @property
+    def success(self) -> bool:
+        return self.status == "converged"
+
+    @classmethod
+    def failure(cls, method: str, problem: ContactProblem, status: str, message: str,
+                **kwargs: Any) -> "ContactSolution":
+        """A solution carrying no answer (NaN vectors) and a reason."""
+        return cls(method=method, u=np.full(problem.n, np.nan), lam=np.full(problem.m, np.nan),
+                   status=status, message=message, **kwargs)

@@ -1,0 +1,132 @@
+"""What a scene is: a mesh, a material, boundary conditions and a rigid obstacle.
+
+A scene family declares its parameters (:class:`Param`) and a ``build``
+function that turns checked parameter values into a :class:`SceneModel` in
+physical units. :mod:`signorini.assembly` turns the model into a
+:class:`~signorini.problem.ContactProblem`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from ..errors import InputError
+
+
+@dataclass(frozen=True)
+class Param:
+    """A scene parameter: name, default, type and the check of its range.
+
+    ``check`` returns ``None`` when the value is fine, otherwise the phrase
+    that completes "must be ..." (for example ``"in (-1, 0.5)"``).
+    """
+
+    name: str
+    default: Any
+    doc: str
+    kind: type = float
+    check: Callable[[Any], str | None] | None = None
+
+    def parse(self, value: Any) -> Any:
+        """Convert (from a string if need be) and check one value."""
+        if value is None:
+            return None
+        try:
+            if self.kind is int:
+                converted = int(value)
+                if isinstance(value, float) and converted != value:
+                    raise ValueError
+                if isinstance(value, str) and str(converted) != value.strip():
+                    raise ValueError
+            else:
+                converted = self.kind(value)
+        except (TypeError, ValueError):
+            raise InputError(
+                f"scene parameter {self.name}={value!r} is not a valid {self.kind.__name__}: "
+                f"pass --set {self.name}=<{self.kind.__name__}> ({self.doc})") from None
+        if isinstance(converted, float) and not math.isfinite(converted):
+            raise InputError(f"scene parameter {self.name}={value!r} must be a finite number")
+        if self.check is not None:
+            problem = self.check(converted)
+            if problem:
+                raise InputError(f"scene parameter {self.name}={value!r} must be {problem}")
+        return converted
+
+
+def positive(x: float) -> str | None:
+    return None if x > 0 else "> 0"
+
+
+def poisson_ratio(x: float) -> str | None:
+    return None if -1.0 < x < 0.5 else "in (-1, 0.5) (0.5 is incompressible, which P1 cannot model)"
+
+
+def at_least(bound: float) -> Callable[[float], str | None]:
+    return lambda x: None if x >= bound else f">= {bound:g}"
+
+
+def between(lo: float, hi: float) -> Callable[[float], str | None]:
+    return lambda x: None if lo < x <= hi else f"in ({lo:g}, {hi:g}]"
+
+
+@dataclass
+class FlatObstacle:
+    """A rigid flat ``y = height``, approached from above (normal (0, −1))."""
+
+    height: float = 0.0
+
+    def normals_and_gaps(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Unit outward normal of the body towards the obstacle and the initial gap per point."""
+        normals = np.tile([0.0, -1.0], (len(points), 1))
+        return normals, points[:, 1] - self.height
+
+
+@dataclass
+class SceneModel:
+    """A scene in physical units, ready for assembly.
+
+    ``dirichlet`` lists ``(component, node indices, value)``: component 0 is x,
+    1 is y. ``load_dofs`` are ``(component, nodes)`` whose reactions make up
+    the applied load (sign: a push towards the obstacle is positive).
+    ``target_load`` (full body, per unit thickness) asks assembly to adjust
+    the prescribed displacement ``delta`` until the contact force equals it;
+    prescribed values are then ``value × delta / delta_nominal``.
+    """
+
+    mesh: Any
+    E: float
+    nu: float
+    dirichlet: list[tuple[int, np.ndarray, float]]
+    contact_nodes: np.ndarray
+    contact_facets: np.ndarray
+    obstacle: FlatObstacle
+    load_dofs: tuple[int, np.ndarray]
+    length_scale: float
+    force_multiplicity: float = 1.0
+    target_load: float | None = None
+    params: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SceneFamily:
+    """A named family of scenes and how to build one."""
+
+    name: str
+    summary: str
+    params: tuple[Param, ...]
+    build: Callable[[dict[str, Any], set[str]], SceneModel]
+    reference: str = ""
+
+    def parse(self, values: dict[str, Any]) -> dict[str, Any]:
+        """Defaults overridden by ``values``; unknown names and bad values raise InputError."""
+        known = {p.name: p for p in self.params}
+        unknown = sorted(set(values) - set(known))
+        if unknown:
+            raise InputError(
+                f"scene {self.name!r} has no parameter {unknown[0]!r}: "
+                f"--set takes {', '.join(known)}")
+        return {name: p.parse(values.get(name, p.default)) for name, p in known.items()}

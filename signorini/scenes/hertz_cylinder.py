@@ -1,0 +1,107 @@
+"""Hertz's cylinder: an elastic disc of radius R on a rigid flat, plane strain.
+
+Modelled as the lower-right quarter of the disc (x ≥ 0 below its centre):
+the cut x = 0 is a symmetry plane (u_x = 0), the cut through the centre
+y = R is pushed down by a uniform displacement δ (u_y = −δ, u_x free), so K
+is non-singular. The load P per unit thickness of the full cylinder is twice
+the quarter model's contact force (the upper half carries no extra load in
+this model: the prescribed cut stands in for it, which Hertz's half-space
+solution does not see for small a/R). The mesh is graded towards the first
+point of contact and only the arc nodes with ``x ≤ candidates · a`` are
+contact candidates.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..analytic import hertz_cylinder_half_width, hertz_cylinder_load
+from ..errors import InputError
+from .base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
+                   poisson_ratio, positive)
+from .meshing import coarse_quarter_disc, distance_to_segment, on_circle_arc, refine_to_size, snap_to_circle
+
+PARAMS = (
+    Param("R", 1.0, "cylinder radius", check=positive),
+    Param("E", 1.0, "Young's modulus", check=positive),
+    Param("nu", 0.3, "Poisson's ratio", check=poisson_ratio),
+    Param("P", None, "load per unit thickness of the full cylinder (exclusive with a_over_R, delta)",
+          check=positive),
+    Param("a_over_R", 0.05, "contact half-width over radius: sets P by Hertz's formula",
+          check=between(0.0, 0.5)),
+    Param("delta", None, "prescribed downward displacement of the centre cut (no load targeting)",
+          check=positive),
+    Param("n_contact", 120, "elements across the contact half-width (mesh fineness)", kind=int,
+          check=at_least(4)),
+    Param("grading", 0.15, "growth of the element size with distance from the contact zone",
+          check=between(0.0, 2.0)),
+    Param("candidates", 2.0, "contact candidates extend to this multiple of the half-width",
+          check=at_least(1.2)),
+)
+
+
+def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
+    """Resolve which load parameter rules: the target P, or a prescribed delta."""
+    chosen = given & {"P", "a_over_R", "delta"}
+    if len(chosen) > 1:
+        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
+                         "give only one of P, a_over_R, delta")
+    E_star = p["E"] / (1.0 - p["nu"] ** 2)
+    if "delta" in chosen:
+        return None, p["delta"]
+    if "P" in chosen:
+        return p["P"], None
+    return hertz_cylinder_load(p["a_over_R"] * p["R"], p["R"], E_star), None
+
+
+def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
+    """The quarter-disc model of Hertz's cylinder in physical units."""
+    given = set() if given is None else given
+    R, E, nu = p["R"], p["E"], p["nu"]
+    E_star = E / (1.0 - nu ** 2)
+    target, delta = _load_choice(p, given)
+    if target is not None:
+        a_est = hertz_cylinder_half_width(target, R, E_star) / R
+        if a_est > 0.5:
+            raise InputError(f"scene parameter P={target:g} gives a/R = {a_est:.2f} > 0.5: "
+                             "Hertz's half-space theory needs a/R small; lower P")
+    else:
+        a_est = p["a_over_R"]
+    h_contact = a_est / p["n_contact"]
+    zone_end = np.array([1.25 * a_est, 0.0])
+
+    def target_size(points: np.ndarray) -> np.ndarray:
+        dist = distance_to_segment(points, np.zeros(2), zone_end)
+        return np.minimum(h_contact + p["grading"] * dist, 0.25)
+
+    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap_to_circle((0.0, 1.0), 1.0))
+    arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
+    origin = np.nonzero(np.hypot(*mesh.p) < 1e-12)[0]
+    arc = np.union1d(arc, origin)
+    mesh = type(mesh)(mesh.p * R, mesh.t)
+    x, y = mesh.p
+    candidates = arc[x[arc] <= p["candidates"] * a_est * R * (1 + 1e-9)]
+    facets = mesh.boundary_facets()
+    on_arc = np.all(np.isin(mesh.facets[:, facets], arc), axis=0)
+    symmetry = np.nonzero(np.abs(x) < 1e-12 * R)[0]
+    top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
+    delta_nominal = delta if delta is not None else a_est ** 2 * R
+    params = dict(p)
+    params.update(P=target, delta=delta_nominal if target is None else None,
+                  a_over_R=a_est if target is not None else None)
+    return SceneModel(
+        mesh=mesh, E=E, nu=nu,
+        dirichlet=[(0, symmetry, 0.0), (1, top, -delta_nominal)],
+        contact_nodes=candidates[np.argsort(x[candidates])],
+        contact_facets=facets[on_arc],
+        obstacle=FlatObstacle(0.0),
+        load_dofs=(1, top), length_scale=R, force_multiplicity=2.0,
+        target_load=target, params=params)
+
+
+FAMILY = SceneFamily(
+    name="hertz-cylinder",
+    summary="elastic cylinder on a rigid flat, plane strain, quarter model graded to the contact",
+    params=PARAMS, build=build, reference="hertz-2d")

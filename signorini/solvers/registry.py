@@ -1,0 +1,163 @@
+"""The method registry: every solver is a plain function with one signature.
+
+``solve(problem, *, tol=None, max_iter=None, **options) -> ContactSolution``
+
+``tol=None`` means the method's own default tolerance (for QP backends: the
+backend's defaults, untouched). Unknown options raise :class:`InputError`.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from ..errors import BackendNotInstalled, InputError, SolverError
+from ..problem import ContactProblem, ContactSolution
+
+log = logging.getLogger(__name__)
+
+SolverFunction = Callable[..., ContactSolution]
+
+#: a claim of success is accepted when every relative KKT residual is at most
+#: ``ACCEPT_FACTOR × tol`` (or ``DEFAULT_ACCEPT`` when no tolerance was asked for)
+ACCEPT_FACTOR = 10.0
+DEFAULT_ACCEPT = 1e-6
+
+
+@dataclass(frozen=True)
+class Method:
+    """A registered method.
+
+    ``requires`` lists the Python modules it imports; ``extra`` is the
+    pip extra that installs them. ``dense`` methods build dense matrices and
+    refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
+    answer up to round-off when they converge.
+    """
+
+    name: str
+    function: SolverFunction
+    summary: str
+    requires: tuple[str, ...] = ()
+    extra: str = ""
+    dense: bool = False
+    exact: bool = False
+    family: str = ""
+    default_tol: float | None = None
+    options: tuple[str, ...] = field(default=())
+
+    @property
+    def installed(self) -> bool:
+        return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
+
+
+REGISTRY: dict[str, Method] = {}
+
+
+def register(method: Method) -> Method:
+    """Add a method to the registry (a later registration of a name replaces it)."""
+    REGISTRY[method.name] = method
+    return method
+
+
+def get_method(name: str) -> Method:
+    """Look a method up by name; unknown names list the known ones."""
+    _load_builtin()
+    if name in REGISTRY:
+        return REGISTRY[name]
+    if ":" in name:
+        return _load_user_method(name)
+    known = ", ".join(sorted(REGISTRY))
+    raise InputError(f"unknown method {name!r}: choose --method from {known}")
+
+
+def methods(installed_only: bool = False) -> list[Method]:
+    """Every registered method, sorted by name."""
+    _load_builtin()
+    out = sorted(REGISTRY.values(), key=lambda m: m.name)
+    return [m for m in out if m.installed] if installed_only else out
+
+
+def _load_user_method(spec: str) -> Method:
+    """``module:function`` names a user-defined solver with the standard signature."""
+    module_name, _, attr = spec.partition(":")
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise InputError(f"method {spec!r}: cannot import module {module_name!r} ({exc})") from exc
+    func = getattr(module, attr, None)
+    if not callable(func):
+        raise InputError(f"method {spec!r}: module {module_name!r} has no function {attr!r}")
+    return Method(name=spec, function=func, summary=(func.__doc__ or "").strip().split("\n")[0],
+                  family="user")
+
+
+_BUILTIN_LOADED = False
+
+
+def _load_builtin() -> None:
+    global _BUILTIN_LOADED
+    if _BUILTIN_LOADED:
+        return
+    _BUILTIN_LOADED = True
+    from . import cvxpy_, pdas, qp, uzawa  # noqa: F401  (each module registers itself)
+
+
+def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
+          max_iter: int | None = None, **options: Any) -> ContactSolution:
+    """Solve ``problem`` with ``method`` and judge the answer with the KKT certificate.
+
+    The method's own claim of success becomes ``converged`` only when every
+    relative residual of :func:`signorini.kkt.certificate` is within
+    ``ACCEPT_FACTOR × tol``; otherwise the status is ``inaccurate`` and the
+    message says by how much it missed. A backend exception becomes a
+    ``failed`` solution; bad input (unknown options, non-positive tolerances)
+    raises :class:`InputError`.
+    """
+    spec = get_method(method)
+    if not spec.installed:
+        missing = [m for m in spec.requires if importlib.util.find_spec(m) is None]
+        raise BackendNotInstalled(
+            f"method {method!r} needs {', '.join(missing)}: "
+            f"pip install 'signorini[{spec.extra or 'all'}]'")
+    if tol is not None and not (np.isfinite(tol) and 0 < tol < 1):
+        raise InputError(f"tol must be a number in (0, 1), got {tol!r}")
+    if max_iter is not None and (int(max_iter) != max_iter or max_iter < 1):
+        raise InputError(f"max_iter must be a positive integer, got {max_iter!r}")
+    start = time.perf_counter()
+    try:
+        solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
+    except InputError:
+        raise
+    except (SolverError, MemoryError, ArithmeticError, RuntimeError, ValueError, TypeError,
+            np.linalg.LinAlgError) as exc:
+        log.warning("method %s raised %s: %s", method, type(exc).__name__, exc)
+        solution = ContactSolution.failure(
+            method, problem, "failed", f"{type(exc).__name__}: {exc}",
+            solve_time=time.perf_counter() - start)
+    solution.method = method
+    return judge(problem, solution, tol if tol is not None else spec.default_tol)
+
+
+def judge(problem: ContactProblem, solution: ContactSolution,
+          tol: float | None) -> ContactSolution:
+    """Downgrade a claim of convergence that the certificate does not back."""
+    from ..kkt import certificate
+
+    if solution.status != "converged":
+        return solution
+    accept = ACCEPT_FACTOR * tol if tol is not None else DEFAULT_ACCEPT
+    cert = certificate(problem, solution)
+    worst_name, worst = cert.worst()
+    if not np.isfinite(worst) or worst > accept:
+        solution.extras["claimed_status"] = "converged"
+        solution.status = "inaccurate"
+        solution.message = (
+            f"{solution.message}; the method claimed success but the KKT certificate's "
+            f"{worst_name} residual is {worst:.1e} > {accept:.0e}: tighten --tol "
+            "or use an exact method (pdas)").lstrip("; ")
+    return solution
