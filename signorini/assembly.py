@@ -5,7 +5,10 @@ parameters. Prescribed dofs are condensed out (``K_II u_I = f_I − K_ID u_D``),
 one gap row per contact candidate node is ``nᵢ · uᵢ ≤ gᵢ`` with ``nᵢ`` the
 body's outward normal towards the obstacle. With ``nondimensionalise`` the
 mesh is divided by the scene's length L and E by itself, so every solver sees
-numbers of order one whatever the user's units.
+numbers of order one whatever the user's units: coordinates are divided by
+the scene's length L, displacements and gaps by a displacement scale U (the
+largest prescribed displacement, else the largest initial gap), E by itself;
+contact forces then come in units of E·U (per unit thickness).
 """
 
 from __future__ import annotations
@@ -39,11 +42,21 @@ def boundary_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray) -> np.nda
     return per_node[nodes]
 
 
+def displacement_scale(model: SceneModel) -> float:
+    """The largest prescribed displacement, else the largest initial gap, else the length."""
+    largest = max((abs(value) for _, nodes, value in model.dirichlet if len(nodes)), default=0.0)
+    if largest == 0.0:
+        _, gaps = model.obstacle.normals_and_gaps(model.mesh.p[:, model.contact_nodes].T)
+        largest = float(np.max(np.abs(gaps))) if len(gaps) else 0.0
+    return largest if largest > 0 else model.length_scale
+
+
 def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProblem:
     """Assemble the contact QP of ``model``; adjust δ first when a target load is set."""
     start = time.perf_counter()
     L = model.length_scale if nondimensionalise else 1.0
     stress = model.E if nondimensionalise else 1.0
+    U = displacement_scale(model) if nondimensionalise else 1.0
     mesh = type(model.mesh)(model.mesh.p / L, model.mesh.t)
     basis = Basis(mesh, ElementVector(ElementTriP1()))
     K_full = asm(linear_elasticity(*lame_parameters(model.E / stress, model.nu)), basis).tocsr()
@@ -53,13 +66,14 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     fixed = []
     for component, nodes, value in model.dirichlet:
         dofs = basis.nodal_dofs[component, nodes]
-        prescribed[dofs] = value / L
+        prescribed[dofs] = value / U
         fixed.append(dofs)
     fixed = np.unique(np.concatenate(fixed))
     free = np.setdiff1d(np.arange(n_full), fixed)
 
     nodes = model.contact_nodes
     normals, gaps = model.obstacle.normals_and_gaps(mesh.p[:, nodes].T)
+    gaps = gaps * (L / U)
     m = len(nodes)
     rows = np.repeat(np.arange(m), 2)
     cols = basis.nodal_dofs[:, nodes].T.ravel()
@@ -82,7 +96,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
 
     scale = 1.0
     if model.target_load is not None:
-        scale = _calibrate(K_II, N_free, lifted, model.target_load / (stress * L),
+        scale = _calibrate(K_II, N_free, lifted, model.target_load / (stress * U),
                            model.force_multiplicity)
     f, d, load_offset, full = lifted(scale)
     params = dict(model.params)
@@ -94,7 +108,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
         K=K_II, f=f, N=N_free, d=d, weights=weights, contact_points=mesh.p[:, nodes].T,
         free_dofs=free, prescribed=full, load_row=load_full[free], load_offset=load_offset,
         force_multiplicity=model.force_multiplicity,
-        scales=Scales(length=L, force=stress * L, weight=L),
+        scales=Scales(length=L, displacement=U, force=stress * U, weight=L),
         params=params, mesh=mesh)
     problem.basis = basis
     problem.assemble_time = time.perf_counter() - start

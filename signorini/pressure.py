@@ -49,7 +49,7 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
     labels = classify(problem, solution)
     return ContactProfile(
         x=problem.contact_points[:, 0] * s.length,
-        gap=problem.gap(solution.u) * s.length,
+        gap=problem.gap(solution.u) * s.displacement,
         force=force,
         pressure=force / (problem.weights * s.weight),
         active=labels == ACTIVE,

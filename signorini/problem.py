@@ -32,12 +32,18 @@ class Scales:
     """Units that make the problem dimensionless.
 
     A physical quantity is its dimensionless value times its scale:
-    ``u = length · û``, ``λ = force · λ̂``, ``w = weight · ŵ`` and
-    ``p = λ / w = pressure · p̂`` with ``pressure = force / weight``.
-    In 2D (per unit thickness) ``force = E·L`` and ``weight = L``.
+    coordinates ``x = length · x̂``, displacements and gaps
+    ``u = displacement · û``, contact forces ``λ = force · λ̂``, weights
+    ``w = weight · ŵ`` and pressures ``p = λ / w = pressure · p̂`` with
+    ``pressure = force / weight``. In 2D (per unit thickness)
+    ``force = E · displacement`` and ``weight = length``. Scaling the
+    displacement apart from the geometry matters: a Hertz contact at
+    a/R = 0.05 moves by about 1e-3 R, and a solver's absolute tolerances
+    only mean something when the unknowns are of order one.
     """
 
     length: float = 1.0
+    displacement: float = 1.0
     force: float = 1.0
     weight: float = 1.0
 

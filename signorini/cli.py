@@ -1,0 +1,176 @@
+"""The ``signorini`` command: a thin shell over the library.
+
+Bad input gives a one-line message on stderr and exit code 2; a failed
+validation exits 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import shlex
+import sys
+from typing import Any, Sequence
+
+from .errors import InputError, SignoriniError
+
+EXIT_FAILED, EXIT_USAGE = 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line and exit 2, like every other bad input
+        raise InputError(f"{message} (see 'signorini {self.prog.split()[-1]} --help')"
+                         if " " in self.prog else f"{message} (see 'signorini --help')")
+
+
+def _pairs(items: Sequence[str], flag: str) -> dict[str, Any]:
+    """``key=value`` strings to a dict; values parsed as int, float, bool or left as text."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise InputError(f"{flag} {item!r} is not key=value: write {flag} name=value")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def _option_value(text: str) -> Any:
+    lowered = text.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    if lowered in ("none", "null"):
+        return None
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def _tol(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(f"--tol {text!r} is not a number: give e.g. --tol 1e-9") from None
+    if not 0 < value < 1:
+        raise InputError(f"--tol {text!r} must be in (0, 1): give e.g. --tol 1e-9")
+    return value
+
+
+def _write_json(path: str, text: str) -> None:
+    from .io import atomic_write_text
+
+    if path == "-":
+        sys.stdout.write(text + "\n")
+    else:
+        atomic_write_text(path, text + "\n")
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    from .io import to_json
+    from .report import solve_record, solve_summary
+    from .scenes import build_problem
+    from .solvers.registry import solve
+
+    params = _pairs(args.set, "--set")
+    options = {k: _option_value(v) for k, v in _pairs(args.opt, "--opt").items()}
+    max_iter = options.pop("max_iter", None)
+    tol = _tol(args.tol) if args.tol is not None else None
+    problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
+    solution = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
+    record = solve_record(problem, solution)
+    if args.json:
+        _write_json(args.json, to_json(record))
+    if args.json != "-":
+        print(solve_summary(record))
+    return 0 if solution.status == "converged" else EXIT_FAILED
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from .io import writable_directory
+    from .report import checks_summary, write_suite_report
+    from .suite import run_suite
+
+    writable_directory(args.out)
+    methods = args.method or None
+    suite = run_suite(method_names=methods, progress=lambda line: print(line, file=sys.stderr))
+    command = "signorini validate" + "".join(f" --method {m}" for m in args.method)
+    if args.out != "validation-report":
+        command += f" --out {shlex.quote(args.out)}"
+    paths = write_suite_report(suite, args.out, command)
+    print(checks_summary(suite))
+    print(f"report: {paths['report.md']}")
+    return 0 if suite.passed else EXIT_FAILED
+
+
+def cmd_scenes(args: argparse.Namespace) -> int:
+    from .scenes import SCENES
+
+    for family in SCENES.values():
+        print(f"{family.name}: {family.summary}")
+        for p in family.params:
+            default = "—" if p.default is None else p.default
+            print(f"    {p.name:<11} {str(default):<8} {p.doc}")
+    return 0
+
+
+def cmd_methods(args: argparse.Namespace) -> int:
+    from .solvers.registry import methods
+
+    for m in methods():
+        state = "installed" if m.installed else f"not installed (pip install 'signorini[{m.extra}]')"
+        kind = ", ".join(x for x in ("exact" if m.exact else "", "dense" if m.dense else "") if x)
+        print(f"{m.name:<14} {state:<12} {m.summary}" + (f" [{kind}]" if kind else ""))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="signorini", description="Frictionless contact as one QP, solved many ways.")
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    solve = sub.add_parser("solve", help="solve one scene with one method")
+    solve.add_argument("scene", help="scene name (see 'signorini scenes')")
+    solve.add_argument("--method", default="pdas", help="method name (see 'signorini methods')")
+    solve.add_argument("--tol", help="the method's tolerance (default: the method's own)")
+    solve.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="scene parameter, e.g. --set a_over_R=0.05")
+    solve.add_argument("--opt", action="append", default=[], metavar="KEY=VALUE",
+                       help="method option, e.g. --opt step_fraction=0.5")
+    solve.add_argument("--json", metavar="FILE", help="write the result as JSON ('-' for stdout)")
+    solve.add_argument("--raw-units", action="store_true",
+                       help="solve in the user's units instead of non-dimensionalising")
+    solve.set_defaults(run=cmd_solve)
+
+    validate = sub.add_parser("validate", help="run the validation suite on the default scenes")
+    validate.add_argument("--out", default="validation-report", help="report directory")
+    validate.add_argument("--method", action="append", default=[],
+                          help="only this method (repeatable; default: every installed one)")
+    validate.set_defaults(run=cmd_validate)
+
+    sub.add_parser("scenes", help="list the scenes and their parameters").set_defaults(run=cmd_scenes)
+    sub.add_parser("methods", help="list the methods and whether they are installed").set_defaults(
+        run=cmd_methods)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    try:
+        args = build_parser().parse_args(argv)
+        logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                            format="%(levelname)s %(name)s: %(message)s")
+        return args.run(args)
+    except InputError as exc:
+        print(f"signorini: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except SignoriniError as exc:
+        print(f"signorini: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    except KeyboardInterrupt:
+        print("signorini: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
