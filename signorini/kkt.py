@@ -14,6 +14,9 @@ from .problem import ContactProblem, ContactSolution
 
 #: normalised force and gap below which a node counts as touching with zero force
 WEAK_TOL = 1e-6
+#: forces are judged against max(‖λ‖∞, FORCE_FLOOR · ‖f‖∞): with no contact at all,
+#: λ is round-off and relative measures against ‖λ‖∞ alone would be meaningless
+FORCE_FLOOR = 1e-5
 
 
 def _inf_norm(x: np.ndarray) -> float:
@@ -34,7 +37,7 @@ class Certificate:
     """Relative KKT residuals of a candidate solution ``(u, λ)``.
 
     - ``primal``: ``max((Nu − d)⁺) / max(‖Nu‖∞, ‖d‖∞)``
-    - ``stationarity``: ``‖Ku − f + Nᵀλ‖∞ / ‖Nᵀλ‖∞`` (``/ ‖f‖∞`` when λ = 0).
+    - ``stationarity``: ``‖Ku − f + Nᵀλ‖∞ / ‖Nᵀλ‖∞``.
       The contact forces set the scale, not ``‖f‖∞ + ‖Nᵀλ‖∞``: the lifted
       load ``f`` sits on dofs next to the prescribed boundary and can be
       hundreds of times the largest nodal contact force, and an imbalance
@@ -50,6 +53,8 @@ class Certificate:
     - ``duality_gap``: ``|J(u) − D(λ)| / max(|J(u)|, |D(λ)|)`` with ``J`` the
       energy and ``D`` the dual function (one factorisation of K, cached).
 
+    Force norms are floored at ``FORCE_FLOOR · ‖f‖∞`` so that a problem with
+    no contact (λ = 0 up to round-off) is judged against its loads.
     Residuals are ``inf`` when ``u`` or ``λ`` is not finite.
     """
 
@@ -80,11 +85,11 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     violation = problem.N @ u - problem.d
     scale_gap = gap_scale(problem, u)
     NT_lam = problem.N.T @ lam
-    lam_norm = _positive(_inf_norm(lam))
+    floor = FORCE_FLOOR * _inf_norm(problem.f)
+    lam_norm = _positive(max(_inf_norm(lam), floor))
     primal = max(float(np.max(violation, initial=0.0)), 0.0) / scale_gap
     residual = problem.K @ u - problem.f + NT_lam
-    force_scale = _inf_norm(NT_lam) or _inf_norm(problem.f)
-    stationarity = _inf_norm(residual) / _positive(force_scale)
+    stationarity = _inf_norm(residual) / _positive(max(_inf_norm(NT_lam), floor))
     dual_sign = max(float(np.max(-lam, initial=0.0)), 0.0) / lam_norm
     complementarity = _inf_norm(lam * violation) / (lam_norm * scale_gap)
     natural = _inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))

@@ -104,8 +104,8 @@ def _load_builtin() -> None:
     global _BUILTIN_LOADED
     if _BUILTIN_LOADED:
         return
-    _BUILTIN_LOADED = True
     from . import cvxpy_, pdas, qp, uzawa  # noqa: F401  (each module registers itself)
+    _BUILTIN_LOADED = True
 
 
 def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
@@ -159,6 +159,6 @@ def judge(problem: ContactProblem, solution: ContactSolution,
         solution.status = "inaccurate"
         solution.message = (
             f"{solution.message}; the method claimed success but the KKT certificate's "
-            f"{worst_name} residual is {worst:.1e} > {accept:.0e}: tighten --tol "
+            f"{worst_name} residual is {worst:.1e} > {accept:.0e}: tighten the tolerance "
             "or use an exact method (pdas)").lstrip("; ")
     return solution

@@ -1,0 +1,168 @@
+"""The primal QP written as a cvxpy model (teaching, cross-checks).
+
+``minimise ½ xᵀKx − fᵀx  subject to  N x ≤ d`` with ``K`` symmetrised. cvxpy's
+``dual_value`` of the constraint ``N @ x <= d`` of a minimisation is the
+multiplier ``λ ≥ 0`` of the Lagrangian ``½xᵀKx − fᵀx + λᵀ(Nx − d)``, so
+``λ = dual_value`` with no sign change (the tests check it for every solver).
+
+Build time is model construction plus canonicalisation
+(:meth:`cvxpy.Problem.get_problem_data`); solve time is the solver call plus
+unpacking the result.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+import warnings
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError, SolverError
+from ..problem import ContactProblem, ContactSolution
+from .qp import BACKEND_BY_NAME
+from .registry import Method, register
+
+log = logging.getLogger(__name__)
+
+METHOD = "cvxpy"
+DEFAULT_SOLVER = "CLARABEL"
+OPTIONS = ("solver",)
+
+#: cvxpy status → ours (anything else is ``failed``)
+STATUS_MAP = {"optimal": "converged", "optimal_inaccurate": "inaccurate",
+              "infeasible": "infeasible", "user_limit": "max_iter"}
+
+#: cvxpy solvers that use the same option names as the qpsolvers backend of the same
+#: name, so one tolerance translation serves both (MOSEK's cvxpy interface differs)
+_SHARED_TRANSLATION = ("CLARABEL", "OSQP", "SCS", "ECOS", "PIQP", "PROXQP", "DAQP", "HIGHS",
+                       "QPALM", "CVXOPT", "GUROBI")
+
+#: solvers that refuse or mishandle a plain continuous QP
+_NOT_FOR_QP = ("ECOS_BB",)  # branch and bound for mixed-integer problems
+
+
+def qp_solvers() -> list[str]:
+    """Installed cvxpy solvers that accept a convex QP (natively or as an SOCP)."""
+    import cvxpy as cp
+    from cvxpy.constraints import SOC
+    from cvxpy.reductions.solvers import defines
+
+    out = []
+    for name in cp.installed_solvers():
+        conic = defines.SOLVER_MAP_CONIC.get(name)
+        if name in _NOT_FOR_QP:
+            continue
+        if name in defines.SOLVER_MAP_QP or (conic is not None
+                                              and SOC in conic.SUPPORTED_CONSTRAINTS):
+            out.append(name)
+    return out
+
+
+def solver_options(solver: str, tol: float | None, max_iter: int | None) -> dict[str, Any]:
+    """cvxpy ``solver_opts`` for a relative tolerance and an iteration limit.
+
+    The translation is the one of :mod:`signorini.solvers.qp` for the backend of
+    the same name; ``tol=None`` and ``max_iter=None`` leave cvxpy's defaults.
+    """
+    # (cvxpy's ProxQP interface builds dense matrices by default; its "sparse"
+    # backend fails with proxsuite 0.8 in cvxpy 1.9.3, so it is left alone)
+    if tol is None and max_iter is None:
+        return {}
+    if solver not in _SHARED_TRANSLATION:
+        raise InputError(
+            f"method 'cvxpy' cannot translate tol/max_iter for solver {solver!r}: "
+            f"leave them unset or use one of {', '.join(_SHARED_TRANSLATION)}")
+    backend = BACKEND_BY_NAME[solver.lower()]
+    return backend.settings(tol, max_iter)
+
+
+def _check_solver(solver: Any) -> str:
+    available = qp_solvers()
+    name = str(solver).upper()
+    if name not in available:
+        raise InputError(
+            f"option solver={solver!r} of method 'cvxpy' is not an installed cvxpy solver "
+            f"for QPs; installed: {', '.join(available)}")
+    return name
+
+
+def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+          **options: Any) -> ContactSolution:
+    """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` as a cvxpy model.
+
+    Parameters
+    ----------
+    problem : the contact QP.
+    tol : relative KKT tolerance, translated into the chosen solver's options
+        (``None``: cvxpy's own defaults).
+    max_iter : iteration limit, translated likewise.
+    solver : (option) cvxpy solver name, default ``"CLARABEL"``; any installed
+        solver that accepts a QP.
+
+    Returns
+    -------
+    ContactSolution
+        ``u = x.value``, ``λ = constraint.dual_value``; ``extras["raw_status"]``
+        is cvxpy's status.
+    """
+    unknown = sorted(set(options) - set(OPTIONS))
+    if unknown:
+        raise InputError(f"method 'cvxpy' does not accept option(s) "
+                         f"{', '.join(repr(u) for u in unknown)}; accepted options: "
+                         f"{', '.join(OPTIONS)}")
+    import cvxpy as cp
+
+    solver = _check_solver(options.get("solver", DEFAULT_SOLVER))
+    opts = solver_options(solver, tol, max_iter)
+
+    start = time.perf_counter()
+    K = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
+    x = cp.Variable(problem.n)
+    contact = problem.N @ x <= problem.d
+    model = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, K, assume_PSD=True) - problem.f @ x),
+                       [contact])
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        try:
+            data, chain, inverse_data = model.get_problem_data(solver, solver_opts=opts)
+        except Exception as exc:
+            raise SolverError(f"cvxpy could not compile the QP for {solver}: {exc}") from exc
+        build_time = time.perf_counter() - start
+        solver_error = False
+        try:
+            raw = chain.solve_via_data(model, data, warm_start=False, verbose=False,
+                                       solver_opts=opts)
+            model.unpack_results(raw, chain, inverse_data)
+        except cp.error.SolverError:  # how cvxpy reports its status "solver_error"
+            solver_error = True
+        except Exception as exc:
+            raise SolverError(f"cvxpy/{solver} raised {type(exc).__name__}: {exc}") from exc
+        solve_time = time.perf_counter() - start - build_time
+    caught = [str(w.message) for w in record]
+    for message in caught:
+        log.debug("cvxpy/%s warned: %s", solver, message)
+    if solver_error:
+        return ContactSolution.failure(
+            METHOD, problem, "failed", f"cvxpy/{solver}: solver_error",
+            build_time=build_time, solve_time=solve_time,
+            extras={"raw_status": "solver_error", "solver": solver, "backend_warnings": caught})
+    raw_status = str(model.status)
+    status = STATUS_MAP.get(raw_status, "failed")
+    iterations = model.solver_stats.num_iters if model.solver_stats is not None else None
+    common = dict(message=f"cvxpy/{solver}: {raw_status}", iterations=int(iterations or 0),
+                  build_time=build_time, solve_time=solve_time,
+                  extras={"raw_status": raw_status, "solver": solver, "backend_warnings": caught})
+    if x.value is None or contact.dual_value is None:
+        return ContactSolution.failure(METHOD, problem, "failed" if status == "converged"
+                                       else status, **common)
+    lam = np.asarray(contact.dual_value, dtype=float).reshape(problem.m).copy()
+    return ContactSolution(method=METHOD, u=np.asarray(x.value, dtype=float).copy(), lam=lam,
+                           status=status, **common)
+
+
+register(Method(name=METHOD, function=solve,
+                summary="the QP as a cvxpy model (Clarabel by default; option solver)",
+                requires=("cvxpy",), extra="", family="cvxpy", exact=False, options=OPTIONS))

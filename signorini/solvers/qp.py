@@ -1,0 +1,498 @@
+"""The primal QP through qpsolvers: one method ``qp-<backend>`` per backend.
+
+``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` is handed to :func:`qpsolvers.solve_problem`
+as ``P = ½(K + Kᵀ)``, ``q = −f``, ``G = N``, ``h = d``. qpsolvers' multiplier
+``z`` of ``Gx ≤ h`` is non-negative and satisfies ``Px + q + Gᵀz = 0``, which
+is our ``K u − f + Nᵀλ = 0`` with ``λ = z``: no sign change.
+
+Every backend is one row of :data:`BACKENDS`: which modules it needs, whether
+qpsolvers feeds it dense matrices, how a relative tolerance ``tol`` and an
+iteration limit translate into its own option names, which options it
+accepts, and how its raw status maps to :data:`signorini.problem.STATUSES`.
+The methods are registered by one loop at the bottom of the module.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import logging
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import BackendNotInstalled, InputError, SolverError
+from ..problem import ContactProblem, ContactSolution
+from .registry import Method, register
+
+log = logging.getLogger(__name__)
+
+#: dense backends refuse problems with more free dofs than this (option ``max_dense_dofs``)
+DEFAULT_MAX_DENSE_DOFS = 3000
+
+#: options every ``qp-*`` method accepts besides its backend's own
+COMMON_OPTIONS = ("max_dense_dofs",)
+
+CONVERGED, INACCURATE, MAX_ITER, INFEASIBLE, FAILED = (
+    "converged", "inaccurate", "max_iter", "infeasible", "failed")
+
+
+class Report(NamedTuple):
+    """What a backend said about its run: raw status, iterations, other facts."""
+
+    raw_status: str
+    iterations: int | None = None
+    details: dict[str, Any] = {}
+
+
+Reader = Callable[[Any, list[str]], Report]
+
+
+@dataclass(frozen=True)
+class Backend:
+    """One qpsolvers backend: its options, tolerance translation and status map.
+
+    ``tolerance`` turns a relative KKT tolerance into backend options (one
+    translation per backend); ``max_iter_option`` receives ``max_iter``. ``statuses``
+    maps the backend's raw status string to one of ours (anything it does not
+    list is ``failed``), or is a function doing so. ``read`` extracts the raw
+    status from a :class:`qpsolvers.Solution` and the warnings it raised.
+    ``fixed`` are settings always passed; ``nest`` rewrites the settings
+    before the call (MOSEK takes its parameters inside one dict).
+    """
+
+    name: str
+    label: str
+    summary: str
+    modules: tuple[str, ...]
+    read: Reader
+    statuses: Mapping[str, str] | Callable[[str], str]
+    options: tuple[str, ...] = ()
+    tolerance: Callable[[float], dict[str, Any]] | None = None
+    max_iter_option: str | None = None
+    dense: bool = False
+    extra: str = "backends"
+    fixed: Mapping[str, Any] = field(default_factory=dict)
+    nest: Callable[[dict[str, Any]], dict[str, Any]] | None = None
+
+    @property
+    def method_name(self) -> str:
+        return f"qp-{self.name}"
+
+    @property
+    def accepted_options(self) -> tuple[str, ...]:
+        return tuple(sorted(set(self.options) | set(COMMON_OPTIONS)))
+
+    def settings(self, tol: float | None, max_iter: int | None) -> dict[str, Any]:
+        """Backend options meaning "relative KKT tolerance ``tol``, at most ``max_iter``"."""
+        out: dict[str, Any] = {}
+        if tol is not None:
+            if self.tolerance is None:
+                log.info("%s has no tolerance to set: tol=%g is ignored", self.label, tol)
+            else:
+                out.update(self.tolerance(tol))
+        if max_iter is not None:
+            if self.max_iter_option is None:
+                log.info("%s has no iteration limit: max_iter=%d is ignored", self.label, max_iter)
+            else:
+                out[self.max_iter_option] = int(max_iter)
+        return out
+
+    def status(self, raw: str) -> str:
+        """Our status for the backend's raw status string."""
+        if callable(self.statuses):
+            return self.statuses(raw)
+        return self.statuses.get(raw, FAILED)
+
+
+# --- reading what a backend reported ------------------------------------------------------
+
+
+def _read_info(solution: Any, caught: list[str]) -> Report:
+    """OSQP, ProxQP, PIQP, QPALM: ``extras["info"]`` with ``status`` and ``iter``."""
+    info = solution.extras["info"]
+    status = info.status
+    raw = getattr(status, "name", None) or str(status)
+    details = {}
+    if hasattr(info, "status_polish"):  # OSQP: polishing can fail silently (osqp#790)
+        details["polish_status"] = int(info.status_polish)
+    return Report(raw, int(info.iter), details)
+
+
+def _read_clarabel(solution: Any, caught: list[str]) -> Report:
+    return Report(str(solution.extras["status"]))  # qpsolvers drops the iteration count
+
+
+def _read_scs(solution: Any, caught: list[str]) -> Report:
+    info = solution.extras
+    return Report(str(info["status"]), int(info["iter"]), {"status_val": int(info["status_val"])})
+
+
+_ECOS_FLAGS = {0: "OPTIMAL", 1: "PINF", 2: "DINF", 10: "OPTIMAL_INACC", 11: "PINF_INACC",
+               12: "DINF_INACC", -1: "MAXIT", -2: "NUMERICS", -3: "OUTCONE", -4: "SIGINT",
+               -7: "FATAL"}
+
+
+def _read_ecos(solution: Any, caught: list[str]) -> Report:
+    info = solution.extras
+    flag = int(info["exitFlag"])
+    return Report(_ECOS_FLAGS.get(flag, f"exitFlag {flag}"), int(info["iter"]),
+                  {"exit_flag": flag, "infostring": info.get("infostring", "")})
+
+
+def _read_found(ok: str, not_ok: str) -> Reader:
+    """Backends whose status qpsolvers does not pass on: only ``found`` is known."""
+    def read(solution: Any, caught: list[str]) -> Report:
+        return Report(ok if solution.found else not_ok)
+    return read
+
+
+def _read_quadprog(solution: Any, caught: list[str]) -> Report:
+    if solution.found:
+        return Report("solved", int(solution.extras["iterations"][0]))
+    # qpsolvers swallows quadprog's "constraints are inconsistent, no solution"
+    # silently and warns about every other ValueError
+    complaints = [c for c in caught if "quadprog raised" in c]
+    return Report(complaints[0] if complaints else "no solution")
+
+
+def _read_cvxopt(solution: Any, caught: list[str]) -> Report:
+    res = solution.extras
+    iterations = res.get("iterations")
+    return Report(str(res.get("status")), None if iterations is None else int(iterations))
+
+
+_GUROBI_CODES = {1: "LOADED", 2: "OPTIMAL", 3: "INFEASIBLE", 4: "INF_OR_UNBD", 5: "UNBOUNDED",
+                 6: "CUTOFF", 7: "ITERATION_LIMIT", 8: "NODE_LIMIT", 9: "TIME_LIMIT",
+                 10: "SOLUTION_LIMIT", 11: "INTERRUPTED", 12: "NUMERIC", 13: "SUBOPTIMAL",
+                 14: "INPROGRESS", 15: "USER_OBJ_LIMIT", 16: "WORK_LIMIT", 17: "MEM_LIMIT"}
+
+
+def _read_gurobi(solution: Any, caught: list[str]) -> Report:
+    code = int(solution.extras["status"])
+    return Report(_GUROBI_CODES.get(code, f"status {code}"), None, {"status_code": code})
+
+
+def _scs_status(raw: str) -> str:
+    """SCS says "solved (inaccurate - reached max_iters)" when it ran out of iterations."""
+    if raw == "solved":
+        return CONVERGED
+    if raw.startswith("solved") and "max_iters" in raw:
+        return MAX_ITER
+    if raw.startswith("solved"):
+        return INACCURATE
+    return INFEASIBLE if raw == "infeasible" else FAILED
+
+
+def _mosek_nest(settings: dict[str, Any]) -> dict[str, Any]:
+    """MOSEK (through CVXOPT) takes its parameters as one dict keyed by ``mosek.*param``."""
+    import mosek
+
+    params = dict(settings.pop("mosek", {}))
+    for name, value in settings.items():
+        group = mosek.dparam if hasattr(mosek.dparam, name) else mosek.iparam
+        params[getattr(group, name)] = value
+    return {"mosek": params}
+
+
+# --- translating a relative tolerance ------------------------------------------------------
+
+
+def _each(*names: str, bounds: tuple[float, float] = (0.0, np.inf),
+          **flags: Any) -> Callable[[float], dict[str, Any]]:
+    """Set every option in ``names`` to ``tol`` (clipped to ``bounds``), plus fixed ``flags``."""
+    def translate(tol: float) -> dict[str, Any]:
+        value = float(np.clip(tol, *bounds))
+        return {**{name: value for name in names}, **flags}
+    return translate
+
+
+def _highs_tolerance(tol: float) -> dict[str, Any]:
+    """HiGHS's QP solver regularises the Hessian by ``qp_regularization_value`` (1e-7).
+
+    That bounds its stationarity error whatever the feasibility tolerances say,
+    so the regularisation shrinks with ``tol`` (never above HiGHS's default).
+    """
+    value = max(tol, 1e-10)  # HiGHS refuses tolerances below 1e-10
+    return {"primal_feasibility_tolerance": value, "dual_feasibility_tolerance": value,
+            "qp_regularization_value": min(1e-7, 0.1 * tol)}
+
+
+# --- the table ------------------------------------------------------------------------------
+
+BACKENDS: tuple[Backend, ...] = (
+    Backend(
+        "osqp", "OSQP", "OSQP (ADMM, first-order) through qpsolvers", ("osqp",),
+        _read_info,
+        {"solved": CONVERGED, "solved inaccurate": INACCURATE,
+         "maximum iterations reached": MAX_ITER, "primal infeasible": INFEASIBLE},
+        options=("rho", "sigma", "alpha", "delta", "scaling", "adaptive_rho",
+                 "adaptive_rho_interval", "adaptive_rho_tolerance", "adaptive_rho_fraction",
+                 "max_iter", "eps_abs", "eps_rel", "eps_prim_inf", "eps_dual_inf",
+                 "scaled_termination", "check_termination", "check_dualgap", "time_limit",
+                 "polishing", "polish_refine_iter", "warm_starting", "linsys_solver"),
+        tolerance=_each("eps_abs", "eps_rel", "eps_prim_inf"), max_iter_option="max_iter",
+        extra="", fixed={"raise_error": False}),
+    Backend(
+        "clarabel", "Clarabel", "Clarabel (interior point) through qpsolvers", ("clarabel",),
+        _read_clarabel,
+        {"Solved": CONVERGED, "AlmostSolved": INACCURATE, "MaxIterations": MAX_ITER,
+         "PrimalInfeasible": INFEASIBLE},
+        options=("max_iter", "time_limit", "max_step_fraction", "tol_gap_abs", "tol_gap_rel",
+                 "tol_feas", "tol_infeas_abs", "tol_infeas_rel", "tol_ktratio",
+                 "reduced_tol_gap_abs", "reduced_tol_gap_rel", "reduced_tol_feas",
+                 "reduced_tol_infeas_abs", "reduced_tol_infeas_rel", "reduced_tol_ktratio",
+                 "equilibrate_enable", "equilibrate_max_iter", "equilibrate_min_scaling",
+                 "equilibrate_max_scaling", "linesearch_backtrack_step",
+                 "min_switch_step_length", "min_terminate_step_length", "max_threads",
+                 "direct_kkt_solver", "direct_solve_method", "static_regularization_enable",
+                 "static_regularization_constant", "static_regularization_proportional",
+                 "dynamic_regularization_enable", "dynamic_regularization_eps",
+                 "dynamic_regularization_delta", "iterative_refinement_enable",
+                 "iterative_refinement_reltol", "iterative_refinement_abstol",
+                 "iterative_refinement_max_iter", "iterative_refinement_stop_ratio",
+                 "presolve_enable"),
+        tolerance=_each("tol_gap_abs", "tol_gap_rel", "tol_feas", "tol_ktratio"),
+        max_iter_option="max_iter", extra=""),
+    Backend(
+        "proxqp", "ProxQP", "ProxQP (proximal augmented Lagrangian) through qpsolvers",
+        ("proxsuite",), _read_info,
+        {"PROXQP_SOLVED": CONVERGED, "PROXQP_MAX_ITER_REACHED": MAX_ITER,
+         "PROXQP_PRIMAL_INFEASIBLE": INFEASIBLE},
+        options=("eps_abs", "eps_rel", "rho", "mu_eq", "mu_in", "max_iter",
+                 "compute_preconditioner", "initial_guess", "check_duality_gap",
+                 "eps_duality_gap_abs", "eps_duality_gap_rel", "primal_infeasibility_solving",
+                 "default_H_eigenvalue_estimate", "sparse_backend"),
+        tolerance=_each("eps_abs", "eps_rel", "eps_duality_gap_abs", "eps_duality_gap_rel",
+                        check_duality_gap=True),  # without the gap test it stops early
+        max_iter_option="max_iter"),
+    Backend(
+        "piqp", "PIQP", "PIQP (proximal interior point) through qpsolvers", ("piqp",),
+        _read_info,
+        {"PIQP_SOLVED": CONVERGED, "PIQP_MAX_ITER_REACHED": MAX_ITER,
+         "PIQP_PRIMAL_INFEASIBLE": INFEASIBLE},
+        options=("rho_init", "delta_init", "eps_abs", "eps_rel", "check_duality_gap",
+                 "eps_duality_gap_abs", "eps_duality_gap_rel", "infeasibility_threshold",
+                 "reg_lower_limit", "reg_finetune_lower_limit",
+                 "reg_finetune_primal_update_threshold", "reg_finetune_dual_update_threshold",
+                 "max_iter", "max_factor_retires", "preconditioner_scale_cost",
+                 "preconditioner_iter", "tau", "kkt_solver",
+                 "iterative_refinement_always_enabled", "iterative_refinement_eps_abs",
+                 "iterative_refinement_eps_rel", "iterative_refinement_max_iter",
+                 "iterative_refinement_min_improvement_rate",
+                 "iterative_refinement_static_regularization_eps",
+                 "iterative_refinement_static_regularization_rel"),
+        tolerance=_each("eps_abs", "eps_rel", "eps_duality_gap_abs", "eps_duality_gap_rel"),
+        max_iter_option="max_iter"),
+    Backend(
+        "scs", "SCS", "SCS (ADMM on the conic form, first-order) through qpsolvers", ("scs",),
+        _read_scs, _scs_status,
+        options=("max_iters", "time_limit_secs", "eps_abs", "eps_rel", "eps_infeas", "normalize",
+                 "scale", "adaptive_scale", "rho_x", "alpha", "acceleration_lookback",
+                 "acceleration_interval", "linear_solver", "write_data_filename",
+                 "log_csv_filename"),
+        tolerance=_each("eps_abs", "eps_rel"), max_iter_option="max_iters"),
+    Backend(
+        "ecos", "ECOS", "ECOS (interior point on an SOCP reformulation) through qpsolvers",
+        ("ecos",), _read_ecos,
+        {"OPTIMAL": CONVERGED, "OPTIMAL_INACC": INACCURATE, "MAXIT": MAX_ITER,
+         "PINF": INFEASIBLE},
+        options=("feastol", "abstol", "reltol", "feastol_inacc", "abstol_inacc",
+                 "reltol_inacc", "max_iters", "nitref"),
+        tolerance=_each("abstol", "reltol", "feastol"), max_iter_option="max_iters",
+        dense=True),  # qpsolvers densifies P and G and takes a Cholesky factor of P
+    Backend(
+        "highs", "HiGHS", "HiGHS (active set QP) through qpsolvers", ("highspy",),
+        _read_found("kOptimal", "not optimal (qpsolvers does not pass HiGHS's model status on)"),
+        {"kOptimal": CONVERGED},
+        options=("primal_feasibility_tolerance", "dual_feasibility_tolerance",
+                 "optimality_tolerance", "kkt_tolerance", "qp_iteration_limit",
+                 "qp_nullspace_limit", "qp_regularization_value", "time_limit", "presolve",
+                 "solver", "threads", "random_seed", "objective_bound"),
+        tolerance=_highs_tolerance, max_iter_option="qp_iteration_limit"),
+    Backend(
+        "daqp", "DAQP", "DAQP (dual active set, dense) through qpsolvers", ("daqp",),
+        _read_found("exitflag > 0", "exitflag <= 0 (qpsolvers does not pass the flag on)"),
+        {"exitflag > 0": CONVERGED},
+        options=("primal_tol", "dual_tol", "zero_tol", "pivot_tol", "progress_tol", "cycle_tol",
+                 "iter_limit", "fval_bound", "eps_prox", "eta_prox", "sing_tol", "refactor_tol",
+                 "time_limit", "eq_reduction"),
+        tolerance=_each("primal_tol", "dual_tol"), max_iter_option="iter_limit", dense=True),
+    Backend(
+        "quadprog", "quadprog", "quadprog (Goldfarb-Idnani dual active set, dense) through "
+        "qpsolvers", ("quadprog",), _read_quadprog,
+        {"solved": CONVERGED, "no solution": INFEASIBLE},
+        dense=True),  # no tolerance and no iteration limit to set
+    Backend(
+        "qpalm", "QPALM", "QPALM (proximal augmented Lagrangian) through qpsolvers", ("qpalm",),
+        _read_info,
+        {"solved": CONVERGED, "maximum iterations reached": MAX_ITER,
+         "primal infeasible": INFEASIBLE},
+        options=("max_iter", "inner_max_iter", "eps_abs", "eps_rel", "eps_abs_in", "eps_rel_in",
+                 "rho", "eps_prim_inf", "eps_dual_inf", "theta", "delta", "sigma_max",
+                 "sigma_init", "proximal", "gamma_init", "gamma_upd", "gamma_max", "scaling",
+                 "nonconvex", "warm_start", "reset_newton_iter", "enable_dual_termination",
+                 "dual_objective_limit", "time_limit", "ordering", "factorization_method",
+                 "max_rank_update", "max_rank_update_fraction"),
+        tolerance=_each("eps_abs", "eps_rel"), max_iter_option="max_iter"),
+    Backend(
+        "cvxopt", "CVXOPT", "CVXOPT (interior point) through qpsolvers", ("cvxopt",),
+        _read_cvxopt, {"optimal": CONVERGED},
+        options=("abstol", "reltol", "feastol", "maxiters", "refinement"),
+        tolerance=_each("abstol", "reltol", "feastol"), max_iter_option="maxiters"),
+    Backend(
+        "gurobi", "Gurobi", "Gurobi (barrier) through qpsolvers", ("gurobipy",),
+        _read_gurobi,
+        {"OPTIMAL": CONVERGED, "SUBOPTIMAL": INACCURATE, "ITERATION_LIMIT": MAX_ITER,
+         "INFEASIBLE": INFEASIBLE},
+        options=("FeasibilityTol", "OptimalityTol", "BarConvTol", "PSDTol", "TimeLimit",
+                 "IterationLimit", "BarIterLimit", "Method", "Threads", "Presolve",
+                 "NumericFocus", "Crossover", "BarHomogeneous", "ScaleFlag"),
+        tolerance=_each("FeasibilityTol", "OptimalityTol", "BarConvTol", bounds=(1e-9, 1e-2)),
+        max_iter_option="BarIterLimit"),
+    Backend(
+        "mosek", "MOSEK", "MOSEK (interior point) through qpsolvers and CVXOPT",
+        ("mosek", "cvxopt"), _read_cvxopt,
+        {"optimal": CONVERGED, "primal infeasible": INFEASIBLE},
+        options=("mosek",),
+        tolerance=_each("intpnt_qo_tol_rel_gap", "intpnt_qo_tol_pfeas", "intpnt_qo_tol_dfeas"),
+        max_iter_option="intpnt_max_iterations", nest=_mosek_nest),
+)
+
+BACKEND_BY_NAME: dict[str, Backend] = {backend.name: backend for backend in BACKENDS}
+
+
+# --- solving --------------------------------------------------------------------------------
+
+
+def _check_options(backend: Backend, options: Mapping[str, Any]) -> int:
+    """Refuse options the backend does not accept; return ``max_dense_dofs``."""
+    unknown = sorted(set(options) - set(backend.accepted_options))
+    if unknown:
+        raise InputError(
+            f"method {backend.method_name!r} does not accept option(s) "
+            f"{', '.join(repr(name) for name in unknown)}; accepted options: "
+            f"{', '.join(backend.accepted_options)}")
+    limit = options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS)
+    if isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 1:
+        raise InputError(f"max_dense_dofs must be a positive integer, got {limit!r}")
+    return int(limit)
+
+
+def _qp_data(problem: ContactProblem, dense: bool) -> tuple[Any, np.ndarray, Any, np.ndarray]:
+    """``(P, q, G, h)`` as qpsolvers wants them: csc matrices, or arrays for dense backends."""
+    P = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
+    G = sp.csc_matrix(problem.N)
+    if dense:
+        return P.toarray(), -problem.f, G.toarray(), problem.d.copy()
+    return P, -problem.f, G, problem.d.copy()
+
+
+def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
+             max_iter: int | None = None, **options: Any) -> ContactSolution:
+    """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with one qpsolvers backend.
+
+    Parameters
+    ----------
+    problem : the contact QP.
+    backend : a qpsolvers backend name listed in :data:`BACKENDS` (``"osqp"``...).
+    tol : relative KKT tolerance, translated into the backend's own options
+        (``None`` leaves the backend's defaults untouched).
+    max_iter : iteration limit, translated likewise (quadprog has none).
+    **options : backend options, passed through after ``tol`` and ``max_iter``
+        (so they win); ``max_dense_dofs`` (default 3000) caps ``n`` for dense backends.
+
+    Returns
+    -------
+    ContactSolution
+        ``u = x``, ``λ = z``; ``extras["raw_status"]`` is the backend's own word.
+
+    Raises
+    ------
+    InputError
+        Unknown option, or a dense backend asked to solve more than ``max_dense_dofs`` dofs.
+    BackendNotInstalled
+        qpsolvers cannot load the backend.
+    SolverError
+        The backend raised (re-raised ``from`` its exception).
+    """
+    spec = BACKEND_BY_NAME[backend]
+    max_dense_dofs = _check_options(spec, options)
+    if spec.dense and problem.n > max_dense_dofs:
+        raise InputError(
+            f"method {spec.method_name!r} builds dense n × n matrices and n = {problem.n} "
+            f"exceeds max_dense_dofs = {max_dense_dofs}: pick a sparse backend or raise "
+            "the option max_dense_dofs")
+    import qpsolvers
+
+    if spec.name not in qpsolvers.available_solvers:
+        missing = [m for m in spec.modules if importlib.util.find_spec(m) is None]
+        raise BackendNotInstalled(
+            f"qpsolvers cannot load backend {spec.name!r} (missing: {', '.join(missing) or '?'}; "
+            f"available: {', '.join(qpsolvers.available_solvers)}): "
+            f"pip install 'signorini[{spec.extra or 'all'}]'")
+    settings = {**spec.settings(tol, max_iter), **spec.fixed,
+                **{k: v for k, v in options.items() if k not in COMMON_OPTIONS}}
+    if spec.nest is not None:
+        settings = spec.nest(settings)
+
+    start = time.perf_counter()
+    P, q, G, h = _qp_data(problem, spec.dense)
+    qp = qpsolvers.Problem(P, q, G, h)
+    build_time = time.perf_counter() - start
+    try:
+        with warnings.catch_warnings(record=True) as record:
+            warnings.simplefilter("always")
+            result = qpsolvers.solve_problem(qp, spec.name, verbose=False, **settings)
+    except qpsolvers.ParamError as exc:
+        raise InputError(f"{spec.label}: bad option: {exc}") from exc
+    except Exception as exc:
+        passed = {k: v for k, v in options.items() if k not in COMMON_OPTIONS}
+        hint = f" (with the options {passed})" if passed else ""
+        raise SolverError(f"{spec.label} raised {type(exc).__name__}: {exc}{hint}") from exc
+    elapsed = time.perf_counter() - start - build_time
+    caught = [str(w.message) for w in record]
+    for message in caught:
+        log.debug("%s warned: %s", spec.label, message)
+
+    report = spec.read(result, caught)
+    status = spec.status(report.raw_status)
+    if (status == FAILED and max_iter is not None and report.iterations is not None
+            and report.iterations >= max_iter):
+        status = MAX_ITER  # e.g. CVXOPT says "unknown" when it runs out of iterations
+    if result.build_time is not None and result.solve_time is not None:
+        build_time += result.build_time
+        elapsed = result.solve_time
+    extras = {"raw_status": report.raw_status, "backend": spec.name,
+              "backend_warnings": caught, **report.details}
+    common = dict(message=f"{spec.label}: {report.raw_status}",
+                  iterations=report.iterations or 0, build_time=build_time,
+                  solve_time=elapsed, extras=extras)
+    if result.x is None or result.z is None:
+        return ContactSolution.failure(spec.method_name, problem,
+                                       FAILED if status == CONVERGED else status, **common)
+    return ContactSolution(method=spec.method_name, u=np.asarray(result.x, dtype=float).copy(),
+                           lam=np.asarray(result.z, dtype=float).copy(), status=status, **common)
+
+
+def _method_function(backend: Backend) -> Callable[..., ContactSolution]:
+    def solve(problem: ContactProblem, *, tol: float | None = None,
+              max_iter: int | None = None, **options: Any) -> ContactSolution:
+        return solve_qp(problem, backend.name, tol=tol, max_iter=max_iter, **options)
+
+    solve.__name__ = f"solve_{backend.name}"
+    solve.__qualname__ = solve.__name__
+    solve.__doc__ = f"{backend.summary}: see :func:`solve_qp`."
+    return solve
+
+
+for _backend in BACKENDS:
+    register(Method(
+        name=_backend.method_name, function=_method_function(_backend),
+        summary=_backend.summary, requires=("qpsolvers", *_backend.modules),
+        extra=_backend.extra, dense=_backend.dense, exact=False, family="qp",
+        options=_backend.accepted_options))
+del _backend
