@@ -28,15 +28,19 @@ def _positive(x: float) -> float:
 
 
 def gap_scale(problem: ContactProblem, u: np.ndarray) -> float:
-    """Length against which gaps are judged: ``max(‖Nu‖∞, ‖d‖∞)``."""
-    return _positive(max(_inf_norm(problem.N @ u), _inf_norm(problem.d)))
+    """Length against which gaps are judged: ``max(‖Nu‖∞, ‖d‖∞, ‖u‖∞)``.
+
+    ``‖u‖∞`` keeps the scale meaningful when the contact nodes neither move
+    nor start apart (a block resting on the flat: ``d = 0``, ``Nu = 0``).
+    """
+    return _positive(max(_inf_norm(problem.N @ u), _inf_norm(problem.d), _inf_norm(u)))
 
 
 @dataclass(frozen=True)
 class Certificate:
     """Relative KKT residuals of a candidate solution ``(u, λ)``.
 
-    - ``primal``: ``max((Nu − d)⁺) / max(‖Nu‖∞, ‖d‖∞)``
+    - ``primal``: ``max((Nu − d)⁺) / max(‖Nu‖∞, ‖d‖∞, ‖u‖∞)``
     - ``stationarity``: ``‖Ku − f + Nᵀλ‖∞ / ‖Nᵀλ‖∞``.
       The contact forces set the scale, not ``‖f‖∞ + ‖Nᵀλ‖∞``: the lifted
       load ``f`` sits on dofs next to the prescribed boundary and can be
@@ -44,9 +48,9 @@ class Certificate:
       that is small against ``f`` can still move λ by much more than the
       tolerance.
     - ``dual_sign``: ``max((−λ)⁺) / ‖λ‖∞``
-    - ``complementarity``: ``max |λᵢ (Nu − d)ᵢ| / (‖λ‖∞ · max(‖Nu‖∞, ‖d‖∞))``
+    - ``complementarity``: ``max |λᵢ (Nu − d)ᵢ| / (‖λ‖∞ · max(‖Nu‖∞, ‖d‖∞, ‖u‖∞))``
     - ``natural``: ``max |min(λ̃ᵢ, g̃ᵢ)|`` with ``λ̃ = λ/‖λ‖∞`` and
-      ``g̃ = (d − Nu)/max(‖Nu‖∞, ‖d‖∞)``: the natural (min-map) residual.
+      ``g̃ = (d − Nu)/max(‖Nu‖∞, ‖d‖∞, ‖u‖∞)``: the natural (min-map) residual.
       The product form above lets a node keep both a force and a gap of
       ``√residual``; this one is linear in both, so it bounds how far λ and
       the active set can be off (times the conditioning of ``W``).
@@ -108,7 +112,7 @@ def classify(problem: ContactProblem, solution: ContactSolution,
              weak_tol: float = WEAK_TOL) -> np.ndarray:
     """Label each candidate ``active``, ``inactive`` or ``weak`` (weakly active).
 
-    With ``λ̃ = λ/‖λ‖∞`` and ``g̃ = (d − Nu)⁺ / max(‖Nu‖∞, ‖d‖∞)``: a node is
+    With ``λ̃ = λ/‖λ‖∞`` and ``g̃ = (d − Nu)⁺ / max(‖Nu‖∞, ‖d‖∞, ‖u‖∞)``: a node is
     weakly active when both are at most ``weak_tol`` (it touches with zero
     force, so its membership of the active set is not determined); otherwise
     it is active when ``λ̃ > g̃`` and inactive when not. For an exact solution

@@ -121,6 +121,9 @@ def compare_hertz(problem: ContactProblem, solution: ContactSolution) -> HertzCo
     profile = contact_profile(problem, solution)
     R = problem.params["R"]
     P = profile.total_force
+    if not P > 0:
+        nan = float("nan")
+        return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
     a_ref = hertz_cylinder_half_width(P, R, contact_modulus(problem.params["E"], problem.params["nu"]))
     p0_ref = hertz_cylinder_peak(P, a_ref)
     return HertzComparison(

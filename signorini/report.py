@@ -135,7 +135,7 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
             hertz = compare_hertz(problem, ref)
             others = [(label, contact_profile(problem, s).pressure)
                       for label, s in result.solutions.items()
-                      if label != "pdas@1e-09" and np.all(np.isfinite(s.lam))]
+                      if label != "pdas@1e-09" and s.status != "failed" and np.all(np.isfinite(s.lam))]
             ax = plots.pressure_profile(profile.x, profile.pressure, a_ref=hertz.a_ref,
                                         p0_ref=hertz.p0_ref, label="pdas", others=others)
             ax.set_title(f"{name}: contact pressure, every method against Hertz", fontsize=9)
@@ -169,6 +169,9 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
                            for k, v in p.params.items() if v is not None)
                + f": {p.n} dofs, {p.m} contact candidates.", ""]
         md += runs_table(result.runs)
+        notes = [r for r in result.runs if r["status"] in ("skipped", "failed")]
+        if notes:
+            md += [""] + [f"- {r['label']} {r['status']}: {r['message']}" for r in notes]
         for key in (f"{result.case.name}-pressure", f"{result.case.name}-kkt-time"):
             if key in figures:
                 md += ["", f"![{key}]({figures[key].name})"]

@@ -52,11 +52,15 @@ class Case:
     scene: str
     params: dict[str, Any] = field(default_factory=dict)
     same_as: str | None = None  # a case whose dimensionless answer this one must reproduce
+    check_reference: bool = True  # hold the answer to the analytic reference's limits
 
 
 DEFAULT_CASES = (
     Case("block", "block"),
     Case("hertz-cylinder", "hertz-cylinder", {"a_over_R": 0.05}),
+    # coarse enough for the dense backends (≤ 3000 dofs); its Hertz errors are not checked
+    Case("hertz-cylinder-coarse", "hertz-cylinder",
+         {"a_over_R": 0.05, "n_contact": 16, "grading": 0.4}, check_reference=False),
     Case("hertz-cylinder-SI", "hertz-cylinder", {"E": 2.1e11, "R": 0.01, "a_over_R": 0.05},
          same_as="hertz-cylinder"),
 )
@@ -156,14 +160,14 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult]) -> list[Chec
         checks.append(Check(case.name, name, float(value), LIMITS[key],
                             bool(np.isfinite(value) and value <= LIMITS[key]), detail))
 
-    metrics = reference_metrics(problem, ref)
+    metrics = reference_metrics(problem, ref) if case.check_reference else {}
     kind = get_scene(case.scene).reference
     if kind == "hertz-2d" and metrics:
         limit("Hertz p0 relative error (pdas)", metrics["p0_rel"], "hertz_p0_rel")
         limit("Hertz a relative error (pdas)", metrics["a_rel"], "hertz_a_rel")
         limit("Hertz pressure L2 relative error (pdas)", metrics["pressure_l2_rel"],
               "hertz_pressure_l2_rel")
-        limit("force balance |P - applied| / P (pdas)", metrics["force_balance"], "force_balance")
+        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
         profile = contact_profile(problem, ref)
         checks.append(Check(case.name, "outermost candidate is not in contact",
                             not bool(profile.active[-1]), None, not bool(profile.active[-1]),
@@ -171,7 +175,7 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult]) -> list[Chec
     if kind == "uniform" and metrics:
         limit("uniform pressure max relative error (pdas)", metrics["pressure_max_rel"],
               "uniform_pressure_rel")
-        limit("force balance |P - applied| / P (pdas)", metrics["force_balance"], "force_balance")
+        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
     for row in result.runs:
         if row["tol"] == TIGHT_TOL and row["status"] == "converged":
             vs = row["vs_reference"]
