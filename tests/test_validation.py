@@ -1,0 +1,51 @@
+"""The executable validation documents, imported and pinned to their claims."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+VALIDATION = Path(__file__).resolve().parents[1] / "validation"
+
+
+def load(name):
+    spec = importlib.util.spec_from_file_location(name, VALIDATION / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def hertz():
+    return load("hertz_cylinder")
+
+
+def test_hertz_cylinder_in_si_units_within_one_percent(hertz):
+    assert hertz.problem.n <= 20_000
+    assert hertz.exact.status == "converged"
+    assert hertz.hertz.p0_rel < 0.01
+    assert hertz.hertz.a_rel < 0.01
+    assert hertz.hertz.pressure_l2_rel < 0.03
+    assert hertz.hertz.force_balance < 1e-8
+
+
+def test_the_papers_uzawa_reaches_the_exact_answer(hertz):
+    assert hertz.paper.status == "converged"
+    assert hertz.agreement.lam_rel < 1e-6
+    assert hertz.agreement.misclassified == 0
+    # the default step is 0.9 of the bound 2/λ_max(W)
+    assert hertz.paper.extras["rho_over_bound"] == pytest.approx(0.9)
+
+
+def test_hertz_figure_is_written(hertz, tmp_path):
+    path = hertz.visualize(tmp_path / "p.png")
+    assert path.stat().st_size > 10_000
+
+
+def test_block_patch_test_is_exact():
+    block = load("block")
+    assert block.uniform.pressure_max_rel < 1e-10
+    assert np.all(block.profile.active)
+    expected_total = 2 * block.PARAMS["W"] * block.pressure_expected
+    assert block.profile.total_force == pytest.approx(expected_total, rel=1e-10)
