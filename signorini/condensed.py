@@ -48,19 +48,24 @@ def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
     raise ArithmeticError(f"active set still changing after {max_iter} PDAS steps")
 
 
-def delassus_max_eigenvalue(N: sp.csr_matrix, factor, rtol: float = 1e-6,
-                            max_iter: int = 500, seed: int = 0) -> tuple[float, int]:
-    """``λ_max(W)`` of ``W = N K⁻¹ Nᵀ`` by power iteration (one back-solve per step).
+def delassus_max_eigenvalue(N: sp.csr_matrix, factor, rtol: float = 1e-6, max_iter: int = 500,
+                            seed: int = 0, apply_W=None) -> tuple[float, int]:
+    """``λ_max(W)`` of ``W = N K⁻¹ Nᵀ`` by power iteration.
 
-    Returns the Rayleigh-quotient estimate (a lower bound of the true value)
-    and the number of steps; stops when it changes by less than ``rtol``.
+    Each step applies W once: by one back-solve, or by ``apply_W`` when W is
+    at hand. Returns the Rayleigh-quotient estimate (a lower bound of the
+    true value) and the number of steps; stops when it changes by less than
+    ``rtol``.
     """
+    if apply_W is None:
+        def apply_W(x):
+            return N @ factor.solve(N.T @ x)
     rng = np.random.default_rng(seed)
     x = rng.standard_normal(N.shape[0])
     x /= np.linalg.norm(x)
     estimate = 0.0
     for step in range(1, max_iter + 1):
-        y = N @ factor.solve(N.T @ x)
+        y = apply_W(x)
         new_estimate = float(x @ y)
         x = y / np.linalg.norm(y)
         if abs(new_estimate - estimate) <= rtol * abs(new_estimate):

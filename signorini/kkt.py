@@ -94,7 +94,7 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     primal = max(float(np.max(violation, initial=0.0)), 0.0) / scale_gap
     residual = problem.K @ u - problem.f + NT_lam
     stationarity = _inf_norm(residual) / _positive(max(_inf_norm(NT_lam), floor))
-    dual_sign = max(float(np.max(-lam, initial=0.0)), 0.0) / lam_norm
+    dual_sign = max(float(np.max(-lam, initial=0.0)), 0.0) / lam_norm + 0.0
     complementarity = _inf_norm(lam * violation) / (lam_norm * scale_gap)
     natural = _inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))
     gap = float("nan")

@@ -64,7 +64,7 @@ def _distance_estimate(steps: list[float]) -> float:
 
 
 def _operator(problem: ContactProblem, factor, choice: str):
-    """``λ ↦ N K⁻¹ (f − Nᵀλ)`` and the matching u, by back-solves or through W."""
+    """The operator choice, ``λ ↦ N K⁻¹ (f − Nᵀλ)`` and ``x ↦ W x`` (None with back-solves)."""
     if choice not in ("auto", "delassus", "backsolve"):
         raise InputError(f"method 'uzawa': option operator={choice!r} must be auto, delassus or backsolve")
     if choice == "auto":
@@ -72,10 +72,10 @@ def _operator(problem: ContactProblem, factor, choice: str):
     if choice == "backsolve":
         def normal_displacement(lam):
             return problem.N @ factor.solve(problem.f - problem.N.T @ lam)
-        return choice, normal_displacement
+        return choice, normal_displacement, None
     W, _ = delassus(problem.N, factor)
     free = problem.N @ factor.solve(problem.f)
-    return choice, lambda lam: free - W @ lam
+    return choice, (lambda lam: free - W @ lam), (lambda x: W @ x)
 
 
 def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
@@ -86,12 +86,12 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
     start = time.perf_counter()
     factor = factorize(problem.K)
-    choice, normal_displacement = _operator(problem, factor, opts["operator"])
+    choice, normal_displacement, apply_W = _operator(problem, factor, opts["operator"])
 
     def displacement(lam: np.ndarray) -> np.ndarray:
         return factor.solve(problem.f - problem.N.T @ lam)
 
-    lam_max, power_steps = delassus_max_eigenvalue(problem.N, factor)
+    lam_max, power_steps = delassus_max_eigenvalue(problem.N, factor, apply_W=apply_W)
     if opts["rho"] is not None:
         rho = positive_number("uzawa", "rho", opts["rho"])
     else:
