@@ -19,7 +19,7 @@ from .scenes import get_scene
 from .suite import LIMITS, SuiteResult
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
-            "proxsuite", "piqp", "scs", "ecos", "highspy", "daqp", "quadprog")
+            "proxsuite", "piqp", "scs", "ecos", "highspy", "daqp", "quadprog", "qpalm", "cvxopt")
 
 
 def provenance() -> dict[str, Any]:
