@@ -36,16 +36,46 @@ def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
     m = len(b)
     lam = np.zeros(m) if lam0 is None else np.maximum(lam0, 0.0)
     active = None
+    seen: set[bytes] = set()
     for iteration in range(1, max_iter + 1):
         gap = W @ lam - b
         new_active = (lam - gap) > 0
         if active is not None and np.array_equal(new_active, active):
             return lam, iteration - 1
+        if new_active.tobytes() in seen:
+            lam, steps = least_index_lcp(W, b)
+            return lam, iteration + steps
+        seen.add(new_active.tobytes())
         active = new_active
         lam = np.zeros(m)
         if active.any():
             lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
     raise ArithmeticError(f"active set still changing after {max_iter} PDAS steps")
+
+
+def least_index_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 100_000) -> tuple[np.ndarray, int]:
+    """Murty's least-index principal pivoting for ``λ ≥ 0, Wλ − b ≥ 0, λ·(Wλ − b) = 0``.
+
+    Starting from the empty active set, each step flips the lowest-numbered
+    node that breaks a condition (a negative force on the active set, or a
+    negative gap off it). It terminates for every P-matrix, SPD W included
+    (Murty 1974), though it may take many steps; it is the fallback when
+    PDAS cycles.
+    """
+    m = len(b)
+    active = np.zeros(m, dtype=bool)
+    for step in range(1, max_iter + 1):
+        lam = np.zeros(m)
+        if active.any():
+            lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
+        gap = W @ lam - b
+        force_tol = 1e-13 * max(float(np.max(np.abs(lam))), 1e-300)
+        gap_tol = 1e-13 * max(float(np.max(np.abs(b))), 1e-300)
+        wrong = np.nonzero((active & (lam < -force_tol)) | (~active & (gap < -gap_tol)))[0]
+        if wrong.size == 0:
+            return np.maximum(lam, 0.0), step
+        active[wrong[0]] = ~active[wrong[0]]
+    raise ArithmeticError(f"least-index pivoting did not finish in {max_iter} steps")
 
 
 def delassus_max_eigenvalue(N: sp.csr_matrix, factor, rtol: float = 1e-6, max_iter: int = 500,

@@ -27,6 +27,11 @@ def _positive(x: float) -> float:
     return x if x > 0 else 1.0
 
 
+def force_scale(problem: ContactProblem, lam: np.ndarray) -> float:
+    """``max(‖λ‖∞, FORCE_FLOOR · ‖f‖∞)``: the force against which forces are judged."""
+    return _positive(max(_inf_norm(lam), FORCE_FLOOR * _inf_norm(problem.f)))
+
+
 def gap_scale(problem: ContactProblem, u: np.ndarray) -> float:
     """Length against which gaps are judged: ``max(‖Nu‖∞, ‖d‖∞, ‖u‖∞)``.
 
@@ -71,8 +76,8 @@ class Certificate:
 
     def worst(self) -> tuple[str, float]:
         """The largest residual and its name."""
-        items = asdict(self)
-        name = max(items, key=lambda k: items[k] if np.isfinite(items[k]) else np.inf)
+        items = {k: v for k, v in asdict(self).items() if not np.isnan(v)}
+        name = max(items, key=lambda k: items[k])
         return name, items[name]
 
     def as_dict(self) -> dict[str, float]:
@@ -90,7 +95,7 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     scale_gap = gap_scale(problem, u)
     NT_lam = problem.N.T @ lam
     floor = FORCE_FLOOR * _inf_norm(problem.f)
-    lam_norm = _positive(max(_inf_norm(lam), floor))
+    lam_norm = force_scale(problem, lam)
     primal = max(float(np.max(violation, initial=0.0)), 0.0) / scale_gap
     residual = problem.K @ u - problem.f + NT_lam
     stationarity = _inf_norm(residual) / _positive(max(_inf_norm(NT_lam), floor))
@@ -119,7 +124,7 @@ def classify(problem: ContactProblem, solution: ContactSolution,
     one of the two is zero; for an inexact one the larger decides.
     """
     u, lam = solution.u, solution.lam
-    lam_n = np.maximum(lam, 0.0) / _positive(_inf_norm(lam))
+    lam_n = np.maximum(lam, 0.0) / force_scale(problem, lam)
     gap_n = np.maximum(problem.gap(u), 0.0) / gap_scale(problem, u)
     labels = np.where(lam_n > gap_n, ACTIVE, INACTIVE).astype(object)
     labels[(lam_n <= weak_tol) & (gap_n <= weak_tol)] = WEAK

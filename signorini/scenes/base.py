@@ -34,7 +34,13 @@ class Param:
     def parse(self, value: Any) -> Any:
         """Convert (from a string if need be) and check one value."""
         if value is None:
-            return None
+            if self.default is None:
+                return None
+            raise InputError(f"scene parameter {self.name} needs a value: "
+                             f"pass --set {self.name}=<{self.kind.__name__}> ({self.doc})")
+        if isinstance(value, bool):
+            raise InputError(f"scene parameter {self.name}={value!r} is not a valid "
+                             f"{self.kind.__name__}: pass --set {self.name}=<{self.kind.__name__}>")
         try:
             if self.kind is int:
                 converted = int(value)
@@ -44,7 +50,7 @@ class Param:
                     raise ValueError
             else:
                 converted = self.kind(value)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InputError(
                 f"scene parameter {self.name}={value!r} is not a valid {self.kind.__name__}: "
                 f"pass --set {self.name}=<{self.kind.__name__}> ({self.doc})") from None

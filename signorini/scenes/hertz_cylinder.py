@@ -44,7 +44,7 @@ PARAMS = (
 
 def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
     """Resolve which load parameter rules: the target P, or a prescribed delta."""
-    chosen = given & {"P", "a_over_R", "delta"}
+    chosen = {name for name in given & {"P", "a_over_R", "delta"} if p[name] is not None}
     if len(chosen) > 1:
         raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
                          "give only one of P, a_over_R, delta")

@@ -125,10 +125,8 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
         raise BackendNotInstalled(
             f"method {method!r} needs {', '.join(missing)}: "
             f"pip install 'signorini[{spec.extra or 'all'}]'")
-    if tol is not None and not (np.isfinite(tol) and 0 < tol < 1):
-        raise InputError(f"tol must be a number in (0, 1), got {tol!r}")
-    if max_iter is not None and (int(max_iter) != max_iter or max_iter < 1):
-        raise InputError(f"max_iter must be a positive integer, got {max_iter!r}")
+    tol = _check_tol(tol)
+    max_iter = _check_max_iter(max_iter)
     start = time.perf_counter()
     try:
         solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
@@ -142,6 +140,26 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
             solve_time=time.perf_counter() - start)
     solution.method = method
     return judge(problem, solution, tol if tol is not None else spec.default_tol)
+
+
+def _check_tol(tol: Any) -> float | None:
+    if tol is None:
+        return None
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
+            or not (np.isfinite(tol) and 0 < tol < 1):
+        raise InputError(f"tol must be a number in (0, 1), got {tol!r}: e.g. tol=1e-9")
+    return float(tol)
+
+
+def _check_max_iter(max_iter: Any) -> int | None:
+    if max_iter is None:
+        return None
+    ok = isinstance(max_iter, (int, np.integer)) and not isinstance(max_iter, bool)
+    ok = ok or (isinstance(max_iter, (float, np.floating)) and np.isfinite(max_iter)
+                and float(max_iter).is_integer())
+    if not ok or max_iter < 1:
+        raise InputError(f"max_iter must be a positive integer, got {max_iter!r}")
+    return int(max_iter)
 
 
 def judge(problem: ContactProblem, solution: ContactSolution,

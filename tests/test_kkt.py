@@ -1,0 +1,283 @@
+"""KKT certificates, classification of the candidates, comparisons and the registry's judge."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from signorini.kkt import (ACTIVE, INACTIVE, WEAK, WEAK_TOL, active_set, certificate, classify,
+                           compare, gap_scale)
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.scenes import build_problem
+from signorini.solvers import registry
+
+RESIDUALS = ("primal", "stationarity", "dual_sign", "complementarity", "natural", "duality_gap")
+
+
+@pytest.fixture(scope="module")
+def hertz():
+    return build_problem("hertz-cylinder", n_contact=20)
+
+
+@pytest.fixture(scope="module")
+def exact(hertz):
+    solution = registry.solve(hertz, "pdas", tol=1e-9)
+    assert solution.status == "converged", solution.message
+    return solution
+
+
+def with_(solution, **changes):
+    """A copy of ``solution`` with some fields replaced (arrays copied)."""
+    fields = {"u": solution.u.copy(), "lam": solution.lam.copy(), **changes}
+    return dataclasses.replace(solution, **fields, history={}, extras={})
+
+
+def nodes_of(problem, solution):
+    gap = problem.gap(solution.u) / gap_scale(problem, solution.u)
+    active = np.nonzero(solution.lam > 0)[0]
+    inactive = np.nonzero((gap > 1e-9) & (solution.lam == 0))[0]  # open beyond round-off
+    assert active.size and inactive.size, "the test needs both active and inactive candidates"
+    return active, inactive
+
+
+def row(problem, i):
+    return problem.N[i].toarray().ravel()
+
+
+def touching_problem():
+    """min ½|u|² − fᵀu s.t. −u ≤ d, with f = (−1, 0), d = (½, 0).
+
+    The minimiser is u = (−½, 0), λ = (½, 0): the first constraint is active, the second
+    touches (gap 0) with zero force — degenerate, weakly active.
+    """
+    return ContactProblem(
+        K=sp.identity(2, format="csr"), f=np.array([-1.0, 0.0]), N=-sp.identity(2, format="csr"),
+        d=np.array([0.5, 0.0]), weights=np.ones(2), contact_points=np.zeros((2, 2)),
+        free_dofs=np.arange(2), prescribed=np.zeros(2), scene="touching")
+
+
+# --- certificate -----------------------------------------------------------------------------
+
+
+def test_exact_solution_has_all_residuals_below_1e_10(hertz, exact):
+    cert = certificate(hertz, exact)
+    for name in RESIDUALS:
+        assert 0.0 <= getattr(cert, name) < 1e-10, name
+    assert cert.worst()[1] < 1e-10
+
+
+def test_penetration_raises_primal(hertz, exact):
+    active, _ = nodes_of(hertz, exact)
+    i = active[len(active) // 2]
+    push = 1e-3 * gap_scale(hertz, exact.u)
+    bad = with_(exact, u=exact.u + push * row(hertz, i))  # (N u)_i grows by push: penetration
+    cert = certificate(hertz, bad)
+    assert cert.primal == pytest.approx(1e-3, rel=0.05)
+    assert certificate(hertz, exact).primal < 1e-12
+
+
+def test_negative_force_raises_dual_sign(hertz, exact):
+    _, inactive = nodes_of(hertz, exact)
+    lam = exact.lam.copy()
+    lam[inactive[0]] = -0.1 * lam.max()
+    cert = certificate(hertz, with_(exact, lam=lam))
+    assert cert.dual_sign == pytest.approx(0.1, rel=1e-12)
+    assert certificate(hertz, exact).dual_sign == 0.0
+
+
+def test_displacement_off_raises_stationarity(hertz, exact):
+    rng = np.random.default_rng(0)
+    u = exact.u + 1e-6 * np.max(np.abs(exact.u)) * rng.standard_normal(hertz.n)
+    cert = certificate(hertz, with_(exact, u=u))
+    base = certificate(hertz, exact).stationarity
+    assert cert.stationarity > 1e-7
+    assert cert.stationarity > 1e3 * base
+
+
+def test_force_on_an_open_node_raises_complementarity(hertz, exact):
+    _, inactive = nodes_of(hertz, exact)
+    gap = hertz.gap(exact.u)
+    i = inactive[np.argmax(gap[inactive])]
+    lam = exact.lam.copy()
+    lam[i] = 0.1 * lam.max()
+    cert = certificate(hertz, with_(exact, lam=lam))
+    expected = 0.1 * gap[i] / gap_scale(hertz, exact.u)
+    assert cert.complementarity == pytest.approx(expected, rel=1e-9)
+    assert cert.complementarity > 1e-3
+    assert cert.natural > 1e-3
+    assert certificate(hertz, exact).complementarity < 1e-12
+
+
+@pytest.mark.parametrize("field, value", [("u", np.nan), ("u", np.inf), ("lam", np.nan),
+                                          ("lam", -np.inf)])
+def test_non_finite_input_gives_inf(hertz, exact, field, value):
+    vector = getattr(exact, field).copy()
+    vector[0] = value
+    cert = certificate(hertz, with_(exact, **{field: vector}))
+    for name in RESIDUALS:
+        assert getattr(cert, name) == np.inf, name
+
+
+def test_certificate_is_unit_free():
+    scaled = build_problem("block", nx=4, ny=4)
+    raw = build_problem("block", nx=4, ny=4, E=2.1e11, delta=1e-3, nondimensionalise=False)
+    s_scaled = registry.solve(scaled, "pdas", tol=1e-9)
+    s_raw = registry.solve(raw, "pdas", tol=1e-9)
+    assert s_scaled.status == s_raw.status == "converged"
+    # the exact answers have the same (round-off) residuals whatever the units
+    assert certificate(scaled, s_scaled).worst()[1] < 1e-10
+    assert certificate(raw, s_raw).worst()[1] < 1e-10
+    # the same relative perturbation of λ gives the same relative residuals in both units
+    for problem, solution in ((scaled, s_scaled), (raw, s_raw)):
+        lam = solution.lam * (1 + 1e-4)
+        cert = certificate(problem, with_(solution, lam=lam))
+        assert cert.stationarity == pytest.approx(1e-4, rel=1e-3)
+
+
+def test_worst_ignores_a_duality_gap_that_was_not_computed(hertz, exact):
+    cert = certificate(hertz, exact, duality_gap=False)
+    name, value = cert.worst()
+    assert np.isfinite(value) and value < 1e-10, (name, value)
+
+
+# --- classify and compare --------------------------------------------------------------------
+
+
+def test_exact_solution_labels_match_forces_and_gaps(hertz, exact):
+    labels = classify(hertz, exact)
+    assert set(labels) <= {ACTIVE, INACTIVE, WEAK}
+    np.testing.assert_array_equal(labels == ACTIVE, exact.lam > 0)
+    np.testing.assert_array_equal(active_set(hertz, exact), exact.lam > 0)
+
+
+def test_solution_compared_with_itself(hertz, exact):
+    comparison = compare(hertz, exact, with_(exact))
+    assert comparison.u_rel == 0.0
+    assert comparison.lam_rel == 0.0
+    assert comparison.misclassified == 0
+    assert comparison.same_active_set
+
+
+def test_opening_one_active_node_is_one_misclassification(hertz, exact):
+    active, _ = nodes_of(hertz, exact)
+    i = active[len(active) // 2]
+    lam = exact.lam.copy()
+    lam[i] = 0.0
+    lift = 1e-2 * gap_scale(hertz, exact.u)
+    flipped = with_(exact, u=exact.u - lift * row(hertz, i), lam=lam)  # gap_i = lift
+    assert classify(hertz, flipped)[i] == INACTIVE
+    comparison = compare(hertz, exact, flipped)
+    assert comparison.misclassified == 1
+    assert not comparison.same_active_set
+    assert comparison.lam_rel > 0 and comparison.u_rel > 0
+
+
+def test_forcing_one_open_node_is_one_misclassification(hertz, exact):
+    _, inactive = nodes_of(hertz, exact)
+    gap_n = hertz.gap(exact.u) / gap_scale(hertz, exact.u)
+    i = inactive[np.argmin(gap_n[inactive])]  # the open node nearest the contact edge
+    assert gap_n[i] < 1.0
+    lam = exact.lam.copy()
+    lam[i] = lam.max()
+    comparison = compare(hertz, exact, with_(exact, lam=lam))
+    assert comparison.misclassified == 1
+
+
+def test_degenerate_node_is_weak_and_not_misclassified():
+    problem = touching_problem()
+    solution = registry.solve(problem, "pdas", tol=1e-9)
+    assert solution.status == "converged"
+    np.testing.assert_allclose(solution.u, [-0.5, 0.0], atol=1e-15)
+    np.testing.assert_allclose(solution.lam, [0.5, 0.0], atol=1e-15)
+    assert certificate(problem, solution).worst()[1] < 1e-14
+    assert list(classify(problem, solution)) == [ACTIVE, WEAK]
+    # another KKT point to within WEAK_TOL: the degenerate node carries a tiny force
+    tiny_force = with_(solution, lam=np.array([0.5, 0.1 * WEAK_TOL]))
+    assert list(classify(problem, tiny_force)) == [ACTIVE, WEAK]
+    # a candidate that opened the weak node: inactive there, but it is not a misclassification
+    opened = with_(solution, u=np.array([-0.5, 1e-2]))
+    assert list(classify(problem, opened)) == [ACTIVE, INACTIVE]
+    comparison = compare(problem, solution, opened)
+    assert comparison.misclassified == 0
+    assert comparison.weak == 1
+    # forcing it instead is not a misclassification either
+    forced = with_(solution, lam=np.array([0.5, 0.25]))
+    assert classify(problem, forced)[1] == ACTIVE
+    assert compare(problem, solution, forced).misclassified == 0
+
+
+def test_non_finite_comparison_counts_every_node(hertz, exact):
+    broken = with_(exact, lam=np.full(hertz.m, np.nan))
+    comparison = compare(hertz, exact, broken)
+    assert comparison.lam_rel == np.inf
+    assert comparison.misclassified == hertz.m
+
+
+def test_round_off_force_without_contact_is_not_active():
+    # min ½|u|² − fᵀu s.t. u ≤ d with f = (0.5, 0.2), d = (1, 1): u = f is feasible, λ = 0
+    problem = ContactProblem(
+        K=sp.identity(2, format="csr"), f=np.array([0.5, 0.2]), N=sp.identity(2, format="csr"),
+        d=np.array([1.0, 1.0]), weights=np.ones(2), contact_points=np.zeros((2, 2)),
+        free_dofs=np.arange(2), prescribed=np.zeros(2))
+    exact = ContactSolution("exact", np.array([0.5, 0.2]), np.zeros(2), "converged")
+    round_off = ContactSolution("round-off", np.array([0.5, 0.2]), np.array([1e-15, 0.0]),
+                                "converged")
+    assert certificate(problem, round_off).worst()[1] < 1e-9
+    assert classify(problem, round_off)[0] != ACTIVE
+    assert compare(problem, exact, round_off).misclassified == 0
+
+
+# --- the registry's judge --------------------------------------------------------------------
+
+
+def test_judge_downgrades_a_false_claim(hertz, exact):
+    bad = with_(exact, lam=exact.lam * 1.01, status="converged", message="backend: solved")
+    judged = registry.judge(hertz, bad, 1e-8)
+    assert judged.status == "inaccurate"
+    assert judged.extras["claimed_status"] == "converged"
+    worst_name, _ = certificate(hertz, with_(exact, lam=exact.lam * 1.01)).worst()
+    assert worst_name in judged.message
+    assert "backend: solved" in judged.message
+
+
+def test_judge_names_the_failing_residual(hertz, exact):
+    active, _ = nodes_of(hertz, exact)
+    i = active[0]
+    push = 1e-3 * gap_scale(hertz, exact.u)
+    bad = with_(exact, u=exact.u + push * row(hertz, i), status="converged")
+    judged = registry.judge(hertz, bad, 1e-6)
+    assert judged.status == "inaccurate"
+    cert = certificate(hertz, bad)
+    name, value = cert.worst()
+    assert name in judged.message and name in RESIDUALS
+
+
+def test_judge_keeps_an_honest_claim(hertz, exact):
+    judged = registry.judge(hertz, with_(exact, status="converged"), 1e-9)
+    assert judged.status == "converged"
+    assert "claimed_status" not in judged.extras
+
+
+def test_judge_leaves_other_statuses_alone(hertz, exact):
+    bad = with_(exact, lam=exact.lam * 2.0, status="max_iter", message="ran out")
+    judged = registry.judge(hertz, bad, 1e-8)
+    assert judged.status == "max_iter"
+    assert judged.message == "ran out"
+
+
+def test_judge_threshold_follows_tol(hertz, exact):
+    # a relative λ error of 1e-7 gives residuals near 1e-7: accepted at 1e-6 and by default
+    # (1e-6 without a tolerance), refused at 1e-8
+    nearly = with_(exact, lam=exact.lam * (1 + 1e-7), status="converged")
+    worst = certificate(hertz, nearly).worst()[1]
+    assert 1e-8 < worst < 1e-6
+    assert registry.judge(hertz, with_(nearly), 1e-6).status == "converged"
+    assert registry.judge(hertz, with_(nearly), None).status == "converged"
+    assert registry.judge(hertz, with_(nearly), 1e-8).status == "inaccurate"
+
+
+def test_judge_refuses_non_finite_claims(hertz):
+    claim = ContactSolution("x", np.full(hertz.n, np.nan), np.zeros(hertz.m), "converged")
+    judged = registry.judge(hertz, claim, 1e-3)
+    assert judged.status == "inaccurate"
