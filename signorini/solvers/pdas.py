@@ -13,6 +13,8 @@ not the last one) is a cycle, and the method then finishes on the condensed
 LCP with Murty's least-index pivoting, which terminates for SPD W. After the
 first step ``c`` no longer matters (closed gaps are zero on A, forces zero
 off A), so ``c`` only weighs a warm start ``lam0`` against the gaps.
+
+Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from ..problem import ContactProblem, ContactSolution
 from .options import positive_number, take_options
 from .registry import Method, register
 
-DEFAULTS = {"c": 1.0, "lam0": None}
+DEFAULTS = {"c": 1.0, "lam0": None, "callback": None}
 MAX_ITER = 100
 
 
@@ -87,6 +89,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         history["changes"].append(changes)
         history["primal"].append(float(max(violation.max(), 0.0)) / gap_scale(problem, u))
         history["active"].append(int(new_active.sum()))
+        if opts["callback"] is not None:
+            opts["callback"](iteration, u, lam)
         if active is not None and changes == 0:
             status = "converged"
             message = f"active set of {int(active.sum())} nodes repeated after {iteration - 1} steps"

@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import importlib.util
 import logging
+import os
+import sys
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
@@ -84,12 +87,26 @@ def methods(installed_only: bool = False) -> list[Method]:
 
 
 def _load_user_method(spec: str) -> Method:
-    """``module:function`` names a user-defined solver with the standard signature."""
+    """``module:function`` or ``path/to/file.py:function``: a user solver with the standard signature.
+
+    A module is looked up on ``sys.path`` and then in the current directory.
+    """
     module_name, _, attr = spec.partition(":")
     try:
-        module = importlib.import_module(module_name)
+        if module_name.endswith(".py"):
+            path = Path(module_name)
+            if not path.is_file():
+                raise ImportError(f"no file {module_name}")
+            loader_spec = importlib.util.spec_from_file_location(path.stem, path)
+            module = importlib.util.module_from_spec(loader_spec)
+            loader_spec.loader.exec_module(module)
+        else:
+            if os.getcwd() not in sys.path:
+                sys.path.append(os.getcwd())
+            module = importlib.import_module(module_name)
     except ImportError as exc:
-        raise InputError(f"method {spec!r}: cannot import module {module_name!r} ({exc})") from exc
+        raise InputError(f"method {spec!r}: cannot import module {module_name!r} ({exc}); "
+                         "give --method module:function or path/to/file.py:function") from exc
     func = getattr(module, attr, None)
     if not callable(func):
         raise InputError(f"method {spec!r}: module {module_name!r} has no function {attr!r}")

@@ -18,6 +18,11 @@ stops far from the answer when the dual is ill-conditioned).
 With ``operator="delassus"`` (the default when m ≤ 2000) the m × m matrix
 ``W`` is formed once by m back-solves and each iteration costs a dense
 matvec instead of a sparse back-solve; the iterates are the same.
+
+Option ``callback(iteration, λ, displacement)`` is called once per iteration
+with the current multipliers and a function ``λ ↦ u(λ)`` (one back-solve, so
+a callback that calls it pays for it): the tutorials record primal and dual
+objectives with it.
 """
 
 from __future__ import annotations
@@ -35,7 +40,7 @@ from .options import positive_number, take_options
 from .registry import Method, register
 
 DEFAULTS = {"rho": None, "step_fraction": 0.9, "lam0": None, "divergence_factor": 1e8,
-            "operator": "auto"}
+            "operator": "auto", "callback": None}
 DELASSUS_MAX_CANDIDATES = 2000
 RATE_WINDOW = 20
 DEFAULT_TOL = 1e-8
@@ -116,6 +121,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             kkt = max(primal, natural)
         history["primal"].append(primal)
         history["natural"].append(natural)
+        if opts["callback"] is not None:
+            opts["callback"](iteration, lam, displacement)
         if kkt <= tol and _distance_estimate(history["step"]) <= tol * lam_norm:
             status, message = "converged", f"KKT residual {kkt:.1e} ≤ {tol:.0e} ({choice} operator)"
             break
