@@ -13,6 +13,14 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --quiet --upgrade pip
 	$(VENV)/bin/python -m pip install --quiet -e '.[all]'
+	@# CHOLMOD (the fastest factorisation here) needs SuiteSparse's headers: install them with
+	@# apt when we are root on Debian; without them SciPy's SuperLU is used and nothing fails.
+	@if [ ! -e /usr/include/suitesparse/cholmod.h ] && command -v apt-get >/dev/null 2>&1 \
+	    && [ "$$(id -u)" = 0 ]; then \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	    libsuitesparse-dev >/dev/null) || echo "make: libsuitesparse-dev not installed"; fi
+	@$(VENV)/bin/python -m pip install --quiet -e '.[fast]' \
+	  || echo "make: CHOLMOD (scikit-sparse) not installed; SuperLU will be used"
 	touch $(STAMP)
 
 validate: $(STAMP)

@@ -1,17 +1,52 @@
-"""Sparse factorisation of the SPD stiffness: factorise once, solve many right-hand sides."""
+"""Sparse linear algebra: factorise once, solve many; and the active-set systems of PDAS.
+
+Backends for the SPD stiffness (one interface, ``factorize(K).solve(b)``):
+
+- ``superlu``: SciPy's SuperLU in symmetric mode; always there.
+- ``cholmod``: CHOLMOD's supernodal Cholesky through scikit-sparse (optional).
+- ``pardiso``: MKL PARDISO through pypardiso (optional).
+
+``auto`` (the default) takes the first installed of cholmod, pardiso, superlu;
+the environment variable ``SIGNORINI_FACTOR`` overrides it.
+"""
 
 from __future__ import annotations
+
+import importlib.util
+import os
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .errors import BackendNotInstalled, InputError
+
+BACKENDS = ("cholmod", "pardiso", "superlu")
+_MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
+
+
+def available_backends() -> list[str]:
+    """The factorisation backends installed here, fastest first."""
+    return [b for b in BACKENDS if importlib.util.find_spec(_MODULES[b]) is not None]
+
+
+def resolve_backend(backend: str | None = None) -> str:
+    """Pick the backend: an explicit name, ``SIGNORINI_FACTOR``, or the first installed."""
+    name = backend or os.environ.get("SIGNORINI_FACTOR") or "auto"
+    if name == "auto":
+        return available_backends()[0]
+    if name not in BACKENDS:
+        raise InputError(f"unknown factorisation backend {name!r}: choose auto, {', '.join(BACKENDS)}")
+    if name not in available_backends():
+        raise BackendNotInstalled(f"factorisation backend {name!r} needs the module "
+                                  f"{_MODULES[name]!r}: pip install 'signorini[fast]'")
+    return name
+
 
 class Factor:
-    """``K⁻¹`` applied by a sparse LU of ``K`` (SciPy's SuperLU, symmetric mode).
+    """``K⁻¹`` applied to a vector or an (n, k) block of right-hand sides."""
 
-    ``solve(b)`` takes a vector or an (n, k) array of right-hand sides.
-    """
+    backend = "superlu"
 
     def __init__(self, K: sp.spmatrix):
         K = sp.csc_matrix(K)
@@ -20,10 +55,133 @@ class Factor:
                              options={"SymmetricMode": True})
 
     def solve(self, b: np.ndarray) -> np.ndarray:
+        return self._lu.solve(np.asarray(b, dtype=float))
+
+
+class CholmodFactor(Factor):
+    """CHOLMOD's supernodal ``K = LLᵀ`` (scikit-sparse)."""
+
+    backend = "cholmod"
+
+    def __init__(self, K: sp.spmatrix):
+        from sksparse.cholmod import CholmodNotPositiveDefiniteError, cholesky
+
+        self.shape = K.shape
+        try:
+            self._factor = cholesky(sp.csc_matrix(K), mode="supernodal")
+        except CholmodNotPositiveDefiniteError as exc:
+            raise np.linalg.LinAlgError(f"K is not positive definite ({exc})") from exc
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return self._factor(np.asarray(b, dtype=float))
+
+
+class PardisoFactor(Factor):
+    """MKL PARDISO's symmetric positive definite solver (pypardiso)."""
+
+    backend = "pardiso"
+
+    def __init__(self, K: sp.spmatrix):
+        import pypardiso
+
+        self.shape = K.shape
+        self._upper = sp.triu(K, format="csr")
+        self._solver = pypardiso.PyPardisoSolver(mtype=2)
+        self._solver.factorize(self._upper)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)
-        return self._lu.solve(b)
+        return self._solver.solve(self._upper, b)
 
 
-def factorize(K: sp.spmatrix) -> Factor:
+_CLASSES = {"superlu": Factor, "cholmod": CholmodFactor, "pardiso": PardisoFactor}
+
+
+def factorize(K: sp.spmatrix, backend: str | None = None) -> Factor:
     """Factorise the SPD matrix ``K`` once for repeated solves."""
-    return Factor(K)
+    return _CLASSES[resolve_backend(backend)](K)
+
+
+def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
+    """The dof of each row when every row of N has one nonzero on its own dof, else None.
+
+    Then each constraint bounds one dof (a flat obstacle, or dofs rotated
+    into each node's normal frame) and an active set is a Dirichlet condition.
+    """
+    N = sp.csr_matrix(N, copy=True)
+    N.eliminate_zeros()
+    N.sort_indices()
+    if not np.all(np.diff(N.indptr) == 1):
+        return None
+    dofs = N.indices.copy()
+    return dofs if np.unique(dofs).size == dofs.size else None
+
+
+class ActiveSetSolver:
+    """Solutions of ``Ku + N_Aᵀλ_A = f, N_A u = d_A`` (``λ`` zero off A), active set after active set.
+
+    When each row of N bounds one dof, the active dofs are fixed and the rest
+    solved with an SPD factorisation. With CHOLMOD the symbolic analysis (the
+    fill-reducing ordering, most of the cost of a large factorisation) is done
+    once: a fixed dof's row and column are zeroed and its diagonal set to 1 in
+    place, so every active set has the same sparsity pattern and only the
+    numeric factorisation is repeated. Otherwise the saddle-point matrix, with
+    its constraint rows scaled by ``s = mean |diag K|`` (both blocks of one
+    size in any units; ``λ = s μ``), is factorised by LU.
+    """
+
+    def __init__(self, K: sp.csr_matrix, N: sp.csr_matrix, backend: str | None = None):
+        self.K, self.N = sp.csc_matrix(K), sp.csr_matrix(N, copy=True)
+        self.K.sort_indices()
+        self.N.eliminate_zeros()
+        self.n, self.m = self.K.shape[0], self.N.shape[0]
+        self.backend = resolve_backend(backend)
+        self._dofs = selection_dofs(self.N)
+        self._coef = self.N.data if self._dofs is not None else None
+        self._symbolic = None
+        if self._dofs is not None and self.backend == "cholmod":
+            from sksparse.cholmod import analyze
+
+            self._symbolic = analyze(self.K, mode="supernodal")
+            self._rows = self.K.indices
+            self._cols = np.repeat(np.arange(self.n), np.diff(self.K.indptr))
+
+    def _pinned_factor(self, fixed: np.ndarray):
+        """A factor of K with the ``fixed`` dofs' rows and columns replaced by the identity."""
+        pinned = np.zeros(self.n, dtype=bool)
+        pinned[fixed] = True
+        touched = pinned[self._rows] | pinned[self._cols]
+        data = np.where(touched, (self._rows == self._cols).astype(float), self.K.data)
+        matrix = sp.csc_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape)
+        factor = self._symbolic.cholesky(matrix)
+        return factor
+
+    def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k)."""
+        active = np.asarray(active, dtype=bool)
+        f, d = np.asarray(f, float), np.asarray(d, float)
+        lam = np.zeros((self.m,) + f.shape[1:])
+        if self._dofs is not None:
+            fixed = self._dofs[active]
+            coef = self._coef[active] if f.ndim == 1 else self._coef[active][:, None]
+            u_fixed = d[active] / coef
+            if self._symbolic is not None:
+                rhs = f - self.K[:, fixed] @ u_fixed
+                rhs[fixed] = u_fixed
+                u = self._pinned_factor(fixed)(rhs)
+            else:
+                free = np.setdiff1d(np.arange(self.n), fixed)
+                u = np.zeros_like(f)
+                u[fixed] = u_fixed
+                u[free] = factorize(self.K[free][:, free], self.backend).solve(
+                    f[free] - self.K[free][:, fixed] @ u_fixed)
+            lam[active] = (f[fixed] - self.K[fixed] @ u) / coef
+            return u, lam
+        N_A = self.N[active]
+        if N_A.shape[0] == 0:
+            return factorize(self.K, self.backend).solve(f), lam
+        scale = float(np.mean(np.abs(self.K.diagonal()))) or 1.0
+        system = sp.bmat([[self.K, scale * N_A.T], [scale * N_A, None]], format="csc")
+        solution = spla.splu(system).solve(np.concatenate([f, scale * d[active]]))
+        lam[active] = scale * solution[self.n:]
+        return solution[:self.n], lam

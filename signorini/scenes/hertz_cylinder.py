@@ -39,6 +39,8 @@ PARAMS = (
           check=between(0.0, 2.0)),
     Param("candidates", 2.0, "contact candidates extend to this multiple of the half-width",
           check=at_least(1.2)),
+    Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
+          kind=int, check=lambda k: None if 0 <= k <= 6 else "in 0..6"),
 )
 
 
@@ -76,7 +78,10 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
         dist = distance_to_segment(points, np.zeros(2), zone_end)
         return np.minimum(h_contact + p["grading"] * dist, 0.25)
 
-    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap_to_circle((0.0, 1.0), 1.0))
+    snap = snap_to_circle((0.0, 1.0), 1.0)
+    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
+    for _ in range(p["refine"]):
+        mesh = snap(mesh.refined())
     arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
     origin = np.nonzero(np.hypot(*mesh.p) < 1e-12)[0]
     arc = np.union1d(arc, origin)

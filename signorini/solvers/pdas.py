@@ -2,7 +2,11 @@
 
 With the complementarity function ``λ = max(0, λ + c(Nu − d))``, each step
 guesses the active set ``A = {i : λᵢ + c (Nu − d)ᵢ > 0}`` and solves the
-equality-constrained saddle-point system on it::
+equality-constrained system on it (when every row of N bounds one dof, as
+for a flat obstacle, by fixing the active dofs and factorising the SPD
+``K_FF``; otherwise the saddle-point matrix by LU; see
+:class:`signorini.linalg.ActiveSetSolver`, which
+for CHOLMOD reuses one symbolic analysis for every step)::
 
     [ K    N_Aᵀ ] [ u   ]   [ f   ]
     [ N_A  0    ] [ λ_A ] = [ d_A ],   λ_I = 0.
@@ -23,38 +27,16 @@ import time
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..condensed import delassus, least_index_lcp
 from ..kkt import gap_scale
-from ..linalg import factorize
+from ..linalg import ActiveSetSolver, factorize
 from ..problem import ContactProblem, ContactSolution
 from .options import positive_number, take_options
 from .registry import Method, register
 
-DEFAULTS = {"c": 1.0, "lam0": None, "callback": None}
+DEFAULTS = {"c": 1.0, "lam0": None, "callback": None, "backend": None}
 MAX_ITER = 100
-
-
-def _saddle_point_solve(problem: ContactProblem, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Solve the saddle-point system on ``active``; returns ``(u, λ)``.
-
-    The constraint rows are scaled by ``s = mean |diag K|`` so that both
-    blocks are of one size whatever the units (``λ = s μ``); unscaled, K of
-    1e12 next to N of 1 leaves the gap rows satisfied only to 1e-4.
-    """
-    N_A = problem.N[active]
-    k = N_A.shape[0]
-    if k == 0:
-        return factorize(problem.K).solve(problem.f), np.zeros(problem.m)
-    s = float(np.mean(np.abs(problem.K.diagonal()))) or 1.0
-    system = sp.bmat([[problem.K, s * N_A.T], [s * N_A, None]], format="csc")
-    rhs = np.concatenate([problem.f, s * problem.d[active]])
-    solution = spla.splu(system).solve(rhs)
-    lam = np.zeros(problem.m)
-    lam[active] = s * solution[problem.n:]
-    return solution[:problem.n], lam
 
 
 def _finish_condensed(problem: ContactProblem, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
@@ -73,8 +55,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     c = positive_number("pdas", "c", opts["c"])
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
     start = time.perf_counter()
+    system = ActiveSetSolver(problem.K, problem.N, opts["backend"])
     if opts["lam0"] is None:
-        u, lam = _saddle_point_solve(problem, np.zeros(problem.m, dtype=bool))
+        u, lam = system.solve(np.zeros(problem.m, dtype=bool), problem.f, problem.d)
     else:
         lam = np.maximum(np.asarray(opts["lam0"], dtype=float), 0.0)
         u = problem.displacement_for(lam)
@@ -105,7 +88,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             break
         seen.add(new_active.tobytes())
         active = new_active
-        u, lam = _saddle_point_solve(problem, active)
+        u, lam = system.solve(active, problem.f, problem.d)
     return ContactSolution(method="pdas", u=u, lam=lam, status=status, message=message,
                            iterations=iteration, solve_time=time.perf_counter() - start,
                            history=history)
