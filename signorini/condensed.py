@@ -16,12 +16,19 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 
-def delassus(N: sp.csr_matrix, factor) -> tuple[np.ndarray, np.ndarray]:
-    """``W = N K⁻¹ Nᵀ`` by m back-solves; also returns ``K⁻¹ Nᵀ`` (n × m)."""
-    K_inv_NT = factor.solve(N.T.toarray())
-    K_inv_NT = K_inv_NT.reshape(N.shape[1], N.shape[0])
-    W = N @ K_inv_NT
-    return 0.5 * (W + W.T), K_inv_NT
+def delassus(N: sp.csr_matrix, factor, block: int = 128) -> np.ndarray:
+    """``W = N K⁻¹ Nᵀ`` by back-solves on blocks of ``block`` columns of ``Nᵀ``.
+
+    Only W (m × m) is kept, never the n × m matrix ``K⁻¹Nᵀ``, which for a
+    large or 3D model would dwarf the factorisation.
+    """
+    m = N.shape[0]
+    NT = sp.csc_matrix(N.T)
+    W = np.empty((m, m))
+    for first in range(0, m, block):
+        last = min(first + block, m)
+        W[:, first:last] = N @ factor.solve(NT[:, first:last].toarray())
+    return 0.5 * (W + W.T)
 
 
 def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,

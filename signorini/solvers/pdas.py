@@ -42,7 +42,7 @@ MAX_ITER = 100
 def _finish_condensed(problem: ContactProblem, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
     """Finish on the condensed LCP with a method that cannot cycle (Murty's least index)."""
     factor = factorize(problem.K)
-    W, _ = delassus(problem.N, factor)
+    W = delassus(problem.N, factor)
     b = problem.N @ factor.solve(problem.f) - problem.d
     lam, steps = least_index_lcp(W, b)
     return factor.solve(problem.f - problem.N.T @ lam), lam, steps

@@ -121,7 +121,7 @@ def _load_builtin() -> None:
     global _BUILTIN_LOADED
     if _BUILTIN_LOADED:
         return
-    from . import cvxpy_, pdas, qp, uzawa  # noqa: F401  (each module registers itself)
+    from . import condensed_dual, cvxpy_, pdas, qp, uzawa  # noqa: F401  (each registers itself)
     _BUILTIN_LOADED = True
 
 

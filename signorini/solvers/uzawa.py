@@ -85,7 +85,7 @@ def _operator(problem: ContactProblem, factor, choice: str):
         def normal_displacement(lam):
             return problem.N @ factor.solve(problem.f - problem.N.T @ lam)
         return choice, normal_displacement, None
-    W, _ = delassus(problem.N, factor)
+    W = delassus(problem.N, factor)
     free = problem.N @ factor.solve(problem.f)
     return choice, (lambda lam: free - W @ lam), (lambda x: W @ x)
 
