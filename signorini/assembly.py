@@ -1,14 +1,29 @@
 """Scene → :class:`ContactProblem`: stiffness, load, gap rows, weights and scales.
 
-The elastic form is scikit-fem's ``linear_elasticity`` with plane-strain Lamé
-parameters. Prescribed dofs are condensed out (``K_II u_I = f_I − K_ID u_D``),
-one gap row per contact candidate node is ``nᵢ · uᵢ ≤ gᵢ`` with ``nᵢ`` the
-body's outward normal towards the obstacle. With ``nondimensionalise`` the
-mesh is divided by the scene's length L and E by itself, so every solver sees
-numbers of order one whatever the user's units: coordinates are divided by
-the scene's length L, displacements and gaps by a displacement scale U (the
-largest prescribed displacement, else the largest initial gap), E by itself;
-contact forces then come in units of E·U (per unit thickness).
+Three kinds of model are assembled with P1 elements of scikit-fem:
+
+- **plane strain** (triangles): scikit-fem's ``linear_elasticity`` with the
+  Lamé parameters; quantities are per unit thickness;
+- **axisymmetric** (triangles in the meridian half-plane (r, z), r ≥ 0):
+  the strain has the hoop component ``ε_θθ = u_r / r`` and every integral
+  carries the weight r (:func:`axisymmetric_elasticity`); quantities are
+  **per radian**: K, f and the contact forces λ are those of a one-radian
+  wedge, the weights are ``wᵢ = ∫ φᵢ r ds`` and the pressure ``λᵢ / wᵢ`` is
+  a true pressure. The scene sets ``force_multiplicity = 2π`` (times the
+  copies from other symmetries), so ``total_contact_force`` and
+  ``applied_load`` are those of the full body of revolution;
+- **3D** (tetrahedra): ``linear_elasticity`` with three-component normals;
+  weights ``wᵢ = ∫ φᵢ dA``.
+
+Prescribed dofs are condensed out (``K_II u_I = f_I − K_ID u_D``), one gap
+row per contact candidate node is ``nᵢ · uᵢ ≤ gᵢ`` with ``nᵢ`` the body's
+outward normal towards the obstacle. With ``nondimensionalise`` every solver
+sees numbers of order one whatever the user's units: coordinates are divided
+by the scene's length L, displacements and gaps by a displacement scale U
+(the largest prescribed displacement, else the largest initial gap), E by
+itself. Contact forces then come in units of E·U per unit thickness in plane
+strain, and of E·U·L (per radian, or for the 3D model) otherwise; weights in
+units of L and L² respectively (see :class:`~signorini.problem.Scales`).
 """
 
 from __future__ import annotations
@@ -20,13 +35,15 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import brentq
-from skfem import Basis, ElementTriP1, ElementVector, asm
+from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, asm
+from skfem.helpers import ddot, sym_grad, trace
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from .condensed import delassus, solve_lcp
+from .condensed import solve_lcp
 from .errors import InputError
 from .linalg import factorize
-from .problem import ContactProblem, Scales
+from .loading import calibrate_push
+from .problem import ContactProblem, Push, Scales
 from .scenes.base import SceneModel
 
 log = logging.getLogger(__name__)
@@ -40,6 +57,65 @@ def boundary_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray) -> np.nda
     np.add.at(per_node, ends[0], 0.5 * lengths)
     np.add.at(per_node, ends[1], 0.5 * lengths)
     return per_node[nodes]
+
+
+def axisymmetric_elasticity(Lambda: float = 1.0, Mu: float = 1.0) -> BilinearForm:
+    """Weak form of axisymmetric linear elasticity, per radian.
+
+    In the meridian half-plane (r, z) with ``u = (u_r, u_z)`` the strain has
+    the in-plane part ``ε = sym ∇u`` and the hoop part ``ε_θθ = u_r / r``;
+    with ``tr ε = ∂_r u_r + ∂_z u_z + u_r / r`` the form is
+
+        a(u, v) = ∫ [2μ (ε(u) : ε(v) + u_r v_r / r²) + λ tr ε(u) tr ε(v)] r dr dz,
+
+    the elastic energy of a one-radian wedge (multiply by 2π for the full
+    body). Quadrature points lie inside the elements, so r > 0 wherever the
+    integrand is evaluated; nodes on the axis need ``u_r = 0``.
+    """
+
+    @BilinearForm
+    def weakform(u, v, w):
+        r = w.x[0]
+        hoop_u, hoop_v = u[0] / r, v[0] / r
+        trace_u = trace(sym_grad(u)) + hoop_u
+        trace_v = trace(sym_grad(v)) + hoop_v
+        return (2.0 * Mu * (ddot(sym_grad(u), sym_grad(v)) + hoop_u * hoop_v)
+                + Lambda * trace_u * trace_v) * r
+
+    return weakform
+
+
+def contact_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray,
+                    axisymmetric: bool = False) -> np.ndarray:
+    """Lumped weights ``wᵢ = ∫_Γ φᵢ ds`` (``∫_Γ φᵢ r ds`` when axisymmetric) of ``nodes``.
+
+    Integrated over the boundary ``facets`` with scikit-fem (exact for P1:
+    the integrand is at most quadratic); in 3D ``ds`` is the area element.
+    """
+    basis = FacetBasis(mesh, mesh.elem(), facets=facets, intorder=2)
+
+    @LinearForm
+    def weight(v, w):
+        return v * w.x[0] if axisymmetric else v
+
+    return asm(weight, basis)[nodes]
+
+
+def stiffness_form(model: SceneModel, E: float) -> BilinearForm:
+    """The elastic bilinear form of ``model``: plane strain or 3D, or axisymmetric."""
+    Lambda, Mu = lame_parameters(E, model.nu)
+    if model.axisymmetric:
+        if model.mesh.p.shape[0] != 2:
+            raise InputError("an axisymmetric scene needs a 2D mesh in (r, z)")
+        if np.min(model.mesh.p[0]) < -1e-12 * model.length_scale:
+            raise InputError("an axisymmetric mesh must lie in r >= 0")
+        return axisymmetric_elasticity(Lambda, Mu)
+    return linear_elasticity(Lambda, Mu)
+
+
+def force_exponent(model: SceneModel) -> int:
+    """k in ``force = E·U·L^k``, ``weight = L^(k+1)``: 0 in plane strain, 1 axisymmetric or 3D."""
+    return 1 if (model.axisymmetric or model.mesh.p.shape[0] == 3) else 0
 
 
 def displacement_scale(model: SceneModel) -> float:
@@ -57,9 +133,13 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     L = model.length_scale if nondimensionalise else 1.0
     stress = model.E if nondimensionalise else 1.0
     U = displacement_scale(model) if nondimensionalise else 1.0
+    axisymmetric = bool(model.axisymmetric)
+    k = force_exponent(model)
+    force_unit = stress * U * L ** k
     mesh = type(model.mesh)(model.mesh.p / L, model.mesh.t)
-    basis = Basis(mesh, ElementVector(ElementTriP1()))
-    K_full = asm(linear_elasticity(*lame_parameters(model.E / stress, model.nu)), basis).tocsr()
+    dim = mesh.p.shape[0]
+    basis = Basis(mesh, ElementVector(mesh.elem()))
+    K_full = asm(stiffness_form(model, model.E / stress), basis).tocsr()
     n_full = K_full.shape[0]
 
     prescribed = np.zeros(n_full)
@@ -75,7 +155,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     normals, gaps = model.obstacle.normals_and_gaps(mesh.p[:, nodes].T)
     gaps = gaps * (L / U)
     m = len(nodes)
-    rows = np.repeat(np.arange(m), 2)
+    rows = np.repeat(np.arange(m), dim)
     cols = basis.nodal_dofs[:, nodes].T.ravel()
     N_full = sp.csr_matrix((normals.ravel(), (rows, cols)), shape=(m, n_full))
 
@@ -96,20 +176,20 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
 
     scale = 1.0
     if model.target_load is not None:
-        scale = _calibrate(K_II, N_free, lifted, model.target_load / (stress * U),
+        scale = _calibrate(K_II, N_free, lifted, model.target_load / force_unit,
                            model.force_multiplicity)
     f, d, load_offset, full = lifted(scale)
     params = dict(model.params)
     if model.target_load is not None:
         delta_nominal = -min(v for c, _, v in model.dirichlet if c == model.load_dofs[0])
         params["delta"] = delta_nominal * scale
-    weights = boundary_weights(mesh, model.contact_facets, nodes)
+    weights = contact_weights(mesh, model.contact_facets, nodes, axisymmetric)
     problem = ContactProblem(
         K=K_II, f=f, N=N_free, d=d, weights=weights, contact_points=mesh.p[:, nodes].T,
         free_dofs=free, prescribed=full, load_row=load_full[free], load_offset=load_offset,
         force_multiplicity=model.force_multiplicity,
-        scales=Scales(length=L, displacement=U, force=stress * U, weight=L),
-        params=params, mesh=mesh)
+        scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
+        params=params, mesh=mesh, push=_push(lifted, scale))
     problem.basis = basis
     problem.assemble_time = time.perf_counter() - start
     log.info("assembled %d free dofs, %d contact candidates in %.2f s",
@@ -117,31 +197,34 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     return problem
 
 
+def _push(lifted, scale: float) -> Push:
+    """How f, d and the load offset depend on the push (they are affine in it)."""
+    f0, d0, offset0, _ = lifted(0.0)
+    f1, d_one, offset_one, _ = lifted(1.0)
+    return Push(f1=f1 - f0, d0=d0, d1=d_one - d0, offset1=offset_one - offset0, scale=scale)
+
+
 def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
                multiplicity: float) -> float:
     """The factor on the prescribed displacement whose contact force is ``target``.
 
-    The force is increasing in the factor; each trial is an exact condensed
-    solve (one factorisation and one Delassus operator for all trials).
+    The load is affine in the factor; :func:`signorini.loading.calibrate_push`
+    solves the augmented active-set system (one factorisation per step).
     """
-    if not np.isfinite(target) or target <= 0:
-        raise InputError(f"the target load must be positive, got {target:g}")
-    factor = factorize(K)
-    W, K_inv_NT = delassus(N, factor)
+    f0, d0 = lifted(0.0)[:2]
+    f1, d_one = lifted(1.0)[:2]
+    return calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity)
 
-    def force(scale: float) -> float:
-        f, d, _, _ = lifted(scale)
-        lam, _ = solve_lcp(W, N @ factor.solve(f) - d)
-        return multiplicity * float(lam.sum())
+def _delassus_blocked(N: sp.csr_matrix, factor, block: int = 128) -> np.ndarray:
+    """``W = N K⁻¹ Nᵀ`` by back-solves on blocks of ``block`` columns of ``Nᵀ``.
 
-    upper = 1.0
-    for _ in range(60):
-        if force(upper) >= target:
-            break
-        upper *= 2.0
-    else:
-        raise InputError("the target load cannot be reached by pushing the body onto the obstacle")
-    lower = upper / 2.0
-    while force(lower) > target and lower > 1e-12:
-        lower /= 2.0
-    return brentq(lambda s: force(s) - target, lower, upper, xtol=1e-14, rtol=1e-12)
+    Only ``W`` (m × m) is kept, never the n × m matrix ``K⁻¹Nᵀ``: for a 3D
+    model that matrix would dwarf the factorisation.
+    """
+    m = N.shape[0]
+    NT = N.T.tocsc()
+    W = np.empty((m, m))
+    for start in range(0, m, block):
+        stop = min(start + block, m)
+        W[:, start:stop] = N @ factor.solve(NT[:, start:stop].toarray())
+    return 0.5 * (W + W.T)

@@ -104,6 +104,33 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return 0 if suite.passed else EXIT_FAILED
 
 
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from .io import atomic_write_text, save_figure, to_json, writable_directory
+    from .scenes import build_problem
+    from .sweep import parse_loads, plot_sweep, sweep_loads
+
+    loads = parse_loads(args.load)
+    directory = writable_directory(args.out)
+    problem = build_problem(args.scene, **_pairs(args.set, "--set"))
+    levels = sweep_loads(problem, loads, progress=lambda i, n: print(
+        f"\r  load level {i}/{n}", end="" if i < n else "\n", file=sys.stderr))
+    rows = [vars(level) for level in levels]
+    header = list(rows[0])
+    csv = "\n".join([",".join(header)] + [",".join(f"{row[k]}" for k in header) for row in rows])
+    atomic_write_text(directory / "sweep.csv", csv + "\n")
+    atomic_write_text(directory / "sweep.json", to_json({"scene": args.scene, "params": problem.params,
+                                                         "levels": rows}))
+    ax = plot_sweep(levels)
+    ax.set_title(f"{args.scene}: {len(levels)} loads, one factorisation", fontsize=9)
+    save_figure(ax.figure, directory / "sweep.png")
+    print(f"{'load':>12} {'a':>12} {'a Hertz':>12} {'p0':>12} {'p0 Hertz':>12}")
+    for lv in levels:
+        print(f"{lv.total_force:12.6g} {lv.a:12.6g} {lv.a_ref or float('nan'):12.6g} "
+              f"{lv.p0:12.6g} {lv.p0_ref or float('nan'):12.6g}")
+    print(f"written: {directory / 'sweep.csv'}, sweep.json, sweep.png")
+    return 0
+
+
 def cmd_scenes(args: argparse.Namespace) -> int:
     from .scenes import SCENES
 
@@ -116,8 +143,11 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 
 
 def cmd_methods(args: argparse.Namespace) -> int:
+    from .linalg import available_backends, resolve_backend
     from .solvers.registry import methods
 
+    print(f"factorisation backend: {resolve_backend()} (installed: {', '.join(available_backends())}; "
+          "set SIGNORINI_FACTOR to choose)")
     for m in methods():
         state = "installed" if m.installed else f"not installed (pip install 'signorini[{m.extra}]')"
         kind = ", ".join(x for x in ("exact" if m.exact else "", "dense" if m.dense else "") if x)
@@ -149,6 +179,15 @@ def build_parser() -> argparse.ArgumentParser:
                           help="only this method (repeatable; default: every installed one)")
     validate.set_defaults(run=cmd_validate)
 
+    sweep = sub.add_parser("sweep", help="solve many load levels with one factorisation")
+    sweep.add_argument("scene", help="scene name (see 'signorini scenes')")
+    sweep.add_argument("--load", required=True, metavar="P1:P2:n",
+                       help="n loads from P1 to P2 (per unit thickness of the full body)")
+    sweep.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="scene parameter, e.g. --set n_contact=80")
+    sweep.add_argument("--out", default="sweep-report", help="output directory")
+    sweep.set_defaults(run=cmd_sweep)
+
     sub.add_parser("scenes", help="list the scenes and their parameters").set_defaults(run=cmd_scenes)
     sub.add_parser("methods", help="list the methods and whether they are installed").set_defaults(
         run=cmd_methods)
@@ -170,6 +209,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("signorini: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. piped into `head`
+        return 0
 
 
 if __name__ == "__main__":

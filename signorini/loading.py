@@ -15,8 +15,10 @@ one factorisation (two right-hand sides) per step, exact when A repeats.
 from __future__ import annotations
 
 import logging
+from typing import Callable
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
 from .errors import InputError
@@ -25,35 +27,64 @@ from .linalg import ActiveSetSolver
 log = logging.getLogger(__name__)
 
 
-def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.ndarray,
-                   d1: np.ndarray, target: float, multiplicity: float = 1.0,
-                   max_iter: int = 100) -> float:
-    """The factor ``s`` on the prescribed displacement whose contact force is ``target``.
+PairSolve = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
-    Raises InputError when the target is not positive or no push reaches it.
+
+def push_for_load(solve_pair: PairSolve, d0: np.ndarray, target: float, multiplicity: float = 1.0,
+                  max_iter: int = 100) -> tuple[float, np.ndarray]:
+    """The push ``s`` whose contact force ``μ Σλ`` is ``target``, and the contact forces then.
+
+    ``solve_pair(A)`` returns, for the active set A, two columns of contact
+    forces and two of constraint values ``Nu − d`` such that at push s they
+    are ``s·[:, 0] + [:, 1]``. Raises InputError when no push reaches the target.
     """
     if not (np.isfinite(target) and target > 0):
         raise InputError(f"the target load must be a positive number, got {target!r}")
     active = d0 <= np.min(d0)  # start from the first point(s) of contact
     seen: set[bytes] = set()
-    system = ActiveSetSolver(K, N)
     for step in range(1, max_iter + 1):
-        u, lam = system.solve(active, np.column_stack([f1, np.zeros_like(f1)]),
-                              np.column_stack([d1, d0]))
+        lam, violation = solve_pair(active)
         per_push, fixed = multiplicity * lam.sum(axis=0)
         if not per_push > 0:
             raise InputError("pushing the body does not press it onto the obstacle: "
                              "check the scene's prescribed displacement and obstacle")
         s = (target - fixed) / per_push
-        u_s, lam_s = s * u[:, 0] + u[:, 1], s * lam[:, 0] + lam[:, 1]
-        violation = N @ u_s - (d0 + s * d1)
-        new_active = lam_s + violation > 0
+        lam_s = s * lam[:, 0] + lam[:, 1]
+        new_active = lam_s + (s * violation[:, 0] + violation[:, 1]) > 0
         if np.array_equal(new_active, active):
-            log.info("push calibrated in %d active-set steps (s = %.6g)", step, s)
-            return float(s)
+            log.info("push found in %d active-set steps (s = %.6g)", step, s)
+            return float(s), lam_s
         if new_active.tobytes() in seen or not new_active.any():
             break
         seen.add(active.tobytes())
         active = new_active
     raise InputError("the target load could not be matched by adjusting the prescribed "
                      "displacement (active set did not settle): try delta= instead of P=")
+
+
+def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.ndarray,
+                   d1: np.ndarray, target: float, multiplicity: float = 1.0) -> float:
+    """The push on the full sparse system (one factorisation per active set)."""
+    system = ActiveSetSolver(K, N)
+    f_pair = np.column_stack([f1, np.zeros_like(f1)])
+    d_pair = np.column_stack([d1, d0])
+
+    def solve_pair(active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        u, lam = system.solve(active, f_pair, d_pair)
+        return lam, N @ u - d_pair
+
+    return push_for_load(solve_pair, d0, target, multiplicity)[0]
+
+
+def push_for_load_condensed(W: np.ndarray, b1: np.ndarray, b0: np.ndarray, d0: np.ndarray,
+                            target: float, multiplicity: float = 1.0) -> tuple[float, np.ndarray]:
+    """The push on the condensed problem, ``b(s) = s b₁ + b₀``: dense work only, no back-solve."""
+    b_pair = np.column_stack([b1, b0])
+
+    def solve_pair(active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        lam = np.zeros((len(b1), 2))
+        if active.any():
+            lam[active] = sla.solve(W[np.ix_(active, active)], b_pair[active], assume_a="pos")
+        return lam, b_pair - W @ lam
+
+    return push_for_load(solve_pair, d0, target, multiplicity)

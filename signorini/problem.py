@@ -52,6 +52,22 @@ class Scales:
         return self.force / self.weight
 
 
+@dataclass(frozen=True)
+class Push:
+    """How the load depends on the prescribed push ``s`` (dimensionless).
+
+    ``f(s) = s f1``, ``d(s) = d0 + s d1`` and the applied-load offset is
+    ``s · offset1``; ``scale`` is the push the problem was assembled with.
+    Load sweeps and load targeting use it without assembling again.
+    """
+
+    f1: np.ndarray
+    d0: np.ndarray
+    d1: np.ndarray
+    offset1: float
+    scale: float
+
+
 @dataclass
 class ContactProblem:
     """Data of ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` (dimensionless).
@@ -74,6 +90,7 @@ class ContactProblem:
     scales : the units of every array above.
     scene, params : where the problem came from.
     mesh : the scene's mesh (for plots and export), in dimensionless coordinates.
+    push : how f, d and the load offset depend on the prescribed push (or None).
     """
 
     K: sp.csr_matrix
@@ -92,6 +109,7 @@ class ContactProblem:
     params: dict[str, Any] = field(default_factory=dict)
     mesh: Any = None
     assemble_time: float = 0.0
+    push: Push | None = None
 
     def __post_init__(self) -> None:
         self.K = sp.csr_matrix(self.K)
@@ -176,6 +194,24 @@ class ContactProblem:
         if self.load_row is None:
             return float("nan")
         return float(self.load_row @ u + self.load_offset)
+
+    def pushed(self, scale: float) -> "ContactProblem":
+        """The same body pushed by ``scale`` times the prescribed displacement."""
+        if self.push is None:
+            raise ValueError("this problem does not record how its load depends on the push")
+        pu = self.push
+        ratio = scale / pu.scale
+        params = dict(self.params)
+        if isinstance(params.get("delta"), float):
+            params["delta"] *= ratio
+        new = self.with_data(f=scale * pu.f1, d=pu.d0 + scale * pu.d1,
+                             load_offset=scale * pu.offset1, prescribed=self.prescribed * ratio,
+                             params=params, push=Push(pu.f1, pu.d0, pu.d1, pu.offset1, scale))
+        new._factor = self._factor  # K is unchanged: keep its factorisation
+        for name in ("basis",):
+            if hasattr(self, name):
+                setattr(new, name, getattr(self, name))
+        return new
 
     def with_data(self, **changes: Any) -> "ContactProblem":
         """A copy with some fields replaced (the cached factorisation is dropped)."""

@@ -92,6 +92,18 @@ class FlatObstacle:
 
 
 @dataclass
+class FlatObstacle3D:
+    """A rigid flat ``z = height`` under a 3D body, approached from above (normal (0, 0, −1))."""
+
+    height: float = 0.0
+
+    def normals_and_gaps(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Unit outward normal of the body towards the obstacle and the initial gap per point."""
+        normals = np.tile([0.0, 0.0, -1.0], (len(points), 1))
+        return normals, points[:, 2] - self.height
+
+
+@dataclass
 class SceneModel:
     """A scene in physical units, ready for assembly.
 
@@ -115,6 +127,8 @@ class SceneModel:
     force_multiplicity: float = 1.0
     target_load: float | None = None
     params: dict[str, Any] = field(default_factory=dict)
+    #: the mesh is the meridian half-plane (r, z) of a body of revolution; forces per radian
+    axisymmetric: bool = False
 
 
 @dataclass(frozen=True)
