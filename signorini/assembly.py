@@ -34,14 +34,11 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import brentq
 from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, asm
 from skfem.helpers import ddot, sym_grad, trace
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from .condensed import solve_lcp
 from .errors import InputError
-from .linalg import factorize
 from .loading import calibrate_push
 from .problem import ContactProblem, Push, Scales
 from .scenes.base import SceneModel
@@ -214,17 +211,3 @@ def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
     f0, d0 = lifted(0.0)[:2]
     f1, d_one = lifted(1.0)[:2]
     return calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity)
-
-def _delassus_blocked(N: sp.csr_matrix, factor, block: int = 128) -> np.ndarray:
-    """``W = N K⁻¹ Nᵀ`` by back-solves on blocks of ``block`` columns of ``Nᵀ``.
-
-    Only ``W`` (m × m) is kept, never the n × m matrix ``K⁻¹Nᵀ``: for a 3D
-    model that matrix would dwarf the factorisation.
-    """
-    m = N.shape[0]
-    NT = N.T.tocsc()
-    W = np.empty((m, m))
-    for start in range(0, m, block):
-        stop = min(start + block, m)
-        W[:, start:stop] = N @ factor.solve(NT[:, start:stop].toarray())
-    return 0.5 * (W + W.T)

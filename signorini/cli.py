@@ -90,12 +90,14 @@ def cmd_solve(args: argparse.Namespace) -> int:
 def cmd_validate(args: argparse.Namespace) -> int:
     from .io import writable_directory
     from .report import checks_summary, write_suite_report
-    from .suite import run_suite
+    from .suite import run_suite, select_cases
 
     writable_directory(args.out)
     methods = args.method or None
-    suite = run_suite(method_names=methods, progress=lambda line: print(line, file=sys.stderr))
+    suite = run_suite(select_cases(args.case), method_names=methods,
+                      progress=lambda line: print(line, file=sys.stderr))
     command = "signorini validate" + "".join(f" --method {m}" for m in args.method)
+    command += "".join(f" --case {c}" for c in args.case)
     if args.out != "validation-report":
         command += f" --out {shlex.quote(args.out)}"
     paths = write_suite_report(suite, args.out, command)
@@ -128,6 +130,47 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         print(f"{lv.total_force:12.6g} {lv.a:12.6g} {lv.a_ref or float('nan'):12.6g} "
               f"{lv.p0:12.6g} {lv.p0_ref or float('nan'):12.6g}")
     print(f"written: {directory / 'sweep.csv'}, sweep.json, sweep.png")
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .bench import TOLERANCES, Run, run_benchmark, write_report
+    from .io import writable_directory
+    from .scenes import get_scene
+    from .solvers.registry import get_method, methods
+
+    out = writable_directory(args.out)
+    family = get_scene(args.scene)
+    try:
+        levels = [int(x) for x in args.sizes.split(",")]
+    except ValueError:
+        raise InputError(f"--sizes {args.sizes!r} is not a comma-separated list of refinement "
+                         "levels, e.g. --sizes 0,1,2") from None
+    tolerances = args.tolerance.split(",")
+    unknown = [t for t in tolerances if t not in TOLERANCES]
+    if unknown:
+        raise InputError(f"--tolerance {unknown[0]!r} is not one of {', '.join(TOLERANCES)}")
+    chosen = [get_method(m) for m in args.method] if args.method else \
+        [m for m in methods(installed_only=True) if not m.dense and m.family != "user"]
+    base = _pairs(args.set, "--set")
+    runs = []
+    for level in levels:
+        params = {**base, "refine": level}
+        family.parse(params)  # bad scene parameters fail here, before any run
+        for method in chosen:
+            for tolerance in (["high"] if method.exact else tolerances):
+                runs.append(Run(args.scene, f"refine{level}", params, method.name, tolerance))
+
+    def progress(i, n, run, row):
+        print(f"[{i}/{n}] {run.size} {run.method}@{run.tolerance}: {row['status']} "
+              f"{row.get('time_s', float('nan')):.3g} s", file=sys.stderr)
+
+    if not args.report_only:
+        run_benchmark(runs, Path(out), time_limit=args.time_limit, progress=progress)
+    command = "signorini bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 2 else "signorini bench"
+    print(f"report: {write_report(Path(out) / 'bench.csv', command)}")
     return 0
 
 
@@ -176,7 +219,10 @@ def build_parser() -> argparse.ArgumentParser:
     validate = sub.add_parser("validate", help="run the validation suite on the default scenes")
     validate.add_argument("--out", default="validation-report", help="report directory")
     validate.add_argument("--method", action="append", default=[],
-                          help="only this method (repeatable; default: every installed one)")
+                          help="only this method (repeatable; default: every installed one); "
+                               "a method named here must converge on every case")
+    validate.add_argument("--case", action="append", default=[],
+                          help="only this case (repeatable; default: all)")
     validate.set_defaults(run=cmd_validate)
 
     sweep = sub.add_parser("sweep", help="solve many load levels with one factorisation")
@@ -187,6 +233,19 @@ def build_parser() -> argparse.ArgumentParser:
                        help="scene parameter, e.g. --set n_contact=80")
     sweep.add_argument("--out", default="sweep-report", help="output directory")
     sweep.set_defaults(run=cmd_sweep)
+
+    bench = sub.add_parser("bench", help="benchmark methods × sizes × tolerances (resumable CSV)")
+    bench.add_argument("--scene", default="hertz-cylinder")
+    bench.add_argument("--sizes", default="0,1", help="refinement levels, e.g. 0,1,2")
+    bench.add_argument("--method", action="append", default=[],
+                       help="only this method (repeatable; default: every installed sparse one)")
+    bench.add_argument("--tolerance", default="low,mid,high,default",
+                       help="tolerance levels: low (1e-3), mid (1e-6), high (1e-9), default")
+    bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    bench.add_argument("--time-limit", type=float, default=600.0, help="seconds per run")
+    bench.add_argument("--out", default="bench-report")
+    bench.add_argument("--report-only", action="store_true", help="rewrite the report from the CSV")
+    bench.set_defaults(run=cmd_bench)
 
     sub.add_parser("scenes", help="list the scenes and their parameters").set_defaults(run=cmd_scenes)
     sub.add_parser("methods", help="list the methods and whether they are installed").set_defaults(

@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .analytic import (contact_modulus, hertz_cylinder_half_width, hertz_cylinder_peak,
-                       hertz_pressure)
+                       hertz_pressure, hertz_sphere_peak, hertz_sphere_radius)
 from .kkt import ACTIVE, classify
 from .problem import ContactProblem, ContactSolution
 
@@ -21,7 +21,8 @@ from .problem import ContactProblem, ContactSolution
 class ContactProfile:
     """The contact state at the candidates, in physical units, sorted along the surface.
 
-    ``x`` is the horizontal distance from the first point of contact, ``gap``
+    ``x`` is the horizontal distance from the first point of contact (the
+    radius from the axis in axisymmetric and 3D models), ``gap``
     the remaining gap ``d − Nu``, ``force`` the nodal force λ, ``pressure``
     ``λ / w``; ``total_force`` is the load of the full body (per unit thickness
     in 2D) and ``applied_load`` the same load measured as the reaction on the
@@ -48,7 +49,7 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
     force = solution.lam * s.force
     labels = classify(problem, solution)
     return ContactProfile(
-        x=problem.contact_points[:, 0] * s.length,
+        x=radial_distance(problem.contact_points) * s.length,
         gap=problem.gap(solution.u) * s.displacement,
         force=force,
         pressure=force / (problem.weights * s.weight),
@@ -157,3 +158,252 @@ def compare_uniform(problem: ContactProblem, solution: ContactSolution) -> Unifo
         pressure_ref=p_ref,
         pressure_max_rel=float(np.max(np.abs(profile.pressure / p_ref - 1.0))),
         force_balance=abs(P - profile.applied_load) / abs(P) if P else float("inf"))
+
+
+# --- Hertz's sphere: axisymmetric (r, z) and 3D models (Johnson 1985, §4.2) -------------------
+
+
+def radial_distance(points: np.ndarray) -> np.ndarray:
+    """Horizontal distance from the vertical axis through the first point of contact.
+
+    ``points`` is (k, 2) for an axisymmetric (r, z) model, where it is r, or
+    (k, 3) for a 3D model with z vertical, where it is ``√(x² + y²)``.
+    """
+    points = np.asarray(points, dtype=float)
+    return np.abs(points[:, 0]) if points.shape[1] == 2 else np.hypot(points[:, 0], points[:, 1])
+
+
+def _sub_profile(profile: ContactProfile, order: np.ndarray, x: np.ndarray) -> ContactProfile:
+    """The candidates ``order`` of ``profile`` as a profile of their own along ``x``."""
+    return ContactProfile(x=x, gap=profile.gap[order], force=profile.force[order],
+                          pressure=profile.pressure[order], active=profile.active[order],
+                          labels=profile.labels[order], total_force=profile.total_force,
+                          applied_load=profile.applied_load)
+
+
+def symmetry_plane_profiles(problem: ContactProblem,
+                            solution: ContactSolution) -> tuple[ContactProfile, ContactProfile]:
+    """Pressure along the two symmetry planes of a 3D quarter model.
+
+    Returns the candidates in the plane y = 0 sorted by x, then those in the
+    plane x = 0 sorted by y; each profile's ``x`` is the distance from the
+    first point of contact along its plane. For an axisymmetric body the two
+    are the same curve p(r).
+    """
+    if problem.contact_points.shape[1] != 3:
+        raise ValueError("symmetry-plane profiles need a 3D model (contact points with x, y, z)")
+    profile = contact_profile(problem, solution)
+    points = problem.contact_points * problem.scales.length
+    tol = 1e-9 * problem.scales.length
+    lines = []
+    for plane, along in ((1, 0), (0, 1)):
+        on = np.nonzero(np.abs(points[:, plane]) <= tol)[0]
+        order = on[np.argsort(points[on, along])]
+        lines.append(_sub_profile(profile, order, points[order, along]))
+    return lines[0], lines[1]
+
+
+def _l2_relative_disc(r: np.ndarray, numeric: np.ndarray, reference) -> float:
+    """‖p_h − p_ref‖ / ‖p_ref‖ over the disc ρ ≤ max r, p_h interpolated linearly in r.
+
+    The norm is that of the contact plane, ``∫ p² 2πρ dρ`` (the 2π cancels).
+    """
+    order = np.argsort(r)
+    grid = np.linspace(0.0, float(r.max()), 20_001)
+    diff = np.interp(grid, r[order], numeric[order]) - reference(grid)
+    ref = reference(grid)
+    return float(np.sqrt(np.trapezoid(diff ** 2 * grid, grid) / np.trapezoid(ref ** 2 * grid, grid)))
+
+
+def _l2_relative_surface(problem: ContactProblem, pressure: np.ndarray, reference,
+                         subdivisions: int = 4) -> float:
+    """‖p_h − p_ref‖ / ‖p_ref‖ over the contact candidates' surface triangles (3D).
+
+    ``p_h`` is the P1 interpolant of the nodal pressures on each boundary
+    triangle whose three nodes are candidates; both norms are integrated
+    over the triangles projected on the flat, each split into
+    ``subdivisions²`` parts with one point at each part's centroid.
+    """
+    from scipy.spatial import cKDTree
+
+    mesh = problem.mesh
+    nodes = cKDTree(mesh.p.T).query(problem.contact_points)[1]
+    position = np.full(mesh.p.shape[1], -1)
+    position[nodes] = np.arange(nodes.size)
+    facets = mesh.facets[:, mesh.boundary_facets()]
+    local = position[facets]
+    local = local[:, np.all(local >= 0, axis=0)]  # (3, triangles) candidate indices
+    xy = problem.contact_points[:, :2] * problem.scales.length
+    k = subdivisions
+    bary = [((i + 1 / 3) / k, (j + 1 / 3) / k) for i in range(k) for j in range(k - i)] + \
+           [((i + 2 / 3) / k, (j + 2 / 3) / k) for i in range(k - 1) for j in range(k - 1 - i)]
+    corners = xy[local]  # (3, triangles, 2)
+    e1, e2 = corners[1] - corners[0], corners[2] - corners[0]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    num = den = 0.0
+    for s, t in bary:
+        point = corners[0] + s * e1 + t * e2
+        p_h = (1 - s - t) * pressure[local[0]] + s * pressure[local[1]] + t * pressure[local[2]]
+        p_ref = reference(np.hypot(point[:, 0], point[:, 1]))
+        num += float(np.sum(area * (p_h - p_ref) ** 2))
+        den += float(np.sum(area * p_ref ** 2))
+    return float(np.sqrt(num / den)) if den > 0 else float("nan")
+
+
+def compare_hertz_sphere(problem: ContactProblem, solution: ContactSolution) -> HertzComparison:
+    """Compare ``solution`` of a Hertz sphere scene (axisymmetric or 3D) with Hertz's solution.
+
+    With the measured total force P (the whole sphere) the references are
+    ``a = (3PR/(4E*))^(1/3)`` and ``p₀ = 3P/(2πa²)``, ``p(ρ) = p₀√(1 − ρ²/a²)``
+    (Johnson 1985, §4.2). The numeric p₀ is the nodal pressure at the first
+    point of contact (ρ = 0). The numeric a is found as for the cylinder
+    (:func:`contact_half_width`) along r in the axisymmetric model, and as
+    the mean of the two values along the symmetry planes in the 3D one.
+    ``pressure_l2_rel`` is relative in the L2 norm of the contact plane
+    (area-weighted), ``edge_margin`` the outermost candidate's radius over a.
+    """
+    profile = contact_profile(problem, solution)
+    params = problem.params
+    P = profile.total_force
+    if not P > 0:
+        nan = float("nan")
+        return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
+    a_ref = hertz_sphere_radius(P, params["R"], contact_modulus(params["E"], params["nu"]))
+    p0_ref = hertz_sphere_peak(P, a_ref)
+    rho = radial_distance(problem.contact_points) * problem.scales.length
+
+    def reference(r: np.ndarray) -> np.ndarray:
+        return hertz_pressure(r, a_ref, p0_ref)
+
+    if problem.contact_points.shape[1] == 2:
+        order = np.argsort(rho)
+        a = contact_half_width(_sub_profile(profile, order, rho[order]))
+        l2 = _l2_relative_disc(rho, profile.pressure, reference)
+    else:
+        a = float(np.mean([contact_half_width(line)
+                           for line in symmetry_plane_profiles(problem, solution)]))
+        l2 = _l2_relative_surface(problem, profile.pressure, reference)
+    return HertzComparison(
+        a=a, a_ref=a_ref, p0=float(profile.pressure[np.argmin(rho)]), p0_ref=p0_ref,
+        pressure_l2_rel=l2,
+        force_balance=abs(P - profile.applied_load) / abs(P),
+        edge_margin=float(rho.max() / a_ref))
+
+
+# --- obstacles beyond a flat: load resultant, flat punch, block on a rigid cylinder ----------
+
+
+def load_resultant(problem: ContactProblem, lam: np.ndarray, component: int = -1) -> float:
+    """The load the obstacle carries along axis ``component``, full body, physical units.
+
+    The contact force on the body is ``−Nᵀλ``; summed over its dofs of one
+    component and multiplied by the model's multiplicity,
+    ``R = −μ Σᵢ (Nᵀλ)ᵢ,k``. With ``component`` the load axis (the last one,
+    y in 2D, by default) this is the load pushed onto an obstacle below the
+    body. For a flat (n = (0, −1)) it is ``μ Σλ``; on a curved obstacle each
+    λᵢ counts with the cosine of its normal's tilt, so ``μ Σλ`` (the total
+    *normal* force) exceeds the load.
+    """
+    dim = problem.contact_points.shape[1]
+    component = component % dim
+    full = np.zeros(problem.prescribed.size)
+    full[problem.free_dofs] = problem.N.T @ np.asarray(lam, dtype=float)
+    basis = getattr(problem, "basis", None)
+    dofs = basis.nodal_dofs[component] if basis is not None else \
+        np.arange(component, full.size, dim)
+    return float(-problem.force_multiplicity * full[dofs].sum() * problem.scales.force)
+
+
+def _half_line(profile: ContactProfile) -> ContactProfile:
+    """The candidates with x ≥ 0, sorted by x (all of a half model; the right half of a whole one)."""
+    right = np.nonzero(profile.x >= -1e-12 * max(1.0, float(np.max(np.abs(profile.x)))))[0]
+    order = right[np.argsort(profile.x[right], kind="stable")]
+    return _sub_profile(profile, order, np.abs(profile.x[order]))
+
+
+@dataclass(frozen=True)
+class PunchComparison:
+    """Numeric against analytic pressure under a rigid flat punch (Johnson 1985, ch. 2).
+
+    With ``P`` the measured vertical load (:func:`load_resultant`), the
+    reference is ``p(x) = P / (π√(a² − x²))``. ``pressure_max_rel`` and
+    ``pressure_l2_rel`` compare nodal pressures with it over ``|x| ≤ inner·a``
+    (away from the singular edges). ``edge_pressure`` is the nodal pressure
+    at the face's edge, ``edge_h`` the length of the element next to it:
+    under refinement the former grows like ``edge_h^(−1/2)``.
+    ``force_balance`` is ``|P − applied| / P`` and ``target_rel``
+    ``|P − P_target| / P_target`` (nan without a target).
+    """
+
+    a: float
+    load: float
+    applied_load: float
+    force_balance: float
+    target_rel: float
+    inner: float
+    pressure_max_rel: float
+    pressure_l2_rel: float
+    centre_rel: float
+    edge_pressure: float
+    edge_pressure_ref_mean: float
+    edge_h: float
+    active_fraction: float
+
+    def as_dict(self) -> dict[str, float]:
+        return asdict(self)
+
+
+def compare_punch(problem: ContactProblem, solution: ContactSolution,
+                  inner: float = 0.5) -> PunchComparison:
+    """Compare ``solution`` of the punch scene with ``p(x) = P/(π√(a² − x²))`` on ``|x| ≤ inner·a``."""
+    from .analytic import punch_load_between, punch_pressure
+
+    profile = _half_line(contact_profile(problem, solution))
+    a = float(problem.params["a"])
+    P = load_resultant(problem, solution.lam)
+    target = problem.params.get("P")
+    nan = float("nan")
+    if not P > 0:
+        return PunchComparison(a, P, profile.applied_load, nan, nan, inner, nan, nan, nan, nan, nan,
+                               nan, 0.0)
+    x, p = profile.x, profile.pressure
+    zone = x <= inner * a * (1 + 1e-12)
+    ref = punch_pressure(x[zone], a, P)
+    under = np.nonzero(x <= a * (1 + 1e-9))[0]
+    edge = under[-1]
+    edge_h = float(x[edge] - x[edge - 1]) if edge > 0 else nan
+    # the mean of the singular pressure over the edge node's half element, for scale
+    edge_mean = punch_load_between(a - 0.5 * edge_h, a, a, P) / (0.5 * edge_h) if edge_h > 0 else nan
+    return PunchComparison(
+        a=a, load=P, applied_load=profile.applied_load,
+        force_balance=abs(P - profile.applied_load) / P,
+        target_rel=abs(P / target - 1.0) if target else nan,
+        inner=inner,
+        pressure_max_rel=float(np.max(np.abs(p[zone] / ref - 1.0))),
+        pressure_l2_rel=_l2_relative(x[zone], p[zone], lambda s: punch_pressure(s, a, P)),
+        centre_rel=float(p[0] / punch_pressure(np.array([x[0]]), a, P)[0] - 1.0),
+        edge_pressure=float(p[edge]), edge_pressure_ref_mean=float(edge_mean), edge_h=edge_h,
+        active_fraction=float(np.mean(profile.active[under])))
+
+
+def compare_reverse_hertz(problem: ContactProblem, solution: ContactSolution) -> HertzComparison:
+    """Compare a block pressed onto a rigid cylinder with Hertz's 2D solution (Johnson 1985, §4.2).
+
+    As :func:`compare_hertz`, but the load is the vertical resultant
+    (:func:`load_resultant`) rather than ``μ Σλ``: on the cylinder the normals
+    tilt by up to a/R, and force balance holds for the resultant.
+    """
+    profile = _half_line(contact_profile(problem, solution))
+    R = problem.params["R"]
+    P = load_resultant(problem, solution.lam)
+    if not P > 0:
+        nan = float("nan")
+        return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
+    a_ref = hertz_cylinder_half_width(P, R, contact_modulus(problem.params["E"], problem.params["nu"]))
+    p0_ref = hertz_cylinder_peak(P, a_ref)
+    return HertzComparison(
+        a=contact_half_width(profile), a_ref=a_ref, p0=float(profile.pressure[0]), p0_ref=p0_ref,
+        pressure_l2_rel=_l2_relative(profile.x, profile.pressure,
+                                     lambda x: hertz_pressure(x, a_ref, p0_ref)),
+        force_balance=abs(P - profile.applied_load) / abs(P),
+        edge_margin=float(profile.x.max() / a_ref))

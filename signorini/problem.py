@@ -36,7 +36,11 @@ class Scales:
     ``u = displacement · û``, contact forces ``λ = force · λ̂``, weights
     ``w = weight · ŵ`` and pressures ``p = λ / w = pressure · p̂`` with
     ``pressure = force / weight``. In 2D (per unit thickness)
-    ``force = E · displacement`` and ``weight = length``. Scaling the
+    ``force = E · displacement`` and ``weight = length``; in 3D and in
+    axisymmetric models ``force = E · displacement · length`` and
+    ``weight = length²``. Axisymmetric forces and weights (``∫ φᵢ r ds``) are
+    **per radian**; ``force_multiplicity`` (2π times any other copies) turns
+    ``Σλ`` into the force on the whole body. Scaling the
     displacement apart from the geometry matters: a Hertz contact at
     a/R = 0.05 moves by about 1e-3 R, and a solver's absolute tolerances
     only mean something when the unknowns are of order one.

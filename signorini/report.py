@@ -13,9 +13,9 @@ import numpy as np
 from . import plots
 from .io import atomic_write_text, save_figure, to_json, writable_directory
 from .kkt import certificate
-from .pressure import compare_hertz, contact_profile
+from .pressure import compare_hertz, compare_hertz_sphere, contact_profile
 from .problem import ContactProblem, ContactSolution
-from .scenes import get_scene
+from .scenes import get_scene, scene_reference
 from .suite import LIMITS, SuiteResult
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
@@ -62,9 +62,18 @@ def solve_record(problem: ContactProblem, solution: ContactSolution) -> dict[str
         record["total_force"] = profile.total_force
         record["applied_load"] = profile.applied_load
         record["contact"] = profile.as_dict()
-        if get_scene(problem.scene).reference == "hertz-2d":
-            hertz = compare_hertz(problem, solution)
-            record["hertz"] = hertz.as_dict()
+        kind = scene_reference(problem.scene)
+        if kind in ("hertz-2d", "hertz-3d"):
+            compare = compare_hertz if kind == "hertz-2d" else compare_hertz_sphere
+            record["hertz"] = compare(problem, solution).as_dict()
+        if kind in ("punch", "reverse-hertz"):  # curved or cornered obstacles: the vertical load
+            from .pressure import compare_punch, compare_reverse_hertz, load_resultant
+
+            record["load_resultant"] = load_resultant(problem, solution.lam)
+            if kind == "punch":
+                record["punch"] = compare_punch(problem, solution).as_dict()
+            else:
+                record["hertz"] = compare_reverse_hertz(problem, solution).as_dict()
     else:
         record["total_force"] = None
         record["contact"] = None
@@ -91,6 +100,12 @@ def solve_summary(record: dict[str, Any]) -> str:
         lines.append(f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "
                      f"p0 = {h['p0']:.6g} (ref {h['p0_ref']:.6g}, {100 * h['p0_rel']:.2f} %), "
                      f"pressure L2 {100 * h['pressure_l2_rel']:.2f} %")
+    if record.get("punch"):
+        q = record["punch"]
+        lines.append(f"  punch: load {q['load']:.6g}; pressure vs P/(π√(a² − x²)) on |x| ≤ "
+                     f"{q['inner']:g}a: max {100 * q['pressure_max_rel']:.2f} %, "
+                     f"L2 {100 * q['pressure_l2_rel']:.2f} %; edge node p = {q['edge_pressure']:.4g} "
+                     f"(element {q['edge_h']:.3g} next to the edge)")
     return "\n".join(lines)
 
 
@@ -130,9 +145,10 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
     for result in suite.results:
         problem, ref = result.problem, result.reference
         name = result.case.name
-        if get_scene(problem.scene).reference == "hertz-2d" and np.all(np.isfinite(ref.lam)):
+        kind = scene_reference(problem.scene)
+        if kind in ("hertz-2d", "hertz-3d") and np.all(np.isfinite(ref.lam)):
             profile = contact_profile(problem, ref)
-            hertz = compare_hertz(problem, ref)
+            hertz = (compare_hertz if kind == "hertz-2d" else compare_hertz_sphere)(problem, ref)
             others = [(label, contact_profile(problem, s).pressure)
                       for label, s in result.solutions.items()
                       if label != "pdas@1e-09" and s.status != "failed" and np.all(np.isfinite(s.lam))]

@@ -18,9 +18,10 @@ import numpy as np
 
 from .errors import InputError
 from .kkt import certificate, compare
-from .pressure import compare_hertz, compare_uniform, contact_profile
+from .pressure import (compare_hertz, compare_hertz_sphere, compare_punch, compare_reverse_hertz,
+                       compare_uniform, contact_profile, radial_distance)
 from .problem import ContactProblem, ContactSolution
-from .scenes import build_problem, get_scene
+from .scenes import build_problem, get_scene, scene_reference
 from .solvers.registry import Method, get_method, methods, solve
 
 log = logging.getLogger(__name__)
@@ -41,6 +42,16 @@ LIMITS = {
     "uniform_pressure_rel": 1e-8,
     "lam_rel_vs_pdas": 1e-6,
     "units_invariance": 1e-8,
+    # the 3D sphere (P1 tetrahedra, quarter model): coarser by design, see docs/spheres.md
+    "hertz_3d_p0_rel": 0.03,
+    "hertz_3d_a_rel": 0.03,
+    "hertz_3d_pressure_l2_rel": 0.06,
+    # two models of one body (axisymmetric and 3D sphere): a and p0 agree
+    "models_agree_rel": 0.03,
+    # flat punch: nodal pressure against P/(π√(a² − x²)) on |x| ≤ a/2, away from the singular edges
+    "punch_pressure_rel": 0.01,
+    # the contact resultant equals the target load
+    "load_target_rel": 1e-8,
 }
 
 
@@ -53,6 +64,7 @@ class Case:
     params: dict[str, Any] = field(default_factory=dict)
     same_as: str | None = None  # a case whose dimensionless answer this one must reproduce
     check_reference: bool = True  # hold the answer to the analytic reference's limits
+    agrees_with: str | None = None  # a case modelling the same body otherwise: same a and p0
 
 
 DEFAULT_CASES = (
@@ -63,6 +75,10 @@ DEFAULT_CASES = (
          {"a_over_R": 0.05, "n_contact": 16, "grading": 0.4}, check_reference=False),
     Case("hertz-cylinder-SI", "hertz-cylinder", {"E": 2.1e11, "R": 0.01, "a_over_R": 0.05},
          same_as="hertz-cylinder"),
+    Case("hertz-sphere", "hertz-sphere", {"a_over_R": 0.05}),
+    Case("hertz-sphere-3d", "hertz-sphere-3d", {"a_over_R": 0.05}, agrees_with="hertz-sphere"),
+    Case("punch", "punch"),
+    Case("reverse-hertz", "reverse-hertz"),
 )
 
 
@@ -91,11 +107,17 @@ class CaseResult:
 
 def reference_metrics(problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:
     """Errors against the scene's analytic reference (Hertz or uniform pressure)."""
-    kind = get_scene(problem.scene).reference
+    kind = scene_reference(problem.scene)
     if not np.all(np.isfinite(solution.lam)):
         return {}
+    if kind == "punch":
+        return compare_punch(problem, solution).as_dict()
+    if kind == "reverse-hertz":
+        return compare_reverse_hertz(problem, solution).as_dict()
     if kind == "hertz-2d":
         return compare_hertz(problem, solution).as_dict()
+    if kind == "hertz-3d":
+        return compare_hertz_sphere(problem, solution).as_dict()
     if kind == "uniform":
         return compare_uniform(problem, solution).as_dict()
     return {}
@@ -150,8 +172,9 @@ def run_case(case: Case, method_names: list[str] | None = None,
     return CaseResult(case, problem, reference, solutions, runs)
 
 
-def case_checks(result: CaseResult, by_name: dict[str, CaseResult]) -> list[Check]:
-    """The suite's claims about one case."""
+def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
+                required: tuple[str, ...] = ()) -> list[Check]:
+    """The suite's claims about one case; ``required`` methods must converge at the tight tolerance."""
     case, problem, ref = result.case, result.problem, result.reference
     checks = [Check(case.name, "pdas converged", ref.status == "converged", None,
                     ref.status == "converged", ref.message)]
@@ -161,8 +184,8 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult]) -> list[Chec
                             bool(np.isfinite(value) and value <= LIMITS[key]), detail))
 
     metrics = reference_metrics(problem, ref) if case.check_reference else {}
-    kind = get_scene(case.scene).reference
-    if kind == "hertz-2d" and metrics:
+    kind = scene_reference(case.scene)
+    if kind in ("hertz-2d", "reverse-hertz") and metrics:
         limit("Hertz p0 relative error (pdas)", metrics["p0_rel"], "hertz_p0_rel")
         limit("Hertz a relative error (pdas)", metrics["a_rel"], "hertz_a_rel")
         limit("Hertz pressure L2 relative error (pdas)", metrics["pressure_l2_rel"],
@@ -172,6 +195,36 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult]) -> list[Chec
         checks.append(Check(case.name, "outermost candidate is not in contact",
                             not bool(profile.active[-1]), None, not bool(profile.active[-1]),
                             "contact reached the end of the candidates: raise 'candidates'"))
+    if kind == "hertz-3d" and metrics:
+        prefix = "hertz_3d_" if problem.contact_points.shape[1] == 3 else "hertz_"
+        limit("Hertz p0 relative error (pdas)", metrics["p0_rel"], prefix + "p0_rel")
+        limit("Hertz a relative error (pdas)", metrics["a_rel"], prefix + "a_rel")
+        limit("Hertz pressure L2 relative error (pdas)", metrics["pressure_l2_rel"],
+              prefix + "pressure_l2_rel")
+        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
+        profile = contact_profile(problem, ref)
+        rho = radial_distance(problem.contact_points)
+        outer = rho >= 0.95 * rho.max()
+        inside = not bool(np.any(profile.active[outer]))
+        checks.append(Check(case.name, "outermost candidates are not in contact", inside, None, inside,
+                            "contact reached the end of the candidates: raise 'candidates'"))
+    if case.agrees_with and case.agrees_with in by_name and metrics:
+        other = by_name[case.agrees_with]
+        theirs = reference_metrics(other.problem, other.reference)
+        for key in ("p0", "a"):
+            if theirs:
+                diff = abs(metrics[key] / theirs[key] - 1.0)
+                limit(f"{key} agrees with that of {case.agrees_with} (pdas)", diff, "models_agree_rel")
+    if kind == "punch" and metrics:
+        limit("punch pressure max relative error on |x| <= a/2 (pdas)", metrics["pressure_max_rel"],
+              "punch_pressure_rel")
+        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
+        if np.isfinite(metrics["target_rel"]) and problem.params.get("corner_radius", 0) == 0:
+            limit("total contact force equals the load P (pdas)", metrics["target_rel"],
+                  "load_target_rel")
+        touching = metrics["active_fraction"] == 1.0
+        checks.append(Check(case.name, "every node under the punch face is in contact", touching, None,
+                            touching, f"only {100 * metrics['active_fraction']:.1f} % are"))
     if kind == "uniform" and metrics:
         limit("uniform pressure max relative error (pdas)", metrics["pressure_max_rel"],
               "uniform_pressure_rel")
@@ -183,11 +236,13 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult]) -> list[Chec
             checks.append(Check(case.name, f"{row['label']} converged: same active set as pdas",
                                 vs["misclassified"] == 0, None, vs["misclassified"] == 0,
                                 f"{vs['misclassified']} nodes misclassified"))
-    uzawa = [r for r in result.runs if r["method"] == "uzawa" and r["tol"] == TIGHT_TOL]
-    for row in uzawa:
-        checks.append(Check(case.name, "uzawa (the paper's method) converged",
-                            row["status"] == "converged", None, row["status"] == "converged",
-                            row["message"]))
+    must_converge = {"uzawa": "uzawa (the paper's method) converged"}
+    must_converge.update({name: f"{name} (asked for by name) converged" for name in required})
+    for row in result.runs:
+        if row["method"] in must_converge and row["tol"] == TIGHT_TOL:
+            ok = row["status"] == "converged"
+            checks.append(Check(case.name, must_converge[row["method"]], ok, None, ok,
+                                row["message"]))
     if case.same_as and case.same_as in by_name:
         other = by_name[case.same_as].reference
         diff = float(np.max(np.abs(other.lam - ref.lam)) / np.max(np.abs(other.lam)))
@@ -210,9 +265,30 @@ class SuiteResult:
         return [row for result in self.results for row in result.runs]
 
 
+def select_cases(names: list[str] | None) -> tuple[Case, ...]:
+    """The default cases named in ``names`` (all when empty); unknown names list the known."""
+    if not names:
+        return DEFAULT_CASES
+    known = {case.name: case for case in DEFAULT_CASES}
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise InputError(f"unknown case {unknown[0]!r}: --case takes {', '.join(known)}")
+    chosen = [known[n] for n in names]
+    # a case compared with another needs that one too
+    for case in list(chosen):
+        for other in (getattr(case, "same_as", None), getattr(case, "agrees_with", None)):
+            if other and known[other] not in chosen:
+                chosen.insert(0, known[other])
+    return tuple(chosen)
+
+
 def run_suite(cases: tuple[Case, ...] = DEFAULT_CASES, method_names: list[str] | None = None,
               progress: Callable[[str], None] | None = None) -> SuiteResult:
-    """Run every case with every installed method (or ``method_names``) and check it."""
+    """Run every case with every installed method (or ``method_names``) and check it.
+
+    Methods named in ``method_names`` must converge at the tight tolerance on
+    every case: a user's method that only claims success fails the suite.
+    """
     start = time.perf_counter()
     results: list[CaseResult] = []
     by_name: dict[str, CaseResult] = {}
@@ -221,5 +297,5 @@ def run_suite(cases: tuple[Case, ...] = DEFAULT_CASES, method_names: list[str] |
         result = run_case(case, method_names, progress)
         results.append(result)
         by_name[case.name] = result
-        checks.extend(case_checks(result, by_name))
+        checks.extend(case_checks(result, by_name, tuple(method_names or ())))
     return SuiteResult(results, checks, time.perf_counter() - start)

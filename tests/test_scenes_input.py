@@ -11,7 +11,7 @@ SMALL = {"block": {"nx": 2, "ny": 2}, "hertz-cylinder": {"n_contact": 4}}
 
 
 def build(scene, **values):
-    return build_problem(scene, **{**SMALL[scene], **values})
+    return build_problem(scene, **{**SMALL.get(scene, {}), **values})
 
 
 def test_unknown_scene_lists_the_known_ones():

@@ -3,18 +3,20 @@
 The target element size is ``h(x) = h_contact + grading · dist(x, zone)``:
 uniform and fine where the pressure varies, growing linearly away from it.
 Elements longer than the target are split (conforming red-green-blue
-refinement) until none is; nodes created on a curved boundary are moved onto
-it after every pass.
+refinement of triangles, longest-edge bisection of tetrahedra) until none is;
+nodes created on a curved boundary are moved onto it after every pass.
 """
 
 from __future__ import annotations
 
 import logging
+from contextlib import contextmanager
+from itertools import combinations
 from typing import Callable
 
 import numpy as np
 from scipy.spatial import Delaunay
-from skfem import MeshTri
+from skfem import Mesh, MeshTet, MeshTri
 
 log = logging.getLogger(__name__)
 
@@ -95,3 +97,127 @@ def snap_to_circle(centre: tuple[float, float], radius: float) -> Callable[[Mesh
         return MeshTri(p, mesh.t)
 
     return snap
+
+
+# --- tetrahedra: the lower octant of a ball -------------------------------------------------
+
+
+def longest_simplex_edges(mesh: Mesh) -> np.ndarray:
+    """Longest edge of each simplex (triangle or tetrahedron) of ``mesh``."""
+    p, t = mesh.p, mesh.t
+    pairs = combinations(range(t.shape[0]), 2)
+    return np.max([np.linalg.norm(p[:, t[i]] - p[:, t[j]], axis=0) for i, j in pairs], axis=0)
+
+
+def signed_volumes(mesh: MeshTet) -> np.ndarray:
+    """Signed volume ``det[p₁ − p₀, p₂ − p₀, p₃ − p₀] / 6`` of each tetrahedron."""
+    p, t = mesh.p, mesh.t
+    e1, e2, e3 = (p[:, t[i]] - p[:, t[0]] for i in (1, 2, 3))
+    return np.einsum("ij,ij->j", e1, np.cross(e2, e3, axis=0)) / 6.0
+
+
+def refine_simplices_to_size(mesh: Mesh, target: Callable[[np.ndarray], np.ndarray],
+                             snap: Callable[[Mesh], Mesh] | None = None,
+                             max_elements: int = 2_000_000, max_passes: int = 120) -> Mesh:
+    """Refine ``mesh`` until every simplex's longest edge is ≤ ``target(centroid)``.
+
+    Works for triangles and tetrahedra alike (scikit-fem's ``refined(marked)``:
+    red-green-blue for triangles, longest-edge bisection for tetrahedra, which
+    halves an edge only every few passes, hence the larger pass limit).
+    """
+    for _ in range(max_passes):
+        centroids = mesh.p[:, mesh.t].mean(axis=1)
+        marked = np.nonzero(longest_simplex_edges(mesh) > target(centroids))[0]
+        if marked.size == 0:
+            return mesh
+        if mesh.t.shape[1] > max_elements:
+            raise RuntimeError(f"mesh grading exceeded {max_elements} elements")
+        with _skfem_copy_warnings_silenced():
+            mesh = mesh.refined(marked)
+        if snap is not None:
+            mesh = snap(mesh)
+    log.warning("mesh grading stopped after %d passes", max_passes)
+    return mesh
+
+
+@contextmanager
+def _skfem_copy_warnings_silenced():
+    """scikit-fem's tetrahedral ``refined(marked)`` builds its new mesh from array slices and
+    then warns (once per pass) that it copies them to C order; the copy is harmless."""
+    logger = logging.getLogger("skfem.mesh.mesh")
+    level = logger.level
+    logger.setLevel(logging.ERROR)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
+
+
+def coarse_ball_octant(refinements: int = 2) -> MeshTet:
+    """A coarse tetrahedral mesh of the lower octant of the unit ball centred at (0, 0, 1).
+
+    The region is ``x ≥ 0, y ≥ 0, z ≤ 1, x² + y² + (z − 1)² ≤ 1``: its
+    lowest point, the first point of contact, is the origin. Built from
+    scikit-fem's ball (whose eight initial tetrahedra are its octants),
+    refined uniformly with the boundary moved onto the sphere, then cut.
+    """
+    ball = MeshTet.init_ball(refinements)
+    centroids = ball.p[:, ball.t].mean(axis=1)
+    octant = ball.restrict(np.nonzero((centroids[0] > 0) & (centroids[1] > 0)
+                                      & (centroids[2] < 0))[0])
+    p = octant.p + np.array([[0.0], [0.0], [1.0]])
+    return MeshTet(np.ascontiguousarray(p), np.ascontiguousarray(octant.t))
+
+
+def on_ball_octant_surface(mesh: MeshTet, centre: tuple[float, float, float],
+                           tol: float = 1e-9) -> np.ndarray:
+    """Nodes on the curved surface of a ball octant cut by the planes through ``centre``.
+
+    A boundary facet is curved unless its three nodes lie in one of the cut
+    planes ``x = cₓ``, ``y = c_y``, ``z = c_z``; the nodes of curved facets
+    (including those on the rims where a plane meets the sphere) are returned.
+    """
+    return np.unique(mesh.facets[:, curved_boundary_facets(mesh, centre, tol)])
+
+
+def curved_boundary_facets(mesh: MeshTet, centre: tuple[float, float, float],
+                           tol: float = 1e-9) -> np.ndarray:
+    """Boundary facets of a ball octant that are not in one of its three cut planes."""
+    facets = mesh.boundary_facets()
+    coords = mesh.p[:, mesh.facets[:, facets]]  # (3, 3 nodes, facets)
+    planar = np.zeros(facets.size, dtype=bool)
+    for axis in range(3):
+        planar |= np.all(np.abs(coords[axis] - centre[axis]) < tol, axis=0)
+    return facets[~planar]
+
+
+def snap_to_sphere(centre: tuple[float, float, float],
+                   radius: float) -> Callable[[MeshTet], MeshTet]:
+    """A function moving the curved surface nodes of a ball octant radially onto the sphere.
+
+    Radial moves from the centre keep nodes in the cut planes through it.
+    Raises ``RuntimeError`` if a move turns a tetrahedron inside out (the
+    mesh was too coarse near the surface for its curvature).
+    """
+    c = np.asarray(centre, dtype=float)[:, None]
+
+    def snap(mesh: MeshTet) -> MeshTet:
+        nodes = on_ball_octant_surface(mesh, centre)
+        p = mesh.p.copy()
+        offset = p[:, nodes] - c
+        p[:, nodes] = c + radius * offset / np.linalg.norm(offset, axis=0)
+        snapped = MeshTet(p, np.ascontiguousarray(mesh.t))
+        before, after = signed_volumes(mesh), signed_volumes(snapped)
+        if np.any(before * after <= 0):
+            raise RuntimeError("snapping to the sphere inverted a tetrahedron: "
+                               "start from a finer coarse mesh")
+        return snapped
+
+    return snap
+
+
+def distance_to_disc(points: np.ndarray, radius: float, height: float = 0.0) -> np.ndarray:
+    """Distance from each column of ``points`` (3, k) to the horizontal disc
+    ``{x² + y² ≤ radius², z = height}``."""
+    rho = np.hypot(points[0], points[1])
+    return np.hypot(np.maximum(rho - radius, 0.0), points[2] - height)

@@ -91,7 +91,7 @@ def _load_user_method(spec: str) -> Method:
 
     A module is looked up on ``sys.path`` and then in the current directory.
     """
-    module_name, _, attr = spec.partition(":")
+    module_name, _, attr = spec.rpartition(":")
     try:
         if module_name.endswith(".py"):
             path = Path(module_name)

@@ -75,6 +75,21 @@ def _distance_estimate(steps: list[float]) -> float:
     return steps[-1] * q / (1.0 - q) if q < 1.0 else float("inf")
 
 
+def _two_step_cycle(new_lam: np.ndarray, lam_prev: np.ndarray, steps: list[float]) -> bool:
+    """True when λ comes back to where it was two steps ago while still taking big steps.
+
+    Beyond the step bound the projection can keep λ bounded: it bounces
+    between two points instead of growing (on Hertz's cylinder, where W has
+    no negative entry, this is what happens), so divergence by size alone is
+    never seen.
+    """
+    if len(steps) < 10 or steps[-1] == 0.0:
+        return False
+    size = float(np.max(np.abs(new_lam))) or 1.0
+    back = float(np.max(np.abs(new_lam - lam_prev)))
+    return back <= 1e-10 * size and steps[-1] > 1e-6 * size and steps[-2] > 1e-6 * size
+
+
 def _operator(problem: ContactProblem, factor, choice: str):
     """The operator choice, ``λ ↦ N K⁻¹ (f − Nᵀλ)`` and ``x ↦ W x`` (None with back-solves)."""
     if choice not in ("auto", "delassus", "backsolve"):
@@ -158,6 +173,13 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         else:
             new_lam = np.maximum(0.0, lam + rho * violation)
         history["step"].append(float(np.max(np.abs(new_lam - lam))))
+        if not accelerated and _two_step_cycle(new_lam, lam_prev, history["step"]):
+            status = "diverged"
+            message = (f"stalled in a two-step cycle at iteration {iteration} (λ returns to the "
+                       f"same value every other step): ρ = {rho:.3g} is beyond the bound "
+                       f"2/λ_max(W) = {2 / lam_max:.3g}; lower rho or step_fraction")
+            lam_prev, Nu_prev, lam = lam, Nu, new_lam
+            break
         lam_prev, Nu_prev, lam = lam, Nu, new_lam
         size = float(np.max(lam))
         if limit is None and size > 0:

@@ -1,0 +1,215 @@
+"""Export a solved scene for ParaView: the deformed mesh with displacement, stress, gap and pressure.
+
+Written through meshio as VTU (``.vtu``, XML) or legacy VTK (``.vtk``), in
+physical units. With P1 elements the displacement gradient is constant on
+each element, so the strain ``ε = sym ∇u`` and the stress
+``σ = λ tr(ε) I + 2μ ε`` are exact per element (cell data). Plane strain
+adds ``σ_zz = λ (ε_xx + ε_yy)``; an axisymmetric (r, z) model adds the hoop
+strain ``ε_θθ = u_r / r`` at the element's centroid (and ``σ_θθ`` takes the
+place of σ_zz). The nodal (point data) stresses are their projection onto P1
+with a lumped mass matrix, i.e. area-weighted averages of the surrounding
+elements. Von Mises is ``√(½[(σ₁₁ − σ₂₂)² + (σ₂₂ − σ₃₃)² + (σ₃₃ − σ₁₁)²] + 3(σ₁₂² + σ₂₃² + σ₁₃²))``.
+
+Data written:
+
+- point data ``displacement`` (3 components), ``von_mises``, ``sigma_yy``,
+  ``gap`` (remaining gap ``d − Nu`` at contact candidates, NaN elsewhere),
+  ``pressure`` and ``contact_force`` (zero off the candidates),
+  ``contact_candidate`` (1 or 0);
+- cell data ``von_mises``, ``sigma_xx``, ``sigma_yy``, ``sigma_xy``,
+  ``sigma_zz`` (in 3D also ``sigma_yz``, ``sigma_xz``).
+
+The points are the deformed positions ``x + u`` (``deformed=False`` keeps
+the reference ones; ParaView's *Warp By Vector* on ``displacement`` moves
+either way). In 3D the vertical stress is ``sigma_zz``; ``sigma_yy`` is
+always the y component.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .pressure import contact_profile
+from .problem import ContactProblem, ContactSolution
+
+log = logging.getLogger(__name__)
+
+#: file suffix → meshio format
+FORMATS = {".vtu": "vtu", ".vtk": "vtk"}
+CELL_TYPES = {3: "triangle", 4: "tetra"}
+
+
+def nodal_displacement(problem: ContactProblem, solution: ContactSolution) -> np.ndarray:
+    """Displacement of every mesh node, shape (nodes, dim), in physical units."""
+    full = problem.expand(solution.u) * problem.scales.displacement
+    mesh = problem.mesh
+    dim, nodes = mesh.p.shape
+    basis = getattr(problem, "basis", None)
+    dofs = basis.nodal_dofs if basis is not None else \
+        np.arange(dim * nodes).reshape(nodes, dim).T  # scikit-fem's interleaved vector dofs
+    return full[dofs].T
+
+
+def element_gradients(points: np.ndarray, elements: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Gradient of the P1 interpolant of nodal ``values`` on each simplex.
+
+    ``points`` (dim, nodes), ``elements`` (dim + 1, k), ``values`` (nodes, c);
+    returns (k, c, dim) with entry ``[e, i, j] = ∂vᵢ/∂x_j`` on element e,
+    from ``J = [x₁ − x₀, …, x_d − x₀]`` and ``∇v = (v₁ − v₀, …) J⁻¹``.
+    """
+    corners = points[:, elements]  # (dim, dim + 1, k)
+    J = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)  # (k, dim, dim): columns are edges
+    dv = np.moveaxis(values[elements[1:]] - values[elements[:1]], 1, 0)  # (k, dim, c)
+    # ∇v J = dvᵀ  ⇒  ∇v = dvᵀ J⁻¹
+    return np.linalg.solve(np.transpose(J, (0, 2, 1)), dv).transpose(0, 2, 1)
+
+
+def element_stress(problem: ContactProblem, solution: ContactSolution,
+                   axisymmetric: bool | None = None) -> np.ndarray:
+    """Cauchy stress per element, shape (k, 3, 3), physical units (σ = λ tr ε I + 2μ ε).
+
+    ``axisymmetric`` (default: the problem's ``axisymmetric`` attribute, if
+    any) adds the hoop strain ``u_r / r`` at each element's centroid; a 2D
+    model is otherwise in plane strain.
+    """
+    params = problem.params
+    if "E" not in params or "nu" not in params:
+        raise InputError("stresses need the material: the problem's params carry no E and nu")
+    E, nu = float(params["E"]), float(params["nu"])
+    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
+    mu = E / (2 * (1 + nu))
+    mesh = problem.mesh
+    points = mesh.p * problem.scales.length
+    dim = points.shape[0]
+    u = nodal_displacement(problem, solution)
+    grad = element_gradients(points, mesh.t, u)
+    strain = np.zeros((mesh.t.shape[1], 3, 3))
+    strain[:, :dim, :dim] = 0.5 * (grad + np.transpose(grad, (0, 2, 1)))
+    if axisymmetric is None:
+        axisymmetric = bool(getattr(problem, "axisymmetric", False))
+    if axisymmetric and dim == 2:
+        r = points[0, mesh.t].mean(axis=0)
+        u_r = u[mesh.t, 0].mean(axis=0)
+        strain[:, 2, 2] = np.divide(u_r, r, out=np.zeros_like(r), where=r > 0)
+    trace = np.trace(strain, axis1=1, axis2=2)
+    return lam * trace[:, None, None] * np.eye(3) + 2 * mu * strain
+
+
+def von_mises(stress: np.ndarray) -> np.ndarray:
+    """``√(½[(σ₁₁ − σ₂₂)² + (σ₂₂ − σ₃₃)² + (σ₃₃ − σ₁₁)²] + 3(σ₁₂² + σ₂₃² + σ₁₃²))`` per tensor."""
+    s = stress
+    normal = (s[:, 0, 0] - s[:, 1, 1]) ** 2 + (s[:, 1, 1] - s[:, 2, 2]) ** 2 + \
+        (s[:, 2, 2] - s[:, 0, 0]) ** 2
+    shear = s[:, 0, 1] ** 2 + s[:, 1, 2] ** 2 + s[:, 0, 2] ** 2
+    return np.sqrt(0.5 * normal + 3.0 * shear)
+
+
+def project_to_nodes(points: np.ndarray, elements: np.ndarray, cell_values: np.ndarray) -> np.ndarray:
+    """Lumped L2 projection of element-wise constants onto P1: measure-weighted nodal averages."""
+    corners = points[:, elements]
+    edges = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)
+    measure = np.abs(np.linalg.det(edges))  # proportional to the area or volume
+    total = np.zeros(points.shape[1])
+    weighted = np.zeros(points.shape[1])
+    for row in elements:
+        np.add.at(total, row, measure)
+        np.add.at(weighted, row, measure * cell_values)
+    return np.divide(weighted, total, out=np.zeros_like(total), where=total > 0)
+
+
+def candidate_nodes(problem: ContactProblem) -> np.ndarray:
+    """The mesh node of each contact candidate (matched by coordinates)."""
+    from scipy.spatial import cKDTree
+
+    distance, nodes = cKDTree(problem.mesh.p.T).query(problem.contact_points)
+    if np.any(distance > 1e-9 * max(1.0, float(np.max(np.abs(problem.mesh.p))))):
+        raise ValueError("a contact candidate is not a mesh node")
+    return nodes
+
+
+def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed: bool = True,
+                axisymmetric: bool | None = None):
+    """The solved scene as a :class:`meshio.Mesh` (physical units; see the module's docstring)."""
+    import meshio
+
+    mesh = problem.mesh
+    if mesh is None:
+        raise InputError("the problem carries no mesh to export")
+    if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
+        raise InputError(f"the {solution.method} solution has no finite answer "
+                         f"({solution.status}): nothing to export")
+    dim, count = mesh.p.shape
+    cell_type = CELL_TYPES.get(mesh.t.shape[0])
+    if cell_type is None:
+        raise InputError(f"export writes triangles and tetrahedra, not {mesh.t.shape[0]}-node cells")
+    points = mesh.p.T * problem.scales.length
+    u = nodal_displacement(problem, solution)
+    stress = element_stress(problem, solution, axisymmetric)
+    mises = von_mises(stress)
+    xyz = np.zeros((count, 3))
+    xyz[:, :dim] = points + (u if deformed else 0.0)
+    disp = np.zeros((count, 3))
+    disp[:, :dim] = u
+    profile = contact_profile(problem, solution)
+    nodes = candidate_nodes(problem)
+    gap = np.full(count, np.nan)
+    gap[nodes] = profile.gap
+    pressure = np.zeros(count)
+    pressure[nodes] = profile.pressure
+    force = np.zeros(count)
+    force[nodes] = profile.force
+    marker = np.zeros(count, dtype=np.int32)
+    marker[nodes] = 1
+    reference_points = points.T
+    point_data = {
+        "displacement": disp,
+        "von_mises": project_to_nodes(reference_points, mesh.t, mises),
+        "sigma_yy": project_to_nodes(reference_points, mesh.t, stress[:, 1, 1]),
+        "gap": gap, "pressure": pressure, "contact_force": force, "contact_candidate": marker,
+    }
+    components = {"sigma_xx": (0, 0), "sigma_yy": (1, 1), "sigma_zz": (2, 2), "sigma_xy": (0, 1)}
+    if dim == 3:
+        components.update(sigma_yz=(1, 2), sigma_xz=(0, 2))
+    cell_data = {"von_mises": [mises]}
+    cell_data.update({name: [stress[:, i, j]] for name, (i, j) in components.items()})
+    return meshio.Mesh(xyz, [(cell_type, mesh.t.T.astype(np.int64))],
+                       point_data=point_data, cell_data=cell_data)
+
+
+def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | os.PathLike, *,
+               deformed: bool = True, axisymmetric: bool | None = None) -> Path:
+    """Write the solved scene to ``path`` (``.vtu`` or ``.vtk``) whole or not at all.
+
+    The file is written under a temporary name in the same directory and
+    renamed, so an existing file is replaced only by a complete one.
+    """
+    target = Path(path)
+    file_format = FORMATS.get(target.suffix.lower())
+    if file_format is None:
+        raise InputError(f"--vtk {str(target)!r}: the file name must end in "
+                         f"{' or '.join(FORMATS)} (VTU is ParaView's XML format)")
+    directory = target.parent if str(target.parent) else Path(".")
+    if not directory.is_dir():
+        raise InputError(f"--vtk {str(target)!r}: the directory {str(directory)!r} does not exist")
+    data = export_mesh(problem, solution, deformed=deformed, axisymmetric=axisymmetric)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=directory)
+    except OSError as exc:
+        raise InputError(f"--vtk {str(target)!r} cannot be written ({exc.strerror})") from None
+    os.close(fd)
+    try:
+        import meshio
+
+        meshio.write(tmp, data, file_format=file_format)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    log.info("wrote %s (%d points, %d cells)", target, data.points.shape[0], len(data.cells[0].data))
+    return target

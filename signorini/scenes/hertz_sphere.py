@@ -1,0 +1,129 @@
+"""Hertz's sphere, axisymmetric: an elastic sphere of radius R on a rigid flat, in (r, z).
+
+A body of revolution loaded along its axis deforms without depending on the
+angle, so the meridian half-plane (r, z), r ≥ 0, carries the whole problem:
+the same quarter disc as the cylinder's model, now read as the lower half of
+the sphere's meridian section, with the axisymmetric elasticity forms (weight
+r, hoop strain u_r/r; see :func:`signorini.assembly.axisymmetric_elasticity`).
+The axis r = 0 has u_r = 0; the cut z = R through the centre is pushed down
+by a uniform δ (u_z = −δ, u_r free), adjusted until the contact force equals
+the target load. Forces are assembled per radian and the model's
+``force_multiplicity`` is 2π, so reported loads are those of the whole sphere.
+The mesh is graded towards the first point of contact; only the arc nodes
+with ``r ≤ candidates · a`` are contact candidates.
+
+Hertz (Johnson 1985, §4.2): ``a = (3PR/(4E*))^(1/3)``, ``p₀ = 3P/(2πa²)``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
+from ..errors import InputError
+from .base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
+                   poisson_ratio, positive)
+from .meshing import coarse_quarter_disc, distance_to_segment, on_circle_arc, refine_to_size, snap_to_circle
+
+COMMON_PARAMS = (
+    Param("R", 1.0, "sphere radius", check=positive),
+    Param("E", 1.0, "Young's modulus", check=positive),
+    Param("nu", 0.3, "Poisson's ratio", check=poisson_ratio),
+    Param("P", None, "total load on the sphere (exclusive with a_over_R, delta)", check=positive),
+    Param("a_over_R", 0.05, "contact radius over sphere radius: sets P by Hertz's formula",
+          check=between(0.0, 0.5)),
+    Param("delta", None, "prescribed downward displacement of the centre cut (no load targeting)",
+          check=positive),
+)
+
+PARAMS = COMMON_PARAMS + (
+    Param("n_contact", 100, "elements across the contact radius (mesh fineness)", kind=int,
+          check=at_least(4)),
+    Param("grading", 0.15, "growth of the element size with distance from the contact zone",
+          check=between(0.0, 2.0)),
+    Param("candidates", 2.0, "contact candidates extend to this multiple of the contact radius",
+          check=at_least(1.2)),
+    Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
+          kind=int, check=lambda k: None if 0 <= k <= 6 else "in 0..6"),
+)
+
+
+def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float]:
+    """The target load P (None when δ is prescribed) and the estimated a/R.
+
+    One of ``P``, ``a_over_R`` (the default) or ``delta`` sets the load; with
+    ``delta`` the estimate of a/R is Hertz's ``√(δ/R)`` from ``δ = a²/R``.
+    """
+    chosen = {name for name in given & {"P", "a_over_R", "delta"} if p[name] is not None}
+    if len(chosen) > 1:
+        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
+                         "give only one of P, a_over_R, delta")
+    R, E_star = p["R"], contact_modulus(p["E"], p["nu"])
+    if "delta" in chosen:
+        a_over_R = float(np.sqrt(p["delta"] / R))
+        if a_over_R > 0.5:
+            raise InputError(f"scene parameter delta={p['delta']:g} gives a/R ≈ {a_over_R:.2f} > 0.5: "
+                             "Hertz's half-space theory needs a/R small; lower delta")
+        return None, a_over_R
+    if "P" in chosen:
+        a_over_R = hertz_sphere_radius(p["P"], R, E_star) / R
+        if a_over_R > 0.5:
+            raise InputError(f"scene parameter P={p['P']:g} gives a/R = {a_over_R:.2f} > 0.5: "
+                             "Hertz's half-space theory needs a/R small; lower P")
+        return p["P"], a_over_R
+    return hertz_sphere_load(p["a_over_R"] * R, R, E_star), p["a_over_R"]
+
+
+def recorded_params(p: dict[str, Any], target: float | None, a_over_R: float,
+                    delta_nominal: float) -> dict[str, Any]:
+    """The parameters as the problem records them: the load that ruled, the others None."""
+    params = dict(p)
+    params.update(P=target, delta=delta_nominal if target is None else None,
+                  a_over_R=a_over_R if target is not None else None)
+    return params
+
+
+def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
+    """The axisymmetric model of Hertz's sphere in physical units (meridian plane (r, z))."""
+    given = set() if given is None else given
+    R = p["R"]
+    target, a_est = load_choice(p, given)
+    h_contact = a_est / p["n_contact"]
+    zone_end = np.array([1.25 * a_est, 0.0])
+
+    def target_size(points: np.ndarray) -> np.ndarray:
+        dist = distance_to_segment(points, np.zeros(2), zone_end)
+        return np.minimum(h_contact + p["grading"] * dist, 0.25)
+
+    snap = snap_to_circle((0.0, 1.0), 1.0)
+    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
+    for _ in range(p["refine"]):
+        mesh = snap(mesh.refined())
+    arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
+    origin = np.nonzero(np.hypot(*mesh.p) < 1e-12)[0]
+    arc = np.union1d(arc, origin)
+    mesh = type(mesh)(mesh.p * R, mesh.t)
+    r, z = mesh.p
+    candidates = arc[r[arc] <= p["candidates"] * a_est * R * (1 + 1e-9)]
+    facets = mesh.boundary_facets()
+    on_arc = np.all(np.isin(mesh.facets[:, facets], arc), axis=0)
+    axis = np.nonzero(np.abs(r) < 1e-12 * R)[0]
+    top = np.nonzero(np.abs(z - R) < 1e-12 * R)[0]
+    delta_nominal = p["delta"] if target is None else a_est ** 2 * R
+    return SceneModel(
+        mesh=mesh, E=p["E"], nu=p["nu"],
+        dirichlet=[(0, axis, 0.0), (1, top, -delta_nominal)],
+        contact_nodes=candidates[np.argsort(r[candidates])],
+        contact_facets=facets[on_arc],
+        obstacle=FlatObstacle(0.0),
+        load_dofs=(1, top), length_scale=R, force_multiplicity=2.0 * np.pi,
+        target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
+        axisymmetric=True)
+
+
+FAMILY = SceneFamily(
+    name="hertz-sphere",
+    summary="elastic sphere on a rigid flat, axisymmetric (r, z) model graded to the contact",
+    params=PARAMS, build=build, reference="hertz-3d")
