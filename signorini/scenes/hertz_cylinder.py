@@ -15,13 +15,12 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
 
 from ..analytic import hertz_cylinder_half_width, hertz_cylinder_load
 from ..errors import InputError
 from .base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
                    poisson_ratio, positive)
-from .meshing import coarse_quarter_disc, distance_to_segment, on_circle_arc, refine_to_size, snap_to_circle
+from .meshing import graded_quarter_disc
 
 PARAMS = (
     Param("R", 1.0, "cylinder radius", check=positive),
@@ -71,38 +70,18 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
                              "Hertz's half-space theory needs a/R small; lower P")
     else:
         a_est = p["a_over_R"]
-    h_contact = a_est / p["n_contact"]
-    zone_end = np.array([1.25 * a_est, 0.0])
-
-    def target_size(points: np.ndarray) -> np.ndarray:
-        dist = distance_to_segment(points, np.zeros(2), zone_end)
-        return np.minimum(h_contact + p["grading"] * dist, 0.25)
-
-    snap = snap_to_circle((0.0, 1.0), 1.0)
-    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
-    for _ in range(p["refine"]):
-        mesh = snap(mesh.refined())
-    arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
-    origin = np.nonzero(np.hypot(*mesh.p) < 1e-12)[0]
-    arc = np.union1d(arc, origin)
-    mesh = type(mesh)(mesh.p * R, mesh.t)
-    x, y = mesh.p
-    candidates = arc[x[arc] <= p["candidates"] * a_est * R * (1 + 1e-9)]
-    facets = mesh.boundary_facets()
-    on_arc = np.all(np.isin(mesh.facets[:, facets], arc), axis=0)
-    symmetry = np.nonzero(np.abs(x) < 1e-12 * R)[0]
-    top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
+    disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
+                               p["candidates"])
     delta_nominal = delta if delta is not None else a_est ** 2 * R
     params = dict(p)
     params.update(P=target, delta=delta_nominal if target is None else None,
                   a_over_R=a_est if target is not None else None)
     return SceneModel(
-        mesh=mesh, E=E, nu=nu,
-        dirichlet=[(0, symmetry, 0.0), (1, top, -delta_nominal)],
-        contact_nodes=candidates[np.argsort(x[candidates])],
-        contact_facets=facets[on_arc],
+        mesh=disc.mesh, E=E, nu=nu,
+        dirichlet=[(0, disc.axis, 0.0), (1, disc.top, -delta_nominal)],
+        contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),
-        load_dofs=(1, top), length_scale=R, force_multiplicity=2.0,
+        load_dofs=(1, disc.top), length_scale=R, force_multiplicity=2.0,
         target_load=target, params=params)
 
 

@@ -25,7 +25,7 @@ from ..analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
 from ..errors import InputError
 from .base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
                    poisson_ratio, positive)
-from .meshing import coarse_quarter_disc, distance_to_segment, on_circle_arc, refine_to_size, snap_to_circle
+from .meshing import graded_quarter_disc
 
 COMMON_PARAMS = (
     Param("R", 1.0, "sphere radius", check=positive),
@@ -90,35 +90,15 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     given = set() if given is None else given
     R = p["R"]
     target, a_est = load_choice(p, given)
-    h_contact = a_est / p["n_contact"]
-    zone_end = np.array([1.25 * a_est, 0.0])
-
-    def target_size(points: np.ndarray) -> np.ndarray:
-        dist = distance_to_segment(points, np.zeros(2), zone_end)
-        return np.minimum(h_contact + p["grading"] * dist, 0.25)
-
-    snap = snap_to_circle((0.0, 1.0), 1.0)
-    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
-    for _ in range(p["refine"]):
-        mesh = snap(mesh.refined())
-    arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
-    origin = np.nonzero(np.hypot(*mesh.p) < 1e-12)[0]
-    arc = np.union1d(arc, origin)
-    mesh = type(mesh)(mesh.p * R, mesh.t)
-    r, z = mesh.p
-    candidates = arc[r[arc] <= p["candidates"] * a_est * R * (1 + 1e-9)]
-    facets = mesh.boundary_facets()
-    on_arc = np.all(np.isin(mesh.facets[:, facets], arc), axis=0)
-    axis = np.nonzero(np.abs(r) < 1e-12 * R)[0]
-    top = np.nonzero(np.abs(z - R) < 1e-12 * R)[0]
+    disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
+                               p["candidates"])
     delta_nominal = p["delta"] if target is None else a_est ** 2 * R
     return SceneModel(
-        mesh=mesh, E=p["E"], nu=p["nu"],
-        dirichlet=[(0, axis, 0.0), (1, top, -delta_nominal)],
-        contact_nodes=candidates[np.argsort(r[candidates])],
-        contact_facets=facets[on_arc],
+        mesh=disc.mesh, E=p["E"], nu=p["nu"],
+        dirichlet=[(0, disc.axis, 0.0), (1, disc.top, -delta_nominal)],
+        contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),
-        load_dofs=(1, top), length_scale=R, force_multiplicity=2.0 * np.pi,
+        load_dofs=(1, disc.top), length_scale=R, force_multiplicity=2.0 * np.pi,
         target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
         axisymmetric=True)
 

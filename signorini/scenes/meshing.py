@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 from contextlib import contextmanager
+from dataclasses import dataclass
 from itertools import combinations
 from typing import Callable
 
@@ -221,3 +222,51 @@ def distance_to_disc(points: np.ndarray, radius: float, height: float = 0.0) -> 
     ``{x² + y² ≤ radius², z = height}``."""
     rho = np.hypot(points[0], points[1])
     return np.hypot(np.maximum(rho - radius, 0.0), points[2] - height)
+
+
+@dataclass(frozen=True)
+class GradedDisc:
+    """The quarter of a disc of radius R below its centre, graded towards the contact point.
+
+    ``candidates`` are the arc nodes with ``x ≤ candidate_extent · a`` sorted by
+    x, ``contact_facets`` the arc's boundary facets, ``axis`` the nodes on the
+    cut x = 0 and ``top`` those on the cut through the centre, y = R.
+    """
+
+    mesh: MeshTri
+    candidates: np.ndarray
+    contact_facets: np.ndarray
+    axis: np.ndarray
+    top: np.ndarray
+
+
+def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: float,
+                        refine: int = 0, candidate_extent: float = 2.0) -> GradedDisc:
+    """Mesh a quarter disc with ``n_contact`` elements across the expected half-width a.
+
+    The element size is ``a/n_contact`` on the zone [0, 1.25 a] of the arc and
+    grows by ``grading`` per unit distance from it; ``refine`` uniform
+    refinements follow, each with the arc's new nodes moved onto the circle.
+    """
+    h_contact = a_over_R / n_contact
+    zone_end = np.array([1.25 * a_over_R, 0.0])
+
+    def target_size(points: np.ndarray) -> np.ndarray:
+        dist = distance_to_segment(points, np.zeros(2), zone_end)
+        return np.minimum(h_contact + grading * dist, 0.25)
+
+    snap = snap_to_circle((0.0, 1.0), 1.0)
+    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
+    for _ in range(refine):
+        mesh = snap(mesh.refined())
+    arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
+    arc = np.union1d(arc, np.nonzero(np.hypot(*mesh.p) < 1e-12)[0])  # the first point of contact
+    mesh = MeshTri(mesh.p * R, mesh.t)
+    x, y = mesh.p
+    candidates = arc[x[arc] <= candidate_extent * a_over_R * R * (1 + 1e-9)]
+    facets = mesh.boundary_facets()
+    on_arc = np.all(np.isin(mesh.facets[:, facets], arc), axis=0)
+    return GradedDisc(mesh=mesh, candidates=candidates[np.argsort(x[candidates])],
+                      contact_facets=facets[on_arc],
+                      axis=np.nonzero(np.abs(x) < 1e-12 * R)[0],
+                      top=np.nonzero(np.abs(y - R) < 1e-12 * R)[0])
