@@ -188,6 +188,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
         scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
         params=params, mesh=mesh, push=_push(lifted, scale))
     problem.basis = basis
+    problem.axisymmetric = model.axisymmetric
     problem.assemble_time = time.perf_counter() - start
     log.info("assembled %d free dofs, %d contact candidates in %.2f s",
              problem.n, problem.m, problem.assemble_time)

@@ -77,6 +77,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
     options = {k: _option_value(v) for k, v in _pairs(args.opt, "--opt").items()}
     max_iter = options.pop("max_iter", None)
     tol = _tol(args.tol) if args.tol is not None else None
+    if args.vtk:
+        from .export import check_vtk_path
+
+        check_vtk_path(args.vtk)  # a bad export path fails before the solve
     problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
     solution = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
     record = solve_record(problem, solution)
@@ -84,7 +88,43 @@ def cmd_solve(args: argparse.Namespace) -> int:
         _write_json(args.json, to_json(record))
     if args.json != "-":
         print(solve_summary(record))
+    if args.vtk:
+        from .export import export_vtk
+
+        if record["contact"] is None:
+            print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
+            return EXIT_FAILED
+        export_vtk(problem, solution, args.vtk)
+        print(f"written: {args.vtk}", file=sys.stderr if args.json == "-" else sys.stdout)
     return 0 if solution.status == "converged" else EXIT_FAILED
+
+
+def cmd_converge(args: argparse.Namespace) -> int:
+    from .convergence import grading_comparison, run_study, study_table, write_study
+    from .io import writable_directory
+
+    writable_directory(args.out)
+    if args.levels < 0 or args.levels > 6:
+        raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
+    if args.uniform_levels is not None and not 0 <= args.uniform_levels <= 4:
+        raise InputError(f"--uniform-levels {args.uniform_levels} must be in 0..4")
+    params = _pairs(args.set, "--set")
+    say = (lambda line: print(line, file=sys.stderr))
+    study = run_study(args.scene, args.levels, params, methods=args.method or None,
+                      fit_from=args.fit_from, progress=say)
+    comparison = None
+    if args.uniform_levels is not None:
+        comparison = grading_comparison(args.scene, study, args.uniform_levels, params, progress=say)
+    command = "signorini converge " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
+        if len(sys.argv) > 2 and sys.argv[1] == "converge" else f"signorini converge {args.scene} --levels {args.levels}"
+    paths = write_study(study, args.out, command, comparison)
+    print("\n".join(study_table(study)))
+    if comparison is not None:
+        print(f"{comparison.metric} {100 * comparison.target:g} %: graded {comparison.graded_dofs:,.0f} dofs "
+              f"({comparison.graded_how}), uniform {comparison.uniform_dofs:,.0f} dofs "
+              f"({comparison.uniform_how}): grading saves {comparison.saving:,.0f}×")
+    print(f"report: {paths['markdown']}")
+    return 0
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -174,6 +214,40 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_stability(args: argparse.Namespace) -> int:
+    import math
+    from pathlib import Path
+
+    from .io import writable_directory
+    from .stability import run_atlas, select_axes, wrapper_record, write_report
+
+    axes = select_axes(args.axis)
+    try:
+        time_limit = float(args.time_limit)
+    except ValueError:
+        time_limit = float("nan")
+    if not (math.isfinite(time_limit) and time_limit > 0):
+        raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
+                         "e.g. --time-limit 30")
+    writable_directory(Path(args.out) / "stability")
+
+    def progress(axis, i, n, task, row):
+        print(f"[axis {axis.number} {axis.name} {i}/{n}] {task.case} {task.method}: {row['status']} "
+              f"({row.get('outcome')}) {row.get('time_s', float('nan')):.2f} s", file=sys.stderr)
+
+    result = run_atlas(axes, quick=args.quick, isolate=not args.in_process,
+                       time_limit=time_limit, progress=progress)
+    command = "signorini stability" + "".join(f" --axis {a}" for a in args.axis)
+    command += " --quick" * args.quick + (f" --out {shlex.quote(args.out)}"
+                                          if args.out != "stability-report" else "")
+    paths = write_report(result, args.out, command)
+    right, runs, _ = wrapper_record(result.rows)
+    print(f"{runs} runs in {result.elapsed_s:.0f} s; the package's status was right in "
+          f"{right} of {runs}")
+    print(f"report: {paths['report']}")
+    return 0
+
+
 def cmd_scenes(args: argparse.Namespace) -> int:
     from .scenes import SCENES
 
@@ -204,7 +278,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     solve = sub.add_parser("solve", help="solve one scene with one method")
-    solve.add_argument("scene", help="scene name (see 'signorini scenes')")
+    solve.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
     solve.add_argument("--method", default="pdas", help="method name (see 'signorini methods')")
     solve.add_argument("--tol", help="the method's tolerance (default: the method's own)")
     solve.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
@@ -214,7 +288,24 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--json", metavar="FILE", help="write the result as JSON ('-' for stdout)")
     solve.add_argument("--raw-units", action="store_true",
                        help="solve in the user's units instead of non-dimensionalising")
+    solve.add_argument("--vtk", metavar="FILE",
+                       help="write the deformed mesh with displacement, stress, gap and pressure "
+                            "(.vtu or .vtk, for ParaView)")
     solve.set_defaults(run=cmd_solve)
+
+    converge = sub.add_parser("converge", help="refine a scene k times: errors, rates, figures")
+    converge.add_argument("scene", help="a scene with a 'refine' parameter (see 'signorini scenes')")
+    converge.add_argument("--levels", type=int, default=3, help="refinements: levels 0..k (default 3)")
+    converge.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                          help="scene parameter of level 0, e.g. --set n_contact=15")
+    converge.add_argument("--method", action="append", default=[],
+                          help="only this method (repeatable; default: every installed exact one)")
+    converge.add_argument("--fit-from", type=int, default=0,
+                          help="fit the rates on levels >= this one (default 0)")
+    converge.add_argument("--uniform-levels", type=int, default=None, metavar="K",
+                          help="also solve uniform meshes at K+1 levels and compare at equal dofs")
+    converge.add_argument("--out", default="convergence-report", help="output directory")
+    converge.set_defaults(run=cmd_converge)
 
     validate = sub.add_parser("validate", help="run the validation suite on the default scenes")
     validate.add_argument("--out", default="validation-report", help="report directory")
@@ -246,6 +337,18 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--out", default="bench-report")
     bench.add_argument("--report-only", action="store_true", help="rewrite the report from the CSV")
     bench.set_defaults(run=cmd_bench)
+
+    stability = sub.add_parser("stability", help="the stability atlas: where each method fails")
+    stability.add_argument("--out", default="stability-report",
+                           help="writes OUT/stability.md and OUT/stability/ (runs, figures)")
+    stability.add_argument("--axis", action="append", default=[],
+                           help="only this axis, by number or name (repeatable; default: all 8)")
+    stability.add_argument("--quick", action="store_true",
+                           help="tiny meshes, few points and methods: a smoke test in seconds")
+    stability.add_argument("--time-limit", default="30", help="seconds per run (default 30)")
+    stability.add_argument("--in-process", action="store_true",
+                           help="run in this process, without worker processes or time limits")
+    stability.set_defaults(run=cmd_stability)
 
     sub.add_parser("scenes", help="list the scenes and their parameters").set_defaults(run=cmd_scenes)
     sub.add_parser("methods", help="list the methods and whether they are installed").set_defaults(

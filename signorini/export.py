@@ -182,6 +182,18 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
                        point_data=point_data, cell_data=cell_data)
 
 
+def check_vtk_path(path: str | os.PathLike) -> tuple[Path, str]:
+    """``(path, meshio format)`` for an export target; InputError for a bad suffix or directory."""
+    target = Path(path)
+    file_format = FORMATS.get(target.suffix.lower())
+    if file_format is None:
+        raise InputError(f"--vtk {str(target)!r}: the file name must end in "
+                         f"{' or '.join(FORMATS)} (VTU is ParaView's XML format)")
+    if not target.parent.is_dir():
+        raise InputError(f"--vtk {str(target)!r}: the directory {str(target.parent)!r} does not exist")
+    return target, file_format
+
+
 def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | os.PathLike, *,
                deformed: bool = True, axisymmetric: bool | None = None) -> Path:
     """Write the solved scene to ``path`` (``.vtu`` or ``.vtk``) whole or not at all.
@@ -189,14 +201,8 @@ def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | o
     The file is written under a temporary name in the same directory and
     renamed, so an existing file is replaced only by a complete one.
     """
-    target = Path(path)
-    file_format = FORMATS.get(target.suffix.lower())
-    if file_format is None:
-        raise InputError(f"--vtk {str(target)!r}: the file name must end in "
-                         f"{' or '.join(FORMATS)} (VTU is ParaView's XML format)")
-    directory = target.parent if str(target.parent) else Path(".")
-    if not directory.is_dir():
-        raise InputError(f"--vtk {str(target)!r}: the directory {str(directory)!r} does not exist")
+    target, file_format = check_vtk_path(path)
+    directory = target.parent
     data = export_mesh(problem, solution, deformed=deformed, axisymmetric=axisymmetric)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=directory)
@@ -207,6 +213,9 @@ def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | o
         import meshio
 
         meshio.write(tmp, data, file_format=file_format)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp made it private; give it the usual permissions
         os.replace(tmp, target)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

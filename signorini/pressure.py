@@ -314,11 +314,12 @@ def load_resultant(problem: ContactProblem, lam: np.ndarray, component: int = -1
     return float(-problem.force_multiplicity * full[dofs].sum() * problem.scales.force)
 
 
-def _half_line(profile: ContactProfile) -> ContactProfile:
-    """The candidates with x ≥ 0, sorted by x (all of a half model; the right half of a whole one)."""
-    right = np.nonzero(profile.x >= -1e-12 * max(1.0, float(np.max(np.abs(profile.x)))))[0]
-    order = right[np.argsort(profile.x[right], kind="stable")]
-    return _sub_profile(profile, order, np.abs(profile.x[order]))
+def _half_line(problem: ContactProblem, profile: ContactProfile) -> ContactProfile:
+    """The candidates with x ≥ 0 (2D), sorted by x: all of a half model, the right half of a whole one."""
+    x = problem.contact_points[:, 0] * problem.scales.length
+    right = np.nonzero(x >= -1e-12 * max(1.0, float(np.max(np.abs(x)))))[0]
+    order = right[np.argsort(x[right], kind="stable")]
+    return _sub_profile(profile, order, np.abs(x[order]))
 
 
 @dataclass(frozen=True)
@@ -330,7 +331,8 @@ class PunchComparison:
     ``pressure_l2_rel`` compare nodal pressures with it over ``|x| ≤ inner·a``
     (away from the singular edges). ``edge_pressure`` is the nodal pressure
     at the face's edge, ``edge_h`` the length of the element next to it:
-    under refinement the former grows like ``edge_h^(−1/2)``.
+    under refinement the former grows like ``edge_h^(−1/2)``;
+    ``edge_over_centre`` is it in units of the centre's ``P/(πa)``.
     ``force_balance`` is ``|P − applied| / P`` and ``target_rel``
     ``|P − P_target| / P_target`` (nan without a target).
     """
@@ -347,6 +349,7 @@ class PunchComparison:
     edge_pressure: float
     edge_pressure_ref_mean: float
     edge_h: float
+    edge_over_centre: float
     active_fraction: float
 
     def as_dict(self) -> dict[str, float]:
@@ -358,14 +361,14 @@ def compare_punch(problem: ContactProblem, solution: ContactSolution,
     """Compare ``solution`` of the punch scene with ``p(x) = P/(π√(a² − x²))`` on ``|x| ≤ inner·a``."""
     from .analytic import punch_load_between, punch_pressure
 
-    profile = _half_line(contact_profile(problem, solution))
+    profile = _half_line(problem, contact_profile(problem, solution))
     a = float(problem.params["a"])
     P = load_resultant(problem, solution.lam)
     target = problem.params.get("P")
     nan = float("nan")
     if not P > 0:
         return PunchComparison(a, P, profile.applied_load, nan, nan, inner, nan, nan, nan, nan, nan,
-                               nan, 0.0)
+                               nan, nan, 0.0)
     x, p = profile.x, profile.pressure
     zone = x <= inner * a * (1 + 1e-12)
     ref = punch_pressure(x[zone], a, P)
@@ -383,6 +386,7 @@ def compare_punch(problem: ContactProblem, solution: ContactSolution,
         pressure_l2_rel=_l2_relative(x[zone], p[zone], lambda s: punch_pressure(s, a, P)),
         centre_rel=float(p[0] / punch_pressure(np.array([x[0]]), a, P)[0] - 1.0),
         edge_pressure=float(p[edge]), edge_pressure_ref_mean=float(edge_mean), edge_h=edge_h,
+        edge_over_centre=float(p[edge] / (P / (np.pi * a))),
         active_fraction=float(np.mean(profile.active[under])))
 
 
@@ -393,7 +397,7 @@ def compare_reverse_hertz(problem: ContactProblem, solution: ContactSolution) ->
     (:func:`load_resultant`) rather than ``μ Σλ``: on the cylinder the normals
     tilt by up to a/R, and force balance holds for the resultant.
     """
-    profile = _half_line(contact_profile(problem, solution))
+    profile = _half_line(problem, contact_profile(problem, solution))
     R = problem.params["R"]
     P = load_resultant(problem, solution.lam)
     if not P > 0:

@@ -50,12 +50,15 @@ import re
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .errors import InputError
 from .obstacles import Circle, FlatPunch, HalfPlane
+
+if TYPE_CHECKING:
+    from .scenes.base import SceneModel
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -142,7 +145,8 @@ def read_scene_file(path: str | Path) -> tuple[dict[str, Any], _Context]:
     return data, _Context(path, _Locator(text))
 
 
-def build_scene_model(path: str | Path, overrides: dict[str, Any] | None = None):
+def build_scene_model(path: str | Path,
+                      overrides: dict[str, Any] | None = None) -> tuple[str, "SceneModel"]:
     """``(scene name, SceneModel)`` of a scene file, with ``--set`` style ``overrides``.
 
     The scene name is the family's for a family scene (so its analytic
@@ -161,7 +165,8 @@ def build_scene_model(path: str | Path, overrides: dict[str, Any] | None = None)
 # --- family scenes --------------------------------------------------------------------------
 
 
-def _family_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]):
+def _family_scene(data: dict[str, Any], ctx: _Context,
+                  overrides: dict[str, Any]) -> tuple[str, "SceneModel"]:
     from .scenes import SCENES
 
     name = data["scene"]
@@ -265,10 +270,12 @@ def read_mesh(path: str | Path) -> MeshWithBoundaries:
     from skfem import MeshTri
 
     path = Path(path)
+    if not path.is_file():
+        raise InputError(f"mesh file {path} does not exist")
+    # .msh is Gmsh's (meshio would also try ANSYS and print its complaint on stdout)
+    file_format = "gmsh" if path.suffix.lower() == ".msh" else None
     try:
-        raw = meshio.read(path)
-    except FileNotFoundError:
-        raise InputError(f"mesh file {path} does not exist") from None
+        raw = meshio.read(path, file_format=file_format)
     except Exception as exc:  # meshio raises many kinds (ReadError, ValueError, KeyError...)
         raise InputError(f"mesh file {path} cannot be read by meshio "
                          f"({type(exc).__name__}: {exc})") from exc
@@ -351,7 +358,7 @@ def _boundary_nodes(ctx: _Context, mesh_info: MeshWithBoundaries, table: str,
                     table, "boundary", index)
 
 
-def _obstacle(ctx: _Context, content: dict[str, Any]):
+def _obstacle(ctx: _Context, content: dict[str, Any]) -> HalfPlane | Circle | FlatPunch:
     kind = content.get("type")
     allowed = {"flat": {"type", "height"}, "half-plane": {"type", "point", "normal"},
                "circle": {"type", "centre", "radius"},
@@ -382,7 +389,7 @@ def _obstacle(ctx: _Context, content: dict[str, Any]):
         raise ctx.error(str(exc), "obstacle", None) from None
 
 
-def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]):
+def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) -> "SceneModel":
     from .obstacles import ScaledQuery
     from .scenes.base import SceneModel, poisson_ratio
 

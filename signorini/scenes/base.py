@@ -121,7 +121,7 @@ class SceneModel:
     dirichlet: list[tuple[int, np.ndarray, float]]
     contact_nodes: np.ndarray
     contact_facets: np.ndarray
-    obstacle: FlatObstacle
+    obstacle: Any  # anything with normals_and_gaps(points): see signorini.obstacles
     load_dofs: tuple[int, np.ndarray]
     length_scale: float
     force_multiplicity: float = 1.0

@@ -111,10 +111,8 @@ def _touching_model(p: dict[str, Any]) -> SceneModel:
 
     mesh, bottom, _, _, _ = _mesh_parts(p)
     x = mesh.p[0]
+    # the outer corner x = W always touches
     supported = bottom[x[bottom] < (1.0 - p["touching"]) * p["W"] * (1 - 1e-12)]
-    if supported.size == bottom.size:
-        raise InputError(f"scene parameter touching={p['touching']!r} leaves no bottom node to "
-                         f"touch at nx={p['nx']}: raise touching to at least {1 / p['nx']:g} or nx")
     problem = assemble(_plain_model(p, contact_nodes=supported))
     solution = pdas(problem)
     if solution.status != "converged":  # pragma: no cover - PDAS is exact on this small LCP

@@ -31,7 +31,7 @@ from skfem import MeshTri
 
 from ..analytic import contact_modulus
 from ..errors import InputError
-from ..obstacles import FlatPunch, ScaledQuery
+from ..obstacles import FlatPunch, Obstacle, ScaledQuery
 from .base import Param, SceneFamily, SceneModel, at_least, between, poisson_ratio, positive
 from .meshing import distance_to_segment, refine_to_size
 
@@ -141,7 +141,7 @@ def mirrored_about_x0(mesh: MeshTri) -> MeshTri:
 
 
 def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidate_end: float,
-                         half: bool, obstacle, E: float, nu: float, delta_nominal: float,
+                         half: bool, obstacle: Obstacle, E: float, nu: float, delta_nominal: float,
                          target: float | None, params: dict[str, Any]) -> SceneModel:
     """A block (half or whole) whose bottom y = 0 is the contact candidate, pushed down at the top.
 

@@ -1,0 +1,1814 @@
+"""The stability atlas: where each method fails, and whether the package says so.
+
+Each **axis** sweeps one thing — Uzawa's step, the mesh, the tolerance, the
+units, Poisson's ratio, a singular K, degenerate contact, ill-posed input —
+and runs every installed method at each point. Every **run** records
+
+- the method's own word (``claimed_status``: what it said before the package
+  judged it) and the package's status (``status``, from
+  :func:`signorini.solvers.registry.solve`);
+- the independent certificate :func:`signorini.kkt.certificate` and whether
+  its worst relative residual is within the accepted tolerance ``τ``
+  (``ACCEPT_FACTOR · tol``, or ``DEFAULT_ACCEPT`` without a tolerance);
+- the distance from a trusted exact answer ``(u*, λ*)`` (PDAS at 1e-9 on the
+  non-dimensionalised problem, or the analytic patch solution):
+  ``‖λ − λ*‖∞ / max(‖λ*‖∞, 1e-5 ‖f‖∞)`` and the number of misclassified
+  contact nodes (weakly active nodes left out, :func:`signorini.kkt.compare`,
+  plus nodes with zero force that penetrate, which that comparison misses);
+- the Hertz errors of a and p₀ where the scene is Hertz's cylinder.
+
+An answer **agrees** with the exact one when no node is misclassified and
+the force error is at most ``min(AGREE_FACTOR · τ, AGREE_CAP)`` (the
+validation suite's ratio, λ within 1e-6 at a tolerance of 1e-9, capped). A
+method's own claim of success is **correct** when its answer passes the
+certificate and agrees; the package's status is **right** when it says
+``converged`` only for answers that agree, grants it whenever the claim was
+correct, calls no solvable problem ``infeasible``, and never raises on a
+problem that was built.
+
+Runs happen in a worker process with a time limit (as in
+:mod:`signorini.bench`): a backend that hangs or crashes costs one row, the
+worker is restarted, and the atlas goes on.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import logging
+import math
+import os
+import select
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from .errors import InputError
+from .problem import ContactProblem, ContactSolution
+
+log = logging.getLogger(__name__)
+
+#: an answer agrees with the exact one when λ is within AGREE_FACTOR × the accepted tolerance
+#: (the validation suite's ratio: 1e-6 at 1e-9), and never further off than AGREE_CAP
+AGREE_FACTOR = 1e3
+AGREE_CAP = 0.1
+#: a right answer turned down by the certificate is "conservative" when λ is within NEAR_FACTOR × τ
+NEAR_FACTOR = 10.0
+#: tolerance of the trusted exact answer (PDAS)
+REFERENCE_TOL = 1e-9
+#: the tolerance every axis uses unless it sweeps the tolerance
+ATLAS_TOL = 1e-8
+#: seconds a run may take (problem assembly and the reference included) before it is stopped
+DEFAULT_TIME_LIMIT = 30.0
+#: iteration caps for first-order backends at tight tolerances (as in the validation suite)
+ITERATION_CAPS = {"qp-osqp": 20_000, "qp-scs": 20_000}
+#: methods of a --quick atlas
+QUICK_METHODS = ("pdas", "uzawa", "qp-osqp", "qp-clarabel")
+#: columns that hold numbers (NaN when not measured)
+NUMERIC = ("dofs", "candidates", "iterations", "time_s", "kkt_worst", "lam_rel", "u_rel",
+           "misclassified", "weak", "misclassified_strict", "weak_penetrating", "a_rel", "p0_rel",
+           "pressure_l2_rel", "ref_a_rel", "ref_p0_rel", "ref_pressure_l2_rel", "rho_over_bound",
+           "lambda_max", "bound_at_solution", "patch_lam_rel")
+#: the "method" of a task that only builds (and diagnoses) its problem
+BUILD_ONLY = "(build)"
+#: the statuses a run can end with besides :data:`signorini.problem.STATUSES`
+EXTRA_STATUSES = ("built", "refused", "input-error", "raised", "timeout", "crashed")
+
+COLUMNS = ("axis", "case", "value", "scene", "dofs", "candidates", "method", "tol", "options",
+           "expect", "status", "claimed_status", "wrapper", "iterations", "time_s", "kkt_worst",
+           "kkt_name", "cert_ok", "lam_rel", "u_rel", "misclassified", "weak",
+           "misclassified_strict", "weak_penetrating", "exact_ok", "near_exact", "claim_correct",
+           "wrapper_right", "conservative", "outcome", "a_rel", "p0_rel", "pressure_l2_rel",
+           "ref_a_rel", "ref_p0_rel", "ref_pressure_l2_rel", "rho_over_bound", "lambda_max",
+           "bound_at_solution", "patch_lam_rel", "diagnosis", "message", "problem")
+
+
+# --- the package's handling of a singular K, and a diagnosis of ill-posed data -------------------
+
+
+def regularise(problem: ContactProblem, epsilon: float) -> ContactProblem:
+    """``K + ε k̄ I`` with ``k̄ = mean |diag K|``: a weak spring on every free dof.
+
+    For a body held only by contact (force control) ``K`` is singular and
+    methods that need ``K⁻¹`` (PDAS, Uzawa, the condensed dual) cannot start;
+    with the springs it is SPD. The springs carry the force
+    ``ε k̄ Σᵢ uᵢ`` that the contact no longer does, so the answer moves by
+    about ``ε k̄ ‖u‖₁ / ‖f‖₁`` (relative; the atlas measures it, see
+    ``docs/stability.md``): ε = 1e-8 changes λ by about 1e-6 on the 8 × 8
+    force-controlled block, and every method but Uzawa then solves it.
+
+    Parameters
+    ----------
+    problem : the contact problem (its K may be singular).
+    epsilon : the relative spring stiffness, a finite number > 0.
+
+    Returns
+    -------
+    ContactProblem
+        a copy with the regularised K and ``params["regularisation"] = epsilon``.
+    """
+    if isinstance(epsilon, bool) or not isinstance(epsilon, (int, float, np.floating)) \
+            or not (math.isfinite(epsilon) and epsilon > 0):
+        raise InputError(f"regularisation epsilon={epsilon!r} must be a finite number > 0, "
+                         "e.g. 1e-8")
+    stiffness = float(np.mean(np.abs(problem.K.diagonal()))) or 1.0
+    K = (problem.K + epsilon * stiffness * sp.identity(problem.n, format="csr")).tocsr()
+    new = problem.with_data(K=K, params={**problem.params, "regularisation": float(epsilon)})
+    if hasattr(problem, "basis"):
+        new.basis = problem.basis
+    return new
+
+
+def diagnose(problem: ContactProblem) -> list[str]:
+    """What makes ``min ½uᵀKu − fᵀu, Nu ≤ d`` infeasible or ill-posed, one sentence each.
+
+    - a row ``Nᵢ = 0`` (every dof of candidate i prescribed) with ``dᵢ < 0``:
+      the prescribed displacement already penetrates the obstacle, no u can
+      satisfy ``0 ≤ dᵢ`` — infeasible;
+    - a row ``Nᵢ = 0`` with ``dᵢ ≥ 0``: the constraint is void;
+    - two equal rows: the two forces are not unique, only their sum is;
+    - ``K`` not positive definite: a rigid mode that only the contact can
+      hold (force control); methods that need ``K⁻¹`` cannot run.
+
+    Returns an empty list when none applies.
+    """
+    findings: list[str] = []
+    N = sp.csr_matrix(problem.N, copy=True)
+    N.eliminate_zeros()
+    empty = np.nonzero(np.diff(N.indptr) == 0)[0]
+    scale = problem.scales.displacement
+    penetrated = empty[problem.d[empty] < 0]
+    if penetrated.size:
+        shown = ", ".join(str(i) for i in penetrated[:5]) + (", …" if penetrated.size > 5 else "")
+        findings.append(
+            f"infeasible: {penetrated.size} contact candidate(s) ({shown}) have every dof "
+            "prescribed and the prescribed displacement already penetrates the obstacle (by up "
+            f"to {-problem.d[penetrated].min() * scale:.3g}): no displacement satisfies Nu ≤ d; "
+            "move the obstacle or change the Dirichlet data")
+    if np.any(problem.d[empty] >= 0):
+        count = int(np.sum(problem.d[empty] >= 0))
+        findings.append(f"{count} contact candidate(s) have every dof prescribed: their "
+                        "constraints are constant; leave them out of the candidates")
+    rows = {}
+    for i in range(problem.m):
+        key = (N.indices[N.indptr[i]:N.indptr[i + 1]].tobytes(),
+               np.round(N.data[N.indptr[i]:N.indptr[i + 1]], 12).tobytes())
+        if N.indptr[i + 1] > N.indptr[i] and key in rows:
+            findings.append(f"ill-posed: contact candidates {rows[key]} and {i} constrain the same "
+                            "dofs in the same direction: their forces are not unique (only the "
+                            "sum is); list each node once")
+            break
+        rows.setdefault(key, i)
+    try:
+        problem.factor()
+    except (np.linalg.LinAlgError, ArithmeticError, RuntimeError) as exc:
+        findings.append(f"K is singular ({exc}): a rigid mode is held only by the contact; pdas, "
+                        "uzawa and condensed need K⁻¹ — prescribe a displacement or use "
+                        "signorini.stability.regularise(problem, 1e-8)")
+    return findings
+
+
+# --- problems, references and one run ------------------------------------------------------------
+
+
+def build_spec(spec: dict[str, Any]) -> ContactProblem:
+    """The problem a spec describes (a JSON-able dict, so that a worker can rebuild it).
+
+    ``{"kind": "scene", "scene", "params", "nondimensionalise"}``,
+    ``{"kind": "force-controlled", "params", "pressure", "regularisation"}`` or
+    ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`).
+    """
+    from .scenes import build_problem
+    from .scenes.block import force_controlled_problem
+
+    kind = spec["kind"]
+    if kind == "scene":
+        return build_problem(spec["scene"], nondimensionalise=spec.get("nondimensionalise", True),
+                             **spec.get("params", {}))
+    if kind == "force-controlled":
+        problem = force_controlled_problem(spec.get("pressure", 0.01), **spec.get("params", {}))
+        epsilon = spec.get("regularisation", 0.0)
+        return regularise(problem, epsilon) if epsilon else problem
+    if kind == "ill-posed":
+        return ill_posed_problem(spec["case"], **spec.get("params", {}))
+    raise ValueError(f"unknown problem kind {kind!r}")
+
+
+#: the ill-posed and infeasible inputs of axis 8
+ILL_POSED_CASES = {
+    "penetrated": "the Dirichlet data push the bottom 0.5 δ through the flat (bottom prescribed)",
+    "no-candidates": "an empty contact set (no candidate node)",
+    "zero-weight": "a candidate that lies on no contact edge (weight 0)",
+    "duplicate": "one bottom node listed twice as a candidate (λ not unique)",
+    "never-touches": "the flat 0.1 H below the bottom: contact never closes (λ = 0)",
+}
+
+
+def ill_posed_problem(case: str, **values: Any) -> ContactProblem:
+    """The block (``values`` are its parameters) made infeasible or ill-posed as ``case`` says.
+
+    ``case`` is one of :data:`ILL_POSED_CASES`. Cases the package refuses
+    raise :class:`~signorini.errors.InputError` here, from the assembly.
+    """
+    from .assembly import assemble
+    from .scenes import block
+    from .scenes.base import FlatObstacle
+
+    if case not in ILL_POSED_CASES:
+        raise InputError(f"unknown ill-posed case {case!r}: choose {', '.join(ILL_POSED_CASES)}")
+    p = block.FAMILY.parse(values)
+    model = block.build(p)
+    bottom = model.contact_nodes
+    if case == "penetrated":
+        model.dirichlet.append((1, bottom, -0.5 * p["delta"]))
+    elif case == "no-candidates":
+        model.contact_nodes = bottom[:0]
+    elif case == "zero-weight":
+        x, y = model.mesh.p
+        interior = int(np.argmin(np.hypot(x - 0.5 * p["W"], y - 0.5 * p["H"])))
+        model.contact_nodes = np.append(bottom, interior)
+    elif case == "duplicate":
+        model.contact_nodes = np.append(bottom, bottom[len(bottom) // 2])
+    elif case == "never-touches":
+        model.obstacle = FlatObstacle(-0.1 * p["H"])
+    problem = assemble(model)
+    problem.scene = f"block ({case})"
+    return problem
+
+
+def reference_solution(problem: ContactProblem, spec: dict[str, Any],
+                       other: ContactProblem | None = None) -> ContactSolution | None:
+    """The trusted exact answer for ``problem`` in its own units, or None when there is none.
+
+    ``spec["kind"]``: ``"pdas"`` (PDAS at :data:`REFERENCE_TOL` on ``problem``,
+    or on ``other`` — the same mesh in other units — converted), or
+    ``"force-controlled-exact"`` (the patch solution).
+    """
+    from .scenes.block import force_controlled_exact
+    from .solvers.registry import solve
+
+    if spec["kind"] == "force-controlled-exact":
+        return force_controlled_exact(problem)
+    source = problem if other is None else other
+    try:
+        solution = solve(source, "pdas", tol=REFERENCE_TOL)
+    except Exception as exc:  # the reference is optional: say so and go on
+        log.warning("no reference for %s: pdas raised %s", problem.scene, exc)
+        return None
+    if solution.status != "converged":
+        return None
+    if other is not None and spec.get("displacement_only"):
+        if other.n != problem.n:
+            raise ValueError("the reference problem has another mesh")
+        u_ratio = other.scales.displacement / problem.scales.displacement
+        return ContactSolution(method="pdas", u=solution.u * u_ratio,
+                               lam=np.full(problem.m, np.nan), status="converged",
+                               message=f"pdas displacement of another problem ({solution.message})")
+    if other is not None:
+        if other.n != problem.n or other.m != problem.m:
+            raise ValueError("the reference problem has another mesh")
+        u_ratio = other.scales.displacement / problem.scales.displacement
+        force_ratio = other.scales.force / problem.scales.force
+        solution = ContactSolution(method="pdas", u=solution.u * u_ratio,
+                                   lam=solution.lam * force_ratio, status="converged",
+                                   message=f"pdas in other units ({solution.message})")
+    return solution
+
+
+@dataclass(frozen=True)
+class Task:
+    """One run of the atlas: a method at a tolerance on a problem, and what to compare it with.
+
+    ``expect`` is ``"solve"`` when a right answer exists, ``"refuse"`` when
+    the right outcome is an error or a non-converged status (infeasible
+    input). ``answer`` says whether answers are compared by ``"lambda"``
+    or, where λ is not unique, by ``"displacement"``.
+    """
+
+    axis: str
+    case: str
+    value: float | str
+    problem: dict[str, Any]
+    method: str
+    tol: float | None = ATLAS_TOL
+    options: dict[str, Any] = field(default_factory=dict)
+    max_iter: int | None = None
+    reference: dict[str, Any] = field(default_factory=lambda: {"kind": "pdas"})
+    expect: str = "solve"
+    answer: str = "lambda"
+    measure: tuple[str, ...] = ()
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+class _Cache:
+    """Problems and references built in this process, the most recent few kept."""
+
+    def __init__(self, size: int = 4):
+        self.size = size
+        self.items: dict[str, Any] = {}
+
+    def get(self, key: str, make: Callable[[], Any]) -> Any:
+        if key not in self.items:
+            value = make()  # may raise: nothing is stored then
+            self.items[key] = value
+            while len(self.items) > self.size:
+                self.items.pop(next(iter(self.items)))
+        return self.items[key]
+
+
+def _key(*parts: Any) -> str:
+    return json.dumps(parts, sort_keys=True, default=str)
+
+
+def _certificate(problem: ContactProblem, solution: ContactSolution):
+    """The certificate; without the duality gap when K cannot be factorised."""
+    from .kkt import certificate
+
+    try:
+        return certificate(problem, solution)
+    except (np.linalg.LinAlgError, ArithmeticError, RuntimeError):
+        return certificate(problem, solution, duality_gap=False)
+
+
+def _own_answer(problem: ContactProblem, task: Task) -> ContactSolution:
+    """The method called directly, without the package's wrapper (when the wrapper raised)."""
+    from .solvers.registry import get_method
+
+    try:
+        solution = get_method(task.method).function(problem, tol=task.tol, max_iter=task.max_iter,
+                                                   **task.options)
+    except Exception as exc:
+        return ContactSolution.failure(task.method, problem, "failed",
+                                       f"{type(exc).__name__}: {exc}")
+    return solution
+
+
+def _hertz(problem: ContactProblem, solution: ContactSolution, prefix: str = "") -> dict[str, float]:
+    from .pressure import compare_hertz
+
+    if not problem.scene.startswith("hertz-cylinder") or not np.all(np.isfinite(solution.lam)):
+        return {}
+    try:
+        h = compare_hertz(problem, solution)
+    except Exception:  # an answer too wrong to measure (no contact at all)
+        return {}
+    return {f"{prefix}a_rel": h.a_rel, f"{prefix}p0_rel": h.p0_rel,
+            f"{prefix}pressure_l2_rel": h.pressure_l2_rel}
+
+
+def _bound_at_solution(problem: ContactProblem, reference: ContactSolution) -> float:
+    """``λ_max(W) / λ_max(W_AA)`` with A the exact active set: Uzawa's effective step bound.
+
+    Once the active set has settled, the iteration only sees the block
+    ``W_AA``, so steps up to ``2/λ_max(W_AA)`` (≥ ``2/λ_max(W)``) still
+    contract; returned as a multiple of the textbook bound ``2/λ_max(W)``.
+    """
+    from .condensed import delassus
+    from .kkt import active_set
+
+    W = delassus(problem.N, problem.factor())
+    active = active_set(problem, reference)
+    if not active.any():
+        return float("nan")
+    return float(np.linalg.eigvalsh(W)[-1] / np.linalg.eigvalsh(W[np.ix_(active, active)])[-1])
+
+
+def _force_error(problem: ContactProblem, reference: ContactSolution,
+                 solution: ContactSolution) -> float:
+    """``‖λ − λ*‖∞ / max(‖λ*‖∞, FORCE_FLOOR ‖f‖∞)``: the force error, judged as the certificate does.
+
+    The floor keeps the measure meaningful when the exact answer has no
+    contact force at all (λ* = 0), where a relative difference is 1 for any λ ≠ 0.
+    """
+    from .kkt import force_scale
+
+    if not np.all(np.isfinite(solution.lam)):
+        return float("inf")
+    return float(np.max(np.abs(solution.lam - reference.lam), initial=0.0)
+                 / force_scale(problem, reference.lam))
+
+
+def _weak_but_penetrating(problem: ContactProblem, solution: ContactSolution) -> int:
+    """Nodes :func:`signorini.kkt.classify` calls weakly active although they penetrate.
+
+    ``classify`` measures the gap as ``(d − Nu)⁺``, so a node with zero force
+    that overlaps the obstacle by more than the weak tolerance is labelled
+    weak and left out of :func:`signorini.kkt.compare` — a misclassification
+    the comparison does not count. The atlas counts it here.
+    """
+    from .kkt import WEAK, WEAK_TOL, classify, gap_scale
+
+    if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
+        return 0
+    labels = classify(problem, solution)
+    violation = (problem.N @ solution.u - problem.d) / gap_scale(problem, solution.u)
+    return int(np.sum((labels == WEAK) & (violation > WEAK_TOL)))
+
+
+def run_task(task: Task, cache: _Cache | None = None) -> dict[str, Any]:
+    """Run one task in this process and measure it: one row of the atlas."""
+    from .kkt import compare
+    from .pressure import contact_profile
+    from .solvers.registry import ACCEPT_FACTOR, DEFAULT_ACCEPT, solve
+
+    cache = cache or _Cache()
+    row: dict[str, Any] = {"axis": task.axis, "case": task.case, "value": task.value,
+                           "method": task.method, "tol": task.tol, "expect": task.expect,
+                           "options": json.dumps(task.options, sort_keys=True) if task.options else "",
+                           "problem": json.dumps(task.problem, sort_keys=True)}
+    try:
+        problem = cache.get(_key("problem", task.problem), lambda: build_spec(task.problem))
+    except InputError as exc:
+        row.update(status="input-error", wrapper="input-error", claimed_status="",
+                   message=str(exc), scene=task.problem.get("scene", "block"))
+        return _verdict(row, task)
+    row.update(scene=problem.scene, dofs=problem.n, candidates=problem.m)
+    if "diagnosis" in task.measure:
+        row["diagnosis"] = " | ".join(diagnose(problem))
+    if task.method == BUILD_ONLY:
+        row.update(status="built", wrapper="returned", claimed_status="",
+                   message="the problem was built: " + (row.get("diagnosis") or "no finding"))
+        return _verdict(row, task)
+
+    def make_reference():
+        other = None
+        if task.reference.get("problem") is not None:
+            other = cache.get(_key("problem", task.reference["problem"]),
+                              lambda: build_spec(task.reference["problem"]))
+        return reference_solution(problem, task.reference, other)
+
+    reference = cache.get(_key("reference", task.problem, task.reference), make_reference)
+    if reference is not None:
+        row.update(_hertz(problem, reference, "ref_"))
+        if "bound" in task.measure:
+            row["bound_at_solution"] = cache.get(_key("bound", task.problem),
+                                                 lambda: _bound_at_solution(problem, reference))
+    start = time.perf_counter()
+    wrapper = "returned"
+    try:
+        solution = solve(problem, task.method, tol=task.tol, max_iter=task.max_iter, **task.options)
+    except InputError as exc:
+        row.update(status="refused", wrapper="input-error", claimed_status="", message=str(exc),
+                   time_s=time.perf_counter() - start)
+        return _verdict(row, task)
+    except Exception as exc:  # the wrapper gave no status: record it, then ask the method itself
+        wrapper = f"raised {type(exc).__name__}: {exc}"
+        solution = _own_answer(problem, task)
+    elapsed = time.perf_counter() - start
+    claimed = solution.extras.get("claimed_status", solution.status)
+    cert = _certificate(problem, solution)
+    worst_name, worst = cert.worst()
+    accept = ACCEPT_FACTOR * task.tol if task.tol is not None else DEFAULT_ACCEPT
+    row.update(status=solution.status if wrapper == "returned" else "raised",
+               claimed_status=claimed, wrapper=wrapper, iterations=solution.iterations,
+               time_s=elapsed, kkt_worst=worst, kkt_name=worst_name,
+               cert_ok=bool(np.isfinite(worst) and worst <= accept), message=solution.message)
+    for name in ("rho_over_bound", "lambda_max"):
+        if name in solution.extras:
+            row[name] = float(solution.extras[name])
+    if reference is not None and task.answer == "displacement":
+        u_rel = compare(problem, reference, solution).u_rel
+        row.update(u_rel=u_rel, exact_ok=bool(u_rel <= AGREE_FACTOR * accept))
+    elif reference is not None and not np.all(np.isfinite(solution.lam)):
+        row.update(lam_rel=float("inf"), exact_ok=False, near_exact=False)  # no answer to compare
+    elif reference is not None:
+        vs = compare(problem, reference, solution)
+        strict = compare(problem, reference, solution, weak_tol=0.0)
+        lam_rel = _force_error(problem, reference, solution)
+        hidden = _weak_but_penetrating(problem, solution)
+        same = vs.misclassified == 0 and hidden == 0
+        row.update(lam_rel=lam_rel, u_rel=vs.u_rel, misclassified=vs.misclassified,
+                   weak=vs.weak, misclassified_strict=strict.misclassified,
+                   weak_penetrating=hidden,
+                   exact_ok=bool(same and lam_rel <= min(AGREE_FACTOR * accept, AGREE_CAP)),
+                   near_exact=bool(same and lam_rel <= NEAR_FACTOR * accept))
+    row.update(_hertz(problem, solution))
+    if "patch" in task.measure:
+        from .scenes.block import force_controlled_exact
+
+        row["patch_lam_rel"] = compare(problem, force_controlled_exact(problem), solution).lam_rel
+    if "profile" in task.measure and np.all(np.isfinite(solution.lam)):
+        from .pressure import compare_hertz
+
+        profile = contact_profile(problem, solution)
+        hertz = compare_hertz(problem, solution)
+        row["profile"] = {"x": profile.x.tolist(), "pressure": profile.pressure.tolist(),
+                          "a_ref": hertz.a_ref, "p0_ref": hertz.p0_ref}
+    return _verdict(row, task)
+
+
+def _verdict(row: dict[str, Any], task: Task) -> dict[str, Any]:
+    """Whether the method's claim and the package's status were right; the run's outcome.
+
+    ``exact_ok``: the answer agrees with the exact one (unknown without one: the
+    certificate stands in). ``claim_correct``: the method did not claim
+    success, or its answer passes the certificate and agrees. ``wrapper_right``:
+    ``converged`` only for an answer that agrees, and granted whenever the
+    method claimed success and the answer passes and agrees. ``conservative``:
+    the certificate turned down a claim whose answer does agree.
+    """
+    status, claimed = row.get("status"), row.get("claimed_status")
+    exact_ok = row.get("exact_ok")
+    if exact_ok is None:
+        exact_ok = row.get("cert_ok")
+    exact_ok = bool(exact_ok) and task.expect == "solve"
+    near_exact = bool(row.get("near_exact", exact_ok)) and exact_ok
+    cert_ok = bool(row.get("cert_ok"))
+    claimed_success = claimed == "converged"
+    row["claim_correct"] = (not claimed_success) or (cert_ok and exact_ok)
+    row["conservative"] = claimed_success and not cert_ok and near_exact
+    if status in ("input-error", "refused", "built", "timeout", "crashed"):
+        row["wrapper_right"] = True  # a clear error, or a method that never answered
+    elif status == "raised":
+        row["wrapper_right"] = False
+    elif status == "infeasible" and task.expect == "solve":
+        row["wrapper_right"] = False  # "infeasible" for a problem that has a solution
+    elif status == "converged":
+        row["wrapper_right"] = exact_ok
+    else:
+        row["wrapper_right"] = not (claimed_success and cert_ok and exact_ok)
+    if task.method == BUILD_ONLY:
+        flagged = status == "input-error" or bool(row.get("diagnosis"))
+        row["outcome"] = "right" if flagged == (task.expect == "refuse") else "wrong"
+    elif task.expect == "refuse":
+        row["outcome"] = "right" if status not in ("converged", "raised") else "wrong"
+    elif status == "converged":
+        row["outcome"] = "right" if exact_ok else "wrong"
+    elif status == "raised" or not row["wrapper_right"]:
+        row["outcome"] = "wrong"
+    elif row["conservative"]:
+        row["outcome"] = "conservative"  # a right answer the certificate did not accept
+    elif claimed_success:
+        row["outcome"] = "caught"  # the method claimed success; the certificate said no
+    else:
+        row["outcome"] = "failed"
+    return row
+
+
+# --- running many tasks: in this process or in a worker with a time limit ------------------------
+
+
+def _json_safe(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _json_safe(value.tolist())
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def serve_worker() -> None:
+    """The worker's loop: one JSON task per line on stdin, one JSON row per line back.
+
+    Anything a backend prints goes to stderr; the rows go to a private copy of
+    the original stdout.
+    """
+    channel = os.fdopen(os.dup(1), "w", buffering=1)
+    os.dup2(2, 1)
+    sys.stdout = sys.stderr
+    logging.disable(logging.WARNING)
+    cache = _Cache()
+    for line in sys.stdin:
+        task = Task(**json.loads(line))
+        try:
+            row = run_task(task, cache)
+        except Exception as exc:  # a bug of the atlas itself: one row says so
+            row = {"axis": task.axis, "case": task.case, "method": task.method,
+                   "status": "crashed", "wrapper": "atlas error", "outcome": "failed",
+                   "message": f"atlas error {type(exc).__name__}: {exc}"}
+        channel.write(json.dumps(_json_safe(row)) + "\n")
+
+
+class Worker:
+    """A child process that runs tasks, stopped and replaced when one exceeds ``time_limit``."""
+
+    def __init__(self, time_limit: float = DEFAULT_TIME_LIMIT):
+        self.time_limit = time_limit
+        self._proc: subprocess.Popen | None = None
+        self._stderr = None
+        self._buffer = b""
+
+    def _start(self) -> None:
+        self._stderr = tempfile.TemporaryFile()
+        self._proc = subprocess.Popen(
+            [sys.executable, "-c", "from signorini.stability import serve_worker; serve_worker()"],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._stderr)
+        self._buffer = b""
+
+    def stop(self) -> None:
+        """Stop the worker (it is restarted by the next task)."""
+        if self._proc is not None:
+            if self._proc.poll() is None:
+                self._proc.kill()
+            self._proc.wait()
+            for stream in (self._proc.stdin, self._proc.stdout):
+                try:
+                    stream.close()
+                except OSError:
+                    pass
+            self._proc = None
+        if self._stderr is not None:
+            self._stderr.close()
+            self._stderr = None
+
+    def _last_error_line(self) -> str:
+        if self._stderr is None:
+            return ""
+        self._stderr.seek(0)
+        lines = self._stderr.read().decode(errors="replace").strip().splitlines()
+        return lines[-1] if lines else ""
+
+    def run(self, task: Task) -> dict[str, Any]:
+        """The row of ``task``, or a ``timeout``/``crashed`` row."""
+        if self._proc is None or self._proc.poll() is not None:
+            self.stop()
+            self._start()
+        try:
+            self._proc.stdin.write((json.dumps(_json_safe(task.as_dict())) + "\n").encode())
+            self._proc.stdin.flush()
+        except BrokenPipeError:
+            return self._lost(task, "crashed")
+        deadline = time.monotonic() + self.time_limit
+        fd = self._proc.stdout.fileno()
+        while b"\n" not in self._buffer:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return self._lost(task, "timeout")
+            ready, _, _ = select.select([fd], [], [], remaining)
+            if not ready:
+                continue
+            chunk = os.read(fd, 1 << 16)
+            if not chunk:
+                return self._lost(task, "crashed")
+            self._buffer += chunk
+        line, self._buffer = self._buffer.split(b"\n", 1)
+        return json.loads(line)
+
+    def _lost(self, task: Task, status: str) -> dict[str, Any]:
+        detail = self._last_error_line() if status == "crashed" else ""
+        self.stop()
+        message = (f"no answer within {self.time_limit:g} s: the run was stopped"
+                   if status == "timeout" else f"the worker process died ({detail or 'no message'})")
+        row = {"axis": task.axis, "case": task.case, "value": task.value, "method": task.method,
+               "tol": task.tol, "expect": task.expect, "status": status, "claimed_status": "",
+               "problem": json.dumps(task.problem, sort_keys=True),
+               "options": json.dumps(task.options, sort_keys=True) if task.options else "",
+               "wrapper": status, "message": message, "time_s": self.time_limit
+               if status == "timeout" else float("nan")}
+        return _verdict(row, task)
+
+
+def _run_here(task: Task, cache: _Cache) -> dict[str, Any]:
+    """:func:`run_task` in this process; an error of the atlas itself becomes one row."""
+    try:
+        return run_task(task, cache)
+    except Exception as exc:
+        log.exception("the atlas failed on %s / %s", task.case, task.method)
+        return _verdict({"axis": task.axis, "case": task.case, "value": task.value,
+                         "method": task.method, "tol": task.tol, "status": "crashed",
+                         "claimed_status": "", "wrapper": "atlas error",
+                         "problem": json.dumps(task.problem, sort_keys=True),
+                         "message": f"atlas error {type(exc).__name__}: {exc}"}, task)
+
+
+def run_tasks(tasks: Sequence[Task], *, isolate: bool = True, time_limit: float = DEFAULT_TIME_LIMIT,
+              progress: Callable[[int, int, Task, dict[str, Any]], None] | None = None
+              ) -> list[dict[str, Any]]:
+    """Run ``tasks`` in order: in a worker process with a time limit, or in this process."""
+    rows = []
+    worker = Worker(time_limit) if isolate else None
+    cache = None if isolate else _Cache()
+    try:
+        for index, task in enumerate(tasks, start=1):
+            row = worker.run(task) if worker is not None else _run_here(task, cache)
+            row = {k: (float("nan") if v is None and k in NUMERIC else v) for k, v in row.items()}
+            rows.append(row)
+            if progress is not None:
+                progress(index, len(tasks), task, row)
+    finally:
+        if worker is not None:
+            worker.stop()
+    return rows
+
+
+# --- the axes ------------------------------------------------------------------------------------
+
+
+def atlas_methods(quick: bool = False) -> list[str]:
+    """Installed methods, exact ones first; a quick atlas takes :data:`QUICK_METHODS`."""
+    from .solvers.registry import methods
+
+    order = {"active set": 0, "dual": 1, "qp": 2, "cvxpy": 3}
+    found = sorted((m for m in methods(installed_only=True) if m.family != "user"),
+                   key=lambda m: (order.get(m.family, 4), m.name))
+    names = [m.name for m in found]
+    return [n for n in names if n in QUICK_METHODS] if quick else names
+
+
+def _scene(scene: str, nondimensionalise: bool = True, **params: Any) -> dict[str, Any]:
+    return {"kind": "scene", "scene": scene, "params": params, "nondimensionalise": nondimensionalise}
+
+
+def _capped(method: str, tol: float | None) -> int | None:
+    return ITERATION_CAPS.get(method) if tol is not None else None
+
+
+def _every_method(axis: str, case: str, value: Any, problem: dict[str, Any], methods: list[str],
+                  **extra: Any) -> list[Task]:
+    tol = extra.pop("tol", ATLAS_TOL)
+    return [Task(axis, case, value, problem, method, tol=tol, max_iter=_capped(method, tol), **extra)
+            for method in methods]
+
+
+# axis 1: Uzawa's step
+STEP_FRACTIONS = (0.05, 0.1, 0.25, 0.5, 0.75, 0.9, 0.95, 0.99, 1.01, 1.05, 1.1, 1.15, 1.2, 1.25,
+                  1.5, 2.0, 2.5)
+STEP_SCENES = {"hertz-cylinder": {"n_contact": 16, "grading": 0.4}, "block": {"nx": 8, "ny": 8}}
+QUICK_STEP_SCENES = {"hertz-cylinder": {"n_contact": 8, "grading": 0.5}, "block": {"nx": 4, "ny": 4}}
+STEP_CAPS = {"uzawa": 60_000, "uzawa-nesterov": 20_000}
+
+
+def _tasks_step(quick: bool, methods: list[str]) -> list[Task]:
+    fractions = (0.5, 0.95, 1.25) if quick else STEP_FRACTIONS
+    out = []
+    for scene, params in (QUICK_STEP_SCENES if quick else STEP_SCENES).items():
+        for method, cap in STEP_CAPS.items():
+            if method in methods:
+                out += [Task("uzawa-step", scene, fraction, _scene(scene, **params), method,
+                             options={"step_fraction": fraction}, max_iter=cap, measure=("bound",))
+                        for fraction in fractions]
+    return out
+
+
+# axis 2: mesh refinement
+MESH_BASE = {"n_contact": 8, "grading": 0.5}
+MESH_LEVELS = (0, 1, 2, 3)
+
+
+def _tasks_mesh(quick: bool, methods: list[str]) -> list[Task]:
+    out = []
+    for level in (MESH_LEVELS[:2] if quick else MESH_LEVELS):
+        out += _every_method("mesh", f"refine {level}", level,
+                             _scene("hertz-cylinder", **MESH_BASE, refine=level), methods)
+    return out
+
+
+# axis 3: tolerance
+TOLERANCES = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+TOLERANCE_SCENE = {"n_contact": 24, "grading": 0.35}
+QUICK_TOLERANCE_SCENE = {"n_contact": 8, "grading": 0.5}
+#: backends without a tolerance to set: run once, at their own settings
+NO_TOLERANCE = ("qp-quadprog",)
+
+
+def _tasks_tolerance(quick: bool, methods: list[str]) -> list[Task]:
+    problem = _scene("hertz-cylinder", **(QUICK_TOLERANCE_SCENE if quick else TOLERANCE_SCENE))
+    tolerances = (1e-3, 1e-8, None) if quick else TOLERANCES + (None,)
+    out = []
+    for method in methods:
+        if not (method.startswith("qp-") or method == "cvxpy"):
+            continue
+        for tol in ((None,) if method in NO_TOLERANCE else tolerances):
+            out.append(Task("tolerance", "default" if tol is None else f"{tol:.0e}",
+                            "default" if tol is None else tol, problem, method, tol=tol,
+                            max_iter=_capped(method, tol)))
+    return out
+
+
+# axis 4: units and scaling
+UNIT_SYSTEMS = (("E=1, R=1", 1.0, 1.0), ("E=1, R=0.01", 1.0, 0.01),
+                ("MPa, mm: E=2.1e5, R=10", 2.1e5, 10.0), ("Pa, m: E=2.1e11, R=0.01", 2.1e11, 0.01),
+                ("Pa, mm: E=2.1e11, R=10", 2.1e11, 10.0), ("E=2.1e11, R=1", 2.1e11, 1.0))
+UNITS_MESH = {"n_contact": 16, "grading": 0.4}
+
+
+def _tasks_units(quick: bool, methods: list[str]) -> list[Task]:
+    systems = UNIT_SYSTEMS[2:4] if quick else UNIT_SYSTEMS
+    mesh = QUICK_TOLERANCE_SCENE if quick else UNITS_MESH
+    out = []
+    for label, E, R in systems:
+        scaled = _scene("hertz-cylinder", **mesh, E=E, R=R)
+        for nondimensionalise in (True, False):
+            problem = _scene("hertz-cylinder", nondimensionalise, **mesh, E=E, R=R)
+            case = f"{label}, {'scaled' if nondimensionalise else 'raw'}"
+            out += _every_method("units", case, label, problem, methods,
+                                 reference={"kind": "pdas", "problem": scaled})
+    return out
+
+
+# axis 5: near-incompressibility
+POISSON = (0.3, 0.4, 0.45, 0.49, 0.499, 0.4999)
+POISSON_MESH = {"n_contact": 16, "grading": 0.4}
+
+
+def _tasks_poisson(quick: bool, methods: list[str]) -> list[Task]:
+    ratios = (0.3, 0.4999) if quick else POISSON
+    mesh = QUICK_TOLERANCE_SCENE if quick else POISSON_MESH
+    out = []
+    for nu in ratios:
+        problem = _scene("hertz-cylinder", **mesh, nu=nu)
+        for task in _every_method("poisson", "mesh A", nu, problem, methods):
+            out.append(Task(**{**task.as_dict(), "measure": ("profile",)}) if task.method == "pdas"
+                       else task)
+    for level, name in ((1, "mesh B"), (2, "mesh C"))[: 1 if quick else 2]:
+        out += [Task("poisson", name, nu, _scene("hertz-cylinder", **mesh, nu=nu, refine=level),
+                     "pdas", measure=("profile",)) for nu in ratios]
+    return out
+
+
+# axis 6: a body held only by contact
+FORCE_BLOCK = {"nx": 8, "ny": 8}
+REGULARISATION = 1e-8
+EPSILONS = (1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2)
+
+
+def _force_spec(params: dict[str, Any], epsilon: float = 0.0) -> dict[str, Any]:
+    return {"kind": "force-controlled", "params": params, "pressure": 0.01,
+            "regularisation": epsilon}
+
+
+def _tasks_force(quick: bool, methods: list[str]) -> list[Task]:
+    params = {"nx": 4, "ny": 4} if quick else FORCE_BLOCK
+    exact = {"kind": "force-controlled-exact"}
+    out = _every_method("force-control", "singular K", 0.0, _force_spec(params), methods,
+                        reference=exact, measure=("diagnosis", "patch"))
+    out += _every_method("force-control", f"regularised ε={REGULARISATION:g}", REGULARISATION,
+                         _force_spec(params, REGULARISATION), methods, measure=("patch",))
+    for epsilon in ((1e-8, 1e-2) if quick else EPSILONS):
+        for method in ("pdas", "qp-clarabel"):
+            if method in methods:
+                out.append(Task("force-control", f"ε={epsilon:g}", epsilon,
+                                _force_spec(params, epsilon), method, measure=("patch",)))
+    return out
+
+
+# axis 7: degenerate contact
+TOUCHING = (0.25, 0.5)
+
+
+def _tasks_degenerate(quick: bool, methods: list[str]) -> list[Task]:
+    params = {"nx": 4, "ny": 4} if quick else {"nx": 8, "ny": 8}
+    out = []
+    for touching in TOUCHING[:1] if quick else TOUCHING:
+        out += _every_method("degenerate", f"touching={touching:g}", touching,
+                             _scene("block", **params, touching=touching), methods)
+    return out
+
+
+# axis 8: infeasible and ill-posed input
+ILL_POSED_EXPECT = {"penetrated": "refuse", "no-candidates": "refuse", "zero-weight": "refuse",
+                    "duplicate": "solve", "never-touches": "solve"}
+
+
+def _tasks_ill_posed(quick: bool, methods: list[str]) -> list[Task]:
+    params = {"nx": 4, "ny": 4}
+    out = []
+    for case, expect in ILL_POSED_EXPECT.items():
+        spec = {"kind": "ill-posed", "case": case, "params": params}
+        flag = "solve" if case == "never-touches" else "refuse"  # the build row: flagged or clean
+        out.append(Task("ill-posed", case, case, spec, BUILD_ONLY, expect=flag,
+                        measure=("diagnosis",)))
+        if case == "duplicate":  # λ is not unique: compare u with that of the block listed once
+            reference = {"kind": "pdas", "problem": _scene("block", **params),
+                         "displacement_only": True}
+            out += _every_method("ill-posed", case, case, spec, methods, expect=expect,
+                                 answer="displacement", reference=reference)
+        elif case in ("penetrated", "never-touches"):
+            out += _every_method("ill-posed", case, case, spec, methods, expect=expect)
+    return out
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One sweep of the atlas: its tasks, what it asks and how it is reported."""
+
+    number: int
+    name: str
+    title: str
+    question: str
+    tasks: Callable[[bool, list[str]], list[Task]]
+
+
+AXES: tuple[Axis, ...] = (
+    Axis(1, "uzawa-step", "Uzawa's step ρ",
+         "Uzawa converges iff 0 < ρ < 2/λ_max(W): what happens on either side of the bound, and "
+         "does the package name a divergence or a two-step cycle?", _tasks_step),
+    Axis(2, "mesh", "Mesh refinement",
+         "How do iterations and time grow as h halves, and does PDAS stay mesh-independent?",
+         _tasks_mesh),
+    Axis(3, "tolerance", "Solver tolerance",
+         "At which tolerance does each QP backend find the right contact, and where is its own "
+         "'solved' dishonest?", _tasks_tolerance),
+    Axis(4, "units", "Units and scaling",
+         "What do raw units (E up to 2.1e11, lengths in m or mm) do to each method, with and "
+         "without the package's non-dimensionalisation?", _tasks_units),
+    Axis(5, "poisson", "Near-incompressibility",
+         "How does P1 locking show in the pressure as ν → 0.5, and do the solvers cope?",
+         _tasks_poisson),
+    Axis(6, "force-control", "A body held only by contact",
+         "K is singular under force control: which methods still work, and what does a small "
+         "regularisation cost?", _tasks_force),
+    Axis(7, "degenerate", "Degenerate contact",
+         "Nodes that touch with zero force: does the comparison classify them and stay quiet?",
+         _tasks_degenerate),
+    Axis(8, "ill-posed", "Infeasible and ill-posed input",
+         "Does every infeasible or ill-posed input end in a clear error or status?",
+         _tasks_ill_posed),
+)
+
+
+def select_axes(names: Iterable[str] | None) -> tuple[Axis, ...]:
+    """The axes named (by number or name) in ``names``; all when empty."""
+    names = list(names or [])
+    if not names:
+        return AXES
+    by_key = {str(a.number): a for a in AXES} | {a.name: a for a in AXES}
+    chosen = []
+    for name in names:
+        if name not in by_key:
+            raise InputError(f"--axis {name!r} is not an axis: choose a number 1-{len(AXES)} or one "
+                             f"of {', '.join(a.name for a in AXES)}")
+        if by_key[name] not in chosen:
+            chosen.append(by_key[name])
+    return tuple(sorted(chosen, key=lambda a: a.number))
+
+
+@dataclass
+class AtlasResult:
+    """Every row of an atlas run, the axes it covered and how long it took."""
+
+    rows: list[dict[str, Any]]
+    axes: tuple[Axis, ...]
+    elapsed_s: float
+    axis_seconds: dict[str, float]
+    quick: bool = False
+
+
+def run_atlas(axes: Sequence[Axis] = AXES, *, quick: bool = False, isolate: bool = True,
+              time_limit: float = DEFAULT_TIME_LIMIT, methods: Sequence[str] | None = None,
+              progress: Callable[[Axis, int, int, Task, dict[str, Any]], None] | None = None
+              ) -> AtlasResult:
+    """Run the tasks of ``axes`` with every installed method (or ``methods``).
+
+    Parameters
+    ----------
+    axes : the axes to run (:data:`AXES` by default).
+    quick : tiny meshes, few points and :data:`QUICK_METHODS` (a smoke test of the machinery).
+    isolate : run each task in a worker process with ``time_limit`` seconds (default), or here.
+    time_limit : seconds a task may take before its worker is stopped.
+    methods : the methods to run (default: :func:`atlas_methods`).
+    progress : called after each task with ``(axis, index, total, task, row)``.
+    """
+    if not (isinstance(time_limit, (int, float)) and math.isfinite(time_limit) and time_limit > 0):
+        raise InputError(f"--time-limit {time_limit!r} must be a positive number of seconds")
+    names = list(methods) if methods is not None else atlas_methods(quick)
+    start = time.perf_counter()
+    rows: list[dict[str, Any]] = []
+    seconds: dict[str, float] = {}
+    for axis in axes:
+        tasks = axis.tasks(quick, names)
+        began = time.perf_counter()
+        report = None if progress is None else (
+            lambda i, n, task, row, axis=axis: progress(axis, i, n, task, row))
+        rows += run_tasks(tasks, isolate=isolate, time_limit=time_limit, progress=report)
+        seconds[axis.name] = time.perf_counter() - began
+        log.info("axis %d (%s): %d runs in %.1f s", axis.number, axis.name, len(tasks),
+                 seconds[axis.name])
+    return AtlasResult(rows, tuple(axes), time.perf_counter() - start, seconds, quick)
+
+
+# --- summaries -----------------------------------------------------------------------------------
+
+
+def _method_rows(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
+    return [r for r in rows if r.get("method") != BUILD_ONLY]
+
+
+def method_summary(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per method: runs, claims of success, how many were correct, and the package's record.
+
+    ``correct_rate`` is the fraction of the method's own claims of success
+    that were true (NaN without claims); ``wrapper_rate`` the fraction of its
+    runs where the package's status was right.
+    """
+    out = []
+    runs = _method_rows(rows)
+    for method in dict.fromkeys(r["method"] for r in runs):
+        mine = [r for r in runs if r["method"] == method]
+        claims = [r for r in mine if r.get("claimed_status") == "converged"]
+        correct = sum(bool(r.get("claim_correct")) for r in claims)
+        wrapper = sum(bool(r.get("wrapper_right")) for r in mine)
+        statuses = {}
+        for r in mine:
+            statuses[r["status"]] = statuses.get(r["status"], 0) + 1
+        out.append({"method": method, "runs": len(mine), "claims": len(claims),
+                    "claims_correct": correct,
+                    "correct_rate": correct / len(claims) if claims else float("nan"),
+                    "right": sum(r.get("outcome") == "right" for r in mine),
+                    "conservative": sum(bool(r.get("conservative")) for r in mine),
+                    "wrapper_right": wrapper, "wrapper_rate": wrapper / len(mine),
+                    "statuses": statuses})
+    return out
+
+
+def wrapper_record(rows: list[dict[str, Any]]) -> tuple[int, int, list[dict[str, Any]]]:
+    """``(right, runs, faults)``: how often the package's status was right, and the rows where not."""
+    runs = _method_rows(rows)
+    faults = [r for r in runs if not r.get("wrapper_right")]
+    return len(runs) - len(faults), len(runs), faults
+
+
+def _applicable(axis: str, row: dict[str, Any]) -> bool:
+    """Runs that count for the method × axis verdict (inside Uzawa's bound; not refused)."""
+    if row.get("status") == "refused" or row.get("method") == BUILD_ONLY:
+        return False
+    if axis == "uzawa-step":
+        return row["value"] <= (0.5 if row["method"] == "uzawa-nesterov" else 1.0)
+    if axis == "force-control":
+        return not str(row["case"]).startswith("ε=")
+    return True
+
+
+def verdicts(rows: list[dict[str, Any]]) -> dict[tuple[str, str], str]:
+    """``(method, axis) → "works n/n" | "degrades k/n" | "fails 0/n"``: right runs among those that count."""
+    out = {}
+    for r in rows:
+        key = (r["method"], r["axis"])
+        if key in out or not _applicable(r["axis"], r):
+            continue
+        mine = [s for s in rows if (s["method"], s["axis"]) == key and _applicable(s["axis"], s)]
+        right = sum(s.get("outcome") == "right" for s in mine)
+        word = "works" if right == len(mine) else ("fails" if right == 0 else "degrades")
+        out[key] = f"{word} {right}/{len(mine)}"
+    return out
+
+
+# --- the report ----------------------------------------------------------------------------------
+
+_SHORT = {"converged": "conv", "inaccurate": "inacc", "max_iter": "max_it", "diverged": "div",
+          "infeasible": "infeas", "failed": "fail", "refused": "n/a", "input-error": "error",
+          "raised": "RAISED", "timeout": "timeout", "crashed": "crash", "built": "built"}
+
+
+def _num(value: Any, digits: int = 1) -> str:
+    if value is None or (isinstance(value, float) and not np.isfinite(value)):
+        return "–"
+    if isinstance(value, (int, np.integer)) or (isinstance(value, float) and value.is_integer()
+                                                 and abs(value) < 1e6 and digits == 0):
+        return f"{int(value):,}"
+    return f"{value:.{digits}e}"
+
+
+def _cell(row: dict[str, Any] | None, detail: str = "") -> str:
+    """Status, ``*`` for a false claim the package caught, ``°`` for a right answer it turned
+    down, ``!`` where the package's status was wrong; then ``detail``."""
+    if row is None:
+        return ""
+    text = _SHORT.get(row["status"], row["status"])
+    if row.get("outcome") == "caught":
+        text += "*"
+    if row.get("conservative"):
+        text += "°"
+    if not row.get("wrapper_right", True):
+        text += "!"
+    return f"{text} {detail}".strip()
+
+
+def _pivot(rows: list[dict[str, Any]], row_key: str, col_key: str,
+           cell: Callable[[dict[str, Any]], str], corner: str = "",
+           col_label: Callable[[Any], str] = str) -> list[str]:
+    row_values = list(dict.fromkeys(r[row_key] for r in rows))
+    col_values = list(dict.fromkeys(r[col_key] for r in rows))
+    index = {(r[row_key], r[col_key]): r for r in rows}
+    lines = ["| " + " | ".join([corner] + [col_label(c) for c in col_values]) + " |",
+             "|" + "---|" * (len(col_values) + 1)]
+    for value in row_values:
+        cells = [_cell_or_blank(index.get((value, c)), cell) for c in col_values]
+        lines.append("| " + " | ".join([str(value)] + cells) + " |")
+    return lines
+
+
+def _cell_or_blank(row: dict[str, Any] | None, cell: Callable[[dict[str, Any]], str]) -> str:
+    return "" if row is None else cell(row)
+
+
+def _axis_rows(rows: list[dict[str, Any]], axis: str) -> list[dict[str, Any]]:
+    return [r for r in rows if r["axis"] == axis]
+
+
+def _fraction_text(value: float) -> str:
+    return f"{value:g}×"
+
+
+# axis 1
+def _findings_step(rows: list[dict[str, Any]]) -> list[str]:
+    out = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        for method in dict.fromkeys(r["method"] for r in rows):
+            mine = sorted((r for r in rows if r["case"] == case and r["method"] == method),
+                          key=lambda r: r["value"])
+            if not mine:
+                continue
+            right = [r["value"] for r in mine if r["outcome"] == "right"]
+            failing = [r for r in mine if r["outcome"] != "right"]
+            text = f"**{case}, {method}** ({mine[0].get('dofs', 0):.0f} dofs): "
+            if right:
+                text += (f"right answer for ρ from {_fraction_text(min(right))} to "
+                         f"{_fraction_text(max(right))} the bound 2/λ_max(W)")
+                iters = {r["value"]: r["iterations"] for r in mine if r["outcome"] == "right"}
+                shown = [v for v in (0.05, 0.5, 0.95) if v in iters]
+                if shown:
+                    text += " (" + ", ".join(f"{iters[v]:,.0f} iterations at {_fraction_text(v)}"
+                                             for v in shown) + ")"
+            beyond = [r for r in failing if r["value"] > (max(right) if right else 0)]
+            if beyond:
+                kinds = {}
+                for r in beyond:
+                    kind = r["status"]
+                    if r["status"] == "diverged":
+                        kind = ("diverged: two-step cycle" if "cycle" in str(r["message"])
+                                else "diverged: growth")
+                    kinds.setdefault(kind, []).append(r["value"])
+                text += "; beyond: " + "; ".join(
+                    f"{kind} at {', '.join(_fraction_text(v) for v in values)}"
+                    for kind, values in kinds.items())
+            inside = [r for r in failing if right and r["value"] < max(right)]
+            if inside:
+                text += "; not right inside that range at " + ", ".join(
+                    f"{_fraction_text(r['value'])} ({r['status']})" for r in inside)
+            bound = mine[0].get("bound_at_solution")
+            if method == "uzawa" and bound is not None and np.isfinite(bound):
+                text += (f". On the exact active set A the bound is 2/λ_max(W_AA) = "
+                         f"{bound:.3f} × 2/λ_max(W)")
+                if right and max(right) > 1.0:
+                    text += (" — steps past 2/λ_max(W) can still converge, but the iteration "
+                             "starts from λ = 0, far from A, so the slack is smaller")
+            out.append(text + ".")
+    return out
+
+
+def _table_step(rows: list[dict[str, Any]]) -> list[str]:
+    for r in rows:
+        r["_column"] = f"{r['case']}, {r['method']}"
+    lines = _pivot(rows, "value", "_column",
+                   lambda r: _cell(r, f"{r.get('iterations', 0):,.0f}"),
+                   corner="ρ / (2/λ_max)")
+    for r in rows:
+        r.pop("_column", None)
+    return lines
+
+
+def _figure_step(rows: list[dict[str, Any]]):
+    from . import plots
+
+    ax = plots.atlas_step_sweep(rows)
+    ax.set_title("Axis 1: Uzawa's step (filled: right answer)", fontsize=9)
+    return ax.figure
+
+
+# axis 2
+def _findings_mesh(rows: list[dict[str, Any]]) -> list[str]:
+    levels = sorted({r["value"] for r in rows})
+    dofs = {lv: next(r["dofs"] for r in rows if r["value"] == lv) for lv in levels}
+    out = ["levels: " + ", ".join(f"refine {lv} = {dofs[lv]:,.0f} dofs" for lv in levels) + "."]
+    for method in dict.fromkeys(r["method"] for r in rows):
+        mine = sorted((r for r in rows if r["method"] == method), key=lambda r: r["value"])
+        if method in ("pdas", "uzawa", "uzawa-nesterov", "condensed"):
+            its = [r.get("iterations", float("nan")) for r in mine]
+            text = (f"**{method}**: iterations " + " → ".join(_num(i, 0) for i in its)
+                    + ", time " + " → ".join(f"{r.get('time_s', float('nan')):.2f}" for r in mine)
+                    + " s")
+            if len(its) >= 2 and all(np.isfinite(its)) and min(its) > 0:
+                growth = (its[-1] / its[0]) ** (1.0 / (len(its) - 1))
+                text += f" (×{growth:.2f} per halving of h"
+                if method == "pdas":
+                    step = (its[-1] - its[0]) / (len(its) - 1)
+                    text += (f": about {step:.1f} more steps per halving — nearly, not exactly, "
+                             "mesh-independent")
+                text += ")"
+            out.append(text + ".")
+    for level in levels:
+        mine = [r for r in rows if r["value"] == level]
+        right = [r for r in mine if r["outcome"] == "right"]
+        fastest = min(right, key=lambda r: r["time_s"]) if right else None
+        not_right = [f"{r['method']} ({_cell(r)})" for r in mine if r["outcome"] != "right"
+                     and r["status"] != "refused"]
+        text = f"refine {level}: {len(right)} of {len(mine)} methods right"
+        if fastest:
+            text += f", fastest {fastest['method']} ({fastest['time_s']:.2f} s)"
+        if not_right:
+            text += "; not right: " + ", ".join(not_right)
+        out.append(text + ".")
+    return out
+
+
+def _table_mesh(rows: list[dict[str, Any]]) -> list[str]:
+    dofs = {r["value"]: r.get("dofs") for r in rows}
+    return _pivot(rows, "method", "value",
+                  lambda r: _cell(r, f"{r.get('iterations', 0):,.0f} it, {r.get('time_s', 0):.2g} s"),
+                  corner="method", col_label=lambda v: f"refine {v} ({dofs[v]:,.0f} dofs)")
+
+
+def _figure_mesh(rows: list[dict[str, Any]]):
+    from matplotlib.figure import Figure
+
+    from . import plots
+
+    figure = Figure(figsize=(11, 4.4), layout="constrained")
+    left, right = figure.subplots(1, 2)
+    answered = [r for r in rows if r["status"] not in ("refused", "input-error")]
+    counted = [r for r in answered if (r.get("iterations") or 0) > 0]  # some backends say 0
+    plots.atlas_series(counted, "dofs", "iterations", ax=left,
+                       ylabel="iterations (as the method counts them)")
+    plots.atlas_series(answered, "dofs", "time_s", ax=right, ylabel="time (build + solve) [s]")
+    figure.suptitle("Axis 2: mesh refinement of Hertz's cylinder (filled: right answer)", fontsize=9)
+    return figure
+
+
+# axis 3
+def _findings_tolerance(rows: list[dict[str, Any]]) -> list[str]:
+    out = []
+    for method in dict.fromkeys(r["method"] for r in rows):
+        mine = [r for r in rows if r["method"] == method]
+        numeric = sorted((r for r in mine if r["value"] != "default"), key=lambda r: -r["value"])
+        right = [r for r in numeric if r["outcome"] == "right"]
+        false_claims = [r for r in mine if not r["claim_correct"]]
+        text = f"**{method}**: "
+        if right:
+            text += f"right from tol = {right[0]['value']:.0e}"
+            later = [r for r in numeric if r["value"] < right[0]["value"] and r["outcome"] != "right"]
+            if later:
+                text += " (not at " + ", ".join(f"{r['value']:.0e}: {_cell(r)}" for r in later) + ")"
+        elif numeric:
+            text += "right at no tolerance"
+        else:
+            text += "no tolerance to set"
+        if false_claims:
+            worst = max(false_claims, key=lambda r: (_wrong_nodes(r), r.get("lam_rel") or 0))
+            text += (f"; its own success was false in {len(false_claims)} of "
+                     f"{sum(r.get('claimed_status') == 'converged' for r in mine)} claims (worst at "
+                     f"tol {worst['case']}: {_plural(_wrong_nodes(worst), 'node')} misclassified, "
+                     f"λ off by {_num(worst.get('lam_rel'))}")
+            if np.isfinite(worst.get("a_rel", np.nan)):
+                text += (f", a off Hertz by {100 * worst['a_rel']:.1f} % and p₀ by "
+                         f"{100 * worst['p0_rel']:.1f} % where the exact answer gives "
+                         f"{100 * worst['ref_a_rel']:.1f} % and {100 * worst['ref_p0_rel']:.1f} %")
+            text += ")"
+        default = next((r for r in mine if r["value"] == "default"), None)
+        if default is not None:
+            text += (f"; at its own defaults: {_cell(default)}, λ off by "
+                     f"{_num(default.get('lam_rel'))}, {_plural(_wrong_nodes(default), 'node')} "
+                     "misclassified")
+            if np.isfinite(default.get("a_rel", np.nan)) and _wrong_nodes(default) > 0:
+                text += (f" (Hertz a off by {100 * default['a_rel']:.1f} %, p₀ by "
+                         f"{100 * default['p0_rel']:.1f} %)")
+        out.append(text + ".")
+    return out
+
+
+def _plural(count: float, noun: str) -> str:
+    if not np.isfinite(count):
+        return f"– {noun}s"
+    return f"{count:.0f} {noun}{'' if count == 1 else 's'}"
+
+
+def _wrong_nodes(row: dict[str, Any]) -> float:
+    """Misclassified nodes, counting those the package labels weak although they penetrate."""
+    values = [row.get("misclassified"), row.get("weak_penetrating")]
+    values = [v for v in values if isinstance(v, (int, float)) and np.isfinite(v)]
+    return float(sum(values)) if values else float("nan")
+
+
+def _nodes_text(row: dict[str, Any]) -> str:
+    hidden = row.get("weak_penetrating")
+    text = _num(row.get("misclassified"), 0)
+    if isinstance(hidden, (int, float)) and np.isfinite(hidden) and hidden > 0:
+        text += f"+{hidden:.0f}p"
+    return text
+
+
+def _table_tolerance(rows: list[dict[str, Any]]) -> list[str]:
+    return _pivot(rows, "method", "case",
+                  lambda r: _cell(r, f"{_num(r.get('lam_rel'), 0)}/{_nodes_text(r)}"),
+                  corner="backend \\ tol")
+
+
+def _figure_tolerance(rows: list[dict[str, Any]]):
+    from matplotlib.figure import Figure
+
+    from . import plots
+
+    numeric = [r for r in rows if r["value"] != "default"]
+    figure = Figure(figsize=(11, 4.4), layout="constrained")
+    left, right = figure.subplots(1, 2)
+    plots.atlas_series(numeric, "value", "lam_rel", ax=left, xlabel="tolerance asked for",
+                       ylabel="‖λ − λ*‖∞ / ‖λ*‖∞")
+    left.plot([1e-10, 1e-2], [1e-10, 1e-2], "k:", lw=0.8)
+    left.invert_xaxis()
+    plots.atlas_series(numeric, "value", "misclassified", ax=right, xlabel="tolerance asked for",
+                       ylabel="misclassified contact nodes", logy=False)
+    right.invert_xaxis()
+    figure.suptitle("Axis 3: tolerance (filled: right answer; red ring: the backend's own "
+                    "'solved' was false)", fontsize=9)
+    return figure
+
+
+# axis 4
+def _findings_units(rows: list[dict[str, Any]]) -> list[str]:
+    out = []
+    for scaling in ("scaled", "raw"):
+        mine = [r for r in rows if r["case"].endswith(scaling)]
+        systems = list(dict.fromkeys(r["value"] for r in mine))
+        counts = [f"{s}: {sum(r['outcome'] == 'right' for r in mine if r['value'] == s)}/"
+                  f"{sum(r['value'] == s for r in mine)}" for s in systems]
+        out.append(f"**{scaling}** — methods right per unit system: " + "; ".join(counts) + ".")
+    for method in dict.fromkeys(r["method"] for r in rows):
+        scaled = [r for r in rows if r["method"] == method and r["case"].endswith("scaled")]
+        raw = [r for r in rows if r["method"] == method and r["case"].endswith("raw")]
+        s_ok = sum(r["outcome"] == "right" for r in scaled)
+        r_ok = sum(r["outcome"] == "right" for r in raw)
+        if s_ok != r_ok or s_ok < len(scaled):
+            bad = [f"{r['value']} ({_cell(r)}, λ off {_num(r.get('lam_rel'))})"
+                   for r in raw if r["outcome"] != "right"]
+            text = f"**{method}**: right in {s_ok}/{len(scaled)} systems scaled, {r_ok}/{len(raw)} raw"
+            if bad:
+                text += "; raw units fail at " + "; ".join(bad)
+            out.append(text + ".")
+    return out
+
+
+def _table_units(rows: list[dict[str, Any]]) -> list[str]:
+    return _pivot(rows, "method", "case", lambda r: _cell(r, _num(r.get("lam_rel"), 0)),
+                  corner="method")
+
+
+def _figure_units(rows: list[dict[str, Any]]):
+    from matplotlib.figure import Figure
+
+    from . import plots
+
+    figure = Figure(figsize=(11, 5.0), layout="constrained")
+    left, right = figure.subplots(1, 2, sharey=True)
+    for ax, scaling in ((left, "scaled"), (right, "raw")):
+        plots.atlas_outcomes([r for r in rows if r["case"].endswith(scaling)], column="value", ax=ax,
+                             title=f"{'non-dimensionalised' if scaling == 'scaled' else 'raw units'}")
+    figure.suptitle("Axis 4: units (green: right; orange: false 'solved' caught; grey: no claim; "
+                    "red: the package's status was wrong)", fontsize=9)
+    return figure
+
+
+# axis 5
+def _findings_poisson(rows: list[dict[str, Any]]) -> list[str]:
+    out = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        pdas = sorted((r for r in rows if r["case"] == case and r["method"] == "pdas"),
+                      key=lambda r: r["value"])
+        if pdas and np.isfinite(pdas[0].get("p0_rel", np.nan)):
+            out.append(f"**pdas on {case}** ({pdas[0]['dofs']:,.0f} dofs), Hertz p₀ error: " + ", ".join(
+                f"ν={r['value']:g}: {100 * r['p0_rel']:.1f} %" for r in pdas)
+                + "; pressure L2 error: " + ", ".join(
+                f"{100 * r['pressure_l2_rel']:.1f} %" for r in pdas) + ".")
+    mesh_a = [r for r in rows if r["case"] == "mesh A"]
+    for nu in sorted({r["value"] for r in mesh_a}):
+        mine = [r for r in mesh_a if r["value"] == nu]
+        bad = [f"{r['method']} ({_cell(r)})" for r in mine if r["outcome"] != "right"
+               and r["status"] != "refused"]
+        text = f"ν = {nu:g}: {sum(r['outcome'] == 'right' for r in mine)}/{len(mine)} methods right"
+        out.append(text + (("; not: " + ", ".join(bad)) if bad else "") + ".")
+    uzawa = sorted((r for r in mesh_a if r["method"] == "uzawa"), key=lambda r: r["value"])
+    if uzawa:
+        out.append("uzawa iterations on mesh A: " + ", ".join(
+            f"ν={r['value']:g}: {r['iterations']:,.0f} ({_SHORT.get(r['status'], r['status'])})"
+            for r in uzawa) + ".")
+    return out
+
+
+def _table_poisson(rows: list[dict[str, Any]]) -> list[str]:
+    mesh_a = [r for r in rows if r["case"] == "mesh A"]
+    return _pivot(mesh_a, "method", "value",
+                  lambda r: _cell(r, f"{_num(r.get('lam_rel'), 0)}"), corner="method \\ ν")
+
+
+def _figure_poisson(rows: list[dict[str, Any]]):
+    from matplotlib.figure import Figure
+
+    from . import plots
+
+    figure = Figure(figsize=(11, 4.4), layout="constrained")
+    left, right = figure.subplots(1, 2)
+    pdas = [dict(r, incompressibility=0.5 - r["value"]) for r in rows if r["method"] == "pdas"]
+    plots.atlas_series(pdas, "incompressibility", "p0_rel", ax=left, group="case",
+                       xlabel="0.5 − ν", ylabel="Hertz p₀ relative error (pdas, exact)")
+    left.invert_xaxis()
+    profiles = {r["value"]: r["profile"] for r in pdas if r["case"] == "mesh A"
+                and isinstance(r.get("profile"), dict)}
+    if profiles:
+        low, high = min(profiles), max(profiles)
+        scaled = {nu: (np.asarray(p["x"]) / p["a_ref"], np.asarray(p["pressure"]) / p["p0_ref"])
+                  for nu, p in profiles.items()}
+        plots.pressure_profile(scaled[low][0], scaled[low][1], a_ref=1.0, p0_ref=1.0,
+                               label=f"ν = {low:g}", ax=right)
+        right.plot(scaled[high][0], scaled[high][1], "x-", ms=4, lw=0.6, color="C3",
+                   label=f"ν = {high:g}")
+        right.legend(fontsize=7)
+        right.set_xlim(0, 1.6)
+        right.set_title("pressure at the nodes (pdas, mesh A)", fontsize=8)
+    figure.suptitle("Axis 5: near-incompressibility — P1 locking in the contact pressure", fontsize=9)
+    return figure
+
+
+# axis 6
+def _findings_force(rows: list[dict[str, Any]]) -> list[str]:
+    out = []
+    for case in ("singular K", f"regularised ε={REGULARISATION:g}"):
+        mine = [r for r in rows if r["case"] == case]
+        if not mine:
+            continue
+        right = [r["method"] for r in mine if r["outcome"] == "right"]
+        raised = [r["method"] for r in mine if r["status"] == "raised"]
+        other = [f"{r['method']} ({_cell(r)})" for r in mine
+                 if r["outcome"] != "right" and r["status"] != "raised"]
+        text = f"**{case}** ({mine[0].get('dofs', 0):,.0f} dofs): right: {', '.join(right) or 'none'}"
+        if raised:
+            text += (f"; the package raised instead of giving a status for {', '.join(raised)} "
+                     f"(own answers: " + ", ".join(
+                         f"{r['method']} {r['claimed_status']}, λ off {_num(r.get('lam_rel'))}"
+                         for r in mine if r["status"] == "raised") + ")")
+        if other:
+            text += "; not right: " + ", ".join(other)
+        diagnosis = next((r.get("diagnosis") for r in mine if r.get("diagnosis")), "")
+        if diagnosis:
+            text += f". Diagnosis: “{diagnosis}”"
+        out.append(text + ".")
+    sweep = [r for r in rows if str(r["case"]).startswith("ε=")]
+    for method in dict.fromkeys(r["method"] for r in sweep):
+        mine = sorted((r for r in sweep if r["method"] == method), key=lambda r: r["value"])
+        out.append(f"**{method}, regularised**: λ off the exact patch solution by " + ", ".join(
+            f"{_num(r.get('patch_lam_rel'))} at ε={r['value']:g}" for r in mine) + ".")
+    return out
+
+
+def _table_force(rows: list[dict[str, Any]]) -> list[str]:
+    main = [r for r in rows if not str(r["case"]).startswith("ε=")]
+    return _pivot(main, "method", "case",
+                  lambda r: _cell(r, f"{_num(r.get('patch_lam_rel'), 0)}"), corner="method")
+
+
+def _figure_force(rows: list[dict[str, Any]]):
+    from matplotlib.figure import Figure
+
+    from . import plots
+
+    figure = Figure(figsize=(11, 4.8), layout="constrained")
+    left, right = figure.subplots(1, 2, width_ratios=(1.0, 0.8))
+    sweep = [r for r in rows if str(r["case"]).startswith("ε=")]
+    plots.atlas_series(sweep, "value", "patch_lam_rel", ax=left, xlabel="regularisation ε",
+                       ylabel="‖λ − λ_exact‖∞ / ‖λ_exact‖∞ (vs the unregularised patch solution)")
+    main = [r for r in rows if not str(r["case"]).startswith("ε=")]
+    plots.atlas_outcomes(main, column="case", ax=right, title="status per method")
+    figure.suptitle("Axis 6: a block held only by contact (force control, singular K)", fontsize=9)
+    return figure
+
+
+# axis 7
+def _findings_degenerate(rows: list[dict[str, Any]]) -> list[str]:
+    out = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        mine = [r for r in rows if r["case"] == case]
+        pdas = next((r for r in mine if r["method"] == "pdas"), mine[0])
+        converged = [r for r in mine if r["status"] == "converged"]
+        wolves = [r for r in converged if (r.get("misclassified") or 0) > 0]
+        strict = [r for r in converged if (r.get("misclassified_strict") or 0) > 0]
+        out.append(
+            f"**{case}** ({pdas.get('candidates', 0):.0f} candidates, {_num(pdas.get('weak'), 0)} "
+            f"weakly active in the exact answer): {len(converged)} methods converged; with weakly "
+            f"active nodes left out, {len(wolves)} of them show a misclassified node; counting "
+            f"strictly (weak tolerance 0), {len(strict)} would (up to "
+            f"{_plural(_most_strict(mine), 'node')} each).")
+    return out
+
+
+def _most_strict(rows: list[dict[str, Any]]) -> float:
+    return max((r.get("misclassified_strict") or 0 for r in rows), default=0)
+
+
+def _table_degenerate(rows: list[dict[str, Any]]) -> list[str]:
+    return _pivot(rows, "method", "case",
+                  lambda r: _cell(r, f"{_num(r.get('misclassified'), 0)} / "
+                                     f"{_num(r.get('misclassified_strict'), 0)} / {_num(r.get('weak'), 0)}"),
+                  corner="method")
+
+
+def _figure_degenerate(rows: list[dict[str, Any]]):
+    from . import plots
+
+    ax = plots.atlas_weak_nodes(rows)
+    ax.figure.set_size_inches(11, 4.4)
+    ax.set_title("Axis 7: degenerate contact — misclassified nodes with and without the weak label",
+                 fontsize=9)
+    return ax.figure
+
+
+# axis 8
+def _findings_ill_posed(rows: list[dict[str, Any]]) -> list[str]:
+    out = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        build = next((r for r in rows if r["case"] == case and r["method"] == BUILD_ONLY), None)
+        mine = [r for r in rows if r["case"] == case and r["method"] != BUILD_ONLY]
+        text = f"**{case}** — {ILL_POSED_CASES.get(case, case)}: "
+        if build is not None:
+            if build["status"] == "input-error":
+                text += f"refused when the problem is built: “{build['message']}”"
+            else:
+                text += ("built; the diagnosis says “" + build["diagnosis"] + "”"
+                         if build.get("diagnosis") else "built; nothing to diagnose")
+        if mine:
+            counts: dict[str, list[str]] = {}
+            for r in mine:
+                counts.setdefault(_cell(r), []).append(r["method"])
+            text += ". Methods: " + "; ".join(f"{k}: {', '.join(v)}" for k, v in counts.items())
+            unclear = [r for r in mine if r["status"] == "failed"]
+            if unclear:
+                text += (". Failure messages: " + "; ".join(
+                    f"{r['method']} “{str(r['message'])[:90]}”" for r in unclear[:3]))
+        out.append(text + ".")
+    return out
+
+
+def _table_ill_posed(rows: list[dict[str, Any]]) -> list[str]:
+    mine = [r for r in rows if r["method"] != BUILD_ONLY]
+    return _pivot(mine, "method", "case", lambda r: _cell(r), corner="method")
+
+
+def _figure_ill_posed(rows: list[dict[str, Any]]):
+    from . import plots
+
+    ax = plots.atlas_outcomes([r for r in rows if r["method"] != BUILD_ONLY], column="case",
+                              title="Axis 8: infeasible and ill-posed input (green: the right "
+                                    "status or answer)")
+    ax.figure.set_size_inches(7, 5)
+    return ax.figure
+
+
+REPORTS: dict[str, tuple[Callable, Callable, Callable, str]] = {
+    "uzawa-step": (_findings_step, _table_step, _figure_step,
+                   "Cells: status and iterations."),
+    "mesh": (_findings_mesh, _table_mesh, _figure_mesh, "Cells: status, iterations, time."),
+    "tolerance": (_findings_tolerance, _table_tolerance, _figure_tolerance,
+                  "Cells: status, λ error / misclassified nodes (`+kp`: k more nodes with zero "
+                  "force that penetrate, which `kkt.classify` labels weakly active)."),
+    "units": (_findings_units, _table_units, _figure_units, "Cells: status, λ error."),
+    "poisson": (_findings_poisson, _table_poisson, _figure_poisson,
+                "Mesh A; cells: status, λ error against PDAS on the same mesh."),
+    "force-control": (_findings_force, _table_force, _figure_force,
+                      "Cells: status, λ error against the exact patch solution."),
+    "degenerate": (_findings_degenerate, _table_degenerate, _figure_degenerate,
+                   "Cells: status, misclassified nodes (weak left out) / counted strictly / "
+                   "weakly active nodes."),
+    "ill-posed": (_findings_ill_posed, _table_ill_posed, _figure_ill_posed, "Cells: status."),
+}
+
+ADVICE = {
+    "uzawa-step": "keep `step_fraction` below 1 (the default 0.9); `uzawa-nesterov` needs at most "
+                  "0.5 (its default). Past the bound the package says `diverged` and names the "
+                  "two-step cycle or the growth; lower `rho` or `step_fraction`.",
+    "mesh": "on fine meshes use `pdas` (or `condensed` while the candidates are few): their "
+            "iterations barely grow, while Uzawa's double with every halving of h. Of the QP "
+            "backends only those shown right here reach tol 1e-8 honestly; check the status.",
+    "tolerance": "ask for the accuracy you need (`--tol`) and trust `converged` only; a "
+                 "backend's own 'solved' at its defaults or at a loose tolerance is no evidence "
+                 "of the right contact zone. For exact contact use `pdas`, `condensed`, daqp or "
+                 "quadprog (the last two on small problems).",
+    "units": "keep the default non-dimensionalisation. Raw units (`--raw-units`, "
+             "`nondimensionalise=False`) leave the exact methods unharmed but put the QP "
+             "backends' absolute tolerances at the mercy of E and the length unit.",
+    "poisson": "P1 triangles lock as ν → 0.5: the contact pressure oscillates from node to node "
+               "and refining the mesh cures it only slowly. Keep ν ≤ 0.45 where the pressure "
+               "matters, read p₀ from a smoothed or averaged pressure if you must go higher, and "
+               "for rubber-like materials use a mixed (u–p) or higher-order element, which this "
+               "package does not provide. The solvers are not the problem: the exact methods "
+               "solve every ν; first-order methods slow down with the conditioning.",
+    "force-control": "prescribe a displacement where you can (every scene of the package does). "
+                     "For a body held only by contact, `signorini.stability.regularise(problem, "
+                     "1e-8)` adds ε·mean(diag K) to the diagonal: PDAS, the condensed dual and "
+                     "the QP backends then solve it with λ within about 100 ε of the exact answer on "
+                     "the 8 × 8 block; "
+                     "Uzawa does not (its W gains an eigenvalue of order 1/ε). Run "
+                     "`signorini.stability.diagnose(problem)` to see whether K is singular.",
+    "degenerate": "nothing: nodes that touch with zero force are labelled weakly active and left "
+                  "out of active-set comparisons, so an inexact method is not blamed for them. "
+                  "Look at their count (`weak`) when two answers seem to disagree.",
+    "ill-posed": "run `signorini.stability.diagnose(problem)` on a problem you built yourself: it "
+                 "names infeasible candidates, duplicated candidates and a singular K in words. "
+                 "The package refuses an empty contact set and zero-weight candidates outright.",
+}
+
+SETUPS = {
+    "uzawa-step": f"Hertz's cylinder {STEP_SCENES['hertz-cylinder']} and the block "
+                  f"{STEP_SCENES['block']}; `uzawa` and `uzawa-nesterov` with "
+                  "`step_fraction` = ρ/(2/λ_max(W)) from 0.05 to 2.5, tol 1e-8, at most "
+                  f"{STEP_CAPS['uzawa']:,} (uzawa) and {STEP_CAPS['uzawa-nesterov']:,} "
+                  "(uzawa-nesterov) iterations.",
+    "mesh": f"Hertz's cylinder {MESH_BASE}, `refine` 0–3 (h halves each level); every method at "
+            "tol 1e-8.",
+    "tolerance": f"Hertz's cylinder {TOLERANCE_SCENE}; every QP backend and cvxpy at tol 1e-2 … "
+                 "1e-10 and at its own defaults (quadprog has no tolerance: defaults only).",
+    "units": f"Hertz's cylinder {UNITS_MESH}, a/R = 0.05, in six unit systems; each assembled "
+             "non-dimensionalised (the default) and raw (`nondimensionalise=False`, "
+             "`--raw-units`); every method at tol 1e-8; the exact answer is PDAS on the scaled "
+             "problem, converted.",
+    "poisson": f"Hertz's cylinder {POISSON_MESH} (mesh A) with every method, and PDAS alone on "
+               "refine 1 (mesh B) and refine 2 (mesh C); ν = 0.3 … 0.4999, tol 1e-8.",
+    "force-control": f"The block {FORCE_BLOCK} under a pressure q = 0.01 E on its top, only the "
+                     "symmetry plane prescribed (`signorini.scenes.block.force_controlled_problem`); "
+                     "the exact answer is the patch solution (p = q). Every method on the singular "
+                     f"problem and on `regularise(problem, {REGULARISATION:g})`; PDAS and Clarabel "
+                     "for ε from 1e-14 to 1e-2.",
+    "degenerate": "The block (8 × 8) with `touching` = 0.25 and 0.5: the outer part of the bottom "
+                  "meets an obstacle shaped exactly to where it goes unsupported, so those nodes "
+                  "touch with zero force. Every method at tol 1e-8.",
+    "ill-posed": "The block (4 × 4) made infeasible or ill-posed five ways "
+                 "(`signorini.stability.ill_posed_problem`); each problem is built and diagnosed "
+                 "(`signorini.stability.diagnose`), then solved by every method where it builds.",
+}
+
+
+def reproduction(row: dict[str, Any]) -> str:
+    """A Python line that repeats the run of ``row`` with the package's wrapper."""
+    options = json.loads(row["options"]) if row.get("options") else {}
+    arguments = f"tol={row['tol']!r}" if row.get("tol") is not None else "tol=None"
+    max_iter = ITERATION_CAPS.get(row["method"]) if row.get("tol") is not None else None
+    if row["axis"] == "uzawa-step":
+        max_iter = STEP_CAPS.get(row["method"])
+    if max_iter:
+        arguments += f", max_iter={max_iter}"
+    arguments += "".join(f", {k}={v!r}" for k, v in options.items())
+    return ("from signorini.stability import build_spec; from signorini.solvers.registry import solve; "
+            f"solve(build_spec({row['problem']}), {row['method']!r}, {arguments})")
+
+
+def _csv_text(rows: list[dict[str, Any]]) -> str:
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: _csv_value(row.get(k)) for k in COLUMNS})
+    return buffer.getvalue()
+
+
+def _csv_value(value: Any) -> Any:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return ""
+    return value
+
+
+def figure_name(axis: Axis) -> str:
+    """The file name of an axis's figure."""
+    return f"axis{axis.number}-{axis.name}.png"
+
+
+def write_report(result: AtlasResult, out: str | os.PathLike, command: str) -> dict[str, Path]:
+    """Write ``out/stability.md``; the runs (CSV, JSON) and a figure per axis in ``out/stability/``.
+
+    Every file is written whole or not at all (a temporary file, then a rename).
+    """
+    from .io import atomic_write_text, save_figure, to_json, writable_directory
+    from .report import provenance
+
+    directory = writable_directory(out)
+    data = writable_directory(Path(out) / "stability")
+    info = provenance()
+    rows = result.rows
+    paths = {"csv": data / "runs.csv", "json": data / "runs.json", "report": directory / "stability.md"}
+    right, runs, faults = wrapper_record(rows)
+    summary = method_summary(rows)
+    atomic_write_text(paths["csv"], _csv_text(rows))
+    atomic_write_text(paths["json"], to_json({
+        "command": command, "provenance": info, "elapsed_s": result.elapsed_s,
+        "axis_seconds": result.axis_seconds, "quick": result.quick,
+        "axes": [a.name for a in result.axes], "wrapper": {"right": right, "runs": runs},
+        "methods": summary, "verdicts": {f"{m} | {a}": v for (m, a), v in verdicts(rows).items()},
+        "rows": rows}) + "\n")
+    for axis in result.axes:
+        mine = _axis_rows(rows, axis.name)
+        if mine:
+            figure = REPORTS[axis.name][2](mine)
+            save_figure(figure, data / figure_name(axis))
+            paths[axis.name] = data / figure_name(axis)
+    atomic_write_text(paths["report"], report_markdown(result, command, info))
+    return paths
+
+
+def report_markdown(result: AtlasResult, command: str, info: dict[str, Any]) -> str:
+    """The atlas as Markdown: summary, the package's record, method × axis, then each axis."""
+    rows = result.rows
+    right, runs, faults = wrapper_record(rows)
+    minutes = result.elapsed_s / 60.0
+    md = ["# signorini stability atlas", "",
+          f"Command: `{command}`  ",
+          f"Run time: {result.elapsed_s:.0f} s ({minutes:.1f} min) for {runs} runs"
+          + (" (quick: tiny meshes, few methods)" if result.quick else "") + "; per axis: "
+          + ", ".join(f"{name} {sec:.0f} s" for name, sec in result.axis_seconds.items()) + "  ",
+          f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",
+          "Versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()), "",
+          "Every run is a method at a tolerance on one problem, in its own worker process with a "
+          f"time limit. Data: [`stability/runs.csv`](stability/runs.csv) and "
+          f"[`stability/runs.json`](stability/runs.json) (one row per run, with the problem's "
+          "spec to repeat it).", "",
+          "## How to read it", "",
+          "- **own status** (`claimed_status`): what the method said before the package judged "
+          "it; **status**: what `signorini.solvers.solve` returned.",
+          "- **certificate**: the worst relative KKT residual of `signorini.kkt.certificate`; it "
+          "passes when ≤ τ (the tolerance asked for; 1e-6 without one).",
+          "- **exact answer**: PDAS at 1e-9 on the non-dimensionalised problem (or the patch "
+          "solution where K is singular). An answer **agrees** when no contact node is "
+          "misclassified (`kkt.compare`, weakly active nodes left out — but a node with zero "
+          "force that penetrates the obstacle counts) and ‖λ − λ*‖∞ ≤ "
+          f"min({AGREE_FACTOR:g} τ, {AGREE_CAP:g}) · max(‖λ*‖∞, 1e-5 ‖f‖∞) (the validation "
+          "suite's ratio, capped so that a loose τ cannot excuse a wrong contact force).",
+          "- a method's claim of success is **correct** when its answer passes the certificate "
+          "and agrees; the **correct rate** is the share of its claims that were correct.",
+          "- the package's status is **right** when it says `converged` only for answers that "
+          "agree, grants `converged` whenever the claim was correct, and returns a status "
+          "instead of raising.",
+          "- outcomes: **right** (converged, agrees), **caught** (a false claim the package "
+          "downgraded to `inaccurate`), **conservative** (a claim the certificate turned down "
+          f"although λ is within {NEAR_FACTOR:g} τ of the exact answer), **failed** (no claim), "
+          "**wrong** (the package's status was wrong: `converged` for an answer that does not "
+          "agree, `infeasible` for a problem that has a solution, or an exception instead of a "
+          "status).",
+          "- in tables: `*` a false claim caught, `°` conservative, `!` the package's status was "
+          "wrong; `n/a` a dense backend refusing a problem above 3000 dofs.", "",
+          "## Per method", "",
+          "| method | runs | own claims of success | correct claims | correct rate | right answers "
+          "| package's status right | statuses |",
+          "|---|---:|---:|---:|---:|---:|---:|---|"]
+    for s in method_summary(rows):
+        rate = "–" if not np.isfinite(s["correct_rate"]) else f"{100 * s['correct_rate']:.0f} %"
+        statuses = ", ".join(f"{k} {v}" for k, v in sorted(s["statuses"].items()))
+        md.append(f"| {s['method']} | {s['runs']} | {s['claims']} | {s['claims_correct']} | {rate} "
+                  f"| {s['right']} | {s['wrapper_right']}/{s['runs']} | {statuses} |")
+    md += ["", "## The package's status", "",
+           f"**Right in {right} of {runs} runs ({100 * right / max(runs, 1):.1f} %).**", ""]
+    if faults:
+        md += ["Where it was not (each line repeats the run):", ""]
+        for r in faults:
+            detail = r.get("wrapper", "") if r["status"] == "raised" else r.get("message", "")
+            md.append(f"- axis {r['axis']}, {r['case']}, `{r['method']}`: status `{r['status']}`, "
+                      f"own `{r.get('claimed_status')}`; {str(detail)[:160]}; "
+                      f"λ off {_num(r.get('lam_rel'))}, {_nodes_text(r)} misclassified.  \n"
+                      f"  `{reproduction(r)}`")
+        md.append("")
+    conservative = [r for r in _method_rows(rows) if r.get("conservative")]
+    if conservative:
+        md += [f"{len(conservative)} runs were **conservative**: the method's answer agreed with the "
+               f"exact one to within {NEAR_FACTOR:g} τ but missed τ on the certificate, so the "
+               "package said `inaccurate` "
+               "(methods: " + ", ".join(sorted({r["method"] for r in conservative})) + ").", ""]
+    table = verdicts(rows)
+    axes = [a for a in result.axes if any(r["axis"] == a.name for r in rows)]
+    methods = list(dict.fromkeys(r["method"] for r in _method_rows(rows)))
+    md += ["## Method × axis", "",
+           "Right answers among the runs that count (inside the step bound on axis 1; not "
+           "refused for size): works = all, degrades = some, fails = none.", "",
+           "| method | " + " | ".join(f"{a.number}. {a.name}" for a in axes) + " |",
+           "|---|" + "---|" * len(axes)]
+    for method in methods:
+        md.append(f"| {method} | " + " | ".join(table.get((method, a.name), "–") for a in axes) + " |")
+    for axis in axes:
+        mine = _axis_rows(rows, axis.name)
+        findings, table_fn, _, legend = REPORTS[axis.name]
+        here_right, here_runs, _ = wrapper_record(mine)
+        md += ["", f"## {axis.number}. {axis.title}", "", f"*{axis.question}*", "",
+               f"Set-up: {SETUPS[axis.name]} {here_runs} runs, "
+               f"{result.axis_seconds.get(axis.name, float('nan')):.0f} s; the package's status "
+               f"was right in {here_right} of them.", "", "Findings:", ""]
+        md += [f"- {line}" for line in findings(mine)]
+        md += ["", f"What to do: {ADVICE[axis.name]}", "", legend, ""] + table_fn(mine)
+        md += ["", f"![axis {axis.number}](stability/{figure_name(axis)})"]
+    md += ["", "## Known limitations", "",
+           "- Times are single runs on a shared 2-core machine: compare them within one axis, "
+           "not across reports.",
+           "- The meshes are kept small so that the atlas runs in minutes; the mesh axis stops at "
+           "about 31k dofs. The benchmark (`signorini bench`) goes further.",
+           "- An answer is compared with one exact answer; at weakly active nodes any force "
+           "between 0 and round-off is right, so those nodes are left out of the comparison.",
+           "- Dense backends (daqp, quadprog, ECOS) refuse problems above 3000 dofs (`n/a`)."]
+    return "\n".join(md) + "\n"

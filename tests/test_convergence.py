@@ -1,0 +1,102 @@
+"""Convergence studies on tiny meshes: rates, agreement of the exact methods, files, the CLI."""
+
+import json
+
+import numpy as np
+import pytest
+
+from signorini.cli import main
+from signorini.convergence import (dofs_for_error, fitted_rate, grading_comparison, plot_convergence,
+                                   plot_grading, plot_punch_edge, plot_punch_pressure, run_study,
+                                   write_study)
+from signorini.errors import InputError
+from signorini.scenes import build_problem
+from signorini.solvers.registry import solve
+
+TINY = {"a_over_R": 0.2, "n_contact": 6, "grading": 0.8}
+
+
+def test_fitted_rate_recovers_a_power_law():
+    h = np.array([0.1, 0.05, 0.025, 0.0125])
+    assert fitted_rate(h, 3.0 * h ** 1.5) == pytest.approx(1.5)
+    assert np.isnan(fitted_rate(h[:1], h[:1]))
+
+
+def test_dofs_for_error_interpolates_and_extrapolates():
+    dofs = np.array([100.0, 400.0, 1600.0])
+    error = 10.0 / np.sqrt(dofs)  # 1.0, 0.5, 0.25
+    assert dofs_for_error(dofs, error, 0.5) == (pytest.approx(400.0), "interpolated")
+    value, how = dofs_for_error(dofs, error, 0.1)
+    assert how == "extrapolated" and value == pytest.approx(10_000.0)
+    assert dofs_for_error(dofs, error[::-1], 0.01)[1] == "not reached"
+
+
+@pytest.fixture(scope="module")
+def hertz_study():
+    return run_study("hertz-cylinder", 2, TINY)
+
+
+def test_exact_methods_coincide_and_errors_fall(hertz_study):
+    study = hertz_study
+    assert set(study.methods) >= {"pdas"}
+    assert study.max_disagreement() < 1e-9
+    for method in study.methods:
+        _, dofs, p0 = study.series(method, "p0_rel")
+        assert len(p0) == 3 and np.all(np.diff(dofs) > 0)
+        assert p0[-1] < p0[0]
+        assert study.rates[method]["p0_rel"] > 0.5
+    rates = [study.rates[m]["p0_rel"] for m in study.methods]
+    assert max(rates) - min(rates) < 1e-6
+
+
+def test_punch_study_shows_the_edge_singularity():
+    study = run_study("punch", 2, {"n_contact": 4, "grading": 0.8, "size": 6}, methods=["pdas"])
+    assert study.rates["pdas"]["edge_over_centre"] == pytest.approx(-0.5, abs=0.1)
+    assert study.rates["pdas"]["pressure_max_rel"] > 0.5
+
+
+def test_grading_comparison_at_equal_dofs():
+    graded = run_study("hertz-cylinder", 2, TINY, methods=["pdas"])
+    comparison = grading_comparison("hertz-cylinder", graded, 1, {"a_over_R": 0.2}, target=0.05)
+    assert comparison.uniform_dofs > comparison.graded_dofs > 0
+    assert comparison.saving > 1
+    for ax in (plot_grading(comparison), plot_convergence(graded)):
+        assert ax.get_xscale() == "log"
+
+
+def test_write_study_writes_markdown_json_and_figures(hertz_study, tmp_path):
+    paths = write_study(hertz_study, tmp_path, "signorini converge hertz-cylinder --levels 2")
+    payload = json.loads(paths["json"].read_text())
+    assert payload["study"]["scene"] == "hertz-cylinder"
+    assert "rates" in payload["study"] and paths["figure"].stat().st_size > 10_000
+    assert "Fitted rates" in paths["markdown"].read_text()
+
+
+def test_punch_figures_take_and_return_axes():
+    from matplotlib.figure import Figure
+
+    problem = build_problem("punch", n_contact=8, grading=0.8, size=6)
+    solution = solve(problem, "pdas", tol=1e-10)
+    ax = Figure().add_subplot()
+    assert plot_punch_pressure(problem, solution, ax=ax) is ax
+    assert plot_punch_edge(problem, solution).get_yscale() == "log"
+
+
+def test_bad_studies_are_input_errors():
+    with pytest.raises(InputError, match="no 'refine' parameter"):
+        run_study("block", 1)
+    with pytest.raises(InputError, match="--levels"):
+        run_study("hertz-cylinder", 9)
+    with pytest.raises(InputError, match="refine"):
+        run_study("hertz-cylinder", 1, {"refine": 2})
+
+
+def test_cli_converge(tmp_path, capsys):
+    out = tmp_path / "conv"
+    code = main(["converge", "punch", "--levels", "1", "--set", "n_contact=4", "--set", "grading=0.8",
+                 "--set", "size=6", "--out", str(out)])
+    assert code == 0
+    assert (out / "convergence-punch.md").exists() and (out / "convergence-punch.png").exists()
+    assert "Fitted rates" in capsys.readouterr().out
+    assert main(["converge", "block", "--levels", "1", "--out", str(out)]) == 2
+    assert "refine" in capsys.readouterr().err
