@@ -165,9 +165,6 @@ def test_regularise_refuses_a_bad_epsilon(epsilon):
         regularise(force_controlled_problem(**TINY_BLOCK), epsilon)
 
 
-@pytest.mark.xfail(strict=True, reason="registry.judge → kkt.certificate → problem.factor() raises "
-                   "LinAlgError for a singular K, and PDAS's CholmodNotPositiveDefiniteError is not "
-                   "caught by registry.solve (reported; files not owned here)")
 @pytest.mark.parametrize("method", ["pdas", "qp-clarabel"])
 def test_a_singular_k_gets_a_status_not_an_exception(method):
     solution = solve(force_controlled_problem(**TINY_BLOCK), method, tol=1e-8)
