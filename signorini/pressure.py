@@ -120,19 +120,23 @@ class HertzComparison:
 def compare_hertz(problem: ContactProblem, solution: ContactSolution) -> HertzComparison:
     """Compare ``solution`` of a Hertz cylinder scene with Hertz's solution."""
     profile = contact_profile(problem, solution)
-    R = problem.params["R"]
-    P = profile.total_force
+    return _against_cylinder(problem, profile, profile.total_force)
+
+
+def _against_cylinder(problem: ContactProblem, profile: ContactProfile, P: float) -> HertzComparison:
+    """A 2D contact profile (sorted by x) against Hertz's cylinder carrying the load P."""
     if not P > 0:
         nan = float("nan")
         return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
-    a_ref = hertz_cylinder_half_width(P, R, contact_modulus(problem.params["E"], problem.params["nu"]))
+    E_star = contact_modulus(problem.params["E"], problem.params["nu"])
+    a_ref = hertz_cylinder_half_width(P, problem.params["R"], E_star)
     p0_ref = hertz_cylinder_peak(P, a_ref)
     return HertzComparison(
         a=contact_half_width(profile), a_ref=a_ref,
         p0=float(profile.pressure[np.argmin(profile.x)]), p0_ref=p0_ref,
         pressure_l2_rel=_l2_relative(profile.x, profile.pressure,
                                      lambda x: hertz_pressure(x, a_ref, p0_ref)),
-        force_balance=abs(P - profile.applied_load) / abs(P) if P else float("inf"),
+        force_balance=abs(P - profile.applied_load) / P,
         edge_margin=float(profile.x.max() / a_ref))
 
 
@@ -398,16 +402,4 @@ def compare_reverse_hertz(problem: ContactProblem, solution: ContactSolution) ->
     tilt by up to a/R, and force balance holds for the resultant.
     """
     profile = _half_line(problem, contact_profile(problem, solution))
-    R = problem.params["R"]
-    P = load_resultant(problem, solution.lam)
-    if not P > 0:
-        nan = float("nan")
-        return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
-    a_ref = hertz_cylinder_half_width(P, R, contact_modulus(problem.params["E"], problem.params["nu"]))
-    p0_ref = hertz_cylinder_peak(P, a_ref)
-    return HertzComparison(
-        a=contact_half_width(profile), a_ref=a_ref, p0=float(profile.pressure[0]), p0_ref=p0_ref,
-        pressure_l2_rel=_l2_relative(profile.x, profile.pressure,
-                                     lambda x: hertz_pressure(x, a_ref, p0_ref)),
-        force_balance=abs(P - profile.applied_load) / abs(P),
-        edge_margin=float(profile.x.max() / a_ref))
+    return _against_cylinder(problem, profile, load_resultant(problem, solution.lam))

@@ -15,7 +15,7 @@ from .io import atomic_write_text, save_figure, to_json, writable_directory
 from .kkt import certificate
 from .pressure import compare_hertz, compare_hertz_sphere, contact_profile
 from .problem import ContactProblem, ContactSolution
-from .scenes import get_scene, scene_reference
+from .scenes import scene_reference
 from .suite import LIMITS, SuiteResult
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",

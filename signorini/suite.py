@@ -21,7 +21,7 @@ from .kkt import certificate, compare
 from .pressure import (compare_hertz, compare_hertz_sphere, compare_punch, compare_reverse_hertz,
                        compare_uniform, contact_profile, radial_distance)
 from .problem import ContactProblem, ContactSolution
-from .scenes import build_problem, get_scene, scene_reference
+from .scenes import build_problem, scene_reference
 from .solvers.registry import Method, get_method, methods, solve
 
 log = logging.getLogger(__name__)

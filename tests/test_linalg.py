@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
 
 from signorini.errors import InputError
 from signorini.linalg import (ActiveSetSolver, available_backends, factorize, resolve_backend,
