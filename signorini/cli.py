@@ -174,6 +174,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
+    import math
     from pathlib import Path
 
     from .bench import TOLERANCES, Run, run_benchmark, write_report
@@ -188,6 +189,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     except ValueError:
         raise InputError(f"--sizes {args.sizes!r} is not a comma-separated list of refinement "
                          "levels, e.g. --sizes 0,1,2") from None
+    if not (math.isfinite(args.time_limit) and args.time_limit > 0):
+        raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
+                         "e.g. --time-limit 120")
     tolerances = args.tolerance.split(",")
     unknown = [t for t in tolerances if t not in TOLERANCES]
     if unknown:
@@ -200,7 +204,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
         params = {**base, "refine": level}
         family.parse(params)  # bad scene parameters fail here, before any run
         for method in chosen:
-            for tolerance in (["high"] if method.exact else tolerances):
+            few = args.default_only_from is not None and level >= args.default_only_from
+            for tolerance in (["high"] if method.exact else ["default"] if few else tolerances):
                 runs.append(Run(args.scene, f"refine{level}", params, method.name, tolerance))
 
     def progress(i, n, run, row):
@@ -333,6 +338,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--tolerance", default="low,mid,high,default",
                        help="tolerance levels: low (1e-3), mid (1e-6), high (1e-9), default")
     bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    bench.add_argument("--default-only-from", type=int, default=None, metavar="LEVEL",
+                       help="from this refinement level on, iterative methods run at their "
+                            "default tolerance only (large sizes)")
     bench.add_argument("--time-limit", type=float, default=600.0, help="seconds per run")
     bench.add_argument("--out", default="bench-report")
     bench.add_argument("--report-only", action="store_true", help="rewrite the report from the CSV")

@@ -145,6 +145,20 @@ class ContactProblem:
                 f"contact candidate {bad} has weight {self.weights[bad]:g} ≤ 0: "
                 "every candidate must lie on a boundary edge of positive length")
         self._factor = None
+        self._basis = None
+
+    @property
+    def basis(self):
+        """scikit-fem's vector P1 basis on ``mesh`` (built when first asked for)."""
+        if self._basis is None and self.mesh is not None:
+            from skfem import Basis, ElementVector
+
+            self._basis = Basis(self.mesh, ElementVector(self.mesh.elem()))
+        return self._basis
+
+    @basis.setter
+    def basis(self, value) -> None:
+        self._basis = value
 
     @property
     def n(self) -> int:
@@ -212,7 +226,7 @@ class ContactProblem:
                              load_offset=scale * pu.offset1, prescribed=self.prescribed * ratio,
                              params=params, push=Push(pu.f1, pu.d0, pu.d1, pu.offset1, scale))
         new._factor = self._factor  # K is unchanged: keep its factorisation
-        for name in ("basis",):
+        for name in ("basis", "zone_solver", "zone"):
             if hasattr(self, name):
                 setattr(new, name, getattr(self, name))
         return new

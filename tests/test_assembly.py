@@ -318,3 +318,37 @@ def test_P_and_a_over_R_together_raise():
     with pytest.raises(InputError, match="P") as info:
         build_problem("hertz-cylinder", **HERTZ, P=0.004, a_over_R=0.05)
     assert "a_over_R" in str(info.value)
+
+
+def test_vectorised_plane_strain_stiffness_is_scikit_fems():
+    from skfem import Basis, ElementVector, MeshTri, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    from signorini.assembly import plane_strain_stiffness
+
+    mesh = MeshTri.init_circle(3)
+    mesh = MeshTri(mesh.p * [[2.0], [0.5]], mesh.t)  # stretched: elements of many shapes
+    Lambda, Mu = lame_parameters(3.0, 0.3)
+    expected = asm(linear_elasticity(Lambda, Mu), Basis(mesh, ElementVector(mesh.elem())))
+    difference = abs(plane_strain_stiffness(mesh, Lambda, Mu) - expected).max()
+    assert difference <= 1e-12 * abs(expected).max()
+
+
+@pytest.mark.parametrize("axisymmetric", [False, True])
+def test_closed_form_contact_weights_are_scikit_fems(axisymmetric):
+    from skfem import FacetBasis, LinearForm, MeshTri, asm
+
+    from signorini.assembly import contact_weights
+
+    mesh = MeshTri.init_circle(3)
+    mesh = MeshTri(mesh.p + [[1.5], [0.0]], mesh.t)  # r > 0 everywhere
+    facets = mesh.boundary_facets()
+    nodes = mesh.boundary_nodes()
+    basis = FacetBasis(mesh, mesh.elem(), facets=facets, intorder=2)
+
+    @LinearForm
+    def weight(v, w):
+        return v * w.x[0] if axisymmetric else v
+
+    np.testing.assert_allclose(contact_weights(mesh, facets, nodes, axisymmetric),
+                               asm(weight, basis)[nodes], rtol=1e-12)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import InputError
-from ..problem import ContactProblem
+from ..problem import ContactProblem, Scales
 from . import block, hertz_cylinder, hertz_sphere, hertz_sphere_3d, punch, reverse_hertz
 from .base import FlatObstacle, Param, SceneFamily, SceneModel
 
@@ -27,6 +27,64 @@ def scene_reference(name: str) -> str:
     return SCENES[name].reference if name in SCENES else ""
 
 
+#: load targeting on a model of at least this many dofs first solves a coarser model of the
+#: scene (when the family has one) and calibrates around its contact zone (signorini.nested)
+NESTED_FROM_DOFS = 20_000
+_LOAD_NAMES = ("P", "delta", "a_over_R", "load_ratio")
+
+
+def coarse_values(name: str, params: dict[str, Any]) -> dict[str, Any] | None:
+    """Parameters of a model of scene ``name`` about 16 times coarser than ``params``, or None.
+
+    Families with ``refine`` and ``n_contact`` lose two uniform refinements
+    (or one, and half the elements across the contact); the load is the
+    same target P, or the same push ``delta`` when no target was set.
+    """
+    family = SCENES.get(name)
+    names = {p.name for p in family.params} if family else set()
+    if not {"refine", "n_contact", "P", "delta"} <= names:
+        return None
+    values = {k: v for k, v in params.items() if k in names and k not in _LOAD_NAMES}
+    if params["refine"] >= 2:
+        values["refine"] = params["refine"] - 2
+    elif params["refine"] == 1 and params["n_contact"] >= 8:
+        values.update(refine=0, n_contact=params["n_contact"] // 2)
+    else:
+        return None
+    if params.get("P") is not None:
+        values["P"] = params["P"]
+    elif params.get("delta") is not None:
+        values["delta"] = params["delta"]
+    else:
+        return None
+    return values
+
+
+def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
+    """A coarser model of the scene ``problem`` was built from (None when there is none)."""
+    values = coarse_values(problem.scene, problem.params)
+    if values is None:
+        return None
+    return build_problem(problem.scene, nondimensionalise=problem.scales != Scales(), **values)
+
+
+def predicted_zone(name: str, model: SceneModel, nondimensionalise: bool):
+    """The contact zone of a large load-targeted model, predicted from a coarser one (or None)."""
+    from ..nested import predict_zone
+    from ..solvers.registry import solve
+
+    dofs = model.mesh.p.shape[0] * model.mesh.p.shape[1]
+    values = coarse_values(name, model.params)
+    if model.target_load is None or dofs < NESTED_FROM_DOFS or values is None:
+        return None
+    coarse = build_problem(name, nondimensionalise=nondimensionalise, **values)
+    solution = solve(coarse, "nested")
+    if solution.status != "converged":
+        return None
+    points = model.mesh.p[:, model.contact_nodes].T / coarse.scales.length
+    return predict_zone(points, coarse.contact_points, solution.lam > 0)
+
+
 def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> ContactProblem:
     """Build scene ``name`` with parameter ``values`` and assemble its contact problem.
 
@@ -35,6 +93,7 @@ def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> C
     """
     from ..assembly import assemble
 
+    zone = None
     if name.lower().endswith(".toml"):  # a scene file: signorini.scenefile
         from ..scenefile import build_scene_model
 
@@ -43,10 +102,11 @@ def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> C
         family = get_scene(name)
         params = family.parse(values)
         model = family.build(params, set(values))
-    problem = assemble(model, nondimensionalise=nondimensionalise)
+        zone = predicted_zone(name, model, nondimensionalise)
+    problem = assemble(model, nondimensionalise=nondimensionalise, zone=zone)
     problem.scene = name
     return problem
 
 
-__all__ = ["SCENES", "FlatObstacle", "Param", "SceneFamily", "SceneModel", "build_problem", "get_scene",
-           "scene_reference"]
+__all__ = ["SCENES", "FlatObstacle", "Param", "SceneFamily", "SceneModel", "build_problem",
+           "coarse_problem", "coarse_values", "get_scene", "scene_reference"]

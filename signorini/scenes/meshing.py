@@ -257,16 +257,61 @@ def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: floa
 
     snap = snap_to_circle((0.0, 1.0), 1.0)
     mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
-    for _ in range(refine):
-        mesh = snap(mesh.refined())
     arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
-    arc = np.union1d(arc, np.nonzero(np.hypot(*mesh.p) < 1e-12)[0])  # the first point of contact
-    mesh = MeshTri(mesh.p * R, mesh.t)
+    ends = np.nonzero((np.hypot(*mesh.p) < 1e-12)  # the first point of contact, the top corner
+                      | (np.hypot(mesh.p[0] - 1.0, mesh.p[1] - 1.0) < 1e-12))[0]
+    chain = np.union1d(arc, ends)
+    chain = chain[np.argsort(np.arctan2(mesh.p[1, chain] - 1.0, mesh.p[0, chain]))]  # from the bottom
+    p, t = mesh.p, mesh.t
+    for _ in range(refine):
+        p, t, chain = refine_uniformly(p, t, chain)
+        offset = p[:, chain] - np.array([[0.0], [1.0]])
+        p[:, chain] = np.array([[0.0], [1.0]]) + offset / np.linalg.norm(offset, axis=0)
+    mesh = MeshTri(p * R, t)
     x, y = mesh.p
-    candidates = arc[x[arc] <= candidate_extent * a_over_R * R * (1 + 1e-9)]
-    facets = mesh.boundary_facets()
-    on_arc = np.all(np.isin(mesh.facets[:, facets], arc), axis=0)
+    candidates = chain[(x[chain] <= candidate_extent * a_over_R * R * (1 + 1e-9))
+                       & (y[chain] < R * (1 - 1e-12))]
     return GradedDisc(mesh=mesh, candidates=candidates[np.argsort(x[candidates])],
-                      contact_facets=facets[on_arc],
+                      contact_facets=facet_indices(mesh, chain[:-2], chain[1:-1]),  # not the top corner
                       axis=np.nonzero(np.abs(x) < 1e-12 * R)[0],
                       top=np.nonzero(np.abs(y - R) < 1e-12 * R)[0])
+
+
+def _edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
+    low, high = np.minimum(first, second), np.maximum(first, second)
+    return low.astype(np.int64) * n + high
+
+
+def refine_uniformly(p: np.ndarray, t: np.ndarray,
+                     chain: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Split every triangle into four at its edge midpoints; ``chain`` (a boundary polyline of
+    node indices) gains its segments' midpoints in order.
+
+    The same mesh as scikit-fem's ``refined()`` up to node numbering, built from integer edge
+    keys (one 1D sort) rather than a sort of index pairs: several times faster on 10⁶ nodes.
+    """
+    n = p.shape[1]
+    corners = [(0, 1), (1, 2), (2, 0)]
+    keys = np.concatenate([_edge_keys(t[i], t[j], n) for i, j in corners])
+    edges, inverse = np.unique(keys, return_inverse=True)
+    middle = n + inverse.reshape(3, -1)  # midpoint of edges 01, 12, 20 of each triangle
+    p_new = np.hstack([p, 0.5 * (p[:, edges // n] + p[:, edges % n])])
+    m01, m12, m20 = middle
+    t_new = np.hstack([np.vstack([t[0], m01, m20]), np.vstack([t[1], m12, m01]),
+                       np.vstack([t[2], m20, m12]), np.vstack([m01, m12, m20])])
+    segment = np.searchsorted(edges, _edge_keys(chain[:-1], chain[1:], n))
+    chain_new = np.empty(2 * len(chain) - 1, dtype=np.int64)
+    chain_new[0::2], chain_new[1::2] = chain, n + segment
+    return p_new, t_new, chain_new
+
+
+def facet_indices(mesh: MeshTri, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """scikit-fem's facet index of each edge ``(first[k], second[k])`` of ``mesh``."""
+    n = mesh.p.shape[1]
+    keys = _edge_keys(mesh.facets[0], mesh.facets[1], n)
+    order = np.argsort(keys)
+    wanted = _edge_keys(np.asarray(first), np.asarray(second), n)
+    found = order[np.searchsorted(keys, wanted, sorter=order)]
+    if not np.array_equal(keys[found], wanted):
+        raise ValueError("an edge of the chain is not an edge of the mesh")
+    return found

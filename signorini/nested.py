@@ -1,0 +1,258 @@
+"""Exact contact from a predicted contact zone: one factorisation and a small LCP on its edge.
+
+A prediction (from a coarser model of the same scene) splits the candidates
+into a *core* that surely touches, a *band* where the edge of the contact
+zone may lie, and the *rest* that surely stays apart. Then:
+
+1. K is factorised once with the core's dofs pinned at gap-closing values
+   (a Dirichlet condition; this needs every row of N to bound one dof, as
+   for a flat obstacle);
+2. the band is condensed onto ``W_B = N_B K̃⁻¹ N_Bᵀ`` (one back-solve per
+   band node, never one per candidate) and its complementarity problem
+   solved exactly (:func:`signorini.condensed.solve_lcp`);
+3. the result is checked on every candidate: a core node whose reaction
+   pulls, or a node of the rest that penetrates, joins the band and the
+   band problem is solved again (a pulling core node also costs a new
+   numeric factorisation with it released).
+
+The loop ends only when every KKT condition holds to round-off, so the
+answer is exact whatever the prediction; a good prediction only makes it
+cheap: one factorisation plus a few dozen back-solves.
+
+With a target load the push ``s`` (see :mod:`signorini.loading`) joins the
+band problem as one more unknown, with the total contact force (band forces
+plus core reactions) as one more equation.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from .condensed import solve_lcp
+from .linalg import Pinning, PinnedFactor, resolve_backend, selection_dofs
+
+log = logging.getLogger(__name__)
+
+#: relative size under which a negative core reaction or a positive violation is round-off
+ROUND_OFF = 1e-10
+#: back-solves are done on blocks of this many band nodes
+BLOCK = 32
+
+
+@dataclass
+class Zone:
+    """A prediction of the contact zone, as boolean masks over the candidates."""
+
+    core: np.ndarray  # surely touching: pinned
+    band: np.ndarray  # unsure: condensed and solved exactly
+
+    @property
+    def rest(self) -> np.ndarray:
+        return ~(self.core | self.band)
+
+    def copy(self) -> "Zone":
+        return Zone(self.core.copy(), self.band.copy())
+
+    def counts(self) -> str:
+        return f"core {int(self.core.sum())}, band {int(self.band.sum())}, rest {int(self.rest.sum())}"
+
+
+def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: np.ndarray,
+                 neighbours: int | None = None) -> Zone:
+    """The zone of candidates at ``points`` from a coarse model's active set.
+
+    A candidate is core when its ``neighbours`` nearest coarse candidates all
+    touch, rest when none does, band otherwise (default: 4 on a contact
+    curve, 2D and axisymmetric; 10 on a contact surface, 3D), i.e. the band
+    is about two coarse elements wide on either side of the coarse edge.
+    """
+    points, coarse_points = np.atleast_2d(points), np.atleast_2d(coarse_points)
+    if neighbours is None:
+        neighbours = 4 if points.shape[1] == 2 else 10
+    k = max(1, min(int(neighbours), len(coarse_points)))
+    _, index = cKDTree(coarse_points).query(points, k=k)
+    votes = np.asarray(coarse_active, dtype=bool)[index.reshape(len(points), k)]
+    core = votes.all(axis=1)
+    band = votes.any(axis=1) & ~core
+    return Zone(core=core, band=band)
+
+
+class ZoneSolver:
+    """``min ½uᵀKu − fᵀu, Nu ≤ d`` solved exactly around a predicted zone (see module doc).
+
+    Keeps its pinned factorisation and its band columns ``K̃⁻¹N_jᵀ`` between
+    calls, so the same K solved for other loads (a sweep, the solve after
+    load targeting) costs back-solves only while the core stays the same.
+    """
+
+    def __init__(self, K: sp.spmatrix, N: sp.spmatrix, backend: str | None = None):
+        self.K = sp.csc_matrix(K)
+        self.N = sp.csr_matrix(N)
+        dofs = selection_dofs(self.N)
+        if dofs is None:
+            raise ValueError("the zone solver needs every row of N to bound one dof "
+                             "(a flat obstacle, or dofs rotated into the obstacle's normal)")
+        rows = sp.csr_matrix(self.N, copy=True)
+        rows.eliminate_zeros()
+        rows.sort_indices()
+        self.dofs, self.coef = dofs, rows.data.copy()
+        self.n, self.m = self.K.shape[0], self.N.shape[0]
+        self.backend = resolve_backend(backend)
+        self._pinning = Pinning(self.K) if self.backend == "cholmod" else None
+        self._core: np.ndarray | None = None
+        self._factor: PinnedFactor | None = None
+        self._columns: dict[int, np.ndarray] = {}
+        self.factorisations = 0
+        self.back_solves = 0
+
+    # --- linear algebra on the pinned factorisation -------------------------------------------
+
+    def _use_core(self, core: np.ndarray) -> None:
+        if self._core is not None and np.array_equal(core, self._core):
+            return
+        self._factor = PinnedFactor(self.K, self.dofs[core], self.backend, self._pinning)
+        self._core = core.copy()
+        self._columns.clear()
+        self.factorisations += 1
+
+    def _band_columns(self, band: np.ndarray) -> np.ndarray:
+        """``Z = K̃⁻¹ N_Bᵀ`` (n × |B|): displacements under a unit force at each band node."""
+        missing = [j for j in band if j not in self._columns]
+        for first in range(0, len(missing), BLOCK):
+            chunk = missing[first:first + BLOCK]
+            rhs = np.zeros((self.n, len(chunk)))
+            rhs[self.dofs[chunk], np.arange(len(chunk))] = self.coef[chunk]
+            block = self._factor.solve(rhs)
+            self.back_solves += len(chunk)
+            for k, j in enumerate(chunk):
+                self._columns[j] = block[:, k]
+        if len(band) == 0:
+            return np.zeros((self.n, 0))
+        return np.column_stack([self._columns[j] for j in band])
+
+    def _particular(self, F: np.ndarray, D: np.ndarray, core: np.ndarray) -> np.ndarray:
+        """u (n × k) with the core's gaps closed, loads F and no band forces."""
+        rhs = np.array(F, dtype=float)
+        coef = self.coef[core][:, None] if rhs.ndim == 2 else self.coef[core]
+        rhs[self.dofs[core]] = D[core] / coef
+        self.back_solves += 1 if rhs.ndim == 1 else rhs.shape[1]
+        return self._factor.solve(rhs)
+
+    def _core_reactions(self, residual: np.ndarray, core: np.ndarray) -> np.ndarray:
+        """Contact forces of the core nodes from ``f − K u`` on their dofs."""
+        coef = self.coef[core][:, None] if residual.ndim == 2 else self.coef[core]
+        return residual[self.dofs[core]] / coef
+
+    def _pieces(self, F: np.ndarray, D: np.ndarray, zone: Zone):
+        """Everything affine: ``u = U0 − Zλ_B``, band gaps ``Wλ_B − b``, core ``R + Gλ_B``."""
+        self._use_core(zone.core)
+        band = np.nonzero(zone.band)[0]
+        Z = self._band_columns(band)
+        U0 = self._particular(F, D, zone.core)
+        W = self.N[band] @ Z
+        W = 0.5 * (W + W.T)
+        b = self.N[band] @ U0 - D[band]
+        R = self._core_reactions(F - self.K @ U0, zone.core)
+        G = self._core_reactions(self.K @ Z, zone.core) if len(band) else np.zeros((0, 0))
+        return band, Z, U0, W, b, R, G
+
+    # --- the check that makes it exact ---------------------------------------------------------
+
+    def _amend(self, zone: Zone, lam: np.ndarray, violation: np.ndarray, d: np.ndarray,
+               u: np.ndarray) -> bool:
+        """Move wrongly predicted nodes into the band; True when none was wrong."""
+        force_tol = ROUND_OFF * max(float(np.max(np.abs(lam), initial=0.0)), 1e-300)
+        gap_tol = ROUND_OFF * max(float(np.max(np.abs(d))), float(np.max(np.abs(self.N @ u))),
+                                  1e-300)
+        pulling = zone.core & (lam < -force_tol)
+        penetrating = zone.rest & (violation > gap_tol)
+        if not (pulling.any() or penetrating.any()):
+            return True
+        log.info("zone amended: %d core nodes pull, %d others penetrate",
+                 int(pulling.sum()), int(penetrating.sum()))
+        zone.core &= ~pulling
+        zone.band |= pulling | penetrating
+        return False
+
+    # --- the two problems ----------------------------------------------------------------------
+
+    def solve(self, f: np.ndarray, d: np.ndarray, zone: Zone,
+              max_rounds: int = 100) -> tuple[np.ndarray, np.ndarray, Zone]:
+        """``(u, λ, final zone)`` for load f and gaps d, starting from ``zone``."""
+        zone = zone.copy()
+        for _ in range(max_rounds):
+            band, Z, U0, W, b, R, G = self._pieces(f, d, zone)
+            lam_band = solve_lcp(W, b)[0] if len(band) else np.zeros(0)
+            u = U0 - Z @ lam_band
+            lam = np.zeros(self.m)
+            lam[band] = lam_band
+            lam[zone.core] = R + (G @ lam_band if len(band) else 0.0)
+            if self._amend(zone, lam, self.N @ u - d, d, u):
+                return u, lam, zone
+        raise ArithmeticError(f"the contact zone kept changing for {max_rounds} rounds")
+
+    def push_for_load(self, f1: np.ndarray, d0: np.ndarray, d1: np.ndarray, target: float,
+                      multiplicity: float, zone: Zone,
+                      max_rounds: int = 100) -> tuple[float, np.ndarray, np.ndarray, Zone]:
+        """The push s with total contact force ``μ Σλ = target`` for ``f = s f1, d = d0 + s d1``.
+
+        Returns ``(s, u, λ, final zone)``.
+        """
+        F = np.column_stack([f1, np.zeros_like(f1)])
+        D = np.column_stack([d1, d0])
+        zone = zone.copy()
+        for _ in range(max_rounds):
+            band, Z, U0, W, b, R, G = self._pieces(F, D, zone)
+            s, lam_band = _band_push(W, b, R, G, target, multiplicity)
+            u = U0 @ [s, 1.0] - Z @ lam_band
+            lam = np.zeros(self.m)
+            lam[band] = lam_band
+            lam[zone.core] = R @ [s, 1.0] + (G @ lam_band if len(band) else 0.0)
+            d = d0 + s * d1
+            if self._amend(zone, lam, self.N @ u - d, d, u):
+                return s, u, lam, zone
+        raise ArithmeticError(f"the contact zone kept changing for {max_rounds} rounds")
+
+
+def _band_push(W: np.ndarray, b: np.ndarray, R: np.ndarray, G: np.ndarray, target: float,
+               multiplicity: float, max_iter: int = 200) -> tuple[float, np.ndarray]:
+    """Primal-dual active set on the band with the push as one more unknown.
+
+    Band gaps ``Wλ − (s b₁ + b₀) ≥ 0``, forces ``λ ≥ 0``, complementary; and
+    ``μ (Σλ + Σ core reactions) = target`` with core reactions ``s R₁ + R₀ + Gλ``.
+    """
+    k = W.shape[0]
+    weight = multiplicity * (1.0 + (G.sum(axis=0) if G.size else np.zeros(k)))
+    per_push, fixed = multiplicity * R.sum(axis=0)
+    active = np.ones(k, dtype=bool)  # start from the band closed
+    seen: set[bytes] = set()
+    for _ in range(max_iter):
+        A = np.nonzero(active)[0]
+        system = np.zeros((len(A) + 1, len(A) + 1))
+        system[:-1, :-1] = W[np.ix_(A, A)]
+        system[:-1, -1] = -b[A, 0]
+        system[-1, :-1] = weight[A]
+        system[-1, -1] = per_push
+        rhs = np.append(b[A, 1], target - fixed)
+        try:
+            solution = sla.solve(system, rhs)
+        except sla.LinAlgError as exc:
+            raise ArithmeticError("the push equation is singular: the load does not depend "
+                                  "on the push") from exc
+        s, lam = float(solution[-1]), np.zeros(k)
+        lam[A] = solution[:-1]
+        gap = W @ lam - (s * b[:, 0] + b[:, 1])
+        new_active = lam - gap > 0
+        if np.array_equal(new_active, active):
+            return s, np.maximum(lam, 0.0)
+        if new_active.tobytes() in seen:
+            raise ArithmeticError("the band's active set cycles while matching the load")
+        seen.add(active.tobytes())
+        active = new_active
+    raise ArithmeticError(f"the band's active set kept changing for {max_iter} steps")

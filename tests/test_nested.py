@@ -1,0 +1,155 @@
+"""The nested method and its zone solver against PDAS: exact whatever the predicted zone."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from signorini.assembly import assemble
+from signorini.kkt import certificate, compare
+from signorini.linalg import PinnedFactor, factorize
+from signorini.nested import Zone, ZoneSolver, predict_zone
+from signorini import scenes
+from signorini.scenes import build_problem, coarse_values, get_scene
+from signorini.solvers.registry import solve
+from signorini.synthetic import random_problem
+
+MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
+
+
+def selection_problem(seed: int, n: int = 40, m: int = 15):
+    """A random problem whose rows of N each bound one dof (what pinning needs)."""
+    problem = random_problem(n, m, seed=seed, condition=50.0)
+    N = problem.N.tocsr()
+    keep = N.data == -1.0
+    rows = np.repeat(np.arange(m), np.diff(N.indptr))[keep]
+    return problem.with_data(N=sp.csr_matrix((N.data[keep], (rows, N.indices[keep])), shape=N.shape))
+
+
+def assert_same_answer(problem, first, second, lam_tol=1e-8):
+    agreement = compare(problem, first, second)
+    assert agreement.lam_rel <= lam_tol, agreement.as_dict()
+    assert agreement.misclassified == 0, agreement.as_dict()
+
+
+def zoned_build(name, **values):
+    """build_problem with load targeting on a predicted zone even for a small model."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(scenes, "NESTED_FROM_DOFS", 0)
+        return build_problem(name, **values)
+
+
+@pytest.fixture(scope="module")
+def cylinder():
+    """Load-targeted with a zone predicted from its coarse model (refine 1 → refine 0)."""
+    return zoned_build("hertz-cylinder", refine=1, n_contact=24, grading=0.4)
+
+
+def test_nested_equals_pdas_on_the_cylinder(cylinder):
+    reference = solve(cylinder, "pdas")
+    fresh = cylinder.with_data()  # no solver kept from load targeting: predicts from scratch
+    nested = solve(fresh, "nested")
+    assert nested.status == "converged" and "coarse model" in nested.message
+    assert_same_answer(cylinder, reference, nested)
+    assert certificate(cylinder, nested).worst()[1] < 1e-10
+
+
+def test_nested_reuses_the_load_targeting_factorisation(cylinder):
+    assert cylinder.zone_solver is not None
+    before = cylinder.zone_solver.factorisations
+    nested = solve(cylinder, "nested")
+    assert cylinder.zone_solver.factorisations == before
+    assert "0 factorisation" in nested.message
+    assert_same_answer(cylinder, solve(cylinder, "pdas"), nested)
+
+
+@pytest.mark.parametrize("scene,params", [
+    ("hertz-sphere", {"refine": 1, "n_contact": 24, "grading": 0.4}),
+    ("punch", {"refine": 1, "n_contact": 16}),
+])
+def test_nested_equals_pdas_on_other_scenes(scene, params):
+    problem = build_problem(scene, **params).with_data()
+    assert_same_answer(problem, solve(problem, "pdas"), solve(problem, "nested"))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_any_zone_gives_the_exact_answer(seed):
+    """However wrong the prediction (random core, band and rest), the answer is exact."""
+    problem = selection_problem(seed)
+    rng = np.random.default_rng(seed)
+    label = rng.integers(0, 3, problem.m)
+    zone = Zone(core=label == 0, band=label == 1)
+    reference = solve(problem, "pdas")
+    nested = solve(problem, "nested", zone=zone)
+    assert nested.status == "converged"
+    assert_same_answer(problem, reference, nested)
+
+
+def test_a_core_that_pulls_is_released():
+    problem = selection_problem(1)
+    everything = Zone(core=np.ones(problem.m, bool), band=np.zeros(problem.m, bool))
+    system = ZoneSolver(problem.K, problem.N)
+    u, lam, final = system.solve(problem.f, problem.d, everything)
+    reference = solve(problem, "pdas")
+    np.testing.assert_allclose(lam, reference.lam, atol=1e-9 * np.abs(reference.lam).max())
+    assert not np.any(final.core & (reference.lam == 0))  # separated nodes left the core
+    assert system.factorisations >= 2
+
+
+def test_the_push_on_a_zone_equals_the_full_active_set_calibration():
+    family = get_scene("hertz-cylinder")
+    values = {"refine": 1, "n_contact": 24, "grading": 0.4}
+    params = family.parse(values)
+    model = family.build(params, set(values))
+    full = assemble(model)  # no zone: one factorisation per active-set step
+    zoned = zoned_build("hertz-cylinder", **values)
+    assert getattr(full, "zone_solver", None) is None and zoned.zone_solver is not None
+    assert zoned.push.scale == pytest.approx(full.push.scale, rel=1e-10)
+    assert_same_answer(full, solve(full, "pdas"), solve(zoned, "nested"))
+
+
+def test_predicted_zone_follows_the_coarse_edge():
+    coarse = np.column_stack([np.linspace(0, 1, 11), np.zeros(11)])
+    fine = np.column_stack([np.linspace(0, 1, 41), np.zeros(41)])
+    zone = predict_zone(fine, coarse, coarse[:, 0] <= 0.5)
+    assert zone.core[fine[:, 0] < 0.3].all() and zone.rest[fine[:, 0] > 0.75].all()
+    assert zone.band[(fine[:, 0] > 0.45) & (fine[:, 0] < 0.55)].all()
+
+
+def test_coarse_values_drop_two_refinements_and_keep_the_load():
+    values = coarse_values("hertz-cylinder", get_scene("hertz-cylinder").parse(
+        {"refine": 3, "P": 0.01}))
+    assert values["refine"] == 1 and values["P"] == 0.01 and "delta" not in values
+    once = coarse_values("hertz-cylinder", get_scene("hertz-cylinder").parse(
+        {"refine": 1, "delta": 0.002, "n_contact": 40}))
+    assert once["refine"] == 0 and once["n_contact"] == 20 and once["delta"] == 0.002
+    assert coarse_values("hertz-cylinder", get_scene("hertz-cylinder").parse({})) is None
+    assert coarse_values("block", get_scene("block").parse({})) is None
+
+
+def test_without_a_coarse_model_nested_says_it_used_pdas():
+    problem = build_problem("block", nx=6, ny=6)
+    nested = solve(problem, "nested")
+    assert nested.status == "converged" and "pdas" in nested.message
+    assert nested.extras["fallback"] == "pdas"
+
+
+def test_zone_solver_refuses_rows_that_couple_dofs():
+    problem = random_problem(10, 4, seed=2)
+    with pytest.raises(ValueError, match="bound one dof"):
+        ZoneSolver(problem.K, problem.N)
+
+
+@pytest.mark.parametrize("backend", sorted(MODULES))
+def test_pinned_factor_matches_superlu_on_the_free_block(backend):
+    pytest.importorskip(MODULES[backend], reason=f"the {backend} backend is not installed")
+    problem = build_problem("hertz-cylinder", n_contact=16, grading=0.4)
+    fixed = np.arange(0, problem.n, 7)
+    rhs = np.column_stack([problem.f, problem.N.T @ np.ones(problem.m)])
+    rhs[fixed] = np.linspace(-1, 1, len(fixed))[:, None]
+    u = PinnedFactor(problem.K, fixed, backend).solve(rhs)
+    free = np.setdiff1d(np.arange(problem.n), fixed)
+    K = problem.K.tocsr()
+    expected = np.array(rhs)
+    expected[free] = factorize(K[free][:, free], "superlu").solve(
+        rhs[free] - K[free][:, fixed] @ rhs[fixed])
+    assert np.max(np.abs(u - expected)) <= 1e-10 * np.max(np.abs(expected))
