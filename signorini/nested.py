@@ -103,7 +103,7 @@ class ZoneSolver:
         rows.sort_indices()
         self.dofs, self.coef = dofs, rows.data.copy()
         self.n, self.m = self.K.shape[0], self.N.shape[0]
-        self.backend = resolve_backend(backend)
+        self.backend = resolve_backend(backend, self.n)
         self._pinning = Pinning(self.K) if self.backend == "cholmod" else None
         self._core: np.ndarray | None = None
         self._factor: PinnedFactor | None = None
