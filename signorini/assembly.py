@@ -229,10 +229,10 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
         full[fixed] = u_D
         return -(K_ID @ u_D), gaps - N_full[:, fixed] @ u_D, float(load_full[fixed] @ u_D), full
 
-    scale, zone_solver = 1.0, None
+    scale, zone_solver, calibration_lam = 1.0, None, None
     if model.target_load is not None:
-        scale, zone_solver = _calibrate(K_II, N_free, lifted, model.target_load / force_unit,
-                                        model.force_multiplicity, zone)
+        scale, calibration_lam, zone_solver = _calibrate(
+            K_II, N_free, lifted, model.target_load / force_unit, model.force_multiplicity, zone)
     f, d, load_offset, full = lifted(scale)
     params = dict(model.params)
     if model.target_load is not None:
@@ -246,6 +246,8 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
         scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
         params=params, mesh=mesh, push=_push(lifted, scale))
     problem.axisymmetric = model.axisymmetric
+    #: the contact forces load targeting found (exact; a coarse model's prediction needs no solve)
+    problem.calibration_lam = calibration_lam
     if zone_solver is not None:
         problem.zone_solver, problem.zone = zone_solver
     problem.assemble_time = time.perf_counter() - start
@@ -262,7 +264,7 @@ def _push(lifted, scale: float) -> Push:
 
 
 def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
-               multiplicity: float, zone=None) -> tuple[float, Any]:
+               multiplicity: float, zone=None) -> tuple[float, np.ndarray, Any]:
     """The factor on the prescribed displacement whose contact force is ``target``.
 
     The load is affine in the factor. With a predicted ``zone``,
@@ -278,11 +280,12 @@ def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
 
         try:
             system = ZoneSolver(K, N)
-            scale, _, _, final = system.push_for_load(f1 - f0, d0, d_one - d0, target,
-                                                      multiplicity, zone)
+            scale, _, lam, final = system.push_for_load(f1 - f0, d0, d_one - d0, target,
+                                                        multiplicity, zone)
             log.info("load targeted on a predicted zone (%s): %d factorisation(s), %d back-solves",
                      final.counts(), system.factorisations, system.back_solves)
-            return scale, (system, final)
+            return scale, lam, (system, final)
         except (ValueError, ArithmeticError) as exc:
             log.info("load targeting on the predicted zone failed (%s): full active set", exc)
-    return calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity), None
+    scale, lam = calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity)
+    return scale, lam, None

@@ -8,9 +8,10 @@ Backends for the SPD stiffness (one interface, ``factorize(K).solve(b)``):
 
 ``auto`` (the default) takes the first installed of pardiso, cholmod, superlu;
 the environment variable ``SIGNORINI_FACTOR`` overrides it. Measured here
-(2 cores) on the Hertz cylinder, factorisation + one solve: 1.6 s (PARDISO),
-4.3 s (CHOLMOD, nested dissection) at 261k dofs; 5.3–6.0 s and 22.8 s at
-1.04M dofs, where the whole end-to-end run peaked at 4.1 GB with PARDISO.
+(2 cores) on the Hertz cylinder, factorisation + one solve: 0.029 s (PARDISO)
+vs 0.050 s (CHOLMOD) at 11k dofs, 0.22 vs 0.52 s at 66k, 1.6 vs 4.3 s at 261k
+and 5.3–6.0 vs 22.8 s at 1.04M dofs, where the whole end-to-end run peaked at
+4.1 GB with PARDISO (see docs/speed.md).
 """
 
 from __future__ import annotations
@@ -33,19 +34,20 @@ def available_backends() -> list[str]:
     return [b for b in BACKENDS if importlib.util.find_spec(_MODULES[b]) is not None]
 
 
-#: below this many dofs ``auto`` prefers CHOLMOD to PARDISO: pypardiso costs about 0.2 s per
-#: factorisation whatever the size (0.22 s vs CHOLMOD's 0.036 s at 11k dofs; 0.36 s vs 0.52 s at 66k)
-PARDISO_FROM = 50_000
+#: ``auto`` leaves matrices below this many dofs to CHOLMOD or SuperLU: time does not matter
+#: there, and on the 6-dof bogie of the tutorials PARDISO's solve left a 1.0e-12 primal
+#: residual where CHOLMOD's and SuperLU's met 1e-12
+PARDISO_FROM = 5_000
 
 
 def resolve_backend(backend: str | None = None, n: int | None = None) -> str:
     """Pick the backend: an explicit name, ``SIGNORINI_FACTOR``, or the first installed
-    (for ``n`` below :data:`PARDISO_FROM` dofs, CHOLMOD before PARDISO)."""
+    (PARDISO only from :data:`PARDISO_FROM` dofs when the size ``n`` is given)."""
     name = backend or os.environ.get("SIGNORINI_FACTOR") or "auto"
     if name == "auto":
         installed = available_backends()
-        if n is not None and n < PARDISO_FROM and "cholmod" in installed:
-            return "cholmod"
+        if n is not None and n < PARDISO_FROM and len(installed) > 1:
+            installed = [b for b in installed if b != "pardiso"]
         return installed[0]
     if name not in BACKENDS:
         raise InputError(f"unknown factorisation backend {name!r}: choose auto, {', '.join(BACKENDS)}")
@@ -123,6 +125,9 @@ class PardisoFactor(Factor):
         self.shape = K.shape
         self._upper = sp.triu(K, format="csr")
         self._solver = pypardiso.PyPardisoSolver(mtype=2)
+        # pypardiso searches sys.prefix for MKL on every new solver (0.2-0.4 s) unless told where
+        # it is (its documented PYPARDISO_MKL_RT): tell it once
+        os.environ.setdefault("PYPARDISO_MKL_RT", self._solver.libmkl._name)
         self._solver.factorize(self._upper)
 
     def solve(self, b: np.ndarray) -> np.ndarray:

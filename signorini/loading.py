@@ -63,8 +63,9 @@ def push_for_load(solve_pair: PairSolve, d0: np.ndarray, target: float, multipli
 
 
 def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.ndarray,
-                   d1: np.ndarray, target: float, multiplicity: float = 1.0) -> float:
-    """The push on the full sparse system (one factorisation per active set)."""
+                   d1: np.ndarray, target: float,
+                   multiplicity: float = 1.0) -> tuple[float, np.ndarray]:
+    """The push on the full sparse system (one factorisation per active set), and λ then."""
     system = ActiveSetSolver(K, N)
     f_pair = np.column_stack([f1, np.zeros_like(f1)])
     d_pair = np.column_stack([d1, d0])
@@ -73,7 +74,7 @@ def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.nd
         u, lam = system.solve(active, f_pair, d_pair)
         return lam, N @ u - d_pair
 
-    return push_for_load(solve_pair, d0, target, multiplicity)[0]
+    return push_for_load(solve_pair, d0, target, multiplicity)
 
 
 def push_for_load_condensed(W: np.ndarray, b1: np.ndarray, b0: np.ndarray, d0: np.ndarray,

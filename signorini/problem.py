@@ -146,6 +146,8 @@ class ContactProblem:
                 "every candidate must lie on a boundary edge of positive length")
         self._factor = None
         self._basis = None
+        #: the exact contact forces, when load targeting already found them (see assembly)
+        self.calibration_lam: np.ndarray | None = None
 
     @property
     def basis(self):

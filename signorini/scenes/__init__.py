@@ -78,11 +78,14 @@ def predicted_zone(name: str, model: SceneModel, nondimensionalise: bool):
     if model.target_load is None or dofs < NESTED_FROM_DOFS or values is None:
         return None
     coarse = build_problem(name, nondimensionalise=nondimensionalise, **values)
-    solution = solve(coarse, "nested")
-    if solution.status != "converged":
-        return None
+    lam = coarse.calibration_lam  # the coarse model is load-targeted too: solved already
+    if lam is None:
+        solution = solve(coarse, "nested")
+        if solution.status != "converged":
+            return None
+        lam = solution.lam
     points = model.mesh.p[:, model.contact_nodes].T / coarse.scales.length
-    return predict_zone(points, coarse.contact_points, solution.lam > 0)
+    return predict_zone(points, coarse.contact_points, lam > 0)
 
 
 def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> ContactProblem:

@@ -45,11 +45,13 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | N
         coarse = coarse_problem(problem)
     if coarse is None:
         return None, ""
-    solution = solve_with(coarse, "nested")
-    if solution.status != "converged":
-        return None, ""
-    zone = predict_zone(problem.contact_points, coarse.contact_points, solution.lam > 0,
-                        opts["neighbours"])
+    lam = coarse.calibration_lam  # load targeting solved it already
+    if lam is None:
+        solution = solve_with(coarse, "nested")
+        if solution.status != "converged":
+            return None, ""
+        lam = solution.lam
+    zone = predict_zone(problem.contact_points, coarse.contact_points, lam > 0, opts["neighbours"])
     return zone, f"coarse model of {coarse.n} dofs"
 
 
