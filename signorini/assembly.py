@@ -207,8 +207,9 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
     free = np.setdiff1d(np.arange(n_full), fixed)
 
     nodes = model.contact_nodes
-    normals, gaps = model.obstacle.normals_and_gaps(mesh.p[:, nodes].T)
-    gaps = gaps * (L / U)
+    # the obstacle is asked at physical coordinates and answers physical gaps
+    normals, gaps = model.obstacle.normals_and_gaps(model.mesh.p[:, nodes].T)
+    gaps = gaps / U
     m = len(nodes)
     rows = np.repeat(np.arange(m), dim)
     cols = dof_table[:, nodes].T.ravel()

@@ -10,6 +10,7 @@ import argparse
 import logging
 import shlex
 import sys
+from pathlib import Path
 from typing import Any, Sequence
 
 from .errors import InputError, SignoriniError
@@ -77,6 +78,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
     options = {k: _option_value(v) for k, v in _pairs(args.opt, "--opt").items()}
     max_iter = options.pop("max_iter", None)
     tol = _tol(args.tol) if args.tol is not None else None
+    if args.json not in (None, "-") and Path(args.json).is_dir():
+        raise InputError(f"--json {args.json!r} is a directory: give a file name, "
+                         f"e.g. --json {Path(args.json) / 'result.json'}")
     if args.vtk:
         from .export import check_vtk_path
 

@@ -232,14 +232,12 @@ class SignedDistance:
 class ScaledQuery:
     """An obstacle in physical units that answers queries in physical or in scene units.
 
-    :func:`signorini.assembly.assemble` asks for normals and gaps at the
-    candidates' coordinates divided by the scene's length ``L`` when it
-    non-dimensionalises (and expects gaps in units of L), and at physical
-    coordinates otherwise. This wrapper knows the candidates' physical
-    coordinates, recognises which of the two it is being asked, evaluates the
-    physical obstacle and returns gaps in the unit of the query. A flat
-    through the origin does not care; a cylinder of radius R does. Queries at
-    other points raise ValueError.
+    :func:`signorini.assembly.assemble` asks at the candidates' physical
+    coordinates; a caller may also ask at coordinates divided by the scene's
+    length ``L`` (and then gets gaps in units of L). This wrapper knows the
+    candidates' physical coordinates, recognises which of the two it is being
+    asked, evaluates the physical obstacle and returns gaps in the unit of the
+    query. Queries at other points raise ValueError.
     """
 
     obstacle: Obstacle

@@ -352,3 +352,19 @@ def test_closed_form_contact_weights_are_scikit_fems(axisymmetric):
 
     np.testing.assert_allclose(contact_weights(mesh, facets, nodes, axisymmetric),
                                asm(weight, basis)[nodes], rtol=1e-12)
+
+
+def test_an_obstacle_away_from_the_origin_gives_the_same_gaps_in_any_units():
+    """A flat at height h ≠ 0 under a body of length L ≠ 1: gaps are physical, whatever the scaling."""
+    from signorini.assembly import assemble
+    from signorini.scenes import get_scene
+    from signorini.scenes.base import FlatObstacle
+
+    family = get_scene("hertz-cylinder")
+    model = family.build(family.parse({"R": 3.0, "n_contact": 12, "delta": 0.01}),
+                         {"R", "n_contact", "delta"})
+    model.obstacle = FlatObstacle(-0.02)
+    scaled, raw = assemble(model), assemble(model, nondimensionalise=False)
+    np.testing.assert_allclose(scaled.d * scaled.scales.displacement, raw.d, rtol=1e-12)
+    first = np.argmin(raw.contact_points[:, 0] ** 2 + raw.contact_points[:, 1] ** 2)
+    assert raw.d[first] == pytest.approx(0.02)  # the flat lies 0.02 below the first point

@@ -159,8 +159,6 @@ def test_bench_time_limit_must_be_positive(capsys, tmp_path, value):
     assert_one_line_exit_2(code, err, ["--time-limit"])
 
 
-@pytest.mark.xfail(strict=True, reason="io.atomic_write_bytes: os.replace onto a directory raises "
-                   "IsADirectoryError, which the CLI does not turn into a one-line error (reported)")
 def test_json_onto_a_directory_is_one_line(capsys, tmp_path):
     code, out, err = run(capsys, ["solve", "block", "--set", "nx=2", "--set", "ny=2",
                                   "--json", str(tmp_path)])
@@ -173,3 +171,18 @@ def test_the_installed_command_gives_no_traceback_for_a_bad_stability_flag(tmp_p
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr and "--time-limit" in proc.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_result_files_are_readable_by_others(tmp_path):
+    import os
+    import stat
+
+    from signorini.io import atomic_write_text
+
+    target = tmp_path / "result.json"
+    old = os.umask(0o022)
+    try:
+        atomic_write_text(target, "{}")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(target.stat().st_mode) == 0o644
