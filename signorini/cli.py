@@ -218,7 +218,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     if not args.report_only:
         run_benchmark(runs, Path(out), time_limit=args.time_limit, progress=progress)
-    command = "signorini bench " + " ".join(sys.argv[2:]) if len(sys.argv) > 2 else "signorini bench"
+    given = [a for a in sys.argv[2:] if a != "--report-only"]  # the command that made the CSV
+    command = "signorini bench " + " ".join(given) if given else "signorini bench"
     print(f"report: {write_report(Path(out) / 'bench.csv', command)}")
     return 0
 

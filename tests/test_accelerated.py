@@ -30,3 +30,14 @@ def test_acceleration_is_an_option_of_uzawa_too(hertz):
     assert via_option.iterations == via_name.iterations
     with pytest.raises(InputError, match="acceleration"):
         solve(hertz, "uzawa", acceleration="heavy-ball")
+
+
+def test_nesterov_beyond_its_step_bound_says_so():
+    from signorini.synthetic import bogie
+
+    problem = bogie()
+    beyond = solve(problem, "uzawa-nesterov", max_iter=3, step_fraction=0.8)  # ρ·λ_max = 1.6
+    assert beyond.status == "max_iter"
+    assert "1.60 > 1" in beyond.message and "step_fraction" in beyond.message
+    within = solve(problem, "uzawa-nesterov", max_iter=3)  # ρ·λ_max = 1
+    assert "bound" not in within.message or within.status == "converged"

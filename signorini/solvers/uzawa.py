@@ -190,9 +190,13 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                        f"iteration {iteration}: ρ = {rho:.3g} exceeds 2/λ_max(W) = "
                        f"{2 / lam_max:.3g}; lower rho or step_fraction")
             break
-    if status == "max_iter" and rho * lam_max >= 2.0:
-        message += (f"; ρ·λ_max(W) = {rho * lam_max:.2f} ≥ 2, beyond the convergence bound: "
-                    "lower rho or step_fraction")
+    # the step bounds: FISTA needs ρ ≤ 1/λ_max(W), plain Uzawa ρ < 2/λ_max(W)
+    nesterov = opts["acceleration"] == "nesterov"
+    bound = 1.0 if nesterov else 2.0
+    beyond = rho * lam_max > bound * (1 + 1e-9) if nesterov else rho * lam_max >= bound
+    if status == "max_iter" and beyond:
+        message += (f"; ρ·λ_max(W) = {rho * lam_max:.2f} {'>' if nesterov else '≥'} {bound:g}, "
+                    "beyond the convergence bound: lower rho or step_fraction")
     u = displacement(lam)
     return ContactSolution(
         method=_name, u=u, lam=lam, status=status, message=message, iterations=iteration,
