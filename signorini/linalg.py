@@ -222,55 +222,53 @@ class Pinning:
     of a large factorisation's cost beyond the numeric work) is computed once.
     """
 
-    def __init__(self, K: sp.csc_matrix):
+    def __init__(self, K: sp.csc_matrix, analyse: bool = True):
         self.K = sp.csc_matrix(K)
         self.K.sort_indices()
         self.n = self.K.shape[0]
-        self._symbolic = cholmod_analysis(self.K)
+        self._symbolic = cholmod_analysis(self.K) if analyse else None
         self._rows = self.K.indices
         self._cols = np.repeat(np.arange(self.n), np.diff(self.K.indptr))
 
-    def factor(self, fixed: np.ndarray):
-        """CHOLMOD's factor of K with the ``fixed`` dofs' rows and columns made the identity's."""
+    def matrix(self, fixed: np.ndarray) -> sp.csc_matrix:
+        """K with the ``fixed`` dofs' rows and columns made the identity's (same pattern)."""
         pinned = np.zeros(self.n, dtype=bool)
         pinned[fixed] = True
         touched = pinned[self._rows] | pinned[self._cols]
         data = np.where(touched, (self._rows == self._cols).astype(float), self.K.data)
-        return cholmod_numeric(self._symbolic,
-                               sp.csc_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape))
+        return sp.csc_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape)
+
+    def factor(self, fixed: np.ndarray):
+        """CHOLMOD's factor of K with the ``fixed`` dofs' rows and columns made the identity's."""
+        return cholmod_numeric(self._symbolic, self.matrix(fixed))
 
 
 class PinnedFactor:
     """Solutions of K u = f with the ``fixed`` dofs prescribed: ``solve(rhs)`` takes their
     values from ``rhs[fixed]`` and the load on the other dofs from the rest of ``rhs``.
 
-    CHOLMOD: one factorisation of the pinned matrix (on a shared :class:`Pinning`);
-    other backends: a factorisation of the free block ``K_FF``.
+    The pinned matrix (K with the fixed dofs' rows and columns made the
+    identity's, K's own pattern) is factorised: CHOLMOD on a shared
+    :class:`Pinning`'s symbolic analysis, other backends from scratch.
     """
 
     def __init__(self, K: sp.csc_matrix, fixed: np.ndarray, backend: str | None = None,
                  pinning: Pinning | None = None):
-        self.K = sp.csc_matrix(K)
-        self.n = self.K.shape[0]
+        self.n = K.shape[0]
         self.fixed = np.asarray(fixed, dtype=int)
         self.backend = resolve_backend(backend, self.n)
-        self._coupling = self.K[:, self.fixed]
+        if pinning is None:
+            pinning = Pinning(K, analyse=self.backend == "cholmod")
+        self._coupling = pinning.K[:, self.fixed]
         if self.backend == "cholmod":
-            pinning = pinning if pinning is not None else Pinning(self.K)
-            self._factor = pinning.factor(self.fixed)
+            self._factor = pinning.factor(self.fixed).solve_A
         else:
-            self._free = np.setdiff1d(np.arange(self.n), self.fixed)
-            self._factor = factorize(self.K[self._free][:, self._free], self.backend)
+            self._factor = factorize(pinning.matrix(self.fixed), self.backend).solve
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``."""
         rhs = np.array(rhs, dtype=float)
         values = rhs[self.fixed]
         rhs -= self._coupling @ values
-        if self.backend == "cholmod":
-            rhs[self.fixed] = values
-            return self._factor(rhs)
-        u = np.empty_like(rhs)
-        u[self.fixed] = values
-        u[self._free] = self._factor.solve(rhs[self._free])
-        return u
+        rhs[self.fixed] = values
+        return self._factor(rhs)

@@ -104,7 +104,7 @@ class ZoneSolver:
         self.dofs, self.coef = dofs, rows.data.copy()
         self.n, self.m = self.K.shape[0], self.N.shape[0]
         self.backend = resolve_backend(backend, self.n)
-        self._pinning = Pinning(self.K) if self.backend == "cholmod" else None
+        self._pinning = Pinning(self.K, analyse=self.backend == "cholmod")
         self._core: np.ndarray | None = None
         self._factor: PinnedFactor | None = None
         self._columns: dict[int, np.ndarray] = {}
