@@ -369,7 +369,9 @@ def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None
     Filled markers are runs the package calls ``converged``; the lower-left
     envelope is the Pareto front.
     """
-    ax = _axes(ax)
+    if ax is None:
+        from matplotlib.figure import Figure
+        ax = Figure(figsize=(10, 5), layout="constrained").add_subplot()
     markers = {"low": "v", "mid": "s", "high": "o", "default": "D"}
     methods = sorted({r["method"] for r in rows})
     for i, method in enumerate(methods):
@@ -386,7 +388,7 @@ def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None
     ax.set_ylabel({"kkt_worst": "worst relative KKT residual",
                    "p0_rel": "Hertz p₀ relative error"}.get(metric, metric))
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=5, ncol=3)
+    ax.legend(fontsize=5, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the front
     return ax
 
 
