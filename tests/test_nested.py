@@ -153,3 +153,11 @@ def test_pinned_factor_matches_superlu_on_the_free_block(backend):
     expected[free] = factorize(K[free][:, free], "superlu").solve(
         rhs[free] - K[free][:, fixed] @ rhs[fixed])
     assert np.max(np.abs(u - expected)) <= 1e-10 * np.max(np.abs(expected))
+
+
+def test_a_coarse_model_out_of_range_means_no_prediction(monkeypatch):
+    """Coarser parameters a scene refuses give no coarse model (pdas), never an input error."""
+    problem = build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4).with_data()
+    monkeypatch.setattr(scenes, "coarse_values", lambda name, params: {"n_contact": 1})
+    nested = solve(problem, "nested")
+    assert nested.status == "converged" and nested.extras["fallback"] == "pdas"

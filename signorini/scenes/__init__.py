@@ -65,7 +65,10 @@ def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
     values = coarse_values(problem.scene, problem.params)
     if values is None:
         return None
-    return build_problem(problem.scene, nondimensionalise=problem.scales != Scales(), **values)
+    try:
+        return build_problem(problem.scene, nondimensionalise=problem.scales != Scales(), **values)
+    except InputError:  # the coarser parameters are out of range: no coarse model
+        return None
 
 
 def predicted_zone(name: str, model: SceneModel, nondimensionalise: bool):
@@ -77,7 +80,10 @@ def predicted_zone(name: str, model: SceneModel, nondimensionalise: bool):
     values = coarse_values(name, model.params)
     if model.target_load is None or dofs < NESTED_FROM_DOFS or values is None:
         return None
-    coarse = build_problem(name, nondimensionalise=nondimensionalise, **values)
+    try:
+        coarse = build_problem(name, nondimensionalise=nondimensionalise, **values)
+    except InputError:  # the coarser parameters are out of range: target the load directly
+        return None
     lam = coarse.calibration_lam  # the coarse model is load-targeted too: solved already
     if lam is None:
         solution = solve(coarse, "nested")
