@@ -161,12 +161,11 @@ def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
 class ActiveSetSolver:
     """Solutions of ``Ku + N_Aᵀλ_A = f, N_A u = d_A`` (``λ`` zero off A), active set after active set.
 
-    When each row of N bounds one dof, the active dofs are fixed and the rest
-    solved with an SPD factorisation. With CHOLMOD the symbolic analysis (the
-    fill-reducing ordering, most of the cost of a large factorisation) is done
-    once: a fixed dof's row and column are zeroed and its diagonal set to 1 in
-    place, so every active set has the same sparsity pattern and only the
-    numeric factorisation is repeated. Otherwise the saddle-point matrix, with
+    When each row of N bounds one dof, the active dofs are pinned
+    (:class:`PinnedFactor`: a fixed dof's row and column become the
+    identity's, so every active set has K's sparsity pattern; with CHOLMOD
+    the symbolic analysis, the fill-reducing ordering, is done once and only
+    the numeric factorisation repeated). Otherwise the saddle-point matrix, with
     its constraint rows scaled by ``s = mean |diag K|`` (both blocks of one
     size in any units; ``λ = s μ``), is factorised by LU.
     """
@@ -180,8 +179,8 @@ class ActiveSetSolver:
         self._dofs = selection_dofs(self.N)
         self._coef = self.N.data if self._dofs is not None else None
         self._pinning = None
-        if self._dofs is not None and self.backend == "cholmod":
-            self._pinning = Pinning(self.K)
+        if self._dofs is not None:
+            self._pinning = Pinning(self.K, analyse=self.backend == "cholmod")
 
     def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k)."""
@@ -191,17 +190,9 @@ class ActiveSetSolver:
         if self._dofs is not None:
             fixed = self._dofs[active]
             coef = self._coef[active] if f.ndim == 1 else self._coef[active][:, None]
-            u_fixed = d[active] / coef
-            if self._pinning is not None:
-                rhs = f - self.K[:, fixed] @ u_fixed
-                rhs[fixed] = u_fixed
-                u = self._pinning.factor(fixed)(rhs)
-            else:
-                free = np.setdiff1d(np.arange(self.n), fixed)
-                u = np.zeros_like(f)
-                u[fixed] = u_fixed
-                u[free] = factorize(self.K[free][:, free], self.backend).solve(
-                    f[free] - self.K[free][:, fixed] @ u_fixed)
+            rhs = np.array(f)
+            rhs[fixed] = d[active] / coef
+            u = PinnedFactor(self.K, fixed, self.backend, self._pinning).solve(rhs)
             lam[active] = (f[fixed] - self.K[fixed] @ u) / coef
             return u, lam
         N_A = self.N[active]
