@@ -179,7 +179,6 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     import math
-    from pathlib import Path
 
     from .bench import TOLERANCES, Run, run_benchmark, write_report
     from .io import writable_directory
@@ -226,7 +225,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def cmd_stability(args: argparse.Namespace) -> int:
     import math
-    from pathlib import Path
 
     from .io import writable_directory
     from .stability import run_atlas, select_axes, wrapper_record, write_report

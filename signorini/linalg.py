@@ -8,10 +8,10 @@ Backends for the SPD stiffness (one interface, ``factorize(K).solve(b)``):
 
 ``auto`` (the default) takes the first installed of pardiso, cholmod, superlu;
 the environment variable ``SIGNORINI_FACTOR`` overrides it. Measured here
-(2 cores) on the Hertz cylinder, factorisation + one solve: 0.029 s (PARDISO)
-vs 0.050 s (CHOLMOD) at 11k dofs, 0.22 vs 0.52 s at 66k, 1.6 vs 4.3 s at 261k
-and 5.3–6.0 vs 22.8 s at 1.04M dofs, where the whole end-to-end run peaked at
-4.1 GB with PARDISO (see docs/speed.md).
+(2 cores) on the Hertz cylinder by examples/factorisations.py, factorisation +
+one solve, PARDISO vs CHOLMOD vs SuperLU: 0.037/0.056/0.091 s at 17k dofs,
+0.18/0.28/0.73 s at 66k, 1.0/1.9/24.5 s at 261k, 5.4/11.3 s at 1.04M (where the
+whole end-to-end run peaked at 4.1 GB with PARDISO; see docs/speed.md).
 """
 
 from __future__ import annotations

@@ -87,6 +87,24 @@ def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: n
     return Zone(core=core, band=band)
 
 
+def zone_from_coarse(points: np.ndarray, coarse, neighbours: int | None = None) -> Zone | None:
+    """The zone at ``points`` predicted by the coarse model ``coarse`` (a ContactProblem).
+
+    Its contact forces come from its load targeting when that ran (exact
+    already), else from solving it with the ``nested`` method; None when
+    that does not converge.
+    """
+    lam = coarse.calibration_lam
+    if lam is None:
+        from .solvers.registry import solve
+
+        solution = solve(coarse, "nested")
+        if solution.status != "converged":
+            return None
+        lam = solution.lam
+    return predict_zone(points, coarse.contact_points, lam > 0, neighbours)
+
+
 class ZoneSolver:
     """``min ½uᵀKu − fᵀu, Nu ≤ d`` solved exactly around a predicted zone (see module doc).
 

@@ -415,6 +415,8 @@ def bench_time_vs_dofs(rows: list[dict], *, axes=None):
         right.axhline(1.0, color="k", ls="--", lw=1)
         if dofs.size >= 2:
             slopes["one factorisation + solve"] = float(np.polyfit(np.log(dofs), np.log(series_f), 1)[0])
+    import matplotlib
+
     for i, method in enumerate(sorted({r["method"] for r in rows})):
         mine = [r for r in rows if r["method"] == method]
         level = "default" if any(r["tolerance"] == "default" for r in mine) else "high"
@@ -426,8 +428,6 @@ def bench_time_vs_dofs(rows: list[dict], *, axes=None):
         times = np.array([r["time_s"] for r in mine])
         ratios = np.array([r["ratio_to_factor"] for r in mine])
         good = np.array([r["status"] == "converged" for r in mine])
-        import matplotlib
-
         colour = matplotlib.colormaps["tab20"](i % 20)
         marker = "osD^v<>ph"[i % 9]
         for ax, values in ((left, times), (right, ratios)):

@@ -60,38 +60,33 @@ def coarse_values(name: str, params: dict[str, Any]) -> dict[str, Any] | None:
     return values
 
 
-def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
-    """A coarser model of the scene ``problem`` was built from (None when there is none)."""
-    values = coarse_values(problem.scene, problem.params)
+def _coarse_model(name: str, params: dict[str, Any], nondimensionalise: bool):
+    """The coarser model of :func:`coarse_values`, or None (none, or parameters out of range)."""
+    values = coarse_values(name, params)
     if values is None:
         return None
     try:
-        return build_problem(problem.scene, nondimensionalise=problem.scales != Scales(), **values)
+        return build_problem(name, nondimensionalise=nondimensionalise, **values)
     except InputError:  # the coarser parameters are out of range: no coarse model
         return None
 
 
+def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
+    """A coarser model of the scene ``problem`` was built from (None when there is none)."""
+    return _coarse_model(problem.scene, problem.params, problem.scales != Scales())
+
+
 def predicted_zone(name: str, model: SceneModel, nondimensionalise: bool):
     """The contact zone of a large load-targeted model, predicted from a coarser one (or None)."""
-    from ..nested import predict_zone
-    from ..solvers.registry import solve
+    from ..nested import zone_from_coarse
 
     dofs = model.mesh.p.shape[0] * model.mesh.p.shape[1]
-    values = coarse_values(name, model.params)
-    if model.target_load is None or dofs < NESTED_FROM_DOFS or values is None:
+    if model.target_load is None or dofs < NESTED_FROM_DOFS:
         return None
-    try:
-        coarse = build_problem(name, nondimensionalise=nondimensionalise, **values)
-    except InputError:  # the coarser parameters are out of range: target the load directly
+    coarse = _coarse_model(name, model.params, nondimensionalise)
+    if coarse is None:
         return None
-    lam = coarse.calibration_lam  # the coarse model is load-targeted too: solved already
-    if lam is None:
-        solution = solve(coarse, "nested")
-        if solution.status != "converged":
-            return None
-        lam = solution.lam
-    points = model.mesh.p[:, model.contact_nodes].T / coarse.scales.length
-    return predict_zone(points, coarse.contact_points, lam > 0)
+    return zone_from_coarse(model.mesh.p[:, model.contact_nodes].T / coarse.scales.length, coarse)
 
 
 def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> ContactProblem:

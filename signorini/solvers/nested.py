@@ -22,7 +22,7 @@ from typing import Any
 
 from ..errors import InputError
 from ..linalg import selection_dofs
-from ..nested import Zone, ZoneSolver, predict_zone
+from ..nested import Zone, ZoneSolver, zone_from_coarse
 from ..problem import ContactProblem, ContactSolution
 from .options import take_options
 from .registry import Method, register, solve as solve_with
@@ -45,13 +45,7 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | N
         coarse = coarse_problem(problem)
     if coarse is None:
         return None, ""
-    lam = coarse.calibration_lam  # load targeting solved it already
-    if lam is None:
-        solution = solve_with(coarse, "nested")
-        if solution.status != "converged":
-            return None, ""
-        lam = solution.lam
-    zone = predict_zone(problem.contact_points, coarse.contact_points, lam > 0, opts["neighbours"])
+    zone = zone_from_coarse(problem.contact_points, coarse, opts["neighbours"])
     return zone, f"coarse model of {coarse.n} dofs"
 
 
