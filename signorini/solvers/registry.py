@@ -121,7 +121,7 @@ def _load_builtin() -> None:
     global _BUILTIN_LOADED
     if _BUILTIN_LOADED:
         return
-    from . import condensed_dual, cvxpy_, nested, pdas, qp, uzawa  # noqa: F401  (each registers itself)
+    from . import condensed_dual, cvxpy_, nested, pdas, petsc_, qp, uzawa  # noqa: F401  (each registers itself)
     _BUILTIN_LOADED = True
 
 

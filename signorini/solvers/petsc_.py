@@ -1,0 +1,323 @@
+"""The contact QP on PETSc: SNES-VI and TAO on the bound form, serial or under MPI.
+
+The constraints become bounds (:mod:`signorini.bounds`: each contact node's
+dofs rotated into its obstacle's normal–tangent frame), and PETSc solves
+
+    min ½ vᵀ K v − fᵀ v   subject to   lower ≤ v ≤ upper
+
+by one of
+
+* ``petsc-vi``: SNES ``vinewtonrsls``, the reduced-space semismooth Newton
+  method for the variational inequality ``K v − f ⟂ bounds``, with a basic
+  (full-step) line search: on a QP a full Newton step is exact on the set it
+  guesses, so a line search only slows it;
+* ``petsc-tron``: TAO ``tron``, a trust-region Newton method that projects
+  gradients onto the bounds and solves on the free variables;
+* ``petsc-gpcg``: TAO ``gpcg``, gradient projection with conjugate gradients,
+  written for bound-constrained QPs.
+
+The linear solves are MUMPS's parallel LU (``ksp=mumps``, the default) or
+CG preconditioned by PETSc's algebraic multigrid GAMG given the rigid-body
+modes as near-null space (``ksp=gamg``). Under ``mpirun -n N`` rank 0
+assembles, rotates and splits the rows by whole nodes
+(:mod:`signorini.cluster`); each rank builds its block of a parallel AIJ
+matrix, and rank 0 gathers the answer, recovers the contact forces as the
+reactions on the active bounds and judges it like any other method's.
+Extra PETSc options go through ``petsc_options`` ("-snes_monitor -ksp_view …").
+"""
+
+from __future__ import annotations
+
+import shlex
+import time
+from typing import Any
+
+import numpy as np
+
+from ..bounds import BoundForm, bound_form
+from ..errors import InputError
+from ..problem import ContactProblem, ContactSolution
+from .options import take_options
+from .registry import Method, register
+
+DEFAULTS = {"ksp": "mumps", "petsc_options": ""}
+KSP_CHOICES = ("mumps", "gamg")
+#: PETSc type of each method
+KINDS = {"petsc-vi": ("snes", "vinewtonrsls"), "petsc-tron": ("tao", "tron"),
+         "petsc-gpcg": ("tao", "gpcg")}
+MAX_ITER = {"snes": 200, "tao": 2000}
+DEFAULT_TOL = 1e-9
+#: how far below the requested tolerance PETSc's own stopping test is set
+SAFETY = 1e-3
+PREFIX = "signorini_"
+
+
+def _petsc():
+    """petsc4py's PETSc module, initialised once (MPI first, through mpi4py when launched)."""
+    import petsc4py
+
+    if not getattr(petsc4py, "_signorini_ready", False):
+        try:
+            import mpi4py.MPI  # noqa: F401  (MPI initialised by mpi4py, so both share the world)
+        except ImportError:
+            pass
+        petsc4py.init([])
+        petsc4py._signorini_ready = True
+    from petsc4py import PETSc
+
+    return PETSc
+
+
+def _split_nodes(count: int, ranks: int) -> np.ndarray:
+    """Node offsets of each rank's contiguous block (as even as whole nodes allow)."""
+    sizes = np.full(ranks, count // ranks)
+    sizes[: count % ranks] += 1
+    return np.concatenate([[0], np.cumsum(sizes)])
+
+
+def pieces(form: BoundForm, ranks: int, x0: np.ndarray, gamg: bool) -> list[dict[str, Any]]:
+    """Each rank's rows of the bound form: CSR block, vectors, rigid modes (for GAMG)."""
+    offsets = _split_nodes(form.n // form.block, ranks) * form.block
+    modes = form.rigid_modes() if gamg else None
+    K = form.K
+    out = []
+    for first, last in zip(offsets[:-1], offsets[1:]):
+        lo, hi = K.indptr[first], K.indptr[last]
+        out.append({
+            "first": int(first), "rows": int(last - first),
+            "indptr": K.indptr[first:last + 1] - lo, "indices": K.indices[lo:hi],
+            "data": K.data[lo:hi], "f": form.f[first:last], "lower": form.lower[first:last],
+            "upper": form.upper[first:last], "x0": x0[first:last],
+            "modes": None if modes is None else modes[first:last]})
+    return out
+
+
+def _vec(PETSc, A, values: np.ndarray):
+    vec = A.createVecLeft()
+    vec.setArray(np.clip(values, -PETSc.INFINITY, PETSc.INFINITY))
+    return vec
+
+
+class FreshMultigrid:
+    """A PETSc python PC: a new GAMG hierarchy for every operator it is given.
+
+    SNES-VI and TAO hand the linear solver the matrix of the free variables,
+    whose size changes as the active set does; PETSc 3.18's GAMG fails when
+    an existing hierarchy meets a new size ("Cannot change local size of
+    Amat after use"), even after a reset. The rigid-body modes restricted to
+    the free variables go with each new matrix when the solver says which
+    variables are free (SNES-VI's inactive set).
+    """
+
+    def __init__(self, PETSc, n: int, modes: np.ndarray | None, first: int, free_set=None):
+        self.PETSc, self.n, self.modes, self.first, self.free_set = PETSc, n, modes, first, free_set
+        self.inner = None
+
+    def _free_rows(self, P) -> np.ndarray | None:
+        """This rank's rows of ``P`` as local indices of the full problem (None when unknown)."""
+        if P.getSize()[0] == self.n:
+            return np.arange(P.getLocalSize()[0])
+        if self.free_set is not None:
+            rows = np.asarray(self.free_set()) - self.first
+            if rows.size == P.getLocalSize()[0]:
+                return rows
+        return None
+
+    def setUp(self, pc) -> None:
+        PETSc = self.PETSc
+        A, P = pc.getOperators()
+        rows = None if self.modes is None else self._free_rows(P)
+        if rows is not None:
+            vectors = []
+            for column in self.modes[rows].T:
+                vec = P.createVecLeft()
+                vec.setArray(column)
+                vectors.append(vec)
+            P.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=P.getComm()))
+        if self.inner is not None:
+            self.inner.destroy()
+        self.inner = PETSc.PC().create(pc.getComm())
+        self.inner.setType("gamg")
+        self.inner.setOperators(A, P)
+        self.inner.setOptionsPrefix(PREFIX + "mg_")
+        self.inner.setFromOptions()
+        self.inner.setUp()
+
+    def apply(self, pc, x, y) -> None:
+        self.inner.apply(x, y)
+
+
+def _configure_ksp(PETSc, ksp, choice: str, tol: float, multigrid=None) -> None:
+    pc = ksp.getPC()
+    if choice == "mumps":
+        ksp.setType("preonly")
+        pc.setType("lu")
+        pc.setFactorSolverType("mumps")
+    else:
+        ksp.setType("cg")
+        pc.setType("python")
+        pc.setPythonContext(multigrid)
+        ksp.setTolerances(rtol=min(1e-10, tol * SAFETY), atol=0.0, max_it=5000)
+
+
+def _set_options(PETSc, text: str) -> None:
+    opts = PETSc.Options(PREFIX)
+    words = shlex.split(text)
+    for i, word in enumerate(words):
+        if not word.startswith("-"):
+            continue
+        value = words[i + 1] if i + 1 < len(words) and not words[i + 1].startswith("-") else None
+        opts.setValue(word[1:], value if value is not None else "")
+
+
+def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
+    """Every rank: build its block of the parallel problem and solve it (collectively)."""
+    PETSc = _petsc()
+    comm = PETSc.COMM_WORLD
+    start = time.perf_counter()
+    n, block, rows = job["n"], job["block"], piece["rows"]
+    A = PETSc.Mat().createAIJ(size=((rows, n), (rows, n)), bsize=block, comm=comm,
+                              csr=(piece["indptr"].astype(PETSc.IntType),
+                                   piece["indices"].astype(PETSc.IntType), piece["data"]))
+    A.assemble()
+    A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    if piece["modes"] is not None:
+        vectors = [_vec(PETSc, A, column) for column in piece["modes"].T]
+        A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=comm))
+    b, lower, upper = (_vec(PETSc, A, piece[key]) for key in ("f", "lower", "upper"))
+    x = _vec(PETSc, A, piece["x0"])
+    _set_options(PETSc, job["petsc_options"])
+    setup_s = time.perf_counter() - start
+    kind, petsc_type = job["kind"]
+    atol = job["tol"] * SAFETY * max(job["f_norm"], 1e-300)
+    if kind == "snes":
+        solver = PETSc.SNES().create(comm)
+        solver.setType(petsc_type)
+        residual = A.createVecLeft()
+
+        def function(snes, v, out):
+            A.mult(v, out)
+            out.axpy(-1.0, b)
+
+        solver.setFunction(function, residual)
+        solver.setJacobian(lambda *args: None, A, A)
+        solver.setVariableBounds(lower, upper)
+        options = PETSc.Options(PREFIX)
+        if not options.hasName("snes_linesearch_type"):
+            options.setValue("snes_linesearch_type", "basic")
+        solver.setTolerances(rtol=1e-14, atol=atol, stol=0.0, max_it=job["max_iter"])
+    else:
+        solver = PETSc.TAO().create(comm)
+        solver.setType(petsc_type)
+        gradient = A.createVecLeft()
+
+        def objective_gradient(tao, v, g):
+            A.mult(v, g)
+            value = 0.5 * v.dot(g) - b.dot(v)
+            g.axpy(-1.0, b)
+            return value
+
+        solver.setObjectiveGradient(objective_gradient, gradient)
+        solver.setHessian(lambda *args: None, A, A)
+        solver.setVariableBounds((lower, upper))
+        solver.setTolerances(gatol=atol, grtol=0.0, gttol=0.0)
+        solver.setMaximumIterations(job["max_iter"])
+    multigrid = None
+    if job["ksp"] == "gamg":
+        free_set = (lambda: solver.getVIInactiveSet().getIndices()) if kind == "snes" else None
+        multigrid = FreshMultigrid(PETSc, n, piece["modes"], piece["first"], free_set)
+    _configure_ksp(PETSc, solver.getKSP(), job["ksp"], job["tol"], multigrid)
+    solver.setOptionsPrefix(PREFIX)
+    solver.setFromOptions()
+    solve_start = time.perf_counter()
+    solver.solve(None, x) if kind == "snes" else solver.solve(x)
+    result = {
+        "x": x.getArray().copy(), "reason": int(solver.getConvergedReason()),
+        "iterations": int(solver.getIterationNumber()),
+        "setup_s": setup_s, "solve_s": time.perf_counter() - solve_start,
+        "local_rows": rows, "local_nnz": int(piece["data"].size)}
+    if kind == "snes":
+        result["linear_iterations"] = int(solver.getLinearSolveIterations())
+    solver.destroy()
+    A.destroy()
+    return result
+
+
+def _reason_text(kind: str, reason: int) -> str:
+    PETSc = _petsc()
+    table = PETSc.SNES.ConvergedReason if kind == "snes" else PETSc.TAO.Reason
+    names = {value: name for name, value in vars(table).items()
+             if isinstance(value, int) and not name.startswith("_")}
+    return names.get(reason, str(reason))
+
+
+def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: int | None,
+           options: dict[str, Any]) -> ContactSolution:
+    from .. import cluster
+
+    opts = take_options(method, options, DEFAULTS)
+    if opts["ksp"] not in KSP_CHOICES:
+        raise InputError(f"method {method!r}: option ksp={opts['ksp']!r} is not one of "
+                         f"{', '.join(KSP_CHOICES)}")
+    if not isinstance(opts["petsc_options"], str):
+        raise InputError(f"method {method!r}: option petsc_options must be a string of PETSc "
+                         "options, e.g. petsc_options='-snes_monitor'")
+    kind, petsc_type = KINDS[method]
+    tol = DEFAULT_TOL if tol is None else tol
+    start = time.perf_counter()
+    form = bound_form(problem)
+    x0 = np.clip(np.zeros(form.n), form.lower, form.upper)
+    ranks = cluster.size()
+    job = {"run": f"{__name__}:solve_piece", "n": form.n, "block": form.block,
+           "kind": (kind, petsc_type), "ksp": opts["ksp"], "tol": tol,
+           "f_norm": float(np.linalg.norm(form.f)),
+           "max_iter": MAX_ITER[kind] if max_iter is None else max_iter,
+           "petsc_options": opts["petsc_options"]}
+    parts = pieces(form, ranks, x0, gamg=opts["ksp"] == "gamg")
+    build_time = time.perf_counter() - start
+    results = cluster.distribute(job, parts)
+    del parts
+    per_rank = [{key: r[key] for key in ("rank", "local_rows", "local_nnz", "setup_s", "solve_s",
+                                         "rank_s", "peak_memory_mb", "error") if key in r}
+                for r in results]
+    extras = {"ranks": ranks, "per_rank": per_rank, "petsc_type": petsc_type, "ksp": opts["ksp"]}
+    errors = [r["error"] for r in results if "error" in r]
+    if errors:
+        return ContactSolution.failure(method, problem, "failed", "; ".join(errors),
+                                       build_time=build_time, extras=extras,
+                                       solve_time=time.perf_counter() - start)
+    v = np.concatenate([r["x"] for r in results])
+    reason = results[0]["reason"]
+    iterations = results[0]["iterations"]
+    if "linear_iterations" in results[0]:
+        extras["linear_iterations"] = results[0]["linear_iterations"]
+    text = _reason_text(kind, reason)
+    status = "converged" if reason > 0 else ("max_iter" if "MAXIT" in text.upper() else "failed")
+    message = (f"{petsc_type} with {opts['ksp']} on {ranks} rank{'s' if ranks > 1 else ''}: "
+               f"{text} after {iterations} iterations")
+    return ContactSolution(method=method, u=form.displacement(v), lam=form.multipliers(v),
+                           status=status, message=message, iterations=iterations,
+                           build_time=build_time, solve_time=time.perf_counter() - start,
+                           extras=extras)
+
+
+def _make(method: str):
+    def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+              **options: Any) -> ContactSolution:
+        return _solve(method, problem, tol, max_iter, options)
+
+    solve.__name__ = method.replace("-", "_")
+    solve.__doc__ = f"PETSc {KINDS[method][1]} on the bound form (MUMPS or CG + GAMG)."
+    return solve
+
+
+SUMMARIES = {
+    "petsc-vi": "PETSc SNES vinewtonrsls (semismooth Newton on the bounds), MUMPS or CG+GAMG; MPI",
+    "petsc-tron": "PETSc TAO tron (trust-region Newton on the bounds), MUMPS or CG+GAMG; MPI",
+    "petsc-gpcg": "PETSc TAO gpcg (gradient projection + CG on the bounds); MPI",
+}
+
+for _name in KINDS:
+    register(Method(name=_name, function=_make(_name), summary=SUMMARIES[_name],
+                    requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
+                    exact=_name == "petsc-vi", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)))
