@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 
 .PHONY: validate test clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml tools/install_petsc.sh
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --quiet --upgrade pip
 	$(VENV)/bin/python -m pip install --quiet -e '.[all]'
@@ -21,6 +21,8 @@ $(STAMP): pyproject.toml
 	    libsuitesparse-dev >/dev/null) || echo "make: libsuitesparse-dev not installed"; fi
 	@$(VENV)/bin/python -m pip install --quiet -e '.[fast]' \
 	  || echo "make: CHOLMOD (scikit-sparse) not installed; SuperLU will be used"
+	@# the petsc methods (SNES-VI, TAO under MPI): Debian's PETSc + petsc4py built against it
+	@sh tools/install_petsc.sh $(VENV)
 	touch $(STAMP)
 
 validate: $(STAMP)

@@ -103,6 +103,19 @@ def cmd_solve(args: argparse.Namespace) -> int:
     return 0 if solution.status == "converged" else EXIT_FAILED
 
 
+def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
+    """Under mpirun only ``solve`` with a distributed (petsc-*) method makes sense."""
+    from .solvers.registry import get_method
+
+    if args.run is not cmd_solve:
+        raise InputError(f"under mpirun -n {ranks} only 'signorini solve' runs: run the other "
+                         "commands without mpirun")
+    if get_method(args.method).family != "petsc":
+        raise InputError(f"under mpirun -n {ranks} only the petsc methods run distributed: give "
+                         f"--method petsc-vi (or petsc-tron, petsc-gpcg), or run {args.method} "
+                         "without mpirun")
+
+
 def cmd_converge(args: argparse.Namespace) -> int:
     from .convergence import grading_comparison, run_study, study_table, write_study
     from .io import writable_directory
@@ -368,10 +381,37 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from . import cluster
+
+    if cluster.launched_size() > 1:
+        return _main_ranks(argv)
+    return _main(argv)
+
+
+def _main_ranks(argv: Sequence[str] | None) -> int:
+    """Under ``mpirun -n N``: rank 0 runs the command, the other ranks serve its solves."""
+    from . import cluster
+
+    try:
+        if cluster.rank() != 0:
+            return cluster.serve()
+    except ImportError:
+        print("signorini: error: started by mpirun but mpi4py is not installed: "
+              "pip install 'signorini[petsc]' (see README, 'PETSc and MPI')", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        return _main(argv, ranks=cluster.size())
+    finally:
+        cluster.release()
+
+
+def _main(argv: Sequence[str] | None, ranks: int = 1) -> int:
     try:
         args = build_parser().parse_args(argv)
         logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                             format="%(levelname)s %(name)s: %(message)s")
+        if ranks > 1:
+            _check_distributed(args, ranks)
         return args.run(args)
     except InputError as exc:
         print(f"signorini: error: {exc}", file=sys.stderr)

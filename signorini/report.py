@@ -44,6 +44,13 @@ def provenance() -> dict[str, Any]:
             "cpu": cpu, "cores": os.cpu_count(), "versions": versions}
 
 
+def _scalar_rows(value: Any) -> bool:
+    """A list of flat records (e.g. per-rank timings): kept in the JSON."""
+    return isinstance(value, list) and all(
+        isinstance(row, dict) and all(isinstance(x, (int, float, str, bool)) for x in row.values())
+        for row in value)
+
+
 def solve_record(problem: ContactProblem, solution: ContactSolution) -> dict[str, Any]:
     """The JSON contract of ``signorini solve --json``."""
     cert = certificate(problem, solution)
@@ -78,7 +85,7 @@ def solve_record(problem: ContactProblem, solution: ContactSolution) -> dict[str
         record["total_force"] = None
         record["contact"] = None
     record["extras"] = {k: v for k, v in solution.extras.items()
-                        if isinstance(v, (int, float, str, bool))}
+                        if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}
     return record
 
 
