@@ -32,6 +32,7 @@ from typing import Any, Callable, Iterable
 import numpy as np
 import scipy.sparse as sp
 
+from . import cluster
 from .errors import InputError
 from .problem import ContactProblem, Push, Scales
 
@@ -42,7 +43,8 @@ log = logging.getLogger(__name__)
 REFERENCE = "nested"
 #: named tolerance levels (qpbenchmark's); "default" leaves each backend's own settings
 TOLERANCES = {"low": 1e-3, "mid": 1e-6, "high": 1e-9, "default": None}
-COLUMNS = ("scene", "size", "dofs", "candidates", "method", "tolerance", "status", "claimed_status",
+COLUMNS = ("scene", "size", "dofs", "candidates", "method", "ranks", "tolerance", "status",
+           "claimed_status",
            "iterations", "build_s", "solve_s", "time_s", "factor_s", "ratio_to_factor",
            "kkt_worst", "lam_rel", "misclassified", "p0_rel", "a_rel", "message")
 
@@ -54,10 +56,17 @@ class Run:
     params: dict[str, Any]
     method: str
     tolerance: str
+    #: MPI ranks (petsc methods only; the others run in one process)
+    ranks: int = 1
+
+    @property
+    def label(self) -> str:
+        """The method as the report names it: ``petsc-vi n=2`` for 2 ranks."""
+        return self.method if self.ranks == 1 else f"{self.method} n={self.ranks}"
 
     @property
     def key(self) -> tuple[str, str, str, str]:
-        return (self.scene, self.size, self.method, self.tolerance)
+        return (self.scene, self.size, self.label, self.tolerance)
 
 
 # --- problem cache ----------------------------------------------------------------------------
@@ -72,6 +81,8 @@ def save_problem(problem: ContactProblem, path: Path) -> None:
         weights=problem.weights, contact_points=problem.contact_points,
         free_dofs=problem.free_dofs, prescribed=problem.prescribed,
         load_row=problem.load_row if problem.load_row is not None else np.zeros(0))
+    if problem.mesh is not None:  # node blocks and rigid modes for the petsc methods
+        arrays.update(mesh_p=problem.mesh.p, mesh_t=problem.mesh.t)
     if pu is not None:
         arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
     meta = {"scene": problem.scene, "params": problem.params, "load_offset": problem.load_offset,
@@ -101,9 +112,19 @@ def load_problem(path: Path) -> ContactProblem:
         free_dofs=z["free_dofs"], prescribed=z["prescribed"],
         load_row=z["load_row"] if z["load_row"].size else None, load_offset=meta["load_offset"],
         force_multiplicity=meta["force_multiplicity"], scales=Scales(**meta["scales"]),
-        scene=meta["scene"], params=meta["params"], push=push)
+        scene=meta["scene"], params=meta["params"], push=push, mesh=_mesh(z))
     problem.assemble_time = meta["assemble_time"]
     return problem
+
+
+def _mesh(z):
+    """The stored mesh (triangles or tetrahedra), or None."""
+    if "mesh_p" not in z:
+        return None
+    from skfem import MeshTet, MeshTri
+
+    kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
+    return kind(z["mesh_p"], z["mesh_t"])
 
 
 # --- one run, in a worker process -------------------------------------------------------------
@@ -156,12 +177,19 @@ def _reference(problem: ContactProblem, problem_path: Path, exact=None):
 
 
 def _worker_main() -> None:
+    from . import cluster
+
     args = json.loads(sys.argv[1])
     logging.disable(logging.WARNING)
+    if cluster.launched_size() > 1 and cluster.rank() != 0:
+        cluster.serve()  # rank 0 runs the benchmark; this rank takes part in its solves
+        return
     try:
         row = run_in_worker(Path(args["problem"]), args["method"], args["tolerance"])
     except Exception as exc:  # every exception becomes a failed row, never a dead benchmark
         row = {"status": "failed", "message": f"{type(exc).__name__}: {exc}"}
+    finally:
+        cluster.release()
     print(json.dumps(row, default=float))
 
 
@@ -212,11 +240,16 @@ def run_benchmark(runs: Iterable[Run], out: Path, time_limit: float = 600.0,
         path = problem_file(out, run.scene, run.size, run.params)
         problem_meta = load_problem(path)
         base = {"scene": run.scene, "size": run.size, "dofs": problem_meta.n,
-                "candidates": problem_meta.m, "method": run.method, "tolerance": run.tolerance}
+                "candidates": problem_meta.m, "method": run.label, "ranks": run.ranks,
+                "tolerance": run.tolerance}
         command = [sys.executable, "-c", "from signorini.bench import _worker_main; _worker_main()",
                    json.dumps({"problem": str(path), "method": run.method, "tolerance": run.tolerance})]
+        env = None
+        if run.ranks > 1:
+            command, env = cluster.mpirun_command(run.ranks, command)
         try:
-            proc = subprocess.run(command, capture_output=True, text=True, timeout=time_limit)
+            proc = subprocess.run(command, capture_output=True, text=True, timeout=time_limit,
+                                  env=env)
             lines = proc.stdout.strip().splitlines()
             result = json.loads(lines[-1]) if proc.returncode == 0 and lines else {
                 "status": "failed", "message": (proc.stderr.strip().splitlines() or ["crashed"])[-1]}
@@ -238,6 +271,9 @@ def read_rows(path: Path) -> list[dict[str, Any]]:
     for row in rows:
         for key in COLUMNS:
             if key in ("scene", "size", "method", "tolerance", "status", "claimed_status", "message"):
+                continue
+            if key == "ranks" and not row.get(key):  # rows written before the column existed
+                row[key] = 1.0
                 continue
             try:
                 row[key] = float(row[key])

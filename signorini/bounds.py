@@ -23,11 +23,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import InputError
+from .errors import SignoriniError
 from .problem import ContactProblem
 
 #: a row entry below this fraction of the row's largest is round-off, not a coupling
 ROUND_OFF = 1e-13
+
+
+class NoBoundForm(SignoriniError):
+    """The constraints are not one bound each in any rotation (two rows share a dof)."""
 
 
 @dataclass
@@ -111,8 +115,9 @@ def _householder(row: np.ndarray) -> np.ndarray:
 def bound_form(problem: ContactProblem) -> BoundForm:
     """Rotate each contact node's free dofs so that every contact row becomes a bound.
 
-    Raises :class:`InputError` when two rows share a dof (two obstacles
-    acting on one node): such a problem has no bound form.
+    Raises :class:`NoBoundForm` when two rows share a dof (two obstacles
+    acting on one node, or general linear constraints): such a problem has
+    no bound form. A row over several nodes' dofs is rotated as one block.
     """
     block, coordinates = _node_blocks(problem)
     n_full, free = problem.prescribed.shape[0], problem.free_dofs
@@ -130,8 +135,8 @@ def bound_form(problem: ContactProblem) -> BoundForm:
         cols, vals = cols[big], vals[big]
         if np.any(owner[cols] >= 0):
             other = int(owner[cols][owner[cols] >= 0][0])
-            raise InputError(f"contact rows {other} and {i} share a dof: the petsc methods need "
-                             "one obstacle row per node; use pdas or a qp-* method")
+            raise NoBoundForm(f"contact rows {other} and {i} share a dof, so the constraints "
+                              "are not bounds in any frame: use pdas or a qp-* method")
         owner[cols] = i
         if cols.size == 1:
             continue
@@ -150,8 +155,7 @@ def bound_form(problem: ContactProblem) -> BoundForm:
     rotated.eliminate_zeros()
     counts = np.diff(rotated.indptr)
     if np.any(counts != 1):
-        raise InputError("a contact row does not reduce to one bound after rotation "
-                         "(its dofs span nodes): use pdas or a qp-* method")
+        raise NoBoundForm("a contact row does not reduce to one bound after rotation")
     index, coef = rotated.indices.copy(), rotated.data.copy()
     prescribed = np.ones(n_full, dtype=bool)
     prescribed[free] = False

@@ -214,6 +214,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise InputError(f"--tolerance {unknown[0]!r} is not one of {', '.join(TOLERANCES)}")
     chosen = [get_method(m) for m in args.method] if args.method else \
         [m for m in methods(installed_only=True) if not m.dense and m.family != "user"]
+    try:
+        ranks = sorted({int(x) for x in args.ranks.split(",")})
+    except ValueError:
+        ranks = [0]
+    if ranks[0] < 1:
+        raise InputError(f"--ranks {args.ranks!r} must be a comma-separated list of positive "
+                         "rank counts, e.g. --ranks 1,2")
+    if ranks[-1] > 1:
+        from .cluster import mpirun_command
+
+        mpirun_command(ranks[-1], [])  # no mpirun, or more ranks than cores: fail before any run
     base = _pairs(args.set, "--set")
     runs = []
     for level in levels:
@@ -222,10 +233,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
         for method in chosen:
             few = args.default_only_from is not None and level >= args.default_only_from
             for tolerance in (["high"] if method.exact else ["default"] if few else tolerances):
-                runs.append(Run(args.scene, f"refine{level}", params, method.name, tolerance))
+                for count in (ranks if method.family == "petsc" else [1]):
+                    runs.append(Run(args.scene, f"refine{level}", params, method.name, tolerance,
+                                    ranks=count))
 
     def progress(i, n, run, row):
-        print(f"[{i}/{n}] {run.size} {run.method}@{run.tolerance}: {row['status']} "
+        print(f"[{i}/{n}] {run.size} {run.label}@{run.tolerance}: {row['status']} "
               f"{row.get('time_s', float('nan')):.3g} s", file=sys.stderr)
 
     if not args.report_only:
@@ -358,6 +371,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="from this refinement level on, iterative methods run at their "
                             "default tolerance only (large sizes)")
     bench.add_argument("--time-limit", type=float, default=600.0, help="seconds per run")
+    bench.add_argument("--ranks", default="1", help="MPI ranks for the petsc methods, e.g. 1,2 "
+                       "(each count is one more run; never more than the cores)")
     bench.add_argument("--out", default="bench-report")
     bench.add_argument("--report-only", action="store_true", help="rewrite the report from the CSV")
     bench.set_defaults(run=cmd_bench)

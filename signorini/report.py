@@ -113,6 +113,11 @@ def solve_summary(record: dict[str, Any]) -> str:
                      f"{q['inner']:g}a: max {100 * q['pressure_max_rel']:.2f} %, "
                      f"L2 {100 * q['pressure_l2_rel']:.2f} %; edge node p = {q['edge_pressure']:.4g} "
                      f"(element {q['edge_h']:.3g} next to the edge)")
+    for rank in record["extras"].get("per_rank", []):
+        if "local_rows" in rank:
+            lines.append(f"  rank {rank['rank']}: {rank['local_rows']} rows, set-up "
+                         f"{rank['setup_s']:.2f} s, solve {rank['solve_s']:.2f} s, "
+                         f"peak memory {rank['peak_memory_mb']:.0f} MB")
     return "\n".join(lines)
 
 

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..bounds import BoundForm, bound_form
+from ..bounds import BoundForm, NoBoundForm, bound_form
 from ..errors import InputError
 from ..problem import ContactProblem, ContactSolution
 from .options import take_options
@@ -265,7 +265,11 @@ def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: in
     kind, petsc_type = KINDS[method]
     tol = DEFAULT_TOL if tol is None else tol
     start = time.perf_counter()
-    form = bound_form(problem)
+    try:
+        form = bound_form(problem)
+    except NoBoundForm as exc:
+        return ContactSolution.failure(method, problem, "failed", str(exc),
+                                       solve_time=time.perf_counter() - start)
     x0 = np.clip(np.zeros(form.n), form.lower, form.upper)
     ranks = cluster.size()
     job = {"run": f"{__name__}:solve_piece", "n": form.n, "block": form.block,
