@@ -60,7 +60,9 @@ class Certificate:
       ``√residual``; this one is linear in both, so it bounds how far λ and
       the active set can be off (times the conditioning of ``W``).
     - ``duality_gap``: ``|J(u) − D(λ)| / max(|J(u)|, |D(λ)|)`` with ``J`` the
-      energy and ``D`` the dual function (one factorisation of K, cached).
+      energy and ``D`` the dual function, evaluated as ``L(u, λ) − ½ rᵀK⁻¹r``
+      with ``r`` the stationarity residual (one factorisation of K, cached, or
+      CG from 300k dofs: see :meth:`ContactProblem.inverse_energy`).
 
     Force norms are floored at ``FORCE_FLOOR · ‖f‖∞`` so that a problem with
     no contact (λ = 0 up to round-off) is judged against its loads.
@@ -104,8 +106,13 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     natural = _inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))
     gap = float("nan")
     if duality_gap:
+        # D(λ⁺) = L(u, λ⁺) − ½ rᵀK⁻¹r with r = ∇ᵤL(u, λ⁺): the dual function through the
+        # residual, so the gap −λ⁺ᵀ(Nu − d) + ½ rᵀK⁻¹r has no cancellation of large terms
+        lam_plus = np.maximum(lam, 0.0)
+        r = problem.K @ u - problem.f + problem.N.T @ lam_plus
         primal_obj = problem.energy(u)
-        dual_obj = problem.dual_objective(np.maximum(lam, 0.0))
+        lagrangian = primal_obj + float(lam_plus @ violation)
+        dual_obj = lagrangian - 0.5 * problem.inverse_energy(r)
         gap = abs(primal_obj - dual_obj) / _positive(max(abs(primal_obj), abs(dual_obj)))
     return Certificate(primal, stationarity, dual_sign, complementarity, natural, gap)
 

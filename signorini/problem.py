@@ -27,6 +27,12 @@ from .errors import InputError
 STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed")
 
 
+#: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
+ITERATIVE_ENERGY_FROM = 300_000
+ITERATIVE_ENERGY_RTOL = 1e-6
+ITERATIVE_ENERGY_MAX_ITER = 20_000
+
+
 @dataclass(frozen=True)
 class Scales:
     """Units that make the problem dimensionless.
@@ -196,6 +202,25 @@ class ContactProblem:
     def displacement_for(self, lam: np.ndarray) -> np.ndarray:
         """``u(λ) = K⁻¹ (f − Nᵀλ)``, the minimiser of the Lagrangian."""
         return self.factor().solve(self.f - self.N.T @ lam)
+
+    def inverse_energy(self, r: np.ndarray) -> float:
+        """``rᵀ K⁻¹ r``: by the cached factorisation, or by conjugate gradients on big problems.
+
+        From :data:`ITERATIVE_ENERGY_FROM` dofs, when no factorisation is at
+        hand (a distributed solve never makes one), Jacobi-preconditioned CG
+        to ``ITERATIVE_ENERGY_RTOL`` replaces a serial factorisation that
+        would cost more than the solve; without convergence it factorises.
+        """
+        if self._factor is None and self.n >= ITERATIVE_ENERGY_FROM and np.any(r):
+            from scipy.sparse.linalg import cg
+
+            diagonal = self.K.diagonal()
+            jacobi = sp.diags(1.0 / diagonal)
+            z, info = cg(self.K, r, rtol=ITERATIVE_ENERGY_RTOL, atol=0.0, M=jacobi,
+                         maxiter=ITERATIVE_ENERGY_MAX_ITER)
+            if info == 0:
+                return float(r @ z)
+        return float(r @ self.factor().solve(r))
 
     def dual_objective(self, lam: np.ndarray) -> float:
         """``D(λ) = min_u ½uᵀKu − fᵀu + λᵀ(Nu − d)``.

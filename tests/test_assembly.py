@@ -334,6 +334,21 @@ def test_vectorised_plane_strain_stiffness_is_scikit_fems():
     assert difference <= 1e-12 * abs(expected).max()
 
 
+def test_vectorised_solid_stiffness_is_scikit_fems(monkeypatch):
+    from skfem import Basis, ElementVector, MeshTet, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    from signorini import assembly
+
+    mesh = MeshTet.init_ball().refined(1)
+    mesh = MeshTet(mesh.p * [[1.3], [0.7], [1.1]] + 0.1 * np.sin(mesh.p), mesh.t)  # distorted
+    Lambda, Mu = lame_parameters(2.0, 0.3)
+    expected = asm(linear_elasticity(Lambda, Mu), Basis(mesh, ElementVector(mesh.elem())))
+    monkeypatch.setattr(assembly, "TETRA_BLOCK", 97)  # several blocks, a ragged last one
+    difference = abs(assembly.solid_stiffness(mesh, Lambda, Mu) - expected).max()
+    assert difference <= 1e-12 * abs(expected).max()
+
+
 @pytest.mark.parametrize("axisymmetric", [False, True])
 def test_closed_form_contact_weights_are_scikit_fems(axisymmetric):
     from skfem import FacetBasis, LinearForm, MeshTri, asm

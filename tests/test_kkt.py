@@ -281,3 +281,18 @@ def test_judge_refuses_non_finite_claims(hertz):
     claim = ContactSolution("x", np.full(hertz.n, np.nan), np.zeros(hertz.m), "converged")
     judged = registry.judge(hertz, claim, 1e-3)
     assert judged.status == "inaccurate"
+
+
+def test_duality_gap_by_conjugate_gradients_equals_the_factorised_one(hertz, exact, monkeypatch):
+    """Big problems evaluate rᵀK⁻¹r by CG (no serial factorisation): the same gap."""
+    from signorini import problem as problem_module
+
+    rng = np.random.default_rng(0)
+    rough = with_(exact, u=exact.u * (1 + 1e-4 * rng.standard_normal(exact.u.size)),
+                  lam=exact.lam * 1.001)
+    expected = certificate(hertz, rough).duality_gap
+    fresh = hertz.with_data()  # no cached factorisation
+    monkeypatch.setattr(problem_module, "ITERATIVE_ENERGY_FROM", 0)
+    by_cg = certificate(fresh, rough).duality_gap
+    assert fresh._factor is None
+    assert expected > 1e-9 and by_cg == pytest.approx(expected, rel=1e-4)

@@ -48,7 +48,7 @@ KINDS = {"petsc-vi": ("snes", "vinewtonrsls"), "petsc-tron": ("tao", "tron"),
 MAX_ITER = {"snes": 200, "tao": 2000}
 DEFAULT_TOL = 1e-9
 #: how far below the requested tolerance PETSc's own stopping test is set
-SAFETY = 1e-3
+SAFETY = 1e-5
 PREFIX = "signorini_"
 
 
