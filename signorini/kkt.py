@@ -88,7 +88,22 @@ class Certificate:
 
 def certificate(problem: ContactProblem, solution: ContactSolution,
                 duality_gap: bool = True) -> Certificate:
-    """Relative KKT residuals of ``solution`` for ``problem`` (see :class:`Certificate`)."""
+    """Relative KKT residuals of ``solution`` for ``problem`` (see :class:`Certificate`).
+
+    The result is kept on the solution (for these same arrays, problem and
+    options): judging a solution and then reporting it costs one evaluation.
+    """
+    key = (id(problem), id(solution.u), id(solution.lam), duality_gap)
+    kept = getattr(solution, "_certificate", None)
+    if kept is not None and kept[0] == key:
+        return kept[1]
+    cert = _certificate(problem, solution, duality_gap)
+    solution._certificate = (key, cert)
+    return cert
+
+
+def _certificate(problem: ContactProblem, solution: ContactSolution,
+                 duality_gap: bool) -> Certificate:
     u, lam = solution.u, solution.lam
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(lam))):
         inf = float("inf")
