@@ -117,6 +117,18 @@ def test_petsc_matches_the_exact_answer(references, name, method, ksp):
     assert answer.extras["ranks"] == 1 and answer.extras["ksp"] == ksp
 
 
+def test_auto_picks_multigrid_for_big_3d_problems_only(references, monkeypatch):
+    require_petsc()
+    from signorini.solvers import petsc_
+
+    monkeypatch.setattr(petsc_, "GAMG_FROM_DOFS", 1000)
+    for name, expected in (("hertz-sphere-3d", "gamg"), ("hertz-cylinder", "mumps")):
+        problem, exact = references[name]
+        answer = solve(problem, "petsc-vi")
+        assert answer.extras["ksp"] == expected and answer.status == "converged"
+        assert compare(problem, answer, exact).lam_rel <= 1e-6
+
+
 def test_petsc_on_a_curved_obstacle(references):
     require_petsc()
     problem, exact = references["reverse-hertz"]
