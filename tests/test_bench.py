@@ -24,6 +24,7 @@ def test_problem_cache_round_trip(tmp_path):
     assert (again.K != problem.K).nnz == 0 and np.array_equal(again.f, problem.f)
     assert again.params == problem.params and again.scales == problem.scales
     assert np.array_equal(again.push.f1, problem.push.f1)
+    assert np.array_equal(again.mesh.p, problem.mesh.p)  # node blocks for the petsc methods
 
 
 def test_rows_resume_and_time_limit(tmp_path):
@@ -63,3 +64,25 @@ def test_bench_command_checks_its_arguments(tmp_path, capsys):
     assert main(["bench", "--sizes", "a,b", "--out", str(tmp_path)]) == 2
     assert main(["bench", "--tolerance", "tight", "--out", str(tmp_path)]) == 2
     assert "tight" in capsys.readouterr().err
+
+
+def test_bench_ranks_are_checked(tmp_path, capsys):
+    assert main(["bench", "--ranks", "0", "--out", str(tmp_path)]) == 2
+    assert main(["bench", "--ranks", "999", "--out", str(tmp_path)]) == 2
+    assert "ranks" in capsys.readouterr().err
+
+
+def test_petsc_runs_under_one_and_two_ranks(tmp_path):
+    """A petsc method is one row per rank count, labelled, and agrees with the exact answer."""
+    import os
+    import shutil
+
+    pytest.importorskip("petsc4py", reason="the petsc methods need petsc4py (make installs it)")
+    if shutil.which("mpirun") is None or (os.cpu_count() or 1) < 2:
+        pytest.skip("needs mpirun and 2 cores")
+    chosen = [Run("hertz-cylinder", "tiny", SMALL, "petsc-vi", "high", ranks=r) for r in (1, 2)]
+    rows = read_rows(run_benchmark(chosen, tmp_path, time_limit=300))
+    assert [(r["method"], r["ranks"]) for r in rows] == [("petsc-vi", 1), ("petsc-vi n=2", 2)]
+    for row in rows:
+        assert row["status"] == "converged", row["message"]
+        assert row["lam_rel"] <= 1e-6 and row["misclassified"] == 0
