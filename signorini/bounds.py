@@ -33,6 +33,15 @@ ROUND_OFF = 1e-13
 class NoBoundForm(SignoriniError):
     """The constraints are not one bound each in any rotation (two rows share a dof)."""
 
+    #: the status a solver reports for it
+    status = "failed"
+
+
+class InfeasibleBounds(NoBoundForm):
+    """A contact row without a free dof starts penetrating: nothing can satisfy it."""
+
+    status = "infeasible"
+
 
 @dataclass
 class BoundForm:
@@ -62,9 +71,15 @@ class BoundForm:
         return (self.T @ v)[self.free_dofs]
 
     def multipliers(self, v: np.ndarray) -> np.ndarray:
-        """The contact forces: the reactions on the bounds, ``(f − K v)_j / a``, never negative."""
-        reaction = (self.f - self.K @ v)[self.bound_index] / self.bound_coef
-        return np.maximum(reaction, 0.0)
+        """The contact forces: the reactions on the bounds, ``(f − K v)_j / a``, never negative.
+
+        A row without a free dof (``bound_index`` −1) bounds nothing and carries no force.
+        """
+        bounded = self.bound_index >= 0
+        lam = np.zeros(self.bound_index.size)
+        gradient = self.f - self.K @ v
+        lam[bounded] = gradient[self.bound_index[bounded]] / self.bound_coef[bounded]
+        return np.maximum(lam, 0.0)
 
     def rigid_modes(self) -> np.ndarray | None:
         """Rigid-body displacements of the mesh in the rotated unknowns, orthonormal columns.
@@ -128,9 +143,16 @@ def bound_form(problem: ContactProblem) -> BoundForm:
     owner = np.full(n_full, -1)
     rows_i, rows_j, rows_v = [np.arange(n_full)], [np.arange(n_full)], [np.ones(n_full)]
     keep = np.ones(n_full, dtype=bool)
+    empty = np.diff(N.indptr) == 0
+    if np.any(empty & (problem.d < 0)):
+        rows = np.nonzero(empty & (problem.d < 0))[0]
+        raise InfeasibleBounds(f"contact candidate(s) {tuple(rows[:5].tolist())} have every dof "
+                               "prescribed and start inside the obstacle: the problem is infeasible")
     for i in range(N.shape[0]):
         cols = N.indices[N.indptr[i]:N.indptr[i + 1]]
         vals = N.data[N.indptr[i]:N.indptr[i + 1]]
+        if cols.size == 0:
+            continue
         big = np.abs(vals) > ROUND_OFF * np.abs(vals).max()
         cols, vals = cols[big], vals[big]
         if np.any(owner[cols] >= 0):
@@ -151,20 +173,21 @@ def bound_form(problem: ContactProblem) -> BoundForm:
     T = sp.csr_matrix((np.concatenate(rows_v), (np.concatenate(rows_i), np.concatenate(rows_j))),
                       shape=(n_full, n_full))
     rotated = (N @ T).tocsr()
-    rotated.data[np.abs(rotated.data) <= ROUND_OFF * np.abs(rotated.data).max()] = 0.0
+    rotated.data[np.abs(rotated.data) <= ROUND_OFF * np.abs(rotated.data).max(initial=0.0)] = 0.0
     rotated.eliminate_zeros()
     counts = np.diff(rotated.indptr)
-    if np.any(counts != 1):
+    if np.any(counts[~empty] != 1):
         raise NoBoundForm("a contact row does not reduce to one bound after rotation")
-    index, coef = rotated.indices.copy(), rotated.data.copy()
+    index, coef = np.full(N.shape[0], -1), np.ones(N.shape[0])
+    index[~empty], coef[~empty] = rotated.indices, rotated.data
     prescribed = np.ones(n_full, dtype=bool)
     prescribed[free] = False
     K_full = embed @ problem.K @ embed.T + sp.diags(prescribed.astype(float))
     lower = np.where(prescribed, 0.0, -np.inf)
     upper = np.where(prescribed, 0.0, np.inf)
     limit = problem.d / coef
-    upper[index[coef > 0]] = limit[coef > 0]
-    lower[index[coef < 0]] = limit[coef < 0]
+    up, down = ~empty & (coef > 0), ~empty & (coef < 0)
+    upper[index[up]], lower[index[down]] = limit[up], limit[down]
     return BoundForm(K=(T.T @ K_full @ T).tocsr(), f=T.T @ (embed @ problem.f), lower=lower,
                      upper=upper, T=T, free_dofs=free, bound_index=index, bound_coef=coef,
                      block=block, coordinates=coordinates)

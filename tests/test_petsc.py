@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from signorini.bounds import NoBoundForm, bound_form
+from signorini.bounds import InfeasibleBounds, NoBoundForm, bound_form
 from signorini.errors import InputError
 from signorini.kkt import active_set, compare
 from signorini.scenes import build_problem
@@ -79,6 +79,20 @@ def test_rows_sharing_a_dof_have_no_bound_form():
     if importlib.util.find_spec("petsc4py") is not None:  # the method says so, and fails
         answer = solve(shared, "petsc-vi")
         assert answer.status == "failed" and "share a dof" in answer.message
+
+
+def test_a_row_without_free_dofs_bounds_nothing_or_is_infeasible():
+    problem = random_problem(12, 4, seed=5)
+    N = problem.N.tocsr()
+    keep = N.data == -1.0  # one dof per row, so the rows are bounds
+    rows = np.repeat(np.arange(4), np.diff(N.indptr))[keep]
+    N = sp.csr_matrix((N.data[keep], (rows, N.indices[keep])), shape=N.shape).tolil()
+    N[3, :] = 0.0  # a candidate whose dofs are all prescribed
+    loose = problem.with_data(N=sp.csr_matrix(N), d=np.r_[problem.d[:3], 1.0])
+    form = bound_form(loose)
+    assert form.bound_index[3] == -1 and form.multipliers(np.zeros(form.n))[3] == 0.0
+    with pytest.raises(InfeasibleBounds, match="infeasible"):
+        bound_form(loose.with_data(d=np.r_[problem.d[:3], -1.0]))
 
 
 def test_rigid_modes_are_a_near_null_space(references):

@@ -345,7 +345,7 @@ def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: in
     try:
         form = bound_form(problem)
     except NoBoundForm as exc:
-        return ContactSolution.failure(method, problem, "failed", str(exc),
+        return ContactSolution.failure(method, problem, exc.status, str(exc),
                                        solve_time=time.perf_counter() - start)
     x0 = np.clip(np.zeros(form.n), form.lower, form.upper)
     if ksp == "auto":
