@@ -217,14 +217,14 @@ def _stationarity_test(PETSc, lower, upper, b, job: dict[str, Any]):
             at_lower, at_upper = at_lower & ~fixed, at_upper & ~fixed
             free = ~(at_lower | at_upper | fixed)
             # off the bounds F must vanish; on an upper bound F ≤ 0, on a lower one F ≥ 0
-            free = max(float(np.abs(F[free]).max(initial=0.0)),
-                       float(np.maximum(F[at_upper], 0.0).max(initial=0.0)),
-                       float(np.maximum(-F[at_lower], 0.0).max(initial=0.0)))
+            violation = max(float(np.abs(F[free]).max(initial=0.0)),
+                            float(np.maximum(F[at_upper], 0.0).max(initial=0.0)),
+                            float(np.maximum(-F[at_lower], 0.0).max(initial=0.0)))
             reaction = float(np.abs(F[at_lower | at_upper]).max(initial=0.0))
             both = np.empty(2)
-            MPI.COMM_WORLD.Allreduce(np.array([free, reaction]), both, op=MPI.MAX)
-            free, reaction = both
-            if free <= target * max(reaction, 1e-5 * load):
+            MPI.COMM_WORLD.Allreduce(np.array([violation, reaction]), both, op=MPI.MAX)
+            violation, reaction = both
+            if violation <= target * max(reaction, 1e-5 * load):
                 return reason.CONVERGED_FNORM_ABS
         if iteration >= job["max_iter"]:
             return reason.DIVERGED_MAX_IT
