@@ -9,8 +9,6 @@ ranks than cores: an oversubscribed run is 20–40× slower.
 
 import importlib.util
 import json
-import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -20,6 +18,7 @@ import pytest
 import scipy.sparse as sp
 
 from signorini.bounds import InfeasibleBounds, NoBoundForm, bound_form
+from signorini.cluster import mpirun_command
 from signorini.errors import InputError
 from signorini.kkt import active_set, compare
 from signorini.scenes import build_problem
@@ -165,16 +164,13 @@ def test_petsc_options_reach_petsc_and_bad_options_are_named(references):
 def mpirun_solve(tmp_path: Path, ranks: int, scene: str, method: str, *extra: str):
     """``mpirun -n ranks signorini solve …`` in a subprocess; returns (process, JSON record)."""
     require_petsc()
-    mpirun = shutil.which("mpirun")
-    if mpirun is None:
-        pytest.skip("no mpirun on the PATH (Debian: openmpi-bin, installed with petsc-dev)")
-    if ranks > (os.cpu_count() or 1):
-        pytest.skip(f"{ranks} ranks on {os.cpu_count()} cores would oversubscribe the machine")
+    try:  # the package's own launcher: no mpirun or too many ranks for the cores → skip, saying so
+        command, env = mpirun_command(ranks, [])
+    except InputError as exc:
+        pytest.skip(str(exc))
     out = tmp_path / f"{scene}-{method}-{ranks}.json"
-    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-           "OMPI_MCA_rmaps_base_oversubscribe": "0"}
-    command = [mpirun, "-n", str(ranks), sys.executable, "-m", "signorini.cli", "solve", scene,
-               "--method", method, "--json", str(out), *extra]
+    command += [sys.executable, "-m", "signorini.cli", "solve", scene, "--method", method,
+                "--json", str(out), *extra]
     proc = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600)
     record = json.loads(out.read_text()) if out.exists() else None
     return proc, record

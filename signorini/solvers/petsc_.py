@@ -102,9 +102,16 @@ def pieces(form: BoundForm, ranks: int, x0: np.ndarray, gamg: bool) -> list[dict
 
 
 def _vec(PETSc, A, values: np.ndarray):
+    """A vector in ``A``'s row layout holding this rank's ``values`` (±inf clipped to PETSc's)."""
     vec = A.createVecLeft()
     vec.setArray(np.clip(values, -PETSc.INFINITY, PETSc.INFINITY))
     return vec
+
+
+def _near_null_space(PETSc, A, modes: np.ndarray):
+    """Give ``A`` the columns of ``modes`` (this rank's rows) as near-null space for GAMG."""
+    vectors = [_vec(PETSc, A, column) for column in modes.T]
+    A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=A.getComm()))
 
 
 class FreshMultigrid:
@@ -144,12 +151,7 @@ class FreshMultigrid:
         A, P = pc.getOperators()
         rows = None if self.modes is None else self._free_rows(P)
         if rows is not None:
-            vectors = []
-            for column in self.modes[rows].T:
-                vec = P.createVecLeft()
-                vec.setArray(column)
-                vectors.append(vec)
-            P.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=P.getComm()))
+            _near_null_space(PETSc, P, self.modes[rows])
         if self.inner is not None:
             self.inner.destroy()
         self.inner = PETSc.PC().create(pc.getComm())
@@ -245,14 +247,12 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
     A.assemble()
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     if piece["modes"] is not None:
-        vectors = [_vec(PETSc, A, column) for column in piece["modes"].T]
-        A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=comm))
+        _near_null_space(PETSc, A, piece["modes"])
     b, lower, upper = (_vec(PETSc, A, piece[key]) for key in ("f", "lower", "upper"))
     x = _vec(PETSc, A, piece["x0"])
     _set_options(PETSc, job["petsc_options"])
     setup_s = time.perf_counter() - start
     kind, petsc_type = job["kind"]
-    atol = max(job["tol"] * SAFETY, ROUND_OFF_FLOOR) * max(job["f_norm"], 1e-300)
     if kind == "snes":
         solver = PETSc.SNES().create(comm)
         solver.setType(petsc_type)
@@ -269,7 +269,7 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
         options = PETSc.Options(PREFIX)
         if not options.hasName("snes_linesearch_type"):
             options.setValue("snes_linesearch_type", "basic")
-        solver.setTolerances(rtol=1e-14, atol=atol, stol=0.0, max_it=job["max_iter"])
+        solver.setTolerances(max_it=job["max_iter"])  # the stopping test is the one above
     else:
         solver = PETSc.TAO().create(comm)
         solver.setType(petsc_type)
@@ -284,7 +284,8 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
         solver.setObjectiveGradient(objective_gradient, gradient)
         solver.setHessian(lambda *args: None, A, A)
         solver.setVariableBounds((lower, upper))
-        solver.setTolerances(gatol=atol, grtol=0.0, gttol=0.0)
+        gatol = max(job["tol"] * SAFETY, ROUND_OFF_FLOOR) * max(job["f_norm"], 1e-300)
+        solver.setTolerances(gatol=gatol, grtol=0.0, gttol=0.0)
         solver.setMaximumIterations(job["max_iter"])
     multigrid = None
     if job["ksp"] == "gamg":
