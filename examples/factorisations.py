@@ -15,7 +15,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.linalg import available_backends, factorize
+from signorini.numerics.factor import available_backends, factorize
 from signorini.scenes import build_problem
 
 levels = [int(x) for x in (sys.argv[1] if len(sys.argv) > 1 else "0,1,2,3").split(",")]

@@ -2,8 +2,8 @@
 
 import logging
 
-from .errors import BackendNotInstalled, InputError, SignoriniError, SolverError
-from .problem import ContactProblem, ContactSolution, Scales
+from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
+from signorini.problem import ContactProblem, ContactSolution, Scales
 
 __version__ = "0.1.0"
 

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 from typing import Any, Sequence
 
-from .errors import InputError, SignoriniError
+from signorini.errors import InputError, SignoriniError
 
 EXIT_FAILED, EXIT_USAGE = 1, 2
 
@@ -60,7 +60,7 @@ def _tol(text: str) -> float:
 
 
 def _write_json(path: str, text: str) -> None:
-    from .io import atomic_write_text
+    from signorini.output.files import atomic_write_text
 
     if path == "-":
         sys.stdout.write(text + "\n")
@@ -69,10 +69,10 @@ def _write_json(path: str, text: str) -> None:
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from .io import to_json
-    from .report import solve_record, solve_summary
-    from .scenes import build_problem
-    from .solvers.registry import solve
+    from signorini.output.files import to_json
+    from signorini.output.report import solve_record, solve_summary
+    from signorini.scenes import build_problem
+    from signorini.solvers.registry import solve
 
     params = _pairs(args.set, "--set")
     options = {k: _option_value(v) for k, v in _pairs(args.opt, "--opt").items()}
@@ -82,7 +82,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         raise InputError(f"--json {args.json!r} is a directory: give a file name, "
                          f"e.g. --json {Path(args.json) / 'result.json'}")
     if args.vtk:
-        from .export import check_vtk_path
+        from signorini.output.export import check_vtk_path
 
         check_vtk_path(args.vtk)  # a bad export path fails before the solve
     problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
@@ -93,7 +93,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.json != "-":
         print(solve_summary(record))
     if args.vtk:
-        from .export import export_vtk
+        from signorini.output.export import export_vtk
 
         if record["contact"] is None:
             print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
@@ -105,7 +105,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
     """Under mpirun only ``solve`` with a distributed (petsc-*) method makes sense."""
-    from .solvers.registry import get_method
+    from signorini.solvers.registry import get_method
 
     if args.run is not cmd_solve:
         raise InputError(f"under mpirun -n {ranks} only 'signorini solve' runs: run the other "
@@ -117,8 +117,8 @@ def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
-    from .convergence import grading_comparison, run_study, study_table, write_study
-    from .io import writable_directory
+    from signorini.studies.convergence import grading_comparison, run_study, study_table, write_study
+    from signorini.output.files import writable_directory
 
     writable_directory(args.out)
     if args.levels < 0 or args.levels > 6:
@@ -145,9 +145,9 @@ def cmd_converge(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from .io import writable_directory
-    from .report import checks_summary, write_suite_report
-    from .suite import run_suite, select_cases
+    from signorini.output.files import writable_directory
+    from signorini.output.report import checks_summary, write_suite_report
+    from signorini.studies.suite import run_suite, select_cases
 
     writable_directory(args.out)
     methods = args.method or None
@@ -164,9 +164,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from .io import atomic_write_text, save_figure, to_json, writable_directory
-    from .scenes import build_problem
-    from .sweep import parse_loads, plot_sweep, sweep_loads
+    from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
+    from signorini.scenes import build_problem
+    from signorini.studies.sweep import parse_loads, plot_sweep, sweep_loads
 
     loads = parse_loads(args.load)
     directory = writable_directory(args.out)
@@ -193,10 +193,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     import math
 
-    from .bench import TOLERANCES, Run, run_benchmark, write_report
-    from .io import writable_directory
-    from .scenes import get_scene
-    from .solvers.registry import get_method, methods
+    from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report
+    from signorini.output.files import writable_directory
+    from signorini.scenes import get_scene
+    from signorini.solvers.registry import get_method, methods
 
     out = writable_directory(args.out)
     family = get_scene(args.scene)
@@ -222,7 +222,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise InputError(f"--ranks {args.ranks!r} must be a comma-separated list of positive "
                          "rank counts, e.g. --ranks 1,2")
     if ranks[-1] > 1:
-        from .cluster import mpirun_command
+        from signorini.solvers.cluster import mpirun_command
 
         mpirun_command(ranks[-1], [])  # no mpirun, or more ranks than cores: fail before any run
     base = _pairs(args.set, "--set")
@@ -252,8 +252,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def cmd_stability(args: argparse.Namespace) -> int:
     import math
 
-    from .io import writable_directory
-    from .stability import run_atlas, select_axes, wrapper_record, write_report
+    from signorini.output.files import writable_directory
+    from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report
 
     axes = select_axes(args.axis)
     try:
@@ -283,7 +283,7 @@ def cmd_stability(args: argparse.Namespace) -> int:
 
 
 def cmd_scenes(args: argparse.Namespace) -> int:
-    from .scenes import SCENES
+    from signorini.scenes import SCENES
 
     for family in SCENES.values():
         print(f"{family.name}: {family.summary}")
@@ -294,8 +294,8 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 
 
 def cmd_methods(args: argparse.Namespace) -> int:
-    from .linalg import available_backends, resolve_backend
-    from .solvers.registry import methods
+    from signorini.numerics.factor import available_backends, resolve_backend
+    from signorini.solvers.registry import methods
 
     print(f"factorisation backend: {resolve_backend()} (installed: {', '.join(available_backends())}; "
           "set SIGNORINI_FACTOR to choose)")
@@ -396,7 +396,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    from . import cluster
+    from signorini.solvers import cluster
 
     if cluster.launched_size() > 1:
         return _main_ranks(argv)
@@ -405,7 +405,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main_ranks(argv: Sequence[str] | None) -> int:
     """Under ``mpirun -n N``: rank 0 runs the command, the other ranks serve its solves."""
-    from . import cluster
+    from signorini.solvers import cluster
 
     try:
         if cluster.rank() != 0:

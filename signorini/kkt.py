@@ -10,7 +10,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .problem import ContactProblem, ContactSolution
+from signorini.problem import ContactProblem, ContactSolution
 
 #: normalised force and gap below which a node counts as touching with zero force
 WEAK_TOL = 1e-6

@@ -11,10 +11,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .analytic import (contact_modulus, hertz_cylinder_half_width, hertz_cylinder_peak,
+from signorini.references import (contact_modulus, hertz_cylinder_half_width, hertz_cylinder_peak,
                        hertz_pressure, hertz_sphere_peak, hertz_sphere_radius)
-from .kkt import ACTIVE, classify
-from .problem import ContactProblem, ContactSolution
+from signorini.kkt import ACTIVE, classify
+from signorini.problem import ContactProblem, ContactSolution
 
 
 @dataclass(frozen=True)
@@ -363,7 +363,7 @@ class PunchComparison:
 def compare_punch(problem: ContactProblem, solution: ContactSolution,
                   inner: float = 0.5) -> PunchComparison:
     """Compare ``solution`` of the punch scene with ``p(x) = P/(π√(a² − x²))`` on ``|x| ≤ inner·a``."""
-    from .analytic import punch_load_between, punch_pressure
+    from signorini.references import punch_load_between, punch_pressure
 
     profile = _half_line(problem, contact_profile(problem, solution))
     a = float(problem.params["a"])

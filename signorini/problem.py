@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import InputError
+from signorini.errors import InputError
+from signorini.numerics.factor import factorize
 
 #: the statuses a :class:`ContactSolution` can carry
 STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed")
@@ -79,6 +80,21 @@ class Push:
 
 
 @dataclass
+class WarmStart:
+    """What load targeting learnt about a problem, for a solver to start from.
+
+    ``lam`` are the exact contact forces at the targeted load (None once the
+    load changes); ``zone_solver`` is the :class:`~signorini.numerics.zone.ZoneSolver`
+    that holds K's factorisation with its final ``zone`` (the ``nested``
+    method reuses both while K is unchanged).
+    """
+
+    lam: np.ndarray | None = None
+    zone_solver: Any = None
+    zone: Any = None
+
+
+@dataclass
 class ContactProblem:
     """Data of ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` (dimensionless).
 
@@ -101,6 +117,13 @@ class ContactProblem:
     scene, params : where the problem came from.
     mesh : the scene's mesh (for plots and export), in dimensionless coordinates.
     push : how f, d and the load offset depend on the prescribed push (or None).
+    axisymmetric : the mesh is the meridian half-plane (r, z) of a body of
+        revolution; forces and weights are per radian.
+    reference : the name of the scene's analytic reference in
+        :data:`signorini.references.REFERENCES` ("" for none).
+    coarse_model : a function of this problem returning a model of the same
+        scene about 16 times coarser (or None), for the ``nested`` method.
+    warm_start : what load targeting learnt (see :class:`WarmStart`).
     """
 
     K: sp.csr_matrix
@@ -120,6 +143,10 @@ class ContactProblem:
     mesh: Any = None
     assemble_time: float = 0.0
     push: Push | None = None
+    axisymmetric: bool = False
+    reference: str = ""
+    coarse_model: Callable[["ContactProblem"], "ContactProblem | None"] | None = None
+    warm_start: WarmStart = field(default_factory=WarmStart)
 
     def __post_init__(self) -> None:
         self.K = sp.csr_matrix(self.K)
@@ -152,8 +179,6 @@ class ContactProblem:
                 "every candidate must lie on a boundary edge of positive length")
         self._factor = None
         self._basis = None
-        #: the exact contact forces, when load targeting already found them (see assembly)
-        self.calibration_lam: np.ndarray | None = None
 
     @property
     def basis(self):
@@ -195,7 +220,6 @@ class ContactProblem:
     def factor(self):
         """A cached factorisation of K (for certificates and dual objectives)."""
         if self._factor is None:
-            from .linalg import factorize
             self._factor = factorize(self.K)
         return self._factor
 
@@ -251,15 +275,20 @@ class ContactProblem:
             params["delta"] *= ratio
         new = self.with_data(f=scale * pu.f1, d=pu.d0 + scale * pu.d1,
                              load_offset=scale * pu.offset1, prescribed=self.prescribed * ratio,
-                             params=params, push=Push(pu.f1, pu.d0, pu.d1, pu.offset1, scale))
-        new._factor = self._factor  # K is unchanged: keep its factorisation
-        for name in ("basis", "zone_solver", "zone"):
-            if hasattr(self, name):
-                setattr(new, name, getattr(self, name))
+                             params=params, push=Push(pu.f1, pu.d0, pu.d1, pu.offset1, scale),
+                             warm_start=WarmStart(zone_solver=self.warm_start.zone_solver,
+                                                  zone=self.warm_start.zone))
+        # K is unchanged: keep its factorisation, its basis and the zone solver (not the forces)
+        new._factor, new._basis = self._factor, self._basis
         return new
 
     def with_data(self, **changes: Any) -> "ContactProblem":
-        """A copy with some fields replaced (the cached factorisation is dropped)."""
+        """A copy with some fields replaced.
+
+        The cached factorisation and the warm start are dropped (they belong
+        to the old data) unless ``warm_start`` is one of the changes.
+        """
+        changes.setdefault("warm_start", WarmStart())
         return dataclasses.replace(self, **changes)
 
 
@@ -283,6 +312,8 @@ class ContactSolution:
     solve_time: float = 0.0
     history: dict[str, list[float]] = field(default_factory=dict)
     extras: dict[str, Any] = field(default_factory=dict)
+    #: the method's own status when the package's certificate disagreed with it ("" otherwise)
+    claimed_status: str = ""
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
@@ -291,6 +322,11 @@ class ContactSolution:
     @property
     def contact_force(self) -> np.ndarray:
         return self.lam
+
+    @property
+    def own_status(self) -> str:
+        """What the method itself said: its claim when the certificate overruled it."""
+        return self.claimed_status or self.status
 
     @property
     def success(self) -> bool:

@@ -11,7 +11,7 @@ import scipy.sparse.linalg as spla
 from skfem import asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from signorini.analytic import contact_modulus, hertz_cylinder_load
+from signorini.references import contact_modulus, hertz_cylinder_load
 from signorini.errors import InputError
 from signorini.kkt import certificate
 from signorini.scenes import build_problem
@@ -324,7 +324,7 @@ def test_vectorised_plane_strain_stiffness_is_scikit_fems():
     from skfem import Basis, ElementVector, MeshTri, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    from signorini.assembly import plane_strain_stiffness
+    from signorini.fem.assembly import plane_strain_stiffness
 
     mesh = MeshTri.init_circle(3)
     mesh = MeshTri(mesh.p * [[2.0], [0.5]], mesh.t)  # stretched: elements of many shapes
@@ -338,7 +338,7 @@ def test_vectorised_solid_stiffness_is_scikit_fems(monkeypatch):
     from skfem import Basis, ElementVector, MeshTet, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    from signorini import assembly
+    from signorini.fem import assembly
 
     mesh = MeshTet.init_ball().refined(1)
     mesh = MeshTet(mesh.p * [[1.3], [0.7], [1.1]] + 0.1 * np.sin(mesh.p), mesh.t)  # distorted
@@ -353,7 +353,7 @@ def test_vectorised_solid_stiffness_is_scikit_fems(monkeypatch):
 def test_closed_form_contact_weights_are_scikit_fems(axisymmetric):
     from skfem import FacetBasis, LinearForm, MeshTri, asm
 
-    from signorini.assembly import contact_weights
+    from signorini.fem.assembly import contact_weights
 
     mesh = MeshTri.init_circle(3)
     mesh = MeshTri(mesh.p + [[1.5], [0.0]], mesh.t)  # r > 0 everywhere
@@ -371,7 +371,7 @@ def test_closed_form_contact_weights_are_scikit_fems(axisymmetric):
 
 def test_an_obstacle_away_from_the_origin_gives_the_same_gaps_in_any_units():
     """A flat at height h ≠ 0 under a body of length L ≠ 1: gaps are physical, whatever the scaling."""
-    from signorini.assembly import assemble
+    from signorini.fem.assembly import assemble
     from signorini.scenes import get_scene
     from signorini.scenes.base import FlatObstacle
 

@@ -5,7 +5,7 @@ import csv
 import numpy as np
 import pytest
 
-from signorini.bench import (Run, load_problem, read_rows, run_benchmark, save_problem,
+from signorini.studies.bench import (Run, load_problem, read_rows, run_benchmark, save_problem,
                              shifted_geometric_mean, summary, write_report)
 from signorini.cli import main
 from signorini.scenes import build_problem

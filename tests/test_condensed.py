@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from signorini.condensed import delassus
+from signorini.numerics.lcp import delassus
 from signorini.errors import InputError
 from signorini.kkt import compare
-from signorini.linalg import factorize
+from signorini.numerics.factor import factorize
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
-from signorini.synthetic import random_problem
+from signorini.teaching.synthetic import random_problem
 
 
 @pytest.mark.parametrize("params", [{"n_contact": 20, "grading": 0.4}, {"candidates": 3.0, "n_contact": 12}])

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from signorini.cli import main
-from signorini.convergence import (dofs_for_error, fitted_rate, grading_comparison, plot_convergence,
+from signorini.studies.convergence import (dofs_for_error, fitted_rate, grading_comparison, plot_convergence,
                                    plot_grading, plot_punch_edge, plot_punch_pressure, run_study,
                                    write_study)
 from signorini.errors import InputError

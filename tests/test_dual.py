@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 from matplotlib.axes import Axes
 
-from signorini import plots
-from signorini.condensed import delassus
-from signorini.dual import (DenseDual, IterationHistory, IterationRecorder, dense_dual,
+from signorini.teaching import figures as plots
+from signorini.numerics.lcp import delassus
+from signorini.teaching.dual import (DenseDual, IterationHistory, IterationRecorder, dense_dual,
                             lagrangian, objectives, solve_recorded, uzawa_path)
 from signorini.errors import InputError
 from signorini.kkt import active_set
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
-from signorini.synthetic import bogie, bogie_compliance, bogie_deflection, random_problem
+from signorini.teaching.synthetic import bogie, bogie_compliance, bogie_deflection, random_problem
 
 
 @pytest.fixture(scope="module")

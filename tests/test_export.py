@@ -7,7 +7,7 @@ from skfem import MeshTet, MeshTri
 
 from signorini.cli import main
 from signorini.errors import InputError
-from signorini.export import element_gradients, export_vtk, project_to_nodes, von_mises
+from signorini.output.export import element_gradients, export_vtk, project_to_nodes, von_mises
 from signorini.pressure import contact_profile
 from signorini.problem import ContactSolution
 from signorini.scenes import build_problem
@@ -61,7 +61,7 @@ def test_patch_test_stresses_and_contact_fields(block, tmp_path):
 
 def test_reference_points_when_not_deformed(block, tmp_path):
     problem, solution = block
-    from signorini.export import export_mesh
+    from signorini.output.export import export_mesh
     mesh = export_mesh(problem, solution, deformed=False)
     np.testing.assert_allclose(mesh.points[:, :2], problem.mesh.p.T * problem.scales.length)
 

@@ -235,7 +235,7 @@ def test_judge_downgrades_a_false_claim(hertz, exact):
     bad = with_(exact, lam=exact.lam * 1.01, status="converged", message="backend: solved")
     judged = registry.judge(hertz, bad, 1e-8)
     assert judged.status == "inaccurate"
-    assert judged.extras["claimed_status"] == "converged"
+    assert judged.claimed_status == "converged"
     worst_name, _ = certificate(hertz, with_(exact, lam=exact.lam * 1.01)).worst()
     assert worst_name in judged.message
     assert "backend: solved" in judged.message
@@ -256,7 +256,7 @@ def test_judge_names_the_failing_residual(hertz, exact):
 def test_judge_keeps_an_honest_claim(hertz, exact):
     judged = registry.judge(hertz, with_(exact, status="converged"), 1e-9)
     assert judged.status == "converged"
-    assert "claimed_status" not in judged.extras
+    assert judged.claimed_status == ""
 
 
 def test_judge_leaves_other_statuses_alone(hertz, exact):

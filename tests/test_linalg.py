@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from signorini.errors import InputError
-from signorini.linalg import (ActiveSetSolver, available_backends, factorize, resolve_backend,
+from signorini.numerics.factor import (ActiveSetSolver, available_backends, factorize, resolve_backend,
                               selection_dofs)
 from signorini.scenes import build_problem
-from signorini.synthetic import random_problem
+from signorini.teaching.synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
 

@@ -4,14 +4,14 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from signorini.assembly import assemble
+from signorini.fem.assembly import assemble
 from signorini.kkt import certificate, compare
-from signorini.linalg import PinnedFactor, factorize
-from signorini.nested import Zone, ZoneSolver, predict_zone
-from signorini import scenes
+from signorini.numerics.factor import PinnedFactor, factorize
+from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
+from signorini.scenes import build as scenes
 from signorini.scenes import build_problem, coarse_values, get_scene
 from signorini.solvers.registry import solve
-from signorini.synthetic import random_problem
+from signorini.teaching.synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
 
@@ -54,10 +54,10 @@ def test_nested_equals_pdas_on_the_cylinder(cylinder):
 
 
 def test_nested_reuses_the_load_targeting_factorisation(cylinder):
-    assert cylinder.zone_solver is not None
-    before = cylinder.zone_solver.factorisations
+    assert cylinder.warm_start.zone_solver is not None
+    before = cylinder.warm_start.zone_solver.factorisations
     nested = solve(cylinder, "nested")
-    assert cylinder.zone_solver.factorisations == before
+    assert cylinder.warm_start.zone_solver.factorisations == before
     assert "0 factorisation" in nested.message
     assert_same_answer(cylinder, solve(cylinder, "pdas"), nested)
 
@@ -102,7 +102,7 @@ def test_the_push_on_a_zone_equals_the_full_active_set_calibration():
     model = family.build(params, set(values))
     full = assemble(model)  # no zone: one factorisation per active-set step
     zoned = zoned_build("hertz-cylinder", **values)
-    assert getattr(full, "zone_solver", None) is None and zoned.zone_solver is not None
+    assert full.warm_start.zone_solver is None and zoned.warm_start.zone_solver is not None
     assert zoned.push.scale == pytest.approx(full.push.scale, rel=1e-10)
     assert_same_answer(full, solve(full, "pdas"), solve(zoned, "nested"))
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from skfem import MeshTri
 
-from signorini.assembly import assemble
+from signorini.fem.assembly import assemble
 from signorini.errors import InputError
-from signorini.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery, SignedDistance
+from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery, SignedDistance
 from signorini.pressure import compare_reverse_hertz, contact_profile, load_resultant
 from signorini.scenes import build_problem
 from signorini.scenes.base import FlatObstacle, SceneModel

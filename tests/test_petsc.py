@@ -17,13 +17,13 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from signorini.bounds import InfeasibleBounds, NoBoundForm, bound_form
-from signorini.cluster import mpirun_command
+from signorini.solvers.bounds import InfeasibleBounds, NoBoundForm, bound_form
+from signorini.solvers.cluster import mpirun_command
 from signorini.errors import InputError
 from signorini.kkt import active_set, compare
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
-from signorini.synthetic import random_problem
+from signorini.teaching.synthetic import random_problem
 
 SCENES = ("hertz-cylinder", "hertz-sphere-3d")
 

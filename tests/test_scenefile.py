@@ -12,7 +12,7 @@ from skfem import MeshTri
 from signorini.cli import main
 from signorini.errors import InputError
 from signorini.pressure import compare_uniform, contact_profile
-from signorini.scenefile import read_mesh
+from signorini.scenes.scenefile import read_mesh
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 

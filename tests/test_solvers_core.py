@@ -5,7 +5,7 @@ import itertools
 import numpy as np
 import pytest
 
-from signorini.condensed import solve_lcp
+from signorini.numerics.lcp import solve_lcp
 from signorini.errors import InputError
 from signorini.kkt import certificate, compare
 from signorini.scenes import build_problem

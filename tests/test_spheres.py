@@ -12,9 +12,9 @@ import pytest
 from skfem import Basis, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
 from skfem.models.elasticity import lame_parameters
 
-from signorini.analytic import (contact_modulus, hertz_sphere_load, hertz_sphere_peak,
+from signorini.references import (contact_modulus, hertz_sphere_load, hertz_sphere_peak,
                                 hertz_sphere_radius)
-from signorini.assembly import assemble, axisymmetric_elasticity
+from signorini.fem.assembly import assemble, axisymmetric_elasticity
 from signorini.errors import InputError
 from signorini.pressure import contact_profile, radial_distance
 from signorini.scenes import build_problem

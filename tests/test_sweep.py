@@ -10,7 +10,7 @@ from signorini.errors import InputError
 from signorini.pressure import contact_half_width, contact_profile
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
-from signorini.sweep import parse_loads, sweep_loads
+from signorini.studies.sweep import parse_loads, sweep_loads
 
 SMALL = {"n_contact": 24, "grading": 0.3}
 

@@ -16,9 +16,10 @@ import nbformat
 import numpy as np
 import pytest
 
-from signorini import cli, suite
+from signorini import cli
+from signorini.studies import suite
 from signorini.solvers.registry import get_method, solve
-from signorini.synthetic import random_problem
+from signorini.teaching.synthetic import random_problem
 
 ROOT = Path(__file__).resolve().parents[1]
 TUTORIALS = ROOT / "docs" / "tutorials"

@@ -11,12 +11,12 @@ from pathlib import Path
 
 import numpy as np
 
-from signorini.convergence import plot_punch_edge, plot_punch_pressure
-from signorini.io import atomic_write_text, save_figure, to_json
+from signorini.studies.convergence import plot_punch_edge, plot_punch_pressure
+from signorini.output.files import atomic_write_text, save_figure, to_json
 from signorini.pressure import compare_punch
 from signorini.scenes import build_problem
 from signorini.solvers.registry import get_method, methods
-from signorini.suite import TIGHT_TOL, run_one
+from signorini.studies.suite import TIGHT_TOL, run_one
 
 HERE = Path(__file__).resolve().parent
 SIZES = (32, 64, 128, 256)

@@ -6,7 +6,7 @@ bottom rests on the flat ``y = 0`` without friction. Every bottom node is in
 contact with the pressure ``p = E* δ / H`` (uniaxial plane strain), so the
 full block carries ``P = 2 W p`` per unit thickness.
 
-Two variants serve the stability atlas (:mod:`signorini.stability`):
+Two variants serve the stability atlas (:mod:`signorini.studies.atlas`):
 
 - ``touching > 0`` (a scene parameter): only the bottom nodes with
   ``x < (1 − touching) W`` rest on the flat; under the outer part the
@@ -26,10 +26,13 @@ from typing import Any
 import numpy as np
 from skfem import MeshTri
 
-from ..errors import InputError
-from ..obstacles import ScaledQuery
-from ..problem import ContactProblem, ContactSolution, Scales
-from .base import FlatObstacle, Param, SceneFamily, SceneModel, at_least, poisson_ratio, positive
+from signorini.errors import InputError
+from signorini.fem.assembly import assemble, boundary_weights
+from signorini.fem.model import FlatObstacle, SceneModel
+from signorini.fem.obstacles import ScaledQuery
+from signorini.problem import ContactProblem, ContactSolution, Scales
+from signorini.scenes.base import Param, SceneFamily, at_least, poisson_ratio, positive
+from signorini.solvers.pdas import solve as pdas
 
 PARAMS = (
     Param("W", 1.0, "half-width of the block", check=positive),
@@ -106,9 +109,6 @@ def _touching_model(p: dict[str, Any]) -> SceneModel:
     that node's deflected height. The solution of the full problem is the same
     one, and at the outer nodes both the gap and the force are zero.
     """
-    from ..assembly import assemble
-    from ..solvers.pdas import solve as pdas
-
     mesh, bottom, _, _, _ = _mesh_parts(p)
     x = mesh.p[0]
     # the outer corner x = W always touches
@@ -146,13 +146,13 @@ def force_controlled_problem(pressure: float = 0.01, nondimensionalise: bool = T
         p = q at every bottom node,  u_y = −q(1 − ν²) y / E,  u_x = q ν(1 + ν) x / E
 
     (exact for P1, see :func:`force_controlled_exact`). Methods that need
-    ``K⁻¹`` cannot solve it as it stands; :func:`signorini.stability.regularise`
+    ``K⁻¹`` cannot solve it as it stands; :func:`signorini.studies.atlas.regularise`
     adds a documented small stiffness.
 
     Parameters
     ----------
     pressure : the uniform pressure q on the top (physical units, > 0).
-    nondimensionalise : scale as :func:`signorini.assembly.assemble` does, with the
+    nondimensionalise : scale as :func:`signorini.fem.assembly.assemble` does, with the
         displacement unit ``q H / E*`` (the size of the answer).
     **values : the block's scene parameters (``W``, ``H``, ``E``, ``nu``, ``nx``, ``ny``);
         ``delta`` and ``touching`` do not apply.
@@ -162,8 +162,6 @@ def force_controlled_problem(pressure: float = 0.01, nondimensionalise: bool = T
     ContactProblem
         with ``params["pressure"] = q``; its ``load_offset`` is the applied load 2Wq.
     """
-    from ..assembly import assemble, boundary_weights
-
     for name in ("delta", "touching"):
         if name in values:
             raise InputError(f"scene parameter {name} does not apply to the force-controlled "

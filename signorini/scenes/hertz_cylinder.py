@@ -16,11 +16,11 @@ from __future__ import annotations
 from typing import Any
 
 
-from ..analytic import hertz_cylinder_half_width, hertz_cylinder_load
-from ..errors import InputError
-from .base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
+from signorini.references import hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.errors import InputError
+from signorini.scenes.base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
                    poisson_ratio, positive)
-from .meshing import graded_quarter_disc
+from signorini.scenes.meshing import graded_quarter_disc
 
 PARAMS = (
     Param("R", 1.0, "cylinder radius", check=positive),

@@ -4,7 +4,7 @@ A body of revolution loaded along its axis deforms without depending on the
 angle, so the meridian half-plane (r, z), r ≥ 0, carries the whole problem:
 the same quarter disc as the cylinder's model, now read as the lower half of
 the sphere's meridian section, with the axisymmetric elasticity forms (weight
-r, hoop strain u_r/r; see :func:`signorini.assembly.axisymmetric_elasticity`).
+r, hoop strain u_r/r; see :func:`signorini.fem.assembly.axisymmetric_elasticity`).
 The axis r = 0 has u_r = 0; the cut z = R through the centre is pushed down
 by a uniform δ (u_z = −δ, u_r free), adjusted until the contact force equals
 the target load. Forces are assembled per radian and the model's
@@ -21,11 +21,11 @@ from typing import Any
 
 import numpy as np
 
-from ..analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
-from ..errors import InputError
-from .base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
+from signorini.references import contact_modulus, hertz_sphere_load, hertz_sphere_radius
+from signorini.errors import InputError
+from signorini.scenes.base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
                    poisson_ratio, positive)
-from .meshing import graded_quarter_disc
+from signorini.scenes.meshing import graded_quarter_disc
 
 COMMON_PARAMS = (
     Param("R", 1.0, "sphere radius", check=positive),

@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 from skfem import MeshTet
 
-from .base import FlatObstacle3D, Param, SceneFamily, SceneModel, at_least, between
-from .hertz_sphere import COMMON_PARAMS, load_choice, recorded_params
-from .meshing import (coarse_ball_octant, curved_boundary_facets, distance_to_disc,
+from signorini.scenes.base import FlatObstacle3D, Param, SceneFamily, SceneModel, at_least, between
+from signorini.scenes.hertz_sphere import COMMON_PARAMS, load_choice, recorded_params
+from signorini.scenes.meshing import (coarse_ball_octant, curved_boundary_facets, distance_to_disc,
                       on_ball_octant_surface, refine_simplices_to_size, snap_to_sphere)
 
 PARAMS = COMMON_PARAMS + (

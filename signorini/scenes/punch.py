@@ -29,11 +29,11 @@ from typing import Any
 import numpy as np
 from skfem import MeshTri
 
-from ..analytic import contact_modulus
-from ..errors import InputError
-from ..obstacles import FlatPunch, Obstacle, ScaledQuery
-from .base import Param, SceneFamily, SceneModel, at_least, between, poisson_ratio, positive
-from .meshing import distance_to_segment, refine_to_size
+from signorini.references import contact_modulus
+from signorini.errors import InputError
+from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
+from signorini.scenes.base import Param, SceneFamily, SceneModel, at_least, between, poisson_ratio, positive
+from signorini.scenes.meshing import distance_to_segment, refine_to_size
 
 
 def _non_negative(x: float) -> str | None:

@@ -5,7 +5,7 @@ top touches the block's bottom at the origin (centre ``(0, −R)``); the
 block's top is pushed down by a uniform δ (u_y = −δ, u_x free) adjusted until
 the contact force equals the target load. The obstacle is curved, so every
 candidate has its own normal ``(−x, −R)/√(x² + R²)`` (towards the centre)
-and gap ``√(x² + R²) − R`` (:class:`signorini.obstacles.Circle`): this scene
+and gap ``√(x² + R²) − R`` (:class:`signorini.fem.obstacles.Circle`): this scene
 exercises obstacles beyond a flat. By default the right half is modelled
 with the symmetry plane x = 0; ``half=0`` models the whole width.
 
@@ -20,11 +20,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
-from ..errors import InputError
-from ..obstacles import Circle
-from .base import Param, SceneFamily, SceneModel, at_least, between, poisson_ratio, positive
-from .punch import bottom_contact_model, graded_half_block, mirrored_about_x0
+from signorini.references import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.errors import InputError
+from signorini.fem.obstacles import Circle
+from signorini.scenes.base import Param, SceneFamily, SceneModel, at_least, between, poisson_ratio, positive
+from signorini.scenes.punch import bottom_contact_model, graded_half_block, mirrored_about_x0
 
 #: the mesh is uniformly fine on the bottom up to this multiple of the half-width
 FINE_END = 1.25

@@ -20,10 +20,10 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError, SolverError
-from ..problem import ContactProblem, ContactSolution
-from .qp import BACKEND_BY_NAME
-from .registry import Method, register
+from signorini.errors import InputError, SolverError
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.qp import BACKEND_BY_NAME
+from signorini.solvers.base import Method
 
 log = logging.getLogger(__name__)
 
@@ -163,6 +163,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                            status=status, **common)
 
 
-register(Method(name=METHOD, function=solve,
-                summary="the QP as a cvxpy model (Clarabel by default; option solver)",
-                requires=("cvxpy",), extra="", family="cvxpy", exact=False, options=OPTIONS))
+METHODS = (
+    Method(name=METHOD, function=solve,
+           summary="the QP as a cvxpy model (Clarabel by default; option solver)",
+           requires=("cvxpy",), extra="", family="cvxpy", exact=False, options=OPTIONS),
+)

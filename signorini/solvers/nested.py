@@ -3,7 +3,7 @@
 The coarse model of the same scene (about 16× fewer dofs; see
 :func:`signorini.scenes.coarse_values`) is solved first, by this method
 again, down to a model with no coarser one (solved by ``pdas``). Its contact
-zone predicts the fine one; :class:`signorini.nested.ZoneSolver` then pins
+zone predicts the fine one; :class:`signorini.numerics.zone.ZoneSolver` then pins
 the predicted core, condenses the uncertain band onto a small dense LCP and
 amends the prediction until every KKT condition holds, so the answer is
 exact whatever the prediction. Cost: one factorisation of K, a back-solve per
@@ -17,16 +17,23 @@ Problems with no coarse model, or whose rows of N do not each bound one dof
 
 from __future__ import annotations
 
+import logging
 import time
+
+import numpy as np
 from typing import Any
 
-from ..errors import InputError
-from ..linalg import selection_dofs
-from ..nested import Zone, ZoneSolver, zone_from_coarse
-from ..problem import ContactProblem, ContactSolution
-from .options import take_options
-from .registry import Method, register, solve as solve_with
+from signorini.errors import InputError
+from signorini.numerics.factor import selection_dofs
+from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.options import take_options
+from signorini.solvers import pdas
+from signorini.solvers.base import Method, judge
 
+log = logging.getLogger(__name__)
+
+DEFAULT_TOL = 1e-9
 DEFAULTS = {"backend": None, "coarse": None, "zone": None, "neighbours": None}
 
 
@@ -35,18 +42,36 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | N
     if opts["zone"] is not None:
         zone = opts["zone"]
         if not isinstance(zone, Zone) or zone.core.shape != (problem.m,):
-            raise InputError(f"method 'nested': option zone must be a signorini.nested.Zone "
+            raise InputError(f"method 'nested': option zone must be a signorini.numerics.zone.Zone "
                              f"over the {problem.m} candidates")
         return zone, "given zone"
     coarse = opts["coarse"]
-    if coarse is None:
-        from ..scenes import coarse_problem
-
-        coarse = coarse_problem(problem)
+    if coarse is None and problem.coarse_model is not None:
+        coarse = problem.coarse_model(problem)
     if coarse is None:
         return None, ""
     zone = zone_from_coarse(problem.contact_points, coarse, opts["neighbours"])
     return zone, f"coarse model of {coarse.n} dofs"
+
+
+def zone_from_coarse(points: np.ndarray, coarse, neighbours: int | None = None) -> Zone | None:
+    """The zone at ``points`` predicted by the coarse model ``coarse`` (a ContactProblem).
+
+    Its contact forces come from its load targeting when that ran (exact
+    already), else from solving it with the ``nested`` method; None when
+    that does not converge.
+    """
+    lam = coarse.warm_start.lam
+    if lam is None:
+        try:
+            solution = judge(coarse, solve(coarse), DEFAULT_TOL)
+        except Exception as exc:  # noqa: BLE001 - any failure of the coarse solve: no prediction
+            log.info("the coarse model did not solve (%s): no prediction", exc)
+            return None
+        if solution.status != "converged":
+            return None
+        lam = solution.lam
+    return predict_zone(points, coarse.contact_points, lam > 0, neighbours)
 
 
 def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
@@ -54,9 +79,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     """Exact contact from a coarse model's contact zone on one factorisation."""
     opts = take_options("nested", options, DEFAULTS)
     start = time.perf_counter()
-    system = getattr(problem, "zone_solver", None)
+    system = problem.warm_start.zone_solver
     if system is not None and opts["zone"] is None and opts["coarse"] is None:
-        zone, source = problem.zone, "the load targeting's zone and factorisation"
+        zone, source = problem.warm_start.zone, "the load targeting's zone and factorisation"
     else:
         system = None
         if selection_dofs(problem.N) is None:
@@ -64,7 +89,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         else:
             zone, source = _prediction(problem, opts)
     if zone is None:
-        solution = solve_with(problem, "pdas", tol=tol, max_iter=max_iter)
+        solution = pdas.solve(problem, tol=tol, max_iter=max_iter)
         solution.method = "nested"
         solution.message = f"no coarse model or no pinnable rows: pdas: {solution.message}"
         solution.extras["fallback"] = "pdas"
@@ -74,7 +99,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         system = ZoneSolver(problem.K, problem.N, opts["backend"])
     factorisations, back_solves = system.factorisations, system.back_solves
     u, lam, final = system.solve(problem.f, problem.d, zone)
-    problem.zone_solver, problem.zone = system, final
+    problem.warm_start.zone_solver, problem.warm_start.zone = system, final
     moved = int((final.band & ~zone.band).sum())
     return ContactSolution(
         method="nested", u=u, lam=lam, status="converged",
@@ -86,6 +111,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                 "band": int(final.band.sum())})
 
 
-register(Method(name="nested", function=solve, family="active set", exact=True,
-                summary="coarse model predicts the contact zone; one factorisation + exact band LCP",
-                default_tol=1e-9, options=tuple(DEFAULTS)))
+METHODS = (
+    Method(name="nested", function=solve, family="active set", exact=True,
+           summary="coarse model predicts the contact zone; one factorisation + exact band LCP",
+           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)),
+)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..errors import InputError
+from signorini.errors import InputError
 
 
 def take_options(method: str, given: dict[str, Any], defaults: dict[str, Any]) -> dict[str, Any]:

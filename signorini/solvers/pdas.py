@@ -5,7 +5,7 @@ guesses the active set ``A = {i : λᵢ + c (Nu − d)ᵢ > 0}`` and solves the
 equality-constrained system on it (when every row of N bounds one dof, as
 for a flat obstacle, by fixing the active dofs and factorising the SPD
 ``K_FF``; otherwise the saddle-point matrix by LU; see
-:class:`signorini.linalg.ActiveSetSolver`, which
+:class:`signorini.numerics.factor.ActiveSetSolver`, which
 for CHOLMOD reuses one symbolic analysis for every step)::
 
     [ K    N_Aᵀ ] [ u   ]   [ f   ]
@@ -28,12 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from ..condensed import delassus, least_index_lcp
-from ..kkt import gap_scale
-from ..linalg import ActiveSetSolver, factorize
-from ..problem import ContactProblem, ContactSolution
-from .options import positive_number, take_options
-from .registry import Method, register
+from signorini.numerics.lcp import delassus, least_index_lcp
+from signorini.kkt import gap_scale
+from signorini.numerics.factor import ActiveSetSolver, factorize
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.options import positive_number, take_options
+from signorini.solvers.base import Method
 
 DEFAULTS = {"c": 1.0, "lam0": None, "callback": None, "backend": None}
 MAX_ITER = 100
@@ -94,6 +94,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                            history=history)
 
 
-register(Method(name="pdas", function=solve, family="active set", exact=True,
-                summary="primal-dual active set / semismooth Newton, exact when it converges",
-                default_tol=1e-9, options=tuple(DEFAULTS)))
+METHODS = (
+    Method(name="pdas", function=solve, family="active set", exact=True,
+           summary="primal-dual active set / semismooth Newton, exact when it converges",
+           default_tol=1e-9, options=tuple(DEFAULTS)),
+)

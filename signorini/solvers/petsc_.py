@@ -1,6 +1,6 @@
 """The contact QP on PETSc: SNES-VI and TAO on the bound form, serial or under MPI.
 
-The constraints become bounds (:mod:`signorini.bounds`: each contact node's
+The constraints become bounds (:mod:`signorini.solvers.bounds`: each contact node's
 dofs rotated into its obstacle's normal–tangent frame), and PETSc solves
 
     min ½ vᵀ K v − fᵀ v   subject to   lower ≤ v ≤ upper
@@ -22,7 +22,7 @@ modes as near-null space (``ksp=gamg``); ``ksp=auto`` (the default) takes
 GAMG for 3D problems from :data:`GAMG_FROM_DOFS` dofs and MUMPS otherwise
 (62,757-dof sphere, 2 ranks: MUMPS 53 s, GAMG 6.5 s; docs/petsc.md). Under ``mpirun -n N`` rank 0
 assembles, rotates and splits the rows by whole nodes
-(:mod:`signorini.cluster`); each rank builds its block of a parallel AIJ
+(:mod:`signorini.solvers.cluster`); each rank builds its block of a parallel AIJ
 matrix, and rank 0 gathers the answer, recovers the contact forces as the
 reactions on the active bounds and judges it like any other method's.
 Extra PETSc options go through ``petsc_options`` ("-snes_monitor -ksp_view …").
@@ -36,11 +36,11 @@ from typing import Any
 
 import numpy as np
 
-from ..bounds import BoundForm, NoBoundForm, bound_form
-from ..errors import InputError
-from ..problem import ContactProblem, ContactSolution
-from .options import take_options
-from .registry import Method, register
+from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
+from signorini.errors import InputError
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.options import take_options
+from signorini.solvers.base import Method
 
 DEFAULTS = {"ksp": "auto", "petsc_options": ""}
 KSP_CHOICES = ("auto", "mumps", "gamg")
@@ -330,7 +330,7 @@ def _reason_text(kind: str, reason: int) -> str:
 
 def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: int | None,
            options: dict[str, Any]) -> ContactSolution:
-    from .. import cluster
+    from signorini.solvers import cluster
 
     opts = take_options(method, options, DEFAULTS)
     if opts["ksp"] not in KSP_CHOICES:
@@ -403,7 +403,8 @@ SUMMARIES = {
     "petsc-gpcg": "PETSc TAO gpcg (gradient projection + CG on the bounds); MPI",
 }
 
-for _name in KINDS:
-    register(Method(name=_name, function=_make(_name), summary=SUMMARIES[_name],
-                    requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
-                    exact=_name == "petsc-vi", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)))
+METHODS = tuple(
+    Method(name=name, function=_make(name), summary=SUMMARIES[name],
+           requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
+           exact=name == "petsc-vi", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS))
+    for name in KINDS)

@@ -24,9 +24,9 @@ from typing import Any, Callable, Mapping, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import BackendNotInstalled, InputError, SolverError
-from ..problem import ContactProblem, ContactSolution
-from .registry import Method, register
+from signorini.errors import BackendNotInstalled, InputError, SolverError
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.base import Method
 
 log = logging.getLogger(__name__)
 
@@ -489,10 +489,9 @@ def _method_function(backend: Backend) -> Callable[..., ContactSolution]:
     return solve
 
 
-for _backend in BACKENDS:
-    register(Method(
-        name=_backend.method_name, function=_method_function(_backend),
-        summary=_backend.summary, requires=("qpsolvers", *_backend.modules),
-        extra=_backend.extra, dense=_backend.dense, exact=False, family="qp",
-        options=_backend.accepted_options))
-del _backend
+METHODS = tuple(
+    Method(name=backend.method_name, function=_method_function(backend),
+           summary=backend.summary, requires=("qpsolvers", *backend.modules),
+           extra=backend.extra, dense=backend.dense, exact=False, family="qp",
+           options=backend.accepted_options)
+    for backend in BACKENDS)

@@ -8,58 +8,28 @@ backend's defaults, untouched). Unknown options raise :class:`InputError`.
 
 from __future__ import annotations
 
+import importlib
 import importlib.util
 import logging
 import os
 import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
-import numpy as np
-
-from ..errors import BackendNotInstalled, InputError
-from ..problem import ContactProblem, ContactSolution
+from signorini.errors import BackendNotInstalled, InputError
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers import condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
+from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol,
+                                    judge)
 
 log = logging.getLogger(__name__)
 
-SolverFunction = Callable[..., ContactSolution]
+#: the backend modules; each lists its methods in ``METHODS`` and never imports this module
+BACKENDS = (nested, pdas, condensed, uzawa, qp, cvxpy_, petsc_)
 
-#: a claim of success is accepted when every relative KKT residual is at most
-#: ``ACCEPT_FACTOR × tol`` (or ``DEFAULT_ACCEPT`` when no tolerance was asked for):
-#: success means what qpbenchmark means by it, the residuals under the tolerance
-ACCEPT_FACTOR = 1.0
-DEFAULT_ACCEPT = 1e-6
-
-
-@dataclass(frozen=True)
-class Method:
-    """A registered method.
-
-    ``requires`` lists the Python modules it imports; ``extra`` is the
-    pip extra that installs them. ``dense`` methods build dense matrices and
-    refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
-    answer up to round-off when they converge.
-    """
-
-    name: str
-    function: SolverFunction
-    summary: str
-    requires: tuple[str, ...] = ()
-    extra: str = ""
-    dense: bool = False
-    exact: bool = False
-    family: str = ""
-    default_tol: float | None = None
-    options: tuple[str, ...] = field(default=())
-
-    @property
-    def installed(self) -> bool:
-        return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
-
-
-REGISTRY: dict[str, Method] = {}
+REGISTRY: dict[str, Method] = {method.name: method for backend in BACKENDS
+                               for method in backend.METHODS}
 
 
 def register(method: Method) -> Method:
@@ -70,7 +40,6 @@ def register(method: Method) -> Method:
 
 def get_method(name: str) -> Method:
     """Look a method up by name; unknown names list the known ones."""
-    _load_builtin()
     if name in REGISTRY:
         return REGISTRY[name]
     if ":" in name:
@@ -81,7 +50,6 @@ def get_method(name: str) -> Method:
 
 def methods(installed_only: bool = False) -> list[Method]:
     """Every registered method, sorted by name."""
-    _load_builtin()
     out = sorted(REGISTRY.values(), key=lambda m: m.name)
     return [m for m in out if m.installed] if installed_only else out
 
@@ -114,16 +82,6 @@ def _load_user_method(spec: str) -> Method:
                   family="user")
 
 
-_BUILTIN_LOADED = False
-
-
-def _load_builtin() -> None:
-    global _BUILTIN_LOADED
-    if _BUILTIN_LOADED:
-        return
-    from . import condensed_dual, cvxpy_, nested, pdas, petsc_, qp, uzawa  # noqa: F401  (each registers itself)
-    _BUILTIN_LOADED = True
-
 
 def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
           max_iter: int | None = None, **options: Any) -> ContactSolution:
@@ -142,8 +100,8 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
         raise BackendNotInstalled(
             f"method {method!r} needs {', '.join(missing)}: "
             f"pip install 'signorini[{spec.extra or 'all'}]'")
-    tol = _check_tol(tol)
-    max_iter = _check_max_iter(max_iter)
+    tol = check_tol(tol)
+    max_iter = check_max_iter(max_iter)
     start = time.perf_counter()
     try:
         solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
@@ -160,44 +118,7 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     return judge(problem, solution, tol if tol is not None else spec.default_tol)
 
 
-def _check_tol(tol: Any) -> float | None:
-    if tol is None:
-        return None
-    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
-            or not (np.isfinite(tol) and 0 < tol < 1):
-        raise InputError(f"tol must be a number in (0, 1), got {tol!r}: e.g. tol=1e-9")
-    return float(tol)
 
 
-def _check_max_iter(max_iter: Any) -> int | None:
-    if max_iter is None:
-        return None
-    ok = isinstance(max_iter, (int, np.integer)) and not isinstance(max_iter, bool)
-    ok = ok or (isinstance(max_iter, (float, np.floating)) and np.isfinite(max_iter)
-                and float(max_iter).is_integer())
-    if not ok or max_iter < 1:
-        raise InputError(f"max_iter must be a positive integer, got {max_iter!r}")
-    return int(max_iter)
-
-
-def judge(problem: ContactProblem, solution: ContactSolution,
-          tol: float | None) -> ContactSolution:
-    """Downgrade a claim of convergence that the certificate does not back."""
-    from ..kkt import certificate
-
-    if solution.status != "converged":
-        return solution
-    accept = ACCEPT_FACTOR * tol if tol is not None else DEFAULT_ACCEPT
-    try:
-        cert = certificate(problem, solution)
-    except np.linalg.LinAlgError:  # K singular: no dual function; judge on the other residuals
-        cert = certificate(problem, solution, duality_gap=False)
-    worst_name, worst = cert.worst()
-    if not np.isfinite(worst) or worst > accept:
-        solution.extras["claimed_status"] = "converged"
-        solution.status = "inaccurate"
-        solution.message = (
-            f"{solution.message}; the method claimed success but the KKT certificate's "
-            f"{worst_name} residual is {worst:.1e} > {accept:.0e}: tighten the tolerance "
-            "or use an exact method (pdas)").lstrip("; ")
-    return solution
+__all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_ACCEPT", "Method", "REGISTRY", "get_method",
+           "judge", "methods", "register", "solve"]

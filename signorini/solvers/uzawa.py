@@ -37,12 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from ..condensed import delassus, delassus_max_eigenvalue
-from ..errors import InputError
-from ..linalg import factorize
-from ..problem import ContactProblem, ContactSolution
-from .options import positive_number, take_options
-from .registry import Method, register
+from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
+from signorini.errors import InputError
+from signorini.numerics.factor import factorize
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.options import positive_number, take_options
+from signorini.solvers.base import Method
 
 DEFAULTS = {"rho": None, "step_fraction": 0.9, "lam0": None, "divergence_factor": 1e8,
             "operator": "auto", "callback": None, "acceleration": "none"}
@@ -207,9 +207,11 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                 "acceleration": opts["acceleration"], "restarts": restarts})
 
 
-register(Method(name="uzawa", function=solve, family="dual", exact=False,
-                summary="the paper's Uzawa iteration: projected gradient ascent on the dual",
-                default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)))
-register(Method(name="uzawa-nesterov", function=solve_nesterov, family="dual", exact=False,
-                summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
-                default_tol=DEFAULT_TOL, options=tuple(NESTEROV_DEFAULTS)))
+METHODS = (
+    Method(name="uzawa", function=solve, family="dual", exact=False,
+           summary="the paper's Uzawa iteration: projected gradient ascent on the dual",
+           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)),
+    Method(name="uzawa-nesterov", function=solve_nesterov, family="dual", exact=False,
+           summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
+           default_tol=DEFAULT_TOL, options=tuple(NESTEROV_DEFAULTS)),
+)

@@ -13,12 +13,12 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from ..condensed import delassus, solve_lcp
-from ..errors import InputError
-from ..linalg import factorize
-from ..problem import ContactProblem, ContactSolution
-from .options import take_options
-from .registry import Method, register
+from signorini.numerics.lcp import delassus, solve_lcp
+from signorini.errors import InputError
+from signorini.numerics.factor import factorize
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.options import take_options
+from signorini.solvers.base import Method
 
 DEFAULTS = {"backend": None, "block": 128, "max_candidates": 20_000}
 
@@ -46,6 +46,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         extras={"backend": factor.backend})
 
 
-register(Method(name="condensed", function=solve, family="active set", exact=True,
-                summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
-                default_tol=1e-9, options=tuple(DEFAULTS)))
+METHODS = (
+    Method(name="condensed", function=solve, family="active set", exact=True,
+           summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
+           default_tol=1e-9, options=tuple(DEFAULTS)),
+)

@@ -21,8 +21,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .errors import InputError
-from .linalg import ActiveSetSolver
+from signorini.errors import InputError
+from signorini.numerics.factor import ActiveSetSolver
 
 log = logging.getLogger(__name__)
 

@@ -16,7 +16,7 @@ candidate x of the body
 
 Every obstacle has ``normals_and_gaps(points) -> (normals, gaps)`` with
 ``points`` of shape (k, dim), ``normals`` (k, dim) and ``gaps`` (k,), which is
-what :func:`signorini.assembly.assemble` consumes. Points and gaps are in the
+what :func:`signorini.fem.assembly.assemble` consumes. Points and gaps are in the
 obstacle's length unit.
 """
 
@@ -28,7 +28,7 @@ from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
-from .errors import InputError
+from signorini.errors import InputError
 
 log = logging.getLogger(__name__)
 
@@ -232,7 +232,7 @@ class SignedDistance:
 class ScaledQuery:
     """An obstacle in physical units that answers queries in physical or in scene units.
 
-    :func:`signorini.assembly.assemble` asks at the candidates' physical
+    :func:`signorini.fem.assembly.assemble` asks at the candidates' physical
     coordinates; a caller may also ask at coordinates divided by the scene's
     length ``L`` (and then gets gaps in units of L). This wrapper knows the
     candidates' physical coordinates, recognises which of the two it is being

@@ -10,13 +10,13 @@ from typing import Any
 
 import numpy as np
 
-from . import plots
-from .io import atomic_write_text, save_figure, to_json, writable_directory
-from .kkt import certificate
-from .pressure import compare_hertz, compare_hertz_sphere, contact_profile
-from .problem import ContactProblem, ContactSolution
-from .scenes import scene_reference
-from .suite import LIMITS, SuiteResult
+from signorini.output import plots
+from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
+from signorini.kkt import certificate
+from signorini.pressure import compare_hertz, compare_hertz_sphere, contact_profile
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.scenes import scene_reference
+from signorini.studies.suite import LIMITS, SuiteResult
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
             "proxsuite", "piqp", "scs", "ecos", "highspy", "daqp", "quadprog", "qpalm", "cvxopt")
@@ -57,7 +57,8 @@ def solve_record(problem: ContactProblem, solution: ContactSolution) -> dict[str
     finite = bool(np.all(np.isfinite(solution.lam)) and np.all(np.isfinite(solution.u)))
     record: dict[str, Any] = {
         "scene": problem.scene, "params": problem.params, "method": solution.method,
-        "status": solution.status, "message": solution.message,
+        "status": solution.status, "claimed_status": solution.own_status,
+        "message": solution.message,
         "iterations": int(solution.iterations), "dofs": problem.n,
         "contact_candidates": problem.m,
         "time": {"assemble_s": problem.assemble_time, "build_s": solution.build_time,
@@ -74,7 +75,7 @@ def solve_record(problem: ContactProblem, solution: ContactSolution) -> dict[str
             compare = compare_hertz if kind == "hertz-2d" else compare_hertz_sphere
             record["hertz"] = compare(problem, solution).as_dict()
         if kind in ("punch", "reverse-hertz"):  # curved or cornered obstacles: the vertical load
-            from .pressure import compare_punch, compare_reverse_hertz, load_resultant
+            from signorini.pressure import compare_punch, compare_reverse_hertz, load_resultant
 
             record["load_resultant"] = load_resultant(problem, solution.lam)
             if kind == "punch":

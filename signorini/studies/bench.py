@@ -32,9 +32,9 @@ from typing import Any, Callable, Iterable
 import numpy as np
 import scipy.sparse as sp
 
-from . import cluster
-from .errors import InputError
-from .problem import ContactProblem, Push, Scales
+from signorini.solvers import cluster
+from signorini.errors import InputError
+from signorini.problem import ContactProblem, Push, Scales
 
 log = logging.getLogger(__name__)
 
@@ -92,7 +92,7 @@ def save_problem(problem: ContactProblem, path: Path) -> None:
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
-    from .io import atomic_write_bytes
+    from signorini.output.files import atomic_write_bytes
     atomic_write_bytes(path, buffer.getvalue())
 
 
@@ -131,10 +131,10 @@ def _mesh(z):
 
 def run_in_worker(problem_path: Path, method: str, tolerance: str) -> dict[str, Any]:
     """Time one factorisation + solve of K, then one method, and measure its answer."""
-    from .kkt import certificate, compare
-    from .linalg import factorize, resolve_backend
-    from .solvers.registry import solve
-    from .suite import reference_metrics
+    from signorini.kkt import certificate, compare
+    from signorini.numerics.factor import factorize, resolve_backend
+    from signorini.solvers.registry import solve
+    from signorini.studies.suite import reference_metrics
 
     problem = load_problem(problem_path)
     backend = resolve_backend(None, problem.n)
@@ -149,7 +149,7 @@ def run_in_worker(problem_path: Path, method: str, tolerance: str) -> dict[str, 
     vs = compare(problem, reference, solution)
     metrics = reference_metrics(problem, solution)
     return {"status": solution.status,
-            "claimed_status": solution.extras.get("claimed_status", solution.status),
+            "claimed_status": solution.own_status,
             "iterations": solution.iterations, "build_s": solution.build_time,
             "solve_s": solution.solve_time, "time_s": elapsed, "factor_s": factor_s,
             "ratio_to_factor": elapsed / factor_s, "kkt_worst": cert.worst()[1],
@@ -160,8 +160,8 @@ def run_in_worker(problem_path: Path, method: str, tolerance: str) -> dict[str, 
 
 def _reference(problem: ContactProblem, problem_path: Path, exact=None):
     """The exact answer of the problem (by :data:`REFERENCE`), computed once and kept beside it."""
-    from .problem import ContactSolution
-    from .solvers.registry import solve
+    from signorini.problem import ContactSolution
+    from signorini.solvers.registry import solve
 
     path = problem_path.with_suffix(".reference.npz")
     if path.exists():
@@ -171,13 +171,13 @@ def _reference(problem: ContactProblem, problem_path: Path, exact=None):
     if exact.status == "converged":
         buffer = io.BytesIO()
         np.savez(buffer, u=exact.u, lam=exact.lam)
-        from .io import atomic_write_bytes
+        from signorini.output.files import atomic_write_bytes
         atomic_write_bytes(path, buffer.getvalue())
     return exact
 
 
 def _worker_main() -> None:
-    from . import cluster
+    from signorini.solvers import cluster
 
     args = json.loads(sys.argv[1])
     logging.disable(logging.WARNING)
@@ -219,7 +219,7 @@ def append_row(path: Path, row: dict[str, Any]) -> None:
 
 def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any]) -> Path:
     """Assemble (once) and cache the problem of one scene and size."""
-    from .scenes import build_problem
+    from signorini.scenes import build_problem
 
     path = directory / "problems" / f"{scene}-{size}.npz"
     if not path.exists():
@@ -242,7 +242,7 @@ def run_benchmark(runs: Iterable[Run], out: Path, time_limit: float = 600.0,
         base = {"scene": run.scene, "size": run.size, "dofs": problem_meta.n,
                 "candidates": problem_meta.m, "method": run.label, "ranks": run.ranks,
                 "tolerance": run.tolerance}
-        command = [sys.executable, "-c", "from signorini.bench import _worker_main; _worker_main()",
+        command = [sys.executable, "-c", "from signorini.studies.bench import _worker_main; _worker_main()",
                    json.dumps({"problem": str(path), "method": run.method, "tolerance": run.tolerance})]
         env = None
         if run.ranks > 1:
@@ -318,9 +318,9 @@ def summary(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 def write_report(csv_path: Path, command: str) -> Path:
     """``bench.md`` and figures next to the CSV."""
-    from . import plots
-    from .io import atomic_write_text, save_figure
-    from .report import provenance
+    from signorini.output import plots
+    from signorini.output.files import atomic_write_text, save_figure
+    from signorini.output.report import provenance
 
     rows = read_rows(csv_path)
     if not rows:

@@ -16,13 +16,13 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .errors import InputError
-from .kkt import certificate, compare
-from .pressure import (compare_hertz, compare_hertz_sphere, compare_punch, compare_reverse_hertz,
+from signorini.errors import InputError
+from signorini.kkt import certificate, compare
+from signorini.pressure import (compare_hertz, compare_hertz_sphere, compare_punch, compare_reverse_hertz,
                        compare_uniform, contact_profile, radial_distance)
-from .problem import ContactProblem, ContactSolution
-from .scenes import build_problem, scene_reference
-from .solvers.registry import Method, get_method, methods, solve
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.scenes import build_problem, scene_reference
+from signorini.solvers.registry import Method, get_method, methods, solve
 
 log = logging.getLogger(__name__)
 
@@ -138,7 +138,7 @@ def run_one(problem: ContactProblem, method: Method, tol: float | None,
     elapsed = time.perf_counter() - start
     cert = certificate(problem, solution)
     row.update(
-        status=solution.status, claimed_status=solution.extras.get("claimed_status", solution.status),
+        status=solution.status, claimed_status=solution.own_status,
         message=solution.message, iterations=solution.iterations,
         build_s=solution.build_time, solve_s=solution.solve_time, time_s=elapsed,
         kkt=cert.as_dict(), kkt_worst=cert.worst()[1])

@@ -34,9 +34,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .pressure import contact_profile
-from .problem import ContactProblem, ContactSolution
+from signorini.errors import InputError
+from signorini.pressure import contact_profile
+from signorini.problem import ContactProblem, ContactSolution
 
 log = logging.getLogger(__name__)
 

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .errors import BackendNotInstalled, InputError
+from signorini.errors import BackendNotInstalled, InputError
 
 BACKENDS = ("pardiso", "cholmod", "superlu")
 _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import SignoriniError
-from .problem import ContactProblem
+from signorini.errors import SignoriniError
+from signorini.problem import ContactProblem
 
 #: a row entry below this fraction of the row's largest is round-off, not a coupling
 ROUND_OFF = 1e-13

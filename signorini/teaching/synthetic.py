@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .problem import ContactProblem
+from signorini.problem import ContactProblem
 
 
 def random_problem(n: int = 8, m: int = 3, seed: int = 0, condition: float = 10.0,
@@ -96,7 +96,7 @@ def bogie(*, half_length: float = 1.0, bending_stiffness: float = 10.0,
     InputError
         A length or stiffness is not positive, or ``gaps`` does not hold two finite numbers.
     """
-    from .errors import InputError
+    from signorini.errors import InputError
 
     for name, value in (("half_length", half_length), ("bending_stiffness", bending_stiffness),
                         ("mount_stiffness", mount_stiffness), ("tilt_stiffness", tilt_stiffness)):

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError
+from signorini.errors import InputError
 
 
 def writable_directory(path: str | os.PathLike) -> Path:

@@ -4,7 +4,7 @@ A study solves a scene at levels 0, 1, …, k of uniform refinement (the
 scene's ``refine`` parameter: every element split in four, so the element
 size h halves and the dofs roughly quadruple) with every installed exact
 method, and measures the errors against the scene's analytic reference
-(:func:`signorini.suite.reference_metrics`). The rate of a metric is the
+(:func:`signorini.studies.suite.reference_metrics`). The rate of a metric is the
 slope s of the least-squares line ``log err = s log h + c``
 (``np.polyfit(np.log(h), np.log(err), 1)``); h is the median distance between
 neighbouring contact candidates. Exact methods solve the same discrete
@@ -27,12 +27,12 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .errors import InputError
-from .problem import ContactProblem, ContactSolution
+from signorini.errors import InputError
+from signorini.problem import ContactProblem, ContactSolution
 
 log = logging.getLogger(__name__)
 
-#: errors measured per reference kind (keys of :func:`signorini.suite.reference_metrics`)
+#: errors measured per reference kind (keys of :func:`signorini.studies.suite.reference_metrics`)
 METRICS = {
     "hertz-2d": ("p0_rel", "a_rel", "pressure_l2_rel"),
     "reverse-hertz": ("p0_rel", "a_rel", "pressure_l2_rel"),
@@ -126,13 +126,13 @@ def candidate_spacing(problem: ContactProblem) -> float:
 
 def exact_methods() -> list[str]:
     """Every installed method that is exact when it converges."""
-    from .solvers.registry import methods
+    from signorini.solvers.registry import methods
 
     return [m.name for m in methods(installed_only=True) if m.exact]
 
 
 def _study_params(scene: str, params: dict[str, Any]) -> dict[str, Any]:
-    from .scenes import get_scene
+    from signorini.scenes import get_scene
 
     family = get_scene(scene)
     names = {p.name for p in family.params}
@@ -147,7 +147,7 @@ def _study_params(scene: str, params: dict[str, Any]) -> dict[str, Any]:
 
 
 def _refinable() -> list[str]:
-    from .scenes import SCENES
+    from signorini.scenes import SCENES
 
     return sorted(name for name, f in SCENES.items() if any(p.name == "refine" for p in f.params))
 
@@ -162,9 +162,9 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     rate fits (pre-asymptotic). Methods that refuse a level (dense ones on
     large meshes) are recorded as ``skipped``.
     """
-    from .scenes import build_problem, scene_reference
-    from .solvers.registry import solve
-    from .suite import reference_metrics
+    from signorini.scenes import build_problem, scene_reference
+    from signorini.solvers.registry import solve
+    from signorini.studies.suite import reference_metrics
 
     say = progress or (lambda message: None)
     if not isinstance(levels, int) or isinstance(levels, bool) or not 0 <= levels <= 6:
@@ -351,8 +351,8 @@ def plot_grading(comparison: GradingComparison, ax=None):
 
 def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=None):
     """Nodal pressure under the punch against ``P/(π√(a² − x²))``, in units of ``P/(πa)``."""
-    from .analytic import punch_pressure
-    from .pressure import compare_punch, contact_profile
+    from signorini.references import punch_pressure
+    from signorini.pressure import compare_punch, contact_profile
 
     ax = _axes(ax)
     comparison = compare_punch(problem, solution)
@@ -375,8 +375,8 @@ def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=N
 
 def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None):
     """Pressure against the distance ``a − |x|`` to the edge (log–log): slope −½ is the singularity."""
-    from .analytic import punch_pressure
-    from .pressure import compare_punch, contact_profile
+    from signorini.references import punch_pressure
+    from signorini.pressure import compare_punch, contact_profile
 
     ax = _axes(ax)
     comparison = compare_punch(problem, solution)
@@ -428,7 +428,7 @@ def study_table(study: ConvergenceStudy) -> list[str]:
 def write_study(study: ConvergenceStudy, out, command: str,
                 comparison: GradingComparison | None = None) -> dict[str, Any]:
     """Write ``convergence-<scene>.md``, ``.json`` and ``.png`` (and the grading figure) to ``out``."""
-    from .io import atomic_write_text, save_figure, to_json, writable_directory
+    from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
 
     directory = writable_directory(out)
     stem = f"convergence-{study.scene}"

@@ -47,7 +47,7 @@ def mpirun_command(ranks: int, argv: list[str]) -> tuple[list[str], dict[str, st
     """
     import shutil
 
-    from .errors import InputError
+    from signorini.errors import InputError
 
     cores = os.cpu_count() or 1
     if ranks > cores:

@@ -27,7 +27,7 @@ correct, calls no solvable problem ``infeasible``, and never raises on a
 problem that was built.
 
 Runs happen in a worker process with a time limit (as in
-:mod:`signorini.bench`): a backend that hangs or crashes costs one row, the
+:mod:`signorini.studies.bench`): a backend that hangs or crashes costs one row, the
 worker is restarted, and the atlas goes on.
 """
 
@@ -51,8 +51,8 @@ from typing import Any, Callable, Iterable, Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import InputError
-from .problem import ContactProblem, ContactSolution
+from signorini.errors import InputError
+from signorini.problem import ContactProblem, ContactSolution
 
 log = logging.getLogger(__name__)
 
@@ -172,7 +172,7 @@ def diagnose(problem: ContactProblem) -> list[str]:
     except (np.linalg.LinAlgError, ArithmeticError, RuntimeError) as exc:
         findings.append(f"K is singular ({exc}): a rigid mode is held only by the contact; pdas, "
                         "uzawa and condensed need K⁻¹ — prescribe a displacement or use "
-                        "signorini.stability.regularise(problem, 1e-8)")
+                        "signorini.studies.atlas.regularise(problem, 1e-8)")
     return findings
 
 
@@ -186,8 +186,8 @@ def build_spec(spec: dict[str, Any]) -> ContactProblem:
     ``{"kind": "force-controlled", "params", "pressure", "regularisation"}`` or
     ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`).
     """
-    from .scenes import build_problem
-    from .scenes.block import force_controlled_problem
+    from signorini.scenes import build_problem
+    from signorini.scenes.block import force_controlled_problem
 
     kind = spec["kind"]
     if kind == "scene":
@@ -218,9 +218,9 @@ def ill_posed_problem(case: str, **values: Any) -> ContactProblem:
     ``case`` is one of :data:`ILL_POSED_CASES`. Cases the package refuses
     raise :class:`~signorini.errors.InputError` here, from the assembly.
     """
-    from .assembly import assemble
-    from .scenes import block
-    from .scenes.base import FlatObstacle
+    from signorini.fem.assembly import assemble
+    from signorini.scenes import block
+    from signorini.scenes.base import FlatObstacle
 
     if case not in ILL_POSED_CASES:
         raise InputError(f"unknown ill-posed case {case!r}: choose {', '.join(ILL_POSED_CASES)}")
@@ -252,8 +252,8 @@ def reference_solution(problem: ContactProblem, spec: dict[str, Any],
     or on ``other`` — the same mesh in other units — converted), or
     ``"force-controlled-exact"`` (the patch solution).
     """
-    from .scenes.block import force_controlled_exact
-    from .solvers.registry import solve
+    from signorini.scenes.block import force_controlled_exact
+    from signorini.solvers.registry import solve
 
     if spec["kind"] == "force-controlled-exact":
         return force_controlled_exact(problem)
@@ -332,7 +332,7 @@ def _key(*parts: Any) -> str:
 
 def _certificate(problem: ContactProblem, solution: ContactSolution):
     """The certificate; without the duality gap when K cannot be factorised."""
-    from .kkt import certificate
+    from signorini.kkt import certificate
 
     try:
         return certificate(problem, solution)
@@ -342,7 +342,7 @@ def _certificate(problem: ContactProblem, solution: ContactSolution):
 
 def _own_answer(problem: ContactProblem, task: Task) -> ContactSolution:
     """The method called directly, without the package's wrapper (when the wrapper raised)."""
-    from .solvers.registry import get_method
+    from signorini.solvers.registry import get_method
 
     try:
         solution = get_method(task.method).function(problem, tol=task.tol, max_iter=task.max_iter,
@@ -354,7 +354,7 @@ def _own_answer(problem: ContactProblem, task: Task) -> ContactSolution:
 
 
 def _hertz(problem: ContactProblem, solution: ContactSolution, prefix: str = "") -> dict[str, float]:
-    from .pressure import compare_hertz
+    from signorini.pressure import compare_hertz
 
     if not problem.scene.startswith("hertz-cylinder") or not np.all(np.isfinite(solution.lam)):
         return {}
@@ -373,8 +373,8 @@ def _bound_at_solution(problem: ContactProblem, reference: ContactSolution) -> f
     ``W_AA``, so steps up to ``2/λ_max(W_AA)`` (≥ ``2/λ_max(W)``) still
     contract; returned as a multiple of the textbook bound ``2/λ_max(W)``.
     """
-    from .condensed import delassus
-    from .kkt import active_set
+    from signorini.numerics.lcp import delassus
+    from signorini.kkt import active_set
 
     W = delassus(problem.N, problem.factor())
     active = active_set(problem, reference)
@@ -390,7 +390,7 @@ def _force_error(problem: ContactProblem, reference: ContactSolution,
     The floor keeps the measure meaningful when the exact answer has no
     contact force at all (λ* = 0), where a relative difference is 1 for any λ ≠ 0.
     """
-    from .kkt import force_scale
+    from signorini.kkt import force_scale
 
     if not np.all(np.isfinite(solution.lam)):
         return float("inf")
@@ -406,7 +406,7 @@ def _weak_but_penetrating(problem: ContactProblem, solution: ContactSolution) ->
     weak and left out of :func:`signorini.kkt.compare` — a misclassification
     the comparison does not count. The atlas counts it here.
     """
-    from .kkt import WEAK, WEAK_TOL, classify, gap_scale
+    from signorini.kkt import WEAK, WEAK_TOL, classify, gap_scale
 
     if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
         return 0
@@ -417,9 +417,9 @@ def _weak_but_penetrating(problem: ContactProblem, solution: ContactSolution) ->
 
 def run_task(task: Task, cache: _Cache | None = None) -> dict[str, Any]:
     """Run one task in this process and measure it: one row of the atlas."""
-    from .kkt import compare
-    from .pressure import contact_profile
-    from .solvers.registry import ACCEPT_FACTOR, DEFAULT_ACCEPT, solve
+    from signorini.kkt import compare
+    from signorini.pressure import contact_profile
+    from signorini.solvers.registry import ACCEPT_FACTOR, DEFAULT_ACCEPT, solve
 
     cache = cache or _Cache()
     row: dict[str, Any] = {"axis": task.axis, "case": task.case, "value": task.value,
@@ -465,7 +465,7 @@ def run_task(task: Task, cache: _Cache | None = None) -> dict[str, Any]:
         wrapper = f"raised {type(exc).__name__}: {exc}"
         solution = _own_answer(problem, task)
     elapsed = time.perf_counter() - start
-    claimed = solution.extras.get("claimed_status", solution.status)
+    claimed = solution.own_status
     cert = _certificate(problem, solution)
     worst_name, worst = cert.worst()
     accept = ACCEPT_FACTOR * task.tol if task.tol is not None else DEFAULT_ACCEPT
@@ -494,11 +494,11 @@ def run_task(task: Task, cache: _Cache | None = None) -> dict[str, Any]:
                    near_exact=bool(same and lam_rel <= NEAR_FACTOR * accept))
     row.update(_hertz(problem, solution))
     if "patch" in task.measure:
-        from .scenes.block import force_controlled_exact
+        from signorini.scenes.block import force_controlled_exact
 
         row["patch_lam_rel"] = compare(problem, force_controlled_exact(problem), solution).lam_rel
     if "profile" in task.measure and np.all(np.isfinite(solution.lam)):
-        from .pressure import compare_hertz
+        from signorini.pressure import compare_hertz
 
         profile = contact_profile(problem, solution)
         hertz = compare_hertz(problem, solution)
@@ -608,7 +608,7 @@ class Worker:
     def _start(self) -> None:
         self._stderr = tempfile.TemporaryFile()
         self._proc = subprocess.Popen(
-            [sys.executable, "-c", "from signorini.stability import serve_worker; serve_worker()"],
+            [sys.executable, "-c", "from signorini.studies.atlas import serve_worker; serve_worker()"],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._stderr)
         self._buffer = b""
 
@@ -713,7 +713,7 @@ def run_tasks(tasks: Sequence[Task], *, isolate: bool = True, time_limit: float 
 
 def atlas_methods(quick: bool = False) -> list[str]:
     """Installed methods, exact ones first; a quick atlas takes :data:`QUICK_METHODS`."""
-    from .solvers.registry import methods
+    from signorini.solvers.registry import methods
 
     order = {"active set": 0, "dual": 1, "qp": 2, "cvxpy": 3}
     found = sorted((m for m in methods(installed_only=True) if m.family != "user"),
@@ -1176,9 +1176,10 @@ def _table_step(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def _figure_step(rows: list[dict[str, Any]]):
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
-    ax = plots.atlas_step_sweep(rows)
+    ax = figures.atlas_step_sweep(rows)
     ax.set_title("Axis 1: Uzawa's step (filled: right answer)", fontsize=9)
     return ax.figure
 
@@ -1229,15 +1230,16 @@ def _table_mesh(rows: list[dict[str, Any]]) -> list[str]:
 def _figure_mesh(rows: list[dict[str, Any]]):
     from matplotlib.figure import Figure
 
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
     figure = Figure(figsize=(11, 4.4), layout="constrained")
     left, right = figure.subplots(1, 2)
     answered = [r for r in rows if r["status"] not in ("refused", "input-error")]
     counted = [r for r in answered if (r.get("iterations") or 0) > 0]  # some backends say 0
-    plots.atlas_series(counted, "dofs", "iterations", ax=left,
+    figures.atlas_series(counted, "dofs", "iterations", ax=left,
                        ylabel="iterations (as the method counts them)")
-    plots.atlas_series(answered, "dofs", "time_s", ax=right, ylabel="time (build + solve) [s]")
+    figures.atlas_series(answered, "dofs", "time_s", ax=right, ylabel="time (build + solve) [s]")
     figure.suptitle("Axis 2: mesh refinement of Hertz's cylinder (filled: right answer)", fontsize=9)
     return figure
 
@@ -1313,16 +1315,17 @@ def _table_tolerance(rows: list[dict[str, Any]]) -> list[str]:
 def _figure_tolerance(rows: list[dict[str, Any]]):
     from matplotlib.figure import Figure
 
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
     numeric = [r for r in rows if r["value"] != "default"]
     figure = Figure(figsize=(11, 4.4), layout="constrained")
     left, right = figure.subplots(1, 2)
-    plots.atlas_series(numeric, "value", "lam_rel", ax=left, xlabel="tolerance asked for",
+    figures.atlas_series(numeric, "value", "lam_rel", ax=left, xlabel="tolerance asked for",
                        ylabel="‖λ − λ*‖∞ / ‖λ*‖∞")
     left.plot([1e-10, 1e-2], [1e-10, 1e-2], "k:", lw=0.8)
     left.invert_xaxis()
-    plots.atlas_series(numeric, "value", "misclassified", ax=right, xlabel="tolerance asked for",
+    figures.atlas_series(numeric, "value", "misclassified", ax=right, xlabel="tolerance asked for",
                        ylabel="misclassified contact nodes", logy=False)
     right.invert_xaxis()
     figure.suptitle("Axis 3: tolerance (filled: right answer; red ring: the backend's own "
@@ -1362,12 +1365,13 @@ def _table_units(rows: list[dict[str, Any]]) -> list[str]:
 def _figure_units(rows: list[dict[str, Any]]):
     from matplotlib.figure import Figure
 
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
     figure = Figure(figsize=(11, 5.0), layout="constrained")
     left, right = figure.subplots(1, 2, sharey=True)
     for ax, scaling in ((left, "scaled"), (right, "raw")):
-        plots.atlas_outcomes([r for r in rows if r["case"].endswith(scaling)], column="value", ax=ax,
+        figures.atlas_outcomes([r for r in rows if r["case"].endswith(scaling)], column="value", ax=ax,
                              title=f"{'non-dimensionalised' if scaling == 'scaled' else 'raw units'}")
     figure.suptitle("Axis 4: units (green: right; orange: false 'solved' caught; grey: no claim; "
                     "red: the package's status was wrong)", fontsize=9)
@@ -1409,12 +1413,13 @@ def _table_poisson(rows: list[dict[str, Any]]) -> list[str]:
 def _figure_poisson(rows: list[dict[str, Any]]):
     from matplotlib.figure import Figure
 
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
     figure = Figure(figsize=(11, 4.4), layout="constrained")
     left, right = figure.subplots(1, 2)
     pdas = [dict(r, incompressibility=0.5 - r["value"]) for r in rows if r["method"] == "pdas"]
-    plots.atlas_series(pdas, "incompressibility", "p0_rel", ax=left, group="case",
+    figures.atlas_series(pdas, "incompressibility", "p0_rel", ax=left, group="case",
                        xlabel="0.5 − ν", ylabel="Hertz p₀ relative error (pdas, exact)")
     left.invert_xaxis()
     profiles = {r["value"]: r["profile"] for r in pdas if r["case"] == "mesh A"
@@ -1474,15 +1479,16 @@ def _table_force(rows: list[dict[str, Any]]) -> list[str]:
 def _figure_force(rows: list[dict[str, Any]]):
     from matplotlib.figure import Figure
 
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
     figure = Figure(figsize=(11, 4.8), layout="constrained")
     left, right = figure.subplots(1, 2, width_ratios=(1.0, 0.8))
     sweep = [r for r in rows if str(r["case"]).startswith("ε=")]
-    plots.atlas_series(sweep, "value", "patch_lam_rel", ax=left, xlabel="regularisation ε",
+    figures.atlas_series(sweep, "value", "patch_lam_rel", ax=left, xlabel="regularisation ε",
                        ylabel="‖λ − λ_exact‖∞ / ‖λ_exact‖∞ (vs the unregularised patch solution)")
     main = [r for r in rows if not str(r["case"]).startswith("ε=")]
-    plots.atlas_outcomes(main, column="case", ax=right, title="status per method")
+    figures.atlas_outcomes(main, column="case", ax=right, title="status per method")
     figure.suptitle("Axis 6: a block held only by contact (force control, singular K)", fontsize=9)
     return figure
 
@@ -1517,9 +1523,10 @@ def _table_degenerate(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def _figure_degenerate(rows: list[dict[str, Any]]):
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
-    ax = plots.atlas_weak_nodes(rows)
+    ax = figures.atlas_weak_nodes(rows)
     ax.figure.set_size_inches(11, 4.4)
     ax.set_title("Axis 7: degenerate contact — misclassified nodes with and without the weak label",
                  fontsize=9)
@@ -1558,9 +1565,10 @@ def _table_ill_posed(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def _figure_ill_posed(rows: list[dict[str, Any]]):
-    from . import plots
+    from signorini.output import plots
+    from signorini.studies.atlas import figures
 
-    ax = plots.atlas_outcomes([r for r in rows if r["method"] != BUILD_ONLY], column="case",
+    ax = figures.atlas_outcomes([r for r in rows if r["method"] != BUILD_ONLY], column="case",
                               title="Axis 8: infeasible and ill-posed input (green: the right "
                                     "status or answer)")
     ax.figure.set_size_inches(7, 5)
@@ -1606,16 +1614,16 @@ ADVICE = {
                "package does not provide. The solvers are not the problem: the exact methods "
                "solve every ν; first-order methods slow down with the conditioning.",
     "force-control": "prescribe a displacement where you can (every scene of the package does). "
-                     "For a body held only by contact, `signorini.stability.regularise(problem, "
+                     "For a body held only by contact, `signorini.studies.atlas.regularise(problem, "
                      "1e-8)` adds ε·mean(diag K) to the diagonal: PDAS, the condensed dual and "
                      "the QP backends then solve it with λ within about 100 ε of the exact answer on "
                      "the 8 × 8 block; "
                      "Uzawa does not (its W gains an eigenvalue of order 1/ε). Run "
-                     "`signorini.stability.diagnose(problem)` to see whether K is singular.",
+                     "`signorini.studies.atlas.diagnose(problem)` to see whether K is singular.",
     "degenerate": "nothing: nodes that touch with zero force are labelled weakly active and left "
                   "out of active-set comparisons, so an inexact method is not blamed for them. "
                   "Look at their count (`weak`) when two answers seem to disagree.",
-    "ill-posed": "run `signorini.stability.diagnose(problem)` on a problem you built yourself: it "
+    "ill-posed": "run `signorini.studies.atlas.diagnose(problem)` on a problem you built yourself: it "
                  "names infeasible candidates, duplicated candidates and a singular K in words. "
                  "The package refuses an empty contact set and zero-weight candidates outright.",
 }
@@ -1645,8 +1653,8 @@ SETUPS = {
                   "meets an obstacle shaped exactly to where it goes unsupported, so those nodes "
                   "touch with zero force. Every method at tol 1e-8.",
     "ill-posed": "The block (4 × 4) made infeasible or ill-posed five ways "
-                 "(`signorini.stability.ill_posed_problem`); each problem is built and diagnosed "
-                 "(`signorini.stability.diagnose`), then solved by every method where it builds.",
+                 "(`signorini.studies.atlas.ill_posed_problem`); each problem is built and diagnosed "
+                 "(`signorini.studies.atlas.diagnose`), then solved by every method where it builds.",
 }
 
 
@@ -1660,7 +1668,7 @@ def reproduction(row: dict[str, Any]) -> str:
     if max_iter:
         arguments += f", max_iter={max_iter}"
     arguments += "".join(f", {k}={v!r}" for k, v in options.items())
-    return ("from signorini.stability import build_spec; from signorini.solvers.registry import solve; "
+    return ("from signorini.studies.atlas import build_spec; from signorini.solvers.registry import solve; "
             f"solve(build_spec({row['problem']}), {row['method']!r}, {arguments})")
 
 
@@ -1689,8 +1697,8 @@ def write_report(result: AtlasResult, out: str | os.PathLike, command: str) -> d
 
     Every file is written whole or not at all (a temporary file, then a rename).
     """
-    from .io import atomic_write_text, save_figure, to_json, writable_directory
-    from .report import provenance
+    from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
+    from signorini.output.report import provenance
 
     directory = writable_directory(out)
     data = writable_directory(Path(out) / "stability")

@@ -2,7 +2,7 @@
 
 For a body pushed by ``s`` times its prescribed displacement, ``b(s) = s b₁ + b₀``
 with ``b₁ = N K⁻¹ f₁ − d₁`` and ``b₀ = −d₀``. Each load level is then a small
-dense problem on the candidates (:func:`signorini.loading.push_for_load_condensed`)
+dense problem on the candidates (:func:`signorini.numerics.loading.push_for_load_condensed`)
 and one back-solve for the displacement.
 """
 
@@ -15,11 +15,11 @@ from typing import Callable
 
 import numpy as np
 
-from .condensed import delassus
-from .errors import InputError
-from .loading import push_for_load_condensed
-from .pressure import compare_hertz, contact_half_width, contact_profile
-from .problem import ContactProblem, ContactSolution
+from signorini.numerics.lcp import delassus
+from signorini.errors import InputError
+from signorini.numerics.loading import push_for_load_condensed
+from signorini.pressure import compare_hertz, contact_half_width, contact_profile
+from signorini.problem import ContactProblem, ContactSolution
 
 log = logging.getLogger(__name__)
 
@@ -87,7 +87,7 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
 
 def plot_sweep(levels: list[SweepLevel], ax=None):
     """Contact half-width and peak pressure against load, with Hertz's curves (a ∝ √P, p₀ ∝ √P)."""
-    from .plots import _axes
+    from signorini.output.plots import axes as _axes
 
     axes = _axes(ax)
     loads = np.array([lv.total_force for lv in levels])

@@ -38,10 +38,11 @@ from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, as
 from skfem.helpers import ddot, sym_grad, trace
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from .errors import InputError
-from .loading import calibrate_push
-from .problem import ContactProblem, Push, Scales
-from .scenes.base import SceneModel
+from signorini.errors import InputError
+from signorini.numerics.loading import calibrate_push
+from signorini.numerics.zone import ZoneSolver
+from signorini.problem import ContactProblem, Push, Scales, WarmStart
+from signorini.fem.model import SceneModel
 
 log = logging.getLogger(__name__)
 
@@ -220,7 +221,7 @@ def displacement_scale(model: SceneModel) -> float:
 def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> ContactProblem:
     """Assemble the contact QP of ``model``; adjust δ first when a target load is set.
 
-    ``zone`` (a :class:`signorini.nested.Zone` over the contact candidates)
+    ``zone`` (a :class:`signorini.numerics.zone.Zone` over the contact candidates)
     predicts the contact zone: load targeting then costs one factorisation
     and a few back-solves, and the solver it used is kept on the problem
     for the ``nested`` method to reuse.
@@ -286,12 +287,8 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
         free_dofs=free, prescribed=full, load_row=load_full[free], load_offset=load_offset,
         force_multiplicity=model.force_multiplicity,
         scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
-        params=params, mesh=mesh, push=_push(lifted, scale))
-    problem.axisymmetric = model.axisymmetric
-    #: the contact forces load targeting found (exact; a coarse model's prediction needs no solve)
-    problem.calibration_lam = calibration_lam
-    if zone_solver is not None:
-        problem.zone_solver, problem.zone = zone_solver
+        params=params, mesh=mesh, push=_push(lifted, scale), axisymmetric=axisymmetric,
+        warm_start=WarmStart(calibration_lam, *(zone_solver or (None, None))))
     problem.assemble_time = time.perf_counter() - start
     log.info("assembled %d free dofs, %d contact candidates in %.2f s",
              problem.n, problem.m, problem.assemble_time)
@@ -310,16 +307,14 @@ def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
     """The factor on the prescribed displacement whose contact force is ``target``.
 
     The load is affine in the factor. With a predicted ``zone``,
-    :class:`signorini.nested.ZoneSolver` finds it on one factorisation and
+    :class:`signorini.numerics.zone.ZoneSolver` finds it on one factorisation and
     returns itself with the final zone for reuse; otherwise (or should that
-    fail) :func:`signorini.loading.calibrate_push` solves the augmented
+    fail) :func:`signorini.numerics.loading.calibrate_push` solves the augmented
     active-set system (one factorisation per step).
     """
     f0, d0 = lifted(0.0)[:2]
     f1, d_one = lifted(1.0)[:2]
     if zone is not None:
-        from .nested import ZoneSolver
-
         try:
             system = ZoneSolver(K, N)
             scale, _, lam, final = system.push_for_load(f1 - f0, d0, d_one - d0, target,

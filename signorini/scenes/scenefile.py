@@ -50,15 +50,15 @@ import re
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from .errors import InputError
-from .obstacles import Circle, FlatPunch, HalfPlane
-
-if TYPE_CHECKING:
-    from .scenes.base import SceneModel
+from signorini.errors import InputError
+from signorini.fem.model import SceneModel
+from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery
+from signorini.scenes.base import poisson_ratio
+from signorini.scenes.families import SCENES
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -167,8 +167,6 @@ def build_scene_model(path: str | Path,
 
 def _family_scene(data: dict[str, Any], ctx: _Context,
                   overrides: dict[str, Any]) -> tuple[str, "SceneModel"]:
-    from .scenes import SCENES
-
     name = data["scene"]
     if not isinstance(name, str) or name not in SCENES:
         raise ctx.error(f"{name!r} is not a scene family: choose one of {', '.join(sorted(SCENES))}",
@@ -390,9 +388,6 @@ def _obstacle(ctx: _Context, content: dict[str, Any]) -> HalfPlane | Circle | Fl
 
 
 def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) -> "SceneModel":
-    from .obstacles import ScaledQuery
-    from .scenes.base import SceneModel, poisson_ratio
-
     unknown = sorted(set(data) - set(MESH_SCENE_KEYS))
     if unknown:
         raise ctx.error(f"unknown entry for a mesh scene: use the tables "

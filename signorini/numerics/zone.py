@@ -9,7 +9,7 @@ zone may lie, and the *rest* that surely stays apart. Then:
    for a flat obstacle);
 2. the band is condensed onto ``W_B = N_B K̃⁻¹ N_Bᵀ`` (one back-solve per
    band node, never one per candidate) and its complementarity problem
-   solved exactly (:func:`signorini.condensed.solve_lcp`);
+   solved exactly (:func:`signorini.numerics.lcp.solve_lcp`);
 3. the result is checked on every candidate: a core node whose reaction
    pulls, or a node of the rest that penetrates, joins the band and the
    band problem is solved again (a pulling core node also costs a new
@@ -19,7 +19,7 @@ The loop ends only when every KKT condition holds to round-off, so the
 answer is exact whatever the prediction; a good prediction only makes it
 cheap: one factorisation plus a few dozen back-solves.
 
-With a target load the push ``s`` (see :mod:`signorini.loading`) joins the
+With a target load the push ``s`` (see :mod:`signorini.numerics.loading`) joins the
 band problem as one more unknown, with the total contact force (band forces
 plus core reactions) as one more equation.
 """
@@ -34,8 +34,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from .condensed import solve_lcp
-from .linalg import Pinning, PinnedFactor, resolve_backend, selection_dofs
+from signorini.numerics.lcp import solve_lcp
+from signorini.numerics.factor import Pinning, PinnedFactor, resolve_backend, selection_dofs
 
 log = logging.getLogger(__name__)
 
@@ -85,24 +85,6 @@ def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: n
     core = votes.all(axis=1)
     band = votes[:, :max(1, k // 2)].any(axis=1) & ~core
     return Zone(core=core, band=band)
-
-
-def zone_from_coarse(points: np.ndarray, coarse, neighbours: int | None = None) -> Zone | None:
-    """The zone at ``points`` predicted by the coarse model ``coarse`` (a ContactProblem).
-
-    Its contact forces come from its load targeting when that ran (exact
-    already), else from solving it with the ``nested`` method; None when
-    that does not converge.
-    """
-    lam = coarse.calibration_lam
-    if lam is None:
-        from .solvers.registry import solve
-
-        solution = solve(coarse, "nested")
-        if solution.status != "converged":
-            return None
-        lam = solution.lam
-    return predict_zone(points, coarse.contact_points, lam > 0, neighbours)
 
 
 class ZoneSolver:

@@ -1,0 +1,60 @@
+"""A scene in physical units, ready for assembly: mesh, material, supports, obstacle, load."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class FlatObstacle:
+    """A rigid flat ``y = height``, approached from above (normal (0, −1))."""
+
+    height: float = 0.0
+
+    def normals_and_gaps(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Unit outward normal of the body towards the obstacle and the initial gap per point."""
+        normals = np.tile([0.0, -1.0], (len(points), 1))
+        return normals, points[:, 1] - self.height
+
+
+@dataclass
+class FlatObstacle3D:
+    """A rigid flat ``z = height`` under a 3D body, approached from above (normal (0, 0, −1))."""
+
+    height: float = 0.0
+
+    def normals_and_gaps(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Unit outward normal of the body towards the obstacle and the initial gap per point."""
+        normals = np.tile([0.0, 0.0, -1.0], (len(points), 1))
+        return normals, points[:, 2] - self.height
+
+
+@dataclass
+class SceneModel:
+    """A scene in physical units, ready for assembly.
+
+    ``dirichlet`` lists ``(component, node indices, value)``: component 0 is x,
+    1 is y. ``load_dofs`` are ``(component, nodes)`` whose reactions make up
+    the applied load (sign: a push towards the obstacle is positive).
+    ``target_load`` (full body, per unit thickness) asks assembly to adjust
+    the prescribed displacement ``delta`` until the contact force equals it;
+    prescribed values are then ``value × delta / delta_nominal``.
+    """
+
+    mesh: Any
+    E: float
+    nu: float
+    dirichlet: list[tuple[int, np.ndarray, float]]
+    contact_nodes: np.ndarray
+    contact_facets: np.ndarray
+    obstacle: Any  # anything with normals_and_gaps(points): see signorini.fem.obstacles
+    load_dofs: tuple[int, np.ndarray]
+    length_scale: float
+    force_multiplicity: float = 1.0
+    target_load: float | None = None
+    params: dict[str, Any] = field(default_factory=dict)
+    #: the mesh is the meridian half-plane (r, z) of a body of revolution; forces per radian
+    axisymmetric: bool = False

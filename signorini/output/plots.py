@@ -1,0 +1,151 @@
+"""Figures of solves and benchmarks. Every function takes ``ax=None`` and returns the Axes.
+
+The tutorials' figures are in :mod:`signorini.teaching.figures`, the atlas's in
+:mod:`signorini.studies.atlas.figures`.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+import numpy as np
+
+from signorini.references import hertz_pressure
+
+
+def axes(ax):
+    """``ax``, or the Axes of a new figure (pyplot's global state untouched)."""
+    if ax is None:
+        from matplotlib.figure import Figure
+        ax = Figure(figsize=(6.4, 4.2), layout="constrained").add_subplot()
+    return ax
+
+
+def pressure_profile(x: np.ndarray, pressure: np.ndarray, *, a_ref: float | None = None,
+                     p0_ref: float | None = None, label: str = "numeric", ax=None,
+                     others: Iterable[tuple[str, np.ndarray]] = ()):
+    """Nodal pressure against x, with Hertz's ``p₀√(1 − x²/a²)`` when ``a_ref`` is given.
+
+    Lengths are shown in units of ``a_ref`` and pressures in units of
+    ``p0_ref`` when both are given. ``others`` adds ``(label, pressure)``
+    series at the same x (other methods), drawn as markers.
+    """
+    ax = axes(ax)
+    xs = 1.0 if a_ref is None else a_ref
+    ps = 1.0 if p0_ref is None else p0_ref
+    if a_ref is not None and p0_ref is not None:
+        grid = np.linspace(0.0, float(x.max()), 800)
+        ax.plot(grid / xs, hertz_pressure(grid, a_ref, p0_ref) / ps, "k-", lw=1.5, label="Hertz")
+    ax.plot(x / xs, pressure / ps, "o", ms=3, mfc="none", label=label)
+    for i, (name, values) in enumerate(others):
+        ax.plot(x / xs, values / ps, ".", ms=2, label=name, alpha=0.7, zorder=2 + i)
+    ax.set_xlabel("x / a (Hertz)" if a_ref is not None else "x")
+    ax.set_ylabel("p / p₀ (Hertz)" if p0_ref is not None else "p")
+    ax.set_xlim(left=0.0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return ax
+
+
+def kkt_against_time(rows: list[dict], *, ax=None, title: str = ""):
+    """Worst relative KKT residual against solve time, one marker per run (log–log)."""
+    ax = axes(ax)
+    for row in rows:
+        time_s, kkt = row["time_s"], row["kkt_worst"]
+        if not (np.isfinite(kkt) and kkt > 0 and time_s > 0):
+            continue
+        marker = "o" if row["status"] == "converged" else "x"
+        ax.loglog(time_s, max(kkt, 1e-17), marker, label=f"{row['label']} ({row['status']})")
+    ax.set_xlabel("build + solve time [s]")
+    ax.set_ylabel("worst relative KKT residual")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=6, ncol=2)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax
+
+
+def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None):
+    """Benchmark runs: time against an accuracy measure, one marker per method and tolerance.
+
+    Filled markers are runs the package calls ``converged``; the lower-left
+    envelope is the Pareto front.
+    """
+    if ax is None:
+        from matplotlib.figure import Figure
+        ax = Figure(figsize=(10, 5), layout="constrained").add_subplot()
+    markers = {"low": "v", "mid": "s", "high": "o", "default": "D"}
+    methods = sorted({r["method"] for r in rows})
+    for i, method in enumerate(methods):
+        for tolerance, marker in markers.items():
+            mine = [r for r in rows if r["method"] == method and r["tolerance"] == tolerance
+                    and np.isfinite(r[metric]) and r["time_s"] > 0]
+            if not mine:
+                continue
+            ok = [r["status"] == "converged" for r in mine]
+            ax.loglog([r["time_s"] for r in mine], [max(r[metric], 1e-16) for r in mine], marker,
+                      color=f"C{i % 10}", mfc=None if all(ok) else "none",
+                      label=f"{method} @ {tolerance}", ms=5)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel({"kkt_worst": "worst relative KKT residual",
+                   "p0_rel": "Hertz p₀ relative error"}.get(metric, metric))
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=5, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the front
+    return ax
+
+
+def bench_time_vs_dofs(rows: list[dict], *, axes=None):
+    """Time (left) and ratio to one factorisation (right) against dofs, log–log, per method.
+
+    Each method at its own default tolerance (exact methods: their one run); filled markers
+    where the answer passed the certificate, hollow where not (a timeout has no point).
+    Returns the left Axes and the fitted slopes ``{label: slope}`` of time against dofs.
+    """
+    if axes is None:
+        from matplotlib.figure import Figure
+        axes = Figure(figsize=(11, 4.4), layout="constrained").subplots(1, 2)
+    left, right = axes
+    slopes: dict[str, float] = {}
+    factor: dict[float, list[float]] = {}
+    for r in rows:
+        if np.isfinite(r["factor_s"]):
+            factor.setdefault(r["dofs"], []).append(r["factor_s"])
+    if factor:
+        dofs = np.array(sorted(factor))
+        series_f = np.array([np.median(factor[d]) for d in dofs])
+        left.loglog(dofs, series_f, "k--", label="one factorisation + solve")
+        right.axhline(1.0, color="k", ls="--", lw=1)
+        if dofs.size >= 2:
+            slopes["one factorisation + solve"] = float(np.polyfit(np.log(dofs), np.log(series_f), 1)[0])
+    import matplotlib
+
+    for i, method in enumerate(sorted({r["method"] for r in rows})):
+        mine = [r for r in rows if r["method"] == method]
+        level = "default" if any(r["tolerance"] == "default" for r in mine) else "high"
+        mine = sorted((r for r in mine if r["tolerance"] == level and np.isfinite(r["time_s"])),
+                      key=lambda r: r["dofs"])
+        if not mine:
+            continue
+        dofs = np.array([r["dofs"] for r in mine])
+        times = np.array([r["time_s"] for r in mine])
+        ratios = np.array([r["ratio_to_factor"] for r in mine])
+        good = np.array([r["status"] == "converged" for r in mine])
+        colour = matplotlib.colormaps["tab20"](i % 20)
+        marker = "osD^v<>ph"[i % 9]
+        for ax, values in ((left, times), (right, ratios)):
+            ax.plot(dofs, values, "-", color=colour, lw=1, marker=marker, ms=0,
+                    label=method if ax is left else None)
+            ax.plot(dofs[good], values[good], marker, color=colour, ms=5)
+            ax.plot(dofs[~good], values[~good], marker, mfc="none", color=colour, ms=5)
+        if np.unique(dofs).size >= 2:
+            slopes[method] = float(np.polyfit(np.log(dofs), np.log(times), 1)[0])
+    left.set_xscale("log"), left.set_yscale("log")
+    right.set_xscale("log"), right.set_yscale("log")
+    left.set_xlabel("dofs"), right.set_xlabel("dofs")
+    left.set_ylabel("time at each method's default tolerance [s]")
+    right.set_ylabel("time / one factorisation + solve")
+    for ax in axes:
+        ax.grid(alpha=0.3, which="both")
+    left.legend(fontsize=6)
+    right.set_title("filled: certificate passed; hollow: not", fontsize=8)
+    return left, slopes

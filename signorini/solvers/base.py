@@ -1,0 +1,96 @@
+"""What a method is, and how its claim of success is judged.
+
+A method is a plain function ``solve(problem, *, tol=None, max_iter=None,
+**options) -> ContactSolution`` described by a :class:`Method`. Backends
+define their methods here-shaped (a ``METHODS`` tuple per backend module);
+:mod:`signorini.solvers.registry` collects them. A method's own claim of
+success becomes ``converged`` only when the KKT certificate backs it
+(:func:`judge`).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from signorini.errors import InputError
+from signorini.kkt import certificate
+from signorini.problem import ContactProblem, ContactSolution
+
+SolverFunction = Callable[..., ContactSolution]
+
+#: a claim of success is accepted when every relative KKT residual is at most
+#: ``ACCEPT_FACTOR × tol`` (or ``DEFAULT_ACCEPT`` when no tolerance was asked for):
+#: success means what qpbenchmark means by it, the residuals under the tolerance
+ACCEPT_FACTOR = 1.0
+DEFAULT_ACCEPT = 1e-6
+
+
+@dataclass(frozen=True)
+class Method:
+    """A registered method.
+
+    ``requires`` lists the Python modules it imports; ``extra`` is the
+    pip extra that installs them. ``dense`` methods build dense matrices and
+    refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
+    answer up to round-off when they converge.
+    """
+
+    name: str
+    function: SolverFunction
+    summary: str
+    requires: tuple[str, ...] = ()
+    extra: str = ""
+    dense: bool = False
+    exact: bool = False
+    family: str = ""
+    default_tol: float | None = None
+    options: tuple[str, ...] = field(default=())
+
+    @property
+    def installed(self) -> bool:
+        return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
+
+
+def check_tol(tol: Any) -> float | None:
+    if tol is None:
+        return None
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
+            or not (np.isfinite(tol) and 0 < tol < 1):
+        raise InputError(f"tol must be a number in (0, 1), got {tol!r}: e.g. tol=1e-9")
+    return float(tol)
+
+
+def check_max_iter(max_iter: Any) -> int | None:
+    if max_iter is None:
+        return None
+    ok = isinstance(max_iter, (int, np.integer)) and not isinstance(max_iter, bool)
+    ok = ok or (isinstance(max_iter, (float, np.floating)) and np.isfinite(max_iter)
+                and float(max_iter).is_integer())
+    if not ok or max_iter < 1:
+        raise InputError(f"max_iter must be a positive integer, got {max_iter!r}")
+    return int(max_iter)
+
+
+def judge(problem: ContactProblem, solution: ContactSolution,
+          tol: float | None) -> ContactSolution:
+    """Downgrade a claim of convergence that the certificate does not back."""
+    if solution.status != "converged":
+        return solution
+    accept = ACCEPT_FACTOR * tol if tol is not None else DEFAULT_ACCEPT
+    try:
+        cert = certificate(problem, solution)
+    except np.linalg.LinAlgError:  # K singular: no dual function; judge on the other residuals
+        cert = certificate(problem, solution, duality_gap=False)
+    worst_name, worst = cert.worst()
+    if not np.isfinite(worst) or worst > accept:
+        solution.claimed_status = "converged"
+        solution.status = "inaccurate"
+        solution.message = (
+            f"{solution.message}; the method claimed success but the KKT certificate's "
+            f"{worst_name} residual is {worst:.1e} > {accept:.0e}: tighten the tolerance "
+            "or use an exact method (pdas)").lstrip("; ")
+    return solution
