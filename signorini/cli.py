@@ -60,7 +60,7 @@ def _tol(text: str) -> float:
 
 
 def _write_json(path: str, text: str) -> None:
-    from signorini.output.files import atomic_write_text
+    from signorini.files import atomic_write_text
 
     if path == "-":
         sys.stdout.write(text + "\n")
@@ -69,7 +69,7 @@ def _write_json(path: str, text: str) -> None:
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.output.files import to_json
+    from signorini.files import to_json
     from signorini.output.report import solve_record, solve_summary
     from signorini.scenes import build_problem
     from signorini.solvers.registry import solve
@@ -117,8 +117,8 @@ def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
+    from signorini.files import writable_directory
     from signorini.studies.convergence import grading_comparison, run_study, study_table, write_study
-    from signorini.output.files import writable_directory
 
     writable_directory(args.out)
     if args.levels < 0 or args.levels > 6:
@@ -145,7 +145,7 @@ def cmd_converge(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from signorini.output.files import writable_directory
+    from signorini.files import writable_directory
     from signorini.output.report import checks_summary, write_suite_report
     from signorini.studies.suite import run_suite, select_cases
 
@@ -164,7 +164,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
+    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
     from signorini.scenes import build_problem
     from signorini.studies.sweep import parse_loads, plot_sweep, sweep_loads
 
@@ -193,10 +193,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     import math
 
-    from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report
-    from signorini.output.files import writable_directory
+    from signorini.files import writable_directory
     from signorini.scenes import get_scene
     from signorini.solvers.registry import get_method, methods
+    from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report
 
     out = writable_directory(args.out)
     family = get_scene(args.scene)
@@ -252,7 +252,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def cmd_stability(args: argparse.Namespace) -> int:
     import math
 
-    from signorini.output.files import writable_directory
+    from signorini.files import writable_directory
     from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report
 
     axes = select_axes(args.axis)

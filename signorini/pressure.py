@@ -11,8 +11,16 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from signorini.references import (contact_modulus, hertz_cylinder_half_width, hertz_cylinder_peak,
-                       hertz_pressure, hertz_sphere_peak, hertz_sphere_radius)
+from signorini.analytic import (
+    contact_modulus,
+    hertz_cylinder_half_width,
+    hertz_cylinder_peak,
+    hertz_pressure,
+    hertz_sphere_peak,
+    hertz_sphere_radius,
+    punch_load_between,
+    punch_pressure,
+)
 from signorini.kkt import ACTIVE, classify
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -363,8 +371,6 @@ class PunchComparison:
 def compare_punch(problem: ContactProblem, solution: ContactSolution,
                   inner: float = 0.5) -> PunchComparison:
     """Compare ``solution`` of the punch scene with ``p(x) = P/(π√(a² − x²))`` on ``|x| ≤ inner·a``."""
-    from signorini.references import punch_load_between, punch_pressure
-
     profile = _half_line(problem, contact_profile(problem, solution))
     a = float(problem.params["a"])
     P = load_resultant(problem, solution.lam)

@@ -15,13 +15,18 @@ turns them back into physical units.
 from __future__ import annotations
 
 import dataclasses
+import io
+import json
+import os
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
+from skfem import MeshTet, MeshTri
 
 from signorini.errors import InputError
+from signorini.files import atomic_write_bytes
 from signorini.numerics.factor import factorize
 
 #: the statuses a :class:`ContactSolution` can carry
@@ -290,6 +295,59 @@ class ContactProblem:
         """
         changes.setdefault("warm_start", WarmStart())
         return dataclasses.replace(self, **changes)
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Store the arrays of this problem (and its mesh) in ``path`` (.npz), atomically.
+
+        :meth:`load` gives it back; the cached factorisation, the warm start
+        and the coarse-model factory are not stored.
+        """
+        K, N = self.K.tocsr(), self.N.tocsr()
+        pu = self.push
+        arrays = dict(
+            K_data=K.data, K_indices=K.indices, K_indptr=K.indptr, N_data=N.data,
+            N_indices=N.indices, N_indptr=N.indptr, shape=np.array([self.n, self.m]), f=self.f,
+            d=self.d, weights=self.weights, contact_points=self.contact_points,
+            free_dofs=self.free_dofs, prescribed=self.prescribed,
+            load_row=self.load_row if self.load_row is not None else np.zeros(0))
+        if self.mesh is not None:  # node blocks and rigid modes for the petsc methods
+            arrays.update(mesh_p=self.mesh.p, mesh_t=self.mesh.t)
+        if pu is not None:
+            arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
+        meta = {"scene": self.scene, "params": self.params, "load_offset": self.load_offset,
+                "force_multiplicity": self.force_multiplicity, "scales": vars(self.scales),
+                "assemble_time": self.assemble_time, "axisymmetric": self.axisymmetric,
+                "reference": self.reference,
+                "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale}}
+        arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+        buffer = io.BytesIO()
+        np.savez(buffer, **arrays)
+        atomic_write_bytes(path, buffer.getvalue())
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> "ContactProblem":
+        """The problem :meth:`save` stored in ``path``."""
+        z = np.load(path)
+        meta = json.loads(bytes(z["meta"]).decode())
+        n, m = (int(v) for v in z["shape"])
+        push = None
+        if meta["push"] is not None:
+            push = Push(z["push_f1"], z["push_d0"], z["push_d1"], meta["push"]["offset1"],
+                        meta["push"]["scale"])
+        mesh = None
+        if "mesh_p" in z:
+            kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
+            mesh = kind(z["mesh_p"], z["mesh_t"])
+        return cls(
+            K=sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]), shape=(n, n)),
+            f=z["f"], N=sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
+            d=z["d"], weights=z["weights"], contact_points=z["contact_points"],
+            free_dofs=z["free_dofs"], prescribed=z["prescribed"],
+            load_row=z["load_row"] if z["load_row"].size else None,
+            load_offset=meta["load_offset"], force_multiplicity=meta["force_multiplicity"],
+            scales=Scales(**meta["scales"]), scene=meta["scene"], params=meta["params"],
+            push=push, mesh=mesh, assemble_time=meta["assemble_time"],
+            axisymmetric=meta.get("axisymmetric", False), reference=meta.get("reference", ""))
 
 
 @dataclass

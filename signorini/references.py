@@ -1,82 +1,95 @@
-"""Analytic references (Johnson, Contact Mechanics, 1985, ch. 4).
+"""The analytic references a scene can declare, by name.
 
-An elastic body on a rigid flat has the contact modulus ``E* = E / (1 − ν²)``
-(plane strain in 2D).
+Each scene family names its reference (``SceneFamily.reference``) and every
+problem built from it carries that name (``ContactProblem.reference``);
+everything that compares an answer with theory looks the reference up here
+instead of testing names:
+
+============== ============================================ ===================
+name           comparison                                   key in solve JSON
+============== ============================================ ===================
+hertz-2d       Hertz's cylinder (plane strain)              ``hertz``
+hertz-3d       Hertz's sphere (axisymmetric or 3D model)    ``hertz``
+reverse-hertz  a block pressed by a rigid cylinder          ``hertz``
+punch          a rigid flat punch, P/(π√(a² − x²))          ``punch``
+uniform        uniform pressure E*δ/H (the block patch test) ``uniform``
+============== ============================================ ===================
+
+Formulas: :mod:`signorini.analytic`; comparisons: :mod:`signorini.pressure`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any, Callable
+
 import numpy as np
 
-
-def contact_modulus(E: float, nu: float) -> float:
-    """``E* = E / (1 − ν²)`` for an elastic body against a rigid one."""
-    return E / (1.0 - nu ** 2)
-
-
-def hertz_cylinder_half_width(P: float, R: float, E_star: float) -> float:
-    """Contact half-width of a cylinder on a flat: ``a = √(4PR / (πE*))`` (P per unit length)."""
-    return float(np.sqrt(4.0 * P * R / (np.pi * E_star)))
-
-
-def hertz_cylinder_load(a: float, R: float, E_star: float) -> float:
-    """The load per unit length that gives half-width ``a``: ``P = πE*a² / (4R)``."""
-    return float(np.pi * E_star * a ** 2 / (4.0 * R))
+from signorini.errors import InputError
+from signorini.pressure import (
+    compare_hertz,
+    compare_hertz_sphere,
+    compare_punch,
+    compare_reverse_hertz,
+    compare_uniform,
+)
+from signorini.problem import ContactProblem, ContactSolution
 
 
-def hertz_cylinder_peak(P: float, a: float) -> float:
-    """Peak pressure of the cylinder: ``p₀ = 2P / (πa)``."""
-    return float(2.0 * P / (np.pi * a))
+@dataclass(frozen=True)
+class Reference:
+    """An analytic reference: how to compare an answer with it, and what that measures.
 
-
-def hertz_pressure(x: np.ndarray, a: float, p0: float) -> np.ndarray:
-    """Hertz's elliptic pressure ``p(x) = p₀ √(1 − x²/a²)`` inside ``|x| < a``, zero outside."""
-    x = np.asarray(x, dtype=float)
-    return p0 * np.sqrt(np.clip(1.0 - (x / a) ** 2, 0.0, None))
-
-
-# --- sphere on a flat (Johnson 1985, §4.2, eqs. 4.22–4.24) ----------------------------------
-
-
-def hertz_sphere_radius(P: float, R: float, E_star: float) -> float:
-    """Contact radius of a sphere on a flat: ``a = (3PR / (4E*))^(1/3)`` (P the total load)."""
-    return float(np.cbrt(3.0 * P * R / (4.0 * E_star)))
-
-
-def hertz_sphere_load(a: float, R: float, E_star: float) -> float:
-    """The load that gives contact radius ``a``: ``P = 4E*a³ / (3R)``."""
-    return float(4.0 * E_star * a ** 3 / (3.0 * R))
-
-
-def hertz_sphere_peak(P: float, a: float) -> float:
-    """Peak pressure of the sphere: ``p₀ = 3P / (2πa²)``, so that ``∫ p dA = P``."""
-    return float(3.0 * P / (2.0 * np.pi * a ** 2))
-
-
-def hertz_sphere_approach(a: float, R: float) -> float:
-    """Approach of distant points of the sphere and the flat: ``δ = a² / R``."""
-    return float(a ** 2 / R)
-
-
-# --- rigid flat punch on a half-plane (Johnson 1985, ch. 2: the flat punch) ----------------
-
-
-def punch_pressure(x: np.ndarray, a: float, P: float) -> np.ndarray:
-    """Pressure under a rigid flat punch of half-width a: ``p(x) = P / (π √(a² − x²))``.
-
-    Frictionless, plane strain, load P per unit length; singular at the edges
-    ``|x| = a`` (infinite there, ``nan`` is returned at and beyond them) and
-    ``∫₋ₐᵃ p dx = P``. The smallest value is the centre's ``P / (πa)``.
+    ``compare(problem, solution)`` returns an object with ``as_dict()``;
+    ``key`` names that dictionary in a solve record; ``resultant`` says the
+    load is the vertical resultant of tilted normals (curved or cornered
+    obstacles), reported beside it; ``convergence`` lists the errors a
+    refinement study fits rates to; ``figure`` says the validation report
+    draws every method's pressure against this reference's profile.
     """
-    x = np.asarray(x, dtype=float)
-    inside = np.abs(x) < a
-    out = np.full(x.shape, np.nan)
-    out[inside] = P / (np.pi * np.sqrt(a ** 2 - x[inside] ** 2))
-    return out
+
+    name: str
+    summary: str
+    compare: Callable[[ContactProblem, ContactSolution], Any]
+    key: str
+    convergence: tuple[str, ...] = ()
+    resultant: bool = False
+    figure: bool = False
+
+    def metrics(self, problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:
+        """The comparison as a flat dictionary; empty when the answer has no finite forces."""
+        if not np.all(np.isfinite(solution.lam)):
+            return {}
+        return self.compare(problem, solution).as_dict()
 
 
-def punch_load_between(x0: float, x1: float, a: float, P: float) -> float:
-    """The load carried by ``x0 ≤ x ≤ x1`` under the punch: ``(P/π)(arcsin(x₁/a) − arcsin(x₀/a))``."""
-    x0, x1 = np.clip([x0, x1], -a, a)
-    return float(P / np.pi * (np.arcsin(x1 / a) - np.arcsin(x0 / a)))
+_PRESSURE_ERRORS = ("p0_rel", "a_rel", "pressure_l2_rel")
 
+REFERENCES: dict[str, Reference] = {r.name: r for r in (
+    Reference("hertz-2d", "Hertz's cylinder on a flat, plane strain", compare_hertz, "hertz",
+              _PRESSURE_ERRORS, figure=True),
+    Reference("hertz-3d", "Hertz's sphere on a flat", compare_hertz_sphere, "hertz",
+              _PRESSURE_ERRORS, figure=True),
+    Reference("reverse-hertz", "a block pressed by a rigid cylinder (Hertz 2D)",
+              compare_reverse_hertz, "hertz", _PRESSURE_ERRORS, resultant=True),
+    Reference("punch", "a rigid flat punch on a half-plane", compare_punch, "punch",
+              ("pressure_max_rel", "pressure_l2_rel", "edge_over_centre"), resultant=True),
+    Reference("uniform", "uniform pressure under a block pressed onto a flat", compare_uniform,
+              "uniform"),
+)}
+
+
+def reference_of(problem: ContactProblem) -> Reference | None:
+    """The reference ``problem`` declares (None when it declares none)."""
+    if not problem.reference:
+        return None
+    if problem.reference not in REFERENCES:
+        raise InputError(f"reference {problem.reference!r} is not one of "
+                         f"{', '.join(sorted(REFERENCES))} (or '' for none)")
+    return REFERENCES[problem.reference]
+
+
+def reference_metrics(problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:
+    """Errors of ``solution`` against the reference ``problem`` declares ({} when none)."""
+    reference = reference_of(problem)
+    return reference.metrics(problem, solution) if reference else {}

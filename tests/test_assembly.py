@@ -11,7 +11,7 @@ import scipy.sparse.linalg as spla
 from skfem import asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from signorini.references import contact_modulus, hertz_cylinder_load
+from signorini.analytic import contact_modulus, hertz_cylinder_load
 from signorini.errors import InputError
 from signorini.kkt import certificate
 from signorini.scenes import build_problem
@@ -373,7 +373,7 @@ def test_an_obstacle_away_from_the_origin_gives_the_same_gaps_in_any_units():
     """A flat at height h ≠ 0 under a body of length L ≠ 1: gaps are physical, whatever the scaling."""
     from signorini.fem.assembly import assemble
     from signorini.scenes import get_scene
-    from signorini.scenes.base import FlatObstacle
+    from signorini.fem.model import FlatObstacle
 
     family = get_scene("hertz-cylinder")
     model = family.build(family.parse({"R": 3.0, "n_contact": 12, "delta": 0.01}),

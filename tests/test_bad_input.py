@@ -177,7 +177,7 @@ def test_result_files_are_readable_by_others(tmp_path):
     import os
     import stat
 
-    from signorini.output.files import atomic_write_text
+    from signorini.files import atomic_write_text
 
     target = tmp_path / "result.json"
     old = os.umask(0o022)

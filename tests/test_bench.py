@@ -5,10 +5,17 @@ import csv
 import numpy as np
 import pytest
 
-from signorini.studies.bench import (Run, load_problem, read_rows, run_benchmark, save_problem,
-                             shifted_geometric_mean, summary, write_report)
 from signorini.cli import main
+from signorini.problem import ContactProblem
 from signorini.scenes import build_problem
+from signorini.studies.bench import (
+    Run,
+    read_rows,
+    run_benchmark,
+    shifted_geometric_mean,
+    summary,
+    write_report,
+)
 
 SMALL = {"n_contact": 16, "grading": 0.4, "refine": 0}
 
@@ -19,8 +26,8 @@ def runs(*methods):
 
 def test_problem_cache_round_trip(tmp_path):
     problem = build_problem("hertz-cylinder", **SMALL)
-    save_problem(problem, tmp_path / "p.npz")
-    again = load_problem(tmp_path / "p.npz")
+    problem.save(tmp_path / "p.npz")
+    again = ContactProblem.load(tmp_path / "p.npz")
     assert (again.K != problem.K).nnz == 0 and np.array_equal(again.f, problem.f)
     assert again.params == problem.params and again.scales == problem.scales
     assert np.array_equal(again.push.f1, problem.push.f1)

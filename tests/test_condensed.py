@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from signorini.numerics.lcp import delassus
 from signorini.errors import InputError
 from signorini.kkt import compare
 from signorini.numerics.factor import factorize
+from signorini.numerics.lcp import delassus
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 from signorini.teaching.synthetic import random_problem

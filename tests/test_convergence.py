@@ -6,12 +6,20 @@ import numpy as np
 import pytest
 
 from signorini.cli import main
-from signorini.studies.convergence import (dofs_for_error, fitted_rate, grading_comparison, plot_convergence,
-                                   plot_grading, plot_punch_edge, plot_punch_pressure, run_study,
-                                   write_study)
 from signorini.errors import InputError
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
+from signorini.studies.convergence import (
+    dofs_for_error,
+    fitted_rate,
+    grading_comparison,
+    plot_convergence,
+    plot_grading,
+    plot_punch_edge,
+    plot_punch_pressure,
+    run_study,
+    write_study,
+)
 
 TINY = {"a_over_R": 0.2, "n_contact": 6, "grading": 0.8}
 

@@ -6,14 +6,22 @@ import numpy as np
 import pytest
 from matplotlib.axes import Axes
 
-from signorini.teaching import figures as plots
-from signorini.numerics.lcp import delassus
-from signorini.teaching.dual import (DenseDual, IterationHistory, IterationRecorder, dense_dual,
-                            lagrangian, objectives, solve_recorded, uzawa_path)
 from signorini.errors import InputError
 from signorini.kkt import active_set
+from signorini.numerics.lcp import delassus
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
+from signorini.teaching import figures as plots
+from signorini.teaching.dual import (
+    DenseDual,
+    IterationHistory,
+    IterationRecorder,
+    dense_dual,
+    lagrangian,
+    objectives,
+    solve_recorded,
+    uzawa_path,
+)
 from signorini.teaching.synthetic import bogie, bogie_compliance, bogie_deflection, random_problem
 
 

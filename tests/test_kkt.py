@@ -6,8 +6,17 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from signorini.kkt import (ACTIVE, INACTIVE, WEAK, WEAK_TOL, active_set, certificate, classify,
-                           compare, gap_scale)
+from signorini.kkt import (
+    ACTIVE,
+    INACTIVE,
+    WEAK,
+    WEAK_TOL,
+    active_set,
+    certificate,
+    classify,
+    compare,
+    gap_scale,
+)
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes import build_problem
 from signorini.solvers import registry

@@ -4,8 +4,13 @@ import numpy as np
 import pytest
 
 from signorini.errors import InputError
-from signorini.numerics.factor import (ActiveSetSolver, available_backends, factorize, resolve_backend,
-                              selection_dofs)
+from signorini.numerics.factor import (
+    ActiveSetSolver,
+    available_backends,
+    factorize,
+    resolve_backend,
+    selection_dofs,
+)
 from signorini.scenes import build_problem
 from signorini.teaching.synthetic import random_problem
 

@@ -4,14 +4,14 @@ import numpy as np
 import pytest
 from skfem import MeshTri
 
-from signorini.fem.assembly import assemble
 from signorini.errors import InputError
+from signorini.fem.assembly import assemble
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery, SignedDistance
+from signorini.kkt import compare
 from signorini.pressure import compare_reverse_hertz, contact_profile, load_resultant
 from signorini.scenes import build_problem
-from signorini.scenes.base import FlatObstacle, SceneModel
+from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.solvers.registry import solve
-from signorini.kkt import compare
 
 RNG = np.random.default_rng(7)
 

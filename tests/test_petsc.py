@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from signorini.solvers.bounds import InfeasibleBounds, NoBoundForm, bound_form
-from signorini.solvers.cluster import mpirun_command
 from signorini.errors import InputError
 from signorini.kkt import active_set, compare
 from signorini.scenes import build_problem
+from signorini.solvers.bounds import InfeasibleBounds, NoBoundForm, bound_form
+from signorini.solvers.cluster import mpirun_command
 from signorini.solvers.registry import solve
 from signorini.teaching.synthetic import random_problem
 

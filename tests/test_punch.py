@@ -4,7 +4,7 @@ the edge singularity under refinement, rounded corners, and agreement of the met
 import numpy as np
 import pytest
 
-from signorini.references import punch_load_between, punch_pressure
+from signorini.analytic import punch_load_between, punch_pressure
 from signorini.errors import InputError
 from signorini.kkt import compare
 from signorini.pressure import compare_punch, contact_profile, load_resultant

@@ -12,8 +12,8 @@ from skfem import MeshTri
 from signorini.cli import main
 from signorini.errors import InputError
 from signorini.pressure import compare_uniform, contact_profile
-from signorini.scenes.scenefile import read_mesh
 from signorini.scenes import build_problem
+from signorini.scenes.scenefile import read_mesh
 from signorini.solvers.registry import solve
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

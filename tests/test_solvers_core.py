@@ -5,9 +5,9 @@ import itertools
 import numpy as np
 import pytest
 
-from signorini.numerics.lcp import solve_lcp
 from signorini.errors import InputError
 from signorini.kkt import certificate, compare
+from signorini.numerics.lcp import solve_lcp
 from signorini.scenes import build_problem
 from signorini.solvers import pdas, registry
 

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from signorini import cli
-from signorini.studies import suite
 from signorini.solvers.registry import get_method, solve
+from signorini.studies import suite
 from signorini.teaching.synthetic import random_problem
 
 ROOT = Path(__file__).resolve().parents[1]

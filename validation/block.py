@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from signorini.references import contact_modulus
+from signorini.analytic import contact_modulus
 from signorini.pressure import compare_uniform, contact_profile
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve

@@ -26,8 +26,8 @@ agreement = compare(problem, exact, paper)
 
 def visualize(path: str | Path = "hertz_cylinder.png") -> Path:
     """Nodal pressures of both methods against Hertz's ellipse."""
+    from signorini.files import save_figure
     from signorini.output import plots
-    from signorini.output.files import save_figure
 
     profile = contact_profile(problem, exact)
     ax = plots.pressure_profile(profile.x, profile.pressure, a_ref=hertz.a_ref, p0_ref=hertz.p0_ref,

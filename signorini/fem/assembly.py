@@ -39,10 +39,10 @@ from skfem.helpers import ddot, sym_grad, trace
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from signorini.errors import InputError
+from signorini.fem.model import SceneModel
 from signorini.numerics.loading import calibrate_push
 from signorini.numerics.zone import ZoneSolver
 from signorini.problem import ContactProblem, Push, Scales, WarmStart
-from signorini.fem.model import SceneModel
 
 log = logging.getLogger(__name__)
 

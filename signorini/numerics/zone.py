@@ -34,8 +34,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from signorini.numerics.factor import PinnedFactor, Pinning, resolve_backend, selection_dofs
 from signorini.numerics.lcp import solve_lcp
-from signorini.numerics.factor import Pinning, PinnedFactor, resolve_backend, selection_dofs
 
 log = logging.getLogger(__name__)
 

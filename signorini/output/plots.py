@@ -10,7 +10,7 @@ from typing import Iterable
 
 import numpy as np
 
-from signorini.references import hertz_pressure
+from signorini.analytic import hertz_pressure
 
 
 def axes(ax):

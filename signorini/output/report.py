@@ -10,12 +10,12 @@ from typing import Any
 
 import numpy as np
 
-from signorini.output import plots
-from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
+from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.kkt import certificate
-from signorini.pressure import compare_hertz, compare_hertz_sphere, contact_profile
+from signorini.output import plots
+from signorini.pressure import contact_profile, load_resultant
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.scenes import scene_reference
+from signorini.references import reference_of
 from signorini.studies.suite import LIMITS, SuiteResult
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
@@ -70,18 +70,11 @@ def solve_record(problem: ContactProblem, solution: ContactSolution) -> dict[str
         record["total_force"] = profile.total_force
         record["applied_load"] = profile.applied_load
         record["contact"] = profile.as_dict()
-        kind = scene_reference(problem.scene)
-        if kind in ("hertz-2d", "hertz-3d"):
-            compare = compare_hertz if kind == "hertz-2d" else compare_hertz_sphere
-            record["hertz"] = compare(problem, solution).as_dict()
-        if kind in ("punch", "reverse-hertz"):  # curved or cornered obstacles: the vertical load
-            from signorini.pressure import compare_punch, compare_reverse_hertz, load_resultant
-
-            record["load_resultant"] = load_resultant(problem, solution.lam)
-            if kind == "punch":
-                record["punch"] = compare_punch(problem, solution).as_dict()
-            else:
-                record["hertz"] = compare_reverse_hertz(problem, solution).as_dict()
+        reference = reference_of(problem)
+        if reference is not None:
+            if reference.resultant:  # curved or cornered obstacles: the vertical load
+                record["load_resultant"] = load_resultant(problem, solution.lam)
+            record[reference.key] = reference.compare(problem, solution).as_dict()
     else:
         record["total_force"] = None
         record["contact"] = None
@@ -158,10 +151,10 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
     for result in suite.results:
         problem, ref = result.problem, result.reference
         name = result.case.name
-        kind = scene_reference(problem.scene)
-        if kind in ("hertz-2d", "hertz-3d") and np.all(np.isfinite(ref.lam)):
+        reference = reference_of(problem)
+        if reference is not None and reference.figure and np.all(np.isfinite(ref.lam)):
             profile = contact_profile(problem, ref)
-            hertz = (compare_hertz if kind == "hertz-2d" else compare_hertz_sphere)(problem, ref)
+            hertz = reference.compare(problem, ref)
             others = [(label, contact_profile(problem, s).pressure)
                       for label, s in result.solutions.items()
                       if label != "pdas@1e-09" and s.status != "failed" and np.all(np.isfinite(s.lam))]
@@ -175,7 +168,7 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
         path = directory / f"{name}-kkt-time.png"
         save_figure(ax.figure, path)
         figures[f"{name}-kkt-time"] = path
-    md = [f"# signorini validation report", "",
+    md = ["# signorini validation report", "",
           f"Command: `{command}`  ", f"Result: **{'PASS' if suite.passed else 'FAIL'}** "
           f"({sum(c.passed for c in suite.checks)}/{len(suite.checks)} checks) in {suite.elapsed_s:.1f} s  ",
           f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",

@@ -10,13 +10,11 @@ function that turns checked parameter values into a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable
 
-import numpy as np
-
 from signorini.errors import InputError
-from signorini.fem.model import FlatObstacle, FlatObstacle3D, SceneModel
+from signorini.fem.model import SceneModel
 
 
 @dataclass(frozen=True)

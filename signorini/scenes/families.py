@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 from signorini.errors import InputError
 from signorini.scenes import block, hertz_cylinder, hertz_sphere, hertz_sphere_3d, punch, reverse_hertz
 from signorini.scenes.base import SceneFamily

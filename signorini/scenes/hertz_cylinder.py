@@ -15,11 +15,10 @@ from __future__ import annotations
 
 from typing import Any
 
-
-from signorini.references import hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.analytic import hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.errors import InputError
-from signorini.scenes.base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
-                   poisson_ratio, positive)
+from signorini.fem.model import FlatObstacle, SceneModel
+from signorini.scenes.base import Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.meshing import graded_quarter_disc
 
 PARAMS = (

@@ -21,10 +21,10 @@ from typing import Any
 
 import numpy as np
 
-from signorini.references import contact_modulus, hertz_sphere_load, hertz_sphere_radius
+from signorini.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
 from signorini.errors import InputError
-from signorini.scenes.base import (FlatObstacle, Param, SceneFamily, SceneModel, at_least, between,
-                   poisson_ratio, positive)
+from signorini.fem.model import FlatObstacle, SceneModel
+from signorini.scenes.base import Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.meshing import graded_quarter_disc
 
 COMMON_PARAMS = (

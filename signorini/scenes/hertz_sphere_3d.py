@@ -24,10 +24,17 @@ from typing import Any
 import numpy as np
 from skfem import MeshTet
 
-from signorini.scenes.base import FlatObstacle3D, Param, SceneFamily, SceneModel, at_least, between
+from signorini.fem.model import FlatObstacle3D, SceneModel
+from signorini.scenes.base import Param, SceneFamily, at_least, between
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, load_choice, recorded_params
-from signorini.scenes.meshing import (coarse_ball_octant, curved_boundary_facets, distance_to_disc,
-                      on_ball_octant_surface, refine_simplices_to_size, snap_to_sphere)
+from signorini.scenes.meshing import (
+    coarse_ball_octant,
+    curved_boundary_facets,
+    distance_to_disc,
+    on_ball_octant_surface,
+    refine_simplices_to_size,
+    snap_to_sphere,
+)
 
 PARAMS = COMMON_PARAMS + (
     Param("n_contact", 10, "elements across the contact radius (mesh fineness)", kind=int,

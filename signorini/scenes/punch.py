@@ -29,10 +29,11 @@ from typing import Any
 import numpy as np
 from skfem import MeshTri
 
-from signorini.references import contact_modulus
+from signorini.analytic import contact_modulus
 from signorini.errors import InputError
+from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
-from signorini.scenes.base import Param, SceneFamily, SceneModel, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.meshing import distance_to_segment, refine_to_size
 
 

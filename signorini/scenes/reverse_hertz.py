@@ -20,10 +20,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from signorini.references import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.errors import InputError
+from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle
-from signorini.scenes.base import Param, SceneFamily, SceneModel, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.punch import bottom_contact_model, graded_half_block, mirrored_about_x0
 
 #: the mesh is uniformly fine on the bottom up to this multiple of the half-width

@@ -435,7 +435,7 @@ def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) 
     for i, entry in enumerate(entries):
         extra = sorted(set(entry) - MESH_SCENE_KEYS["dirichlet"])
         if extra:
-            raise ctx.error(f"unknown key: [[dirichlet]] takes boundary, component, value",
+            raise ctx.error("unknown key: [[dirichlet]] takes boundary, component, value",
                             "dirichlet", extra[0], i)
         nodes, _ = _boundary_nodes(ctx, mesh_info, "dirichlet", entry, i)
         dirichlet.append((_component(ctx, "dirichlet", entry, i), nodes,

@@ -20,6 +20,8 @@ import resource
 import time
 from typing import Any, Callable
 
+from signorini.errors import InputError
+
 log = logging.getLogger(__name__)
 
 #: environment variables by which Open MPI, MPICH / Hydra and PMIx launchers announce the world size
@@ -46,8 +48,6 @@ def mpirun_command(ranks: int, argv: list[str]) -> tuple[list[str], dict[str, st
     Open MPI refuses to run as root unless told to (containers and CI run as root).
     """
     import shutil
-
-    from signorini.errors import InputError
 
     cores = os.cpu_count() or 1
     if ranks > cores:

@@ -13,12 +13,12 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.errors import InputError
 from signorini.numerics.factor import factorize
+from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.options import take_options
 from signorini.solvers.base import Method
+from signorini.solvers.options import take_options
 
 DEFAULTS = {"backend": None, "block": 128, "max_candidates": 20_000}
 

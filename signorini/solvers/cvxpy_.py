@@ -22,8 +22,8 @@ import scipy.sparse as sp
 
 from signorini.errors import InputError, SolverError
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.qp import BACKEND_BY_NAME
 from signorini.solvers.base import Method
+from signorini.solvers.qp import BACKEND_BY_NAME
 
 log = logging.getLogger(__name__)
 

@@ -19,17 +19,17 @@ from __future__ import annotations
 
 import logging
 import time
+from typing import Any
 
 import numpy as np
-from typing import Any
 
 from signorini.errors import InputError
 from signorini.numerics.factor import selection_dofs
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.options import take_options
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
+from signorini.solvers.options import take_options
 
 log = logging.getLogger(__name__)
 

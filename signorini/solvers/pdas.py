@@ -28,12 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.kkt import gap_scale
 from signorini.numerics.factor import ActiveSetSolver, factorize
+from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.options import positive_number, take_options
 from signorini.solvers.base import Method
+from signorini.solvers.options import positive_number, take_options
 
 DEFAULTS = {"c": 1.0, "lam0": None, "callback": None, "backend": None}
 MAX_ITER = 100

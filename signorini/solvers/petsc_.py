@@ -36,11 +36,12 @@ from typing import Any
 
 import numpy as np
 
-from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
 from signorini.errors import InputError
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.options import take_options
+from signorini.solvers import cluster
 from signorini.solvers.base import Method
+from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
+from signorini.solvers.options import take_options
 
 DEFAULTS = {"ksp": "auto", "petsc_options": ""}
 KSP_CHOICES = ("auto", "mumps", "gamg")
@@ -330,8 +331,6 @@ def _reason_text(kind: str, reason: int) -> str:
 
 def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: int | None,
            options: dict[str, Any]) -> ContactSolution:
-    from signorini.solvers import cluster
-
     opts = take_options(method, options, DEFAULTS)
     if opts["ksp"] not in KSP_CHOICES:
         raise InputError(f"method {method!r}: option ksp={opts['ksp']!r} is not one of "

@@ -20,8 +20,7 @@ from typing import Any
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
-from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol,
-                                    judge)
+from signorini.solvers.base import ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol, judge
 
 log = logging.getLogger(__name__)
 

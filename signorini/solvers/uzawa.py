@@ -37,12 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
 from signorini.errors import InputError
 from signorini.numerics.factor import factorize
+from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.options import positive_number, take_options
 from signorini.solvers.base import Method
+from signorini.solvers.options import positive_number, take_options
 
 DEFAULTS = {"rho": None, "step_fraction": 0.9, "lam0": None, "divergence_factor": 1e8,
             "operator": "auto", "callback": None, "acceleration": "none"}

@@ -32,9 +32,9 @@ from typing import Any, Callable, Iterable
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.solvers import cluster
 from signorini.errors import InputError
-from signorini.problem import ContactProblem, Push, Scales
+from signorini.problem import ContactProblem
+from signorini.solvers import cluster
 
 log = logging.getLogger(__name__)
 
@@ -69,74 +69,16 @@ class Run:
         return (self.scene, self.size, self.label, self.tolerance)
 
 
-# --- problem cache ----------------------------------------------------------------------------
-
-def save_problem(problem: ContactProblem, path: Path) -> None:
-    """Store the arrays of ``problem`` (not its mesh) in ``path`` (.npz), atomically."""
-    K, N = problem.K.tocsr(), problem.N.tocsr()
-    pu = problem.push
-    arrays = dict(
-        K_data=K.data, K_indices=K.indices, K_indptr=K.indptr, N_data=N.data, N_indices=N.indices,
-        N_indptr=N.indptr, shape=np.array([problem.n, problem.m]), f=problem.f, d=problem.d,
-        weights=problem.weights, contact_points=problem.contact_points,
-        free_dofs=problem.free_dofs, prescribed=problem.prescribed,
-        load_row=problem.load_row if problem.load_row is not None else np.zeros(0))
-    if problem.mesh is not None:  # node blocks and rigid modes for the petsc methods
-        arrays.update(mesh_p=problem.mesh.p, mesh_t=problem.mesh.t)
-    if pu is not None:
-        arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
-    meta = {"scene": problem.scene, "params": problem.params, "load_offset": problem.load_offset,
-            "force_multiplicity": problem.force_multiplicity, "scales": vars(problem.scales),
-            "assemble_time": problem.assemble_time,
-            "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale}}
-    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
-    buffer = io.BytesIO()
-    np.savez(buffer, **arrays)
-    from signorini.output.files import atomic_write_bytes
-    atomic_write_bytes(path, buffer.getvalue())
-
-
-def load_problem(path: Path) -> ContactProblem:
-    """The problem stored by :func:`save_problem`."""
-    z = np.load(path)
-    meta = json.loads(bytes(z["meta"]).decode())
-    n, m = (int(v) for v in z["shape"])
-    push = None
-    if meta["push"] is not None:
-        push = Push(z["push_f1"], z["push_d0"], z["push_d1"], meta["push"]["offset1"],
-                    meta["push"]["scale"])
-    problem = ContactProblem(
-        K=sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]), shape=(n, n)),
-        f=z["f"], N=sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
-        d=z["d"], weights=z["weights"], contact_points=z["contact_points"],
-        free_dofs=z["free_dofs"], prescribed=z["prescribed"],
-        load_row=z["load_row"] if z["load_row"].size else None, load_offset=meta["load_offset"],
-        force_multiplicity=meta["force_multiplicity"], scales=Scales(**meta["scales"]),
-        scene=meta["scene"], params=meta["params"], push=push, mesh=_mesh(z))
-    problem.assemble_time = meta["assemble_time"]
-    return problem
-
-
-def _mesh(z):
-    """The stored mesh (triangles or tetrahedra), or None."""
-    if "mesh_p" not in z:
-        return None
-    from skfem import MeshTet, MeshTri
-
-    kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
-    return kind(z["mesh_p"], z["mesh_t"])
-
-
 # --- one run, in a worker process -------------------------------------------------------------
 
 def run_in_worker(problem_path: Path, method: str, tolerance: str) -> dict[str, Any]:
     """Time one factorisation + solve of K, then one method, and measure its answer."""
     from signorini.kkt import certificate, compare
     from signorini.numerics.factor import factorize, resolve_backend
+    from signorini.references import reference_metrics
     from signorini.solvers.registry import solve
-    from signorini.studies.suite import reference_metrics
 
-    problem = load_problem(problem_path)
+    problem = ContactProblem.load(problem_path)
     backend = resolve_backend(None, problem.n)
     factorize(sp.identity(2, format="csc"), backend).solve(np.ones(2))  # load the library first
     start = time.perf_counter()
@@ -171,7 +113,7 @@ def _reference(problem: ContactProblem, problem_path: Path, exact=None):
     if exact.status == "converged":
         buffer = io.BytesIO()
         np.savez(buffer, u=exact.u, lam=exact.lam)
-        from signorini.output.files import atomic_write_bytes
+        from signorini.files import atomic_write_bytes
         atomic_write_bytes(path, buffer.getvalue())
     return exact
 
@@ -224,7 +166,7 @@ def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any])
     path = directory / "problems" / f"{scene}-{size}.npz"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        save_problem(build_problem(scene, **params), path)
+        build_problem(scene, **params).save(path)
     return path
 
 
@@ -238,7 +180,7 @@ def run_benchmark(runs: Iterable[Run], out: Path, time_limit: float = 600.0,
     todo = [r for r in runs if r.key not in done]
     for index, run in enumerate(todo, start=1):
         path = problem_file(out, run.scene, run.size, run.params)
-        problem_meta = load_problem(path)
+        problem_meta = ContactProblem.load(path)
         base = {"scene": run.scene, "size": run.size, "dofs": problem_meta.n,
                 "candidates": problem_meta.m, "method": run.label, "ranks": run.ranks,
                 "tolerance": run.tolerance}
@@ -318,8 +260,8 @@ def summary(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 def write_report(csv_path: Path, command: str) -> Path:
     """``bench.md`` and figures next to the CSV."""
+    from signorini.files import atomic_write_text, save_figure
     from signorini.output import plots
-    from signorini.output.files import atomic_write_text, save_figure
     from signorini.output.report import provenance
 
     rows = read_rows(csv_path)

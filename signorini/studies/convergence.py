@@ -4,7 +4,7 @@ A study solves a scene at levels 0, 1, …, k of uniform refinement (the
 scene's ``refine`` parameter: every element split in four, so the element
 size h halves and the dofs roughly quadruple) with every installed exact
 method, and measures the errors against the scene's analytic reference
-(:func:`signorini.studies.suite.reference_metrics`). The rate of a metric is the
+(:attr:`signorini.references.Reference.convergence`). The rate of a metric is the
 slope s of the least-squares line ``log err = s log h + c``
 (``np.polyfit(np.log(h), np.log(err), 1)``); h is the median distance between
 neighbouring contact candidates. Exact methods solve the same discrete
@@ -29,16 +29,10 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.references import REFERENCES
 
 log = logging.getLogger(__name__)
 
-#: errors measured per reference kind (keys of :func:`signorini.studies.suite.reference_metrics`)
-METRICS = {
-    "hertz-2d": ("p0_rel", "a_rel", "pressure_l2_rel"),
-    "reverse-hertz": ("p0_rel", "a_rel", "pressure_l2_rel"),
-    "hertz-3d": ("p0_rel", "a_rel", "pressure_l2_rel"),
-    "punch": ("pressure_max_rel", "pressure_l2_rel", "edge_over_centre"),
-}
 LABELS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
           "pressure_max_rel": "pressure max error on the inner half",
           "edge_over_centre": "edge node pressure / (P/πa)"}
@@ -164,14 +158,13 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     """
     from signorini.scenes import build_problem, scene_reference
     from signorini.solvers.registry import solve
-    from signorini.studies.suite import reference_metrics
 
     say = progress or (lambda message: None)
     if not isinstance(levels, int) or isinstance(levels, bool) or not 0 <= levels <= 6:
         raise InputError(f"--levels {levels!r} must be an integer in 0..6 (each level quadruples the dofs)")
     base = _study_params(scene, dict(params or {}))
-    kind = scene_reference(scene)
-    if kind not in METRICS:
+    reference = REFERENCES.get(scene_reference(scene))
+    if reference is None or not reference.convergence:
         raise InputError(f"scene {scene!r} has no analytic reference to converge to")
     chosen = methods or exact_methods()
     rows: list[LevelResult] = []
@@ -191,8 +184,8 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
                 log.info("level %d: %s skipped (%s)", level, name, exc)
                 continue
             solve_s = time.perf_counter() - start
-            errors = {k: float(v) for k, v in reference_metrics(problem, solution).items()
-                      if k in METRICS[kind]} if solution.status == "converged" else {}
+            errors = {k: float(v) for k, v in reference.metrics(problem, solution).items()
+                      if k in reference.convergence} if solution.status == "converged" else {}
             if first is None and solution.status == "converged":
                 first = solution
             lam_rel = float(np.max(np.abs(solution.lam - first.lam)) / np.max(np.abs(first.lam))) \
@@ -201,7 +194,7 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
                                     lam_rel, assemble_s, solve_s))
             say(f"level {level}: {problem.n} dofs, h = {h:.3g}, {name} {solution.status} in "
                 f"{solve_s:.2f} s: " + ", ".join(f"{k} {v:.3e}" for k, v in errors.items()))
-    study = ConvergenceStudy(scene, {**base, "levels": levels}, METRICS[kind], rows, fit_from=fit_from)
+    study = ConvergenceStudy(scene, {**base, "levels": levels}, reference.convergence, rows, fit_from=fit_from)
     for name in study.methods:
         study.rates[name] = {}
         for metric in study.metrics:
@@ -351,7 +344,7 @@ def plot_grading(comparison: GradingComparison, ax=None):
 
 def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=None):
     """Nodal pressure under the punch against ``P/(π√(a² − x²))``, in units of ``P/(πa)``."""
-    from signorini.references import punch_pressure
+    from signorini.analytic import punch_pressure
     from signorini.pressure import compare_punch, contact_profile
 
     ax = _axes(ax)
@@ -375,7 +368,7 @@ def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=N
 
 def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None):
     """Pressure against the distance ``a − |x|`` to the edge (log–log): slope −½ is the singularity."""
-    from signorini.references import punch_pressure
+    from signorini.analytic import punch_pressure
     from signorini.pressure import compare_punch, contact_profile
 
     ax = _axes(ax)
@@ -428,7 +421,7 @@ def study_table(study: ConvergenceStudy) -> list[str]:
 def write_study(study: ConvergenceStudy, out, command: str,
                 comparison: GradingComparison | None = None) -> dict[str, Any]:
     """Write ``convergence-<scene>.md``, ``.json`` and ``.png`` (and the grading figure) to ``out``."""
-    from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
+    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 
     directory = writable_directory(out)
     stem = f"convergence-{study.scene}"

@@ -18,10 +18,10 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.kkt import certificate, compare
-from signorini.pressure import (compare_hertz, compare_hertz_sphere, compare_punch, compare_reverse_hertz,
-                       compare_uniform, contact_profile, radial_distance)
+from signorini.pressure import contact_profile, radial_distance
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.scenes import build_problem, scene_reference
+from signorini.references import reference_metrics
+from signorini.scenes import build_problem
 from signorini.solvers.registry import Method, get_method, methods, solve
 
 log = logging.getLogger(__name__)
@@ -105,24 +105,6 @@ class CaseResult:
     runs: list[dict[str, Any]]
 
 
-def reference_metrics(problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:
-    """Errors against the scene's analytic reference (Hertz or uniform pressure)."""
-    kind = scene_reference(problem.scene)
-    if not np.all(np.isfinite(solution.lam)):
-        return {}
-    if kind == "punch":
-        return compare_punch(problem, solution).as_dict()
-    if kind == "reverse-hertz":
-        return compare_reverse_hertz(problem, solution).as_dict()
-    if kind == "hertz-2d":
-        return compare_hertz(problem, solution).as_dict()
-    if kind == "hertz-3d":
-        return compare_hertz_sphere(problem, solution).as_dict()
-    if kind == "uniform":
-        return compare_uniform(problem, solution).as_dict()
-    return {}
-
-
 def run_one(problem: ContactProblem, method: Method, tol: float | None,
             reference: ContactSolution | None) -> tuple[dict[str, Any], ContactSolution | None]:
     """Solve with one method at one tolerance and measure the answer."""
@@ -184,7 +166,7 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
                             bool(np.isfinite(value) and value <= LIMITS[key]), detail))
 
     metrics = reference_metrics(problem, ref) if case.check_reference else {}
-    kind = scene_reference(case.scene)
+    kind = problem.reference
     if kind in ("hertz-2d", "reverse-hertz") and metrics:
         limit("Hertz p0 relative error (pdas)", metrics["p0_rel"], "hertz_p0_rel")
         limit("Hertz a relative error (pdas)", metrics["a_rel"], "hertz_a_rel")

@@ -15,9 +15,10 @@ from typing import Callable
 
 import numpy as np
 
-from signorini.numerics.lcp import delassus
 from signorini.errors import InputError
+from signorini.numerics.lcp import delassus
 from signorini.numerics.loading import push_for_load_condensed
+from signorini.output.plots import axes as _axes
 from signorini.pressure import compare_hertz, contact_half_width, contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -87,8 +88,6 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
 
 def plot_sweep(levels: list[SweepLevel], ax=None):
     """Contact half-width and peak pressure against load, with Hertz's curves (a ∝ √P, p₀ ∝ √P)."""
-    from signorini.output.plots import axes as _axes
-
     axes = _axes(ax)
     loads = np.array([lv.total_force for lv in levels])
     grid = np.linspace(0.0, loads.max() * 1.05, 200)

@@ -24,10 +24,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.errors import InputError
 from signorini.kkt import force_scale, gap_scale
+from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.registry import solve
 
 #: the dense dual builds W (m × m) by m back-solves: refuse larger problems
 MAX_DENSE_CANDIDATES = 2000
@@ -305,8 +306,6 @@ def solve_recorded(problem: ContactProblem, method: str, *, tol: float | None = 
     InputError
         ``method`` has no ``callback`` option (QP backends report only their final point).
     """
-    from signorini.solvers.registry import solve
-
     if method not in _CALLBACKS:
         raise InputError(f"solve_recorded: method {method!r} cannot report its iterates; "
                          f"choose one of {', '.join(sorted(_CALLBACKS))} (for a QP solver "
@@ -378,8 +377,6 @@ def uzawa_path(problem: ContactProblem, rho: float | None = None, *,
         Neither or both of ``rho`` and ``step_ratio`` given, or not positive;
         too many candidates for the dense ``λ_max``.
     """
-    from signorini.solvers.registry import solve
-
     if (rho is None) == (step_ratio is None):
         raise InputError("uzawa_path: give exactly one of rho and step_ratio")
     lambda_max = dense_dual(problem).lipschitz

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from signorini.errors import InputError
 from signorini.problem import ContactProblem
 
 
@@ -96,8 +97,6 @@ def bogie(*, half_length: float = 1.0, bending_stiffness: float = 10.0,
     InputError
         A length or stiffness is not positive, or ``gaps`` does not hold two finite numbers.
     """
-    from signorini.errors import InputError
-
     for name, value in (("half_length", half_length), ("bending_stiffness", bending_stiffness),
                         ("mount_stiffness", mount_stiffness), ("tilt_stiffness", tilt_stiffness)):
         if not (np.isfinite(value) and value > 0):

@@ -220,7 +220,7 @@ def ill_posed_problem(case: str, **values: Any) -> ContactProblem:
     """
     from signorini.fem.assembly import assemble
     from signorini.scenes import block
-    from signorini.scenes.base import FlatObstacle
+    from signorini.fem.model import FlatObstacle
 
     if case not in ILL_POSED_CASES:
         raise InputError(f"unknown ill-posed case {case!r}: choose {', '.join(ILL_POSED_CASES)}")
@@ -373,8 +373,8 @@ def _bound_at_solution(problem: ContactProblem, reference: ContactSolution) -> f
     ``W_AA``, so steps up to ``2/λ_max(W_AA)`` (≥ ``2/λ_max(W)``) still
     contract; returned as a multiple of the textbook bound ``2/λ_max(W)``.
     """
-    from signorini.numerics.lcp import delassus
     from signorini.kkt import active_set
+    from signorini.numerics.lcp import delassus
 
     W = delassus(problem.N, problem.factor())
     active = active_set(problem, reference)
@@ -1697,7 +1697,7 @@ def write_report(result: AtlasResult, out: str | os.PathLike, command: str) -> d
 
     Every file is written whole or not at all (a temporary file, then a rename).
     """
-    from signorini.output.files import atomic_write_text, save_figure, to_json, writable_directory
+    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
     from signorini.output.report import provenance
 
     directory = writable_directory(out)
@@ -1737,8 +1737,8 @@ def report_markdown(result: AtlasResult, command: str, info: dict[str, Any]) -> 
           f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",
           "Versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()), "",
           "Every run is a method at a tolerance on one problem, in its own worker process with a "
-          f"time limit. Data: [`stability/runs.csv`](stability/runs.csv) and "
-          f"[`stability/runs.json`](stability/runs.json) (one row per run, with the problem's "
+          "time limit. Data: [`stability/runs.csv`](stability/runs.csv) and "
+          "[`stability/runs.json`](stability/runs.json) (one row per run, with the problem's "
           "spec to repeat it).", "",
           "## How to read it", "",
           "- **own status** (`claimed_status`): what the method said before the package judged "

@@ -6,7 +6,6 @@ import numpy as np
 
 from signorini.output.plots import axes
 
-
 #: colours of the atlas's outcomes
 OUTCOME_COLOURS = {"right": "#4daf4a", "conservative": "#a6d96a", "caught": "#fdae61",
                    "failed": "#d9d9d9", "wrong": "#d7191c"}

@@ -1,0 +1,149 @@
+"""The package's imports run one way, low layer to high, with no cycle (read with ``ast``).
+
+Layers, low to high (a module may import its own layer and the layers below):
+
+0. ``errors``, ``files``                 exceptions, atomic writes
+1. ``numerics``                          factorisations, dense LCP, zone kernel, load targeting
+2. ``problem``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``fem``
+3. ``solvers``                           the registry collects each backend's METHODS
+4. ``scenes``                            families, meshing, scene files, building problems
+5. ``api`` and the package itself        the public Python API
+6. ``studies``, ``output``, ``teaching`` one runner and its studies; reports, plots, export
+7. ``cli``                               parsing only
+
+Imports of the package's own modules sit at the top of a module; one inside a
+function is allowed only in ``cli.py`` (each command loads what it needs, so
+that ``signorini methods`` does not start matplotlib) and must carry a comment
+saying why.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
+
+LAYERS = {
+    "errors": 0, "files": 0,
+    "numerics": 1,
+    "problem": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "fem": 2,
+    "solvers": 3,
+    "scenes": 4,
+    "api": 5, "": 5,
+    "studies": 6, "output": 6, "teaching": 6,
+    "cli": 7,
+}
+#: modules that may import the package's own modules inside functions (with a comment)
+LAZY_ALLOWED = {"signorini.cli"}
+MAX_LINES = 500
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def resolve(module: str, node: ast.ImportFrom | ast.Import) -> list[str]:
+    """The package modules an import statement loads (a name may be a submodule)."""
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names if a.name.split(".")[0] == "signorini"]
+    base = node.module or ""
+    if node.level:
+        package = module.split(".") if MODULES[module].name == "__init__.py" else module.split(".")[:-1]
+        package = package[:len(package) - node.level + 1]
+        base = ".".join(package + ([node.module] if node.module else []))
+    if base.split(".")[0] != "signorini":
+        return []
+    targets = []
+    for alias in node.names:
+        candidate = f"{base}.{alias.name}"
+        targets.append(candidate if candidate in MODULES else base)
+    return targets
+
+
+def imports(module: str) -> list[tuple[str, int, bool]]:
+    """(imported module, line, inside a function) for every package import of ``module``."""
+    tree = ast.parse(MODULES[module].read_text())
+    found = []
+
+    def visit(node: ast.AST, in_function: bool) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef))
+            if isinstance(child, (ast.Import, ast.ImportFrom)):
+                found.extend((target, child.lineno, in_function) for target in resolve(module, child))
+            visit(child, inner)
+
+    visit(tree, False)
+    return found
+
+
+def layer(module: str) -> int:
+    parts = module.split(".")
+    key = parts[1] if len(parts) > 1 else ""
+    assert key in LAYERS, f"{module} is in no layer: add it to LAYERS in {__file__}"
+    return LAYERS[key]
+
+
+def test_every_module_has_a_layer():
+    for module in MODULES:
+        layer(module)
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_imports_run_down_the_layers(module):
+    upward = [(target, line) for target, line, _ in imports(module) if layer(target) > layer(module)]
+    assert not upward, f"{module} imports up the layers: {upward}"
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_package_imports_sit_at_the_top(module):
+    lines = MODULES[module].read_text().splitlines()
+    lazy = [(target, line) for target, line, inner in imports(module) if inner]
+    if module not in LAZY_ALLOWED:
+        assert not lazy, f"{module} imports package modules inside functions: {lazy}"
+        return
+    for target, line in lazy:
+        said = lines[line - 1] + lines[line - 2]
+        assert "#" in said, f"{module}:{line} imports {target} inside a function without saying why"
+
+
+def test_no_import_cycle():
+    graph = {m: {t for t, _, _ in imports(m) if t in MODULES and t != m} for m in MODULES}
+    state: dict[str, int] = {}
+    path: list[str] = []
+
+    def visit(node: str) -> None:
+        state[node] = 1
+        path.append(node)
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == 1:
+                cycle = path[path.index(nxt):] + [nxt]
+                pytest.fail("import cycle: " + " → ".join(cycle))
+            if nxt not in state:
+                visit(nxt)
+        path.pop()
+        state[node] = 2
+
+    for module in sorted(graph):
+        if module not in state:
+            visit(module)
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_modules_are_small(module):
+    count = len(MODULES[module].read_text().splitlines())
+    assert count <= MAX_LINES, f"{module} has {count} lines (at most {MAX_LINES}): split it"
+
+
+def test_the_resolver_sees_imports():
+    """The resolver is not blind: problem.py's own imports include lower layers' modules."""
+    targets = {t for t, _, _ in imports("signorini.problem")}
+    assert "signorini.numerics.factor" in targets and "signorini.errors" in targets
