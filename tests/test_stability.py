@@ -19,20 +19,10 @@ from signorini.problem import ContactSolution
 from signorini.scenes import build_problem
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
 from signorini.solvers.registry import solve
-from signorini.studies.atlas import (
-    BUILD_ONLY,
-    Task,
-    _verdict,
-    diagnose,
-    ill_posed_problem,
-    regularise,
-    run_atlas,
-    run_task,
-    run_tasks,
-    select_axes,
-    wrapper_record,
-    write_report,
-)
+from signorini.diagnose import diagnose, regularise
+from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report
+from signorini.studies.problems import ill_posed_problem
+from signorini.studies.runner import BUILD_ONLY, Task, _verdict, run_task, run_tasks
 
 TINY_HERTZ = {"n_contact": 8, "grading": 0.5}
 TINY_BLOCK = {"nx": 4, "ny": 4}
