@@ -1,0 +1,1 @@
+"""What the package shows: reports of the validation suite, plots, VTK export."""
