@@ -117,8 +117,9 @@ def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
+    # each command loads what it needs (the studies start matplotlib)
     from signorini.files import writable_directory
-    from signorini.studies.convergence import grading_comparison, run_study, study_table, write_study
+    from signorini.studies.convergence import grading_comparison, run_study, study_table, write_study  # as above
 
     writable_directory(args.out)
     if args.levels < 0 or args.levels > 6:
@@ -145,9 +146,10 @@ def cmd_converge(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    # each command loads what it needs (the report starts matplotlib)
     from signorini.files import writable_directory
-    from signorini.output.report import checks_summary, write_suite_report
-    from signorini.studies.suite import run_suite, select_cases
+    from signorini.output.report import checks_summary, write_suite_report  # as above
+    from signorini.studies.suite import run_suite, select_cases  # as above
 
     writable_directory(args.out)
     methods = args.method or None
@@ -193,10 +195,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     import math
 
+    # each command loads what it needs (the benchmark's report starts matplotlib)
     from signorini.files import writable_directory
-    from signorini.scenes import get_scene
-    from signorini.solvers.registry import get_method, methods
-    from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report
+    from signorini.scenes import get_scene  # as above
+    from signorini.solvers.registry import get_method, methods  # as above
+    from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
 
     out = writable_directory(args.out)
     family = get_scene(args.scene)
@@ -222,7 +225,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise InputError(f"--ranks {args.ranks!r} must be a comma-separated list of positive "
                          "rank counts, e.g. --ranks 1,2")
     if ranks[-1] > 1:
-        from signorini.solvers.cluster import mpirun_command
+        from signorini.solvers.cluster import mpirun_command  # only when ranks are asked for
 
         mpirun_command(ranks[-1], [])  # no mpirun, or more ranks than cores: fail before any run
     base = _pairs(args.set, "--set")

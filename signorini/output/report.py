@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime
+import os
 import platform
 from importlib import metadata
 from pathlib import Path
@@ -16,7 +17,7 @@ from signorini.output import plots
 from signorini.pressure import contact_profile, load_resultant
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_of
-from signorini.studies.suite import LIMITS, SuiteResult
+from signorini.studies.suite import LIMITS, REFERENCE_LABEL, SuiteResult
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
             "proxsuite", "piqp", "scs", "ecos", "highspy", "daqp", "quadprog", "qpalm", "cvxopt")
@@ -38,7 +39,6 @@ def provenance() -> dict[str, Any]:
                 break
     except OSError:
         pass
-    import os
     return {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
             "python": platform.python_version(), "platform": platform.platform(),
             "cpu": cpu, "cores": os.cpu_count(), "versions": versions}
@@ -155,9 +155,8 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
         if reference is not None and reference.figure and np.all(np.isfinite(ref.lam)):
             profile = contact_profile(problem, ref)
             hertz = reference.compare(problem, ref)
-            others = [(label, contact_profile(problem, s).pressure)
-                      for label, s in result.solutions.items()
-                      if label != "pdas@1e-09" and s.status != "failed" and np.all(np.isfinite(s.lam))]
+            others = [(label, np.array(pressure, dtype=float))
+                      for label, pressure in result.profiles.items() if label != REFERENCE_LABEL]
             ax = plots.pressure_profile(profile.x, profile.pressure, a_ref=hertz.a_ref,
                                         p0_ref=hertz.p0_ref, label="pdas", others=others)
             ax.set_title(f"{name}: contact pressure, every method against Hertz", fontsize=9)

@@ -1,12 +1,15 @@
 """Benchmarks: scenes × sizes × methods × tolerance levels → one tidy CSV row per run.
 
-Each run happens in its own process with a time limit, so that a backend that
-hangs or crashes costs one failed row and nothing else. Problems are
-assembled once per size and cached as ``.npz`` beside the CSV; every row
-carries the time of one factorisation + solve of the same K with the same
-backend, measured in the same process, so that methods are compared as
-ratios measured in one run. Rows are appended one ``write`` at a time and the
-run resumes where it stopped: an interrupted benchmark leaves a valid CSV.
+Every run goes through the study runner (:mod:`signorini.studies.runner`) as a
+``fresh`` task: a process of its own with a time limit, so that a backend
+that hangs or crashes costs one failed row and nothing else, memory is given
+back after each run and the method starts cold. Problems are assembled once
+per size and stored as ``.npz`` beside the CSV (the tasks' problem specs
+point at them); every row carries the time of one factorisation + solve of
+the same K with the same backend, measured in the same process before the
+method, so that methods are compared as ratios measured in one run. Rows are
+appended one ``write`` at a time and the run resumes where it stopped: an
+interrupted benchmark leaves a valid CSV.
 
 Metrics follow qpbenchmark: a run is a *success* when the method says
 ``converged`` (which the package grants only when the KKT certificate is
@@ -19,22 +22,20 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import logging
 import os
-import subprocess
-import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
 import numpy as np
-import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.problem import ContactProblem
-from signorini.solvers import cluster
+from signorini.files import atomic_write_text, save_figure
+from signorini.output import plots
+from signorini.output.report import provenance
+from signorini.scenes import build_problem
+from signorini.studies.runner import Row, Task, run_tasks
 
 log = logging.getLogger(__name__)
 
@@ -47,6 +48,10 @@ COLUMNS = ("scene", "size", "dofs", "candidates", "method", "ranks", "tolerance"
            "claimed_status",
            "iterations", "build_s", "solve_s", "time_s", "factor_s", "ratio_to_factor",
            "kkt_worst", "lam_rel", "misclassified", "p0_rel", "a_rel", "message")
+#: what the benchmark measures of each run besides the runner's row
+MEASURES = ("factorisation", "times", "vs_reference", "reference")
+#: the runner's statuses for a run that gave no answer of its own, written as "failed"
+FAILED = ("refused", "input-error", "raised", "crashed")
 
 
 @dataclass(frozen=True)
@@ -69,70 +74,41 @@ class Run:
         return (self.scene, self.size, self.label, self.tolerance)
 
 
-# --- one run, in a worker process -------------------------------------------------------------
-
-def run_in_worker(problem_path: Path, method: str, tolerance: str) -> dict[str, Any]:
-    """Time one factorisation + solve of K, then one method, and measure its answer."""
-    from signorini.kkt import certificate, compare
-    from signorini.numerics.factor import factorize, resolve_backend
-    from signorini.references import reference_metrics
-    from signorini.solvers.registry import solve
-
-    problem = ContactProblem.load(problem_path)
-    backend = resolve_backend(None, problem.n)
-    factorize(sp.identity(2, format="csc"), backend).solve(np.ones(2))  # load the library first
-    start = time.perf_counter()
-    factorize(problem.K, backend).solve(problem.f)
-    factor_s = time.perf_counter() - start
-    solution = solve(problem, method, tol=TOLERANCES[tolerance])
-    elapsed = solution.extras["method_s"]  # the method alone, not the certificate that judges it
-    reference = _reference(problem, problem_path, solution if method == REFERENCE else None)
-    cert = certificate(problem, solution)
-    vs = compare(problem, reference, solution)
-    metrics = reference_metrics(problem, solution)
-    return {"status": solution.status,
-            "claimed_status": solution.own_status,
-            "iterations": solution.iterations, "build_s": solution.build_time,
-            "solve_s": solution.solve_time, "time_s": elapsed, "factor_s": factor_s,
-            "ratio_to_factor": elapsed / factor_s, "kkt_worst": cert.worst()[1],
-            "lam_rel": vs.lam_rel, "misclassified": vs.misclassified,
-            "p0_rel": metrics.get("p0_rel", np.nan), "a_rel": metrics.get("a_rel", np.nan),
-            "message": solution.message}
+def reference_policy(problem_path: Path) -> dict[str, Any]:
+    """The benchmark's exact answer: :data:`REFERENCE` at the high tolerance, kept beside the problem."""
+    return {"kind": REFERENCE, "tol": TOLERANCES["high"],
+            "keep": str(problem_path.with_suffix(".reference.npz"))}
 
 
-def _reference(problem: ContactProblem, problem_path: Path, exact=None):
-    """The exact answer of the problem (by :data:`REFERENCE`), computed once and kept beside it."""
-    from signorini.problem import ContactSolution
-    from signorini.solvers.registry import solve
-
-    path = problem_path.with_suffix(".reference.npz")
-    if path.exists():
-        z = np.load(path)
-        return ContactSolution(REFERENCE, z["u"], z["lam"], "converged")
-    exact = exact if exact is not None else solve(problem, REFERENCE, tol=1e-9)
-    if exact.status == "converged":
-        buffer = io.BytesIO()
-        np.savez(buffer, u=exact.u, lam=exact.lam)
-        from signorini.files import atomic_write_bytes
-        atomic_write_bytes(path, buffer.getvalue())
-    return exact
+def task_of(run: Run, problem_path: Path) -> Task:
+    """The runner's task for one run: a fresh process, the stored problem, the factorisation next to it."""
+    return Task("bench", f"{run.scene} {run.size}", run.tolerance,
+                {"kind": "stored", "path": str(problem_path)}, run.method,
+                tol=TOLERANCES[run.tolerance], reference=reference_policy(problem_path),
+                measure=MEASURES, fresh=True, ranks=run.ranks)
 
 
-def _worker_main() -> None:
-    from signorini.solvers import cluster
+def bench_row(run: Run, row: Row, size: tuple[int, int]) -> Row:
+    """The CSV row of a run (:data:`COLUMNS`; the method's label, its own time as ``time_s``)."""
+    vs = row.get("vs_reference") or {}
+    theory = row.get("reference") or {}
 
-    args = json.loads(sys.argv[1])
-    logging.disable(logging.WARNING)
-    if cluster.launched_size() > 1 and cluster.rank() != 0:
-        cluster.serve()  # rank 0 runs the benchmark; this rank takes part in its solves
-        return
-    try:
-        row = run_in_worker(Path(args["problem"]), args["method"], args["tolerance"])
-    except Exception as exc:  # every exception becomes a failed row, never a dead benchmark
-        row = {"status": "failed", "message": f"{type(exc).__name__}: {exc}"}
-    finally:
-        cluster.release()
-    print(json.dumps(row, default=float))
+    def number(value: Any) -> float:
+        return float("nan") if value is None else value
+
+    out = Row(scene=run.scene, size=run.size, dofs=size[0], candidates=size[1], method=run.label,
+              ranks=run.ranks, tolerance=run.tolerance,
+              status="failed" if row["status"] in FAILED else row["status"],
+              message=("InputError: " if row["status"] == "refused" else "") + row.get("message", ""))
+    if "method_s" not in row:  # no answer: the status and the reason only
+        return out
+    out.update(claimed_status=row["claimed_status"], iterations=row["iterations"],
+               build_s=row["build_s"], solve_s=row["solve_s"], time_s=row["method_s"],
+               factor_s=row["factor_s"], ratio_to_factor=row["ratio_to_factor"],
+               kkt_worst=number(row["kkt_worst"]), lam_rel=number(vs.get("lam_rel")),
+               misclassified=number(vs.get("misclassified")),
+               p0_rel=number(theory.get("p0_rel")), a_rel=number(theory.get("a_rel")))
+    return out
 
 
 # --- the runner ------------------------------------------------------------------------------
@@ -160,9 +136,7 @@ def append_row(path: Path, row: dict[str, Any]) -> None:
 
 
 def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any]) -> Path:
-    """Assemble (once) and cache the problem of one scene and size."""
-    from signorini.scenes import build_problem
-
+    """Assemble (once) and store the problem of one scene and size."""
     path = directory / "problems" / f"{scene}-{size}.npz"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -170,37 +144,31 @@ def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any])
     return path
 
 
+def stored_size(path: Path) -> tuple[int, int]:
+    """``(dofs, candidates)`` of a stored problem, read without loading its matrices."""
+    with np.load(path) as stored:
+        n, m = (int(v) for v in stored["shape"])
+    return n, m
+
+
 def run_benchmark(runs: Iterable[Run], out: Path, time_limit: float = 600.0,
                   progress: Callable[[int, int, Run, dict], None] | None = None) -> Path:
-    """Run every ``run`` not yet in ``out/bench.csv``, each in its own process."""
+    """Run every ``run`` not yet in ``out/bench.csv``, each in a process of its own."""
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "bench.csv"
-    runs = list(runs)
     done = done_keys(csv_path)
     todo = [r for r in runs if r.key not in done]
-    for index, run in enumerate(todo, start=1):
-        path = problem_file(out, run.scene, run.size, run.params)
-        problem_meta = ContactProblem.load(path)
-        base = {"scene": run.scene, "size": run.size, "dofs": problem_meta.n,
-                "candidates": problem_meta.m, "method": run.label, "ranks": run.ranks,
-                "tolerance": run.tolerance}
-        command = [sys.executable, "-c", "from signorini.studies.bench import _worker_main; _worker_main()",
-                   json.dumps({"problem": str(path), "method": run.method, "tolerance": run.tolerance})]
-        env = None
-        if run.ranks > 1:
-            command, env = cluster.mpirun_command(run.ranks, command)
-        try:
-            proc = subprocess.run(command, capture_output=True, text=True, timeout=time_limit,
-                                  env=env)
-            lines = proc.stdout.strip().splitlines()
-            result = json.loads(lines[-1]) if proc.returncode == 0 and lines else {
-                "status": "failed", "message": (proc.stderr.strip().splitlines() or ["crashed"])[-1]}
-        except subprocess.TimeoutExpired:
-            result = {"status": "timeout", "message": f"no answer within {time_limit:g} s"}
-        row = {**base, **result}
-        append_row(csv_path, row)
+    paths = {r.key: problem_file(out, r.scene, r.size, r.params) for r in todo}
+    sizes = {path: stored_size(path) for path in set(paths.values())}
+
+    def record(index: int, count: int, task: Task, row: Row) -> None:
+        run = todo[index - 1]
+        written = bench_row(run, row, sizes[paths[run.key]])
+        append_row(csv_path, written)
         if progress is not None:
-            progress(index, len(todo), run, row)
+            progress(index, count, run, written)
+
+    run_tasks([task_of(r, paths[r.key]) for r in todo], time_limit=time_limit, progress=record)
     return csv_path
 
 
@@ -260,10 +228,6 @@ def summary(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 def write_report(csv_path: Path, command: str) -> Path:
     """``bench.md`` and figures next to the CSV."""
-    from signorini.files import atomic_write_text, save_figure
-    from signorini.output import plots
-    from signorini.output.report import provenance
-
     rows = read_rows(csv_path)
     if not rows:
         raise InputError(f"{csv_path} has no rows to report")

@@ -7,9 +7,12 @@ method, and measures the errors against the scene's analytic reference
 (:attr:`signorini.references.Reference.convergence`). The rate of a metric is the
 slope s of the least-squares line ``log err = s log h + c``
 (``np.polyfit(np.log(h), np.log(err), 1)``); h is the median distance between
-neighbouring contact candidates. Exact methods solve the same discrete
-problem, so their errors must coincide; the study records how far their λ
-are apart.
+neighbouring contact candidates (:func:`signorini.studies.problems.candidate_spacing`).
+Exact methods solve the same discrete problem, so their errors must
+coincide; the study records how far their λ are apart. Every run goes
+through the study runner (:mod:`signorini.studies.runner`) with no exact
+answer (the reference policy ``none``): the worker rebuilds each level from
+its spec, and λ is compared with the first converged method's in this process.
 
 :func:`grading_comparison` sets the graded default against a uniform mesh
 (the scene with ``grading`` → 0, i.e. the contact size everywhere) at equal
@@ -21,15 +24,21 @@ rate when a series does not reach it).
 from __future__ import annotations
 
 import logging
-import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, Callable
 
 import numpy as np
+from matplotlib.figure import Figure
 
+from signorini.analytic import punch_pressure
 from signorini.errors import InputError
+from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
+from signorini.pressure import compare_punch, contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import REFERENCES
+from signorini.scenes import SCENES, get_scene, scene_reference
+from signorini.solvers.registry import methods as registered_methods
+from signorini.studies.runner import Row, Task, run_tasks
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +54,8 @@ COARSE_START = {
 }
 #: grading that makes a graded scene uniform: the contact's element size everywhere
 UNIFORM_GRADING = 1e-6
+#: seconds one run (assembly of its level included) may take before it is stopped
+TIME_LIMIT = 3600.0
 
 
 @dataclass(frozen=True)
@@ -107,27 +118,12 @@ def fitted_rate(h: np.ndarray, error: np.ndarray) -> float:
     return float(slope)
 
 
-def candidate_spacing(problem: ContactProblem) -> float:
-    """Median distance from each contact candidate to its nearest neighbour (physical units)."""
-    from scipy.spatial import cKDTree
-
-    points = problem.contact_points * problem.scales.length
-    if len(points) < 2:
-        return float("nan")
-    distance, _ = cKDTree(points).query(points, k=2)
-    return float(np.median(distance[:, 1]))
-
-
 def exact_methods() -> list[str]:
     """Every installed method that is exact when it converges."""
-    from signorini.solvers.registry import methods
-
-    return [m.name for m in methods(installed_only=True) if m.exact]
+    return [m.name for m in registered_methods(installed_only=True) if m.exact]
 
 
 def _study_params(scene: str, params: dict[str, Any]) -> dict[str, Any]:
-    from signorini.scenes import get_scene
-
     family = get_scene(scene)
     names = {p.name for p in family.params}
     if "refine" not in names:
@@ -141,24 +137,51 @@ def _study_params(scene: str, params: dict[str, Any]) -> dict[str, Any]:
 
 
 def _refinable() -> list[str]:
-    from signorini.scenes import SCENES
-
     return sorted(name for name, f in SCENES.items() if any(p.name == "refine" for p in f.params))
+
+
+def level_task(scene: str, level: int, params: dict[str, Any], method: str, tol: float) -> Task:
+    """The runner's task of one method at one level: no exact answer, the errors against theory."""
+    return Task("convergence", scene, level,
+                {"kind": "scene", "scene": scene, "params": {**params, "refine": level}}, method,
+                tol=tol, reference={"kind": "none"}, measure=("reference", "lam", "mesh"))
+
+
+def level_results(rows: list[Row], metrics: tuple[str, ...]) -> list[LevelResult]:
+    """The rows of one level as results: errors of converged runs, λ against the first converged."""
+    known = next((r for r in rows if "h" in r), {})
+    first: np.ndarray | None = None
+    out = []
+    for row in rows:
+        status = "skipped" if row["status"] == "refused" else row["status"]
+        converged = status == "converged"
+        errors = {k: float("nan") if v is None else float(v)
+                  for k, v in row.get("reference", {}).items() if k in metrics} if converged else {}
+        lam = np.array(row.get("lam", []), dtype=float)
+        if first is None and converged:
+            first = lam
+        lam_rel = float(np.max(np.abs(lam - first)) / np.max(np.abs(first))) \
+            if first is not None and converged else float("nan")
+        out.append(LevelResult(int(row["value"]), row["method"], status,
+                               int(known.get("dofs", 0)), int(known.get("candidates", 0)),
+                               float(known.get("h", float("nan"))), errors, lam_rel,
+                               float(known.get("assemble_s", float("nan"))),
+                               0.0 if status == "skipped" else float(row.get("time_s", float("nan")))))
+    return out
 
 
 def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
               methods: list[str] | None = None, tol: float = 1e-10, fit_from: int = 0,
-              progress: Callable[[str], None] | None = None) -> ConvergenceStudy:
+              progress: Callable[[str], None] | None = None, *, isolate: bool = True,
+              time_limit: float = TIME_LIMIT) -> ConvergenceStudy:
     """Solve ``scene`` at refinement levels 0..``levels`` with every exact method and fit rates.
 
     ``params`` override the scene's parameters (and the coarse start in
     :data:`COARSE_START`); ``fit_from`` leaves the first levels out of the
     rate fits (pre-asymptotic). Methods that refuse a level (dense ones on
-    large meshes) are recorded as ``skipped``.
+    large meshes) are recorded as ``skipped``. The runs go through the study
+    runner: one worker process (``isolate``), each run within ``time_limit`` seconds.
     """
-    from signorini.scenes import build_problem, scene_reference
-    from signorini.solvers.registry import solve
-
     say = progress or (lambda message: None)
     if not isinstance(levels, int) or isinstance(levels, bool) or not 0 <= levels <= 6:
         raise InputError(f"--levels {levels!r} must be an integer in 0..6 (each level quadruples the dofs)")
@@ -167,33 +190,24 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     if reference is None or not reference.convergence:
         raise InputError(f"scene {scene!r} has no analytic reference to converge to")
     chosen = methods or exact_methods()
+    tasks = [level_task(scene, level, base, name, tol) for level in range(levels + 1)
+             for name in chosen]
+
+    def report(index: int, count: int, task: Task, row: Row) -> None:
+        if row["status"] == "refused":
+            log.info("level %d: %s skipped (%s)", task.value, task.method, row.get("message"))
+            return
+        errors = {k: v for k, v in row.get("reference", {}).items() if k in reference.convergence} \
+            if row["status"] == "converged" else {}
+        say(f"level {task.value}: {row.get('dofs')} dofs, h = {row.get('h', float('nan')):.3g}, "
+            f"{task.method} {row['status']} in {row.get('time_s', float('nan')):.2f} s: "
+            + ", ".join(f"{k} {v:.3e}" for k, v in errors.items()))
+
+    done = run_tasks(tasks, isolate=isolate, time_limit=time_limit, progress=report)
     rows: list[LevelResult] = []
     for level in range(levels + 1):
-        start = time.perf_counter()
-        problem = build_problem(scene, refine=level, **base)
-        assemble_s = time.perf_counter() - start
-        h = candidate_spacing(problem)
-        first: ContactSolution | None = None
-        for name in chosen:
-            start = time.perf_counter()
-            try:
-                solution = solve(problem, name, tol=tol)
-            except InputError as exc:
-                rows.append(LevelResult(level, name, "skipped", problem.n, problem.m, h, {},
-                                        float("nan"), assemble_s, 0.0))
-                log.info("level %d: %s skipped (%s)", level, name, exc)
-                continue
-            solve_s = time.perf_counter() - start
-            errors = {k: float(v) for k, v in reference.metrics(problem, solution).items()
-                      if k in reference.convergence} if solution.status == "converged" else {}
-            if first is None and solution.status == "converged":
-                first = solution
-            lam_rel = float(np.max(np.abs(solution.lam - first.lam)) / np.max(np.abs(first.lam))) \
-                if first is not None and solution.status == "converged" else float("nan")
-            rows.append(LevelResult(level, name, solution.status, problem.n, problem.m, h, errors,
-                                    lam_rel, assemble_s, solve_s))
-            say(f"level {level}: {problem.n} dofs, h = {h:.3g}, {name} {solution.status} in "
-                f"{solve_s:.2f} s: " + ", ".join(f"{k} {v:.3e}" for k, v in errors.items()))
+        rows += level_results([r for t, r in zip(tasks, done) if t.value == level],
+                              reference.convergence)
     study = ConvergenceStudy(scene, {**base, "levels": levels}, reference.convergence, rows, fit_from=fit_from)
     for name in study.methods:
         study.rates[name] = {}
@@ -288,7 +302,6 @@ def grading_comparison(scene: str, graded: ConvergenceStudy, uniform_levels: int
 
 def _axes(ax):
     if ax is None:
-        from matplotlib.figure import Figure
         ax = Figure(figsize=(6.4, 4.4), layout="constrained").add_subplot()
     return ax
 
@@ -342,18 +355,19 @@ def plot_grading(comparison: GradingComparison, ax=None):
 # --- the punch's edge ---------------------------------------------------------------------
 
 
+def _punch(problem: ContactProblem, solution: ContactSolution):
+    """The punch comparison, the pressure profile and the pressure unit ``P/(πa)``."""
+    comparison = compare_punch(problem, solution)
+    return comparison, contact_profile(problem, solution), comparison.load / (np.pi * comparison.a)
+
+
 def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=None):
     """Nodal pressure under the punch against ``P/(π√(a² − x²))``, in units of ``P/(πa)``."""
-    from signorini.analytic import punch_pressure
-    from signorini.pressure import compare_punch, contact_profile
-
     ax = _axes(ax)
-    comparison = compare_punch(problem, solution)
+    comparison, profile, scale = _punch(problem, solution)
     a, P = comparison.a, comparison.load
-    profile = contact_profile(problem, solution)
     x, p = np.abs(profile.x), profile.pressure
     order = np.argsort(x)
-    scale = P / (np.pi * a)
     grid = np.linspace(0.0, a * (1 - 1e-4), 2000)
     ax.plot(grid / a, punch_pressure(grid, a, P) / scale, "k-", lw=1.2, label="P / (π√(a² − x²))")
     ax.plot(x[order] / a, p[order] / scale, "o", ms=3, mfc="none", label=f"{solution.method}")
@@ -368,16 +382,11 @@ def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=N
 
 def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None):
     """Pressure against the distance ``a − |x|`` to the edge (log–log): slope −½ is the singularity."""
-    from signorini.analytic import punch_pressure
-    from signorini.pressure import compare_punch, contact_profile
-
     ax = _axes(ax)
-    comparison = compare_punch(problem, solution)
+    comparison, profile, scale = _punch(problem, solution)
     a, P = comparison.a, comparison.load
-    profile = contact_profile(problem, solution)
     distance = a - np.abs(profile.x)
     under = distance >= -1e-12 * a
-    scale = P / (np.pi * a)
     grid = np.geomspace(1e-4 * a, a, 400)
     ax.loglog(grid / a, punch_pressure(a - grid, a, P) / scale, "k-", lw=1.2, label="P / (π√(a² − x²))")
     positive = under & (distance > 0)
@@ -421,8 +430,6 @@ def study_table(study: ConvergenceStudy) -> list[str]:
 def write_study(study: ConvergenceStudy, out, command: str,
                 comparison: GradingComparison | None = None) -> dict[str, Any]:
     """Write ``convergence-<scene>.md``, ``.json`` and ``.png`` (and the grading figure) to ``out``."""
-    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-
     directory = writable_directory(out)
     stem = f"convergence-{study.scene}"
     paths = {}

@@ -1,21 +1,40 @@
 """The problems a study runs on, as JSON-able specs, and the trusted answers it compares with.
 
 A worker process rebuilds a problem from its spec (:func:`build_spec`), so
-a study can send runs to a fresh process; a reference policy
-(:func:`reference_solution`) says which exact answer a run is held to.
+a study can send runs to a fresh process. A reference policy, named by the
+study in a spec ``{"kind": name, ...}`` (:data:`REFERENCE_POLICIES`), says
+which exact answer a run is held to:
+
+========================= ==========================================================
+policy                    the exact answer
+========================= ==========================================================
+``pdas``                  PDAS at ``tol`` (:data:`REFERENCE_TOL`), converged
+``nested``                the nested method at ``tol``, converged
+``force-controlled-exact`` the patch solution of the force-controlled block
+``none``                  none: a run is judged by its certificate alone
+========================= ==========================================================
+
+A method's policy may solve ``problem`` (another problem in other units,
+converted: the atlas's units axis) and keep its answer in a ``.npz`` file
+(``"keep"``) that later runs, in other processes, read instead of solving.
 """
 
 from __future__ import annotations
 
+import io
 import logging
-from typing import Any
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from signorini.diagnose import regularise
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.model import FlatObstacle
+from signorini.files import atomic_write_bytes
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes import block, build_problem
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
@@ -27,24 +46,56 @@ log = logging.getLogger(__name__)
 REFERENCE_TOL = 1e-9
 
 
+# --- problem specs ------------------------------------------------------------------------------
+
+
+def _scene(spec: dict[str, Any]) -> ContactProblem:
+    return build_problem(spec["scene"], nondimensionalise=spec.get("nondimensionalise", True),
+                         **spec.get("params", {}))
+
+
+def _force_controlled(spec: dict[str, Any]) -> ContactProblem:
+    problem = force_controlled_problem(spec.get("pressure", 0.01), **spec.get("params", {}))
+    epsilon = spec.get("regularisation", 0.0)
+    return regularise(problem, epsilon) if epsilon else problem
+
+
+def _ill_posed(spec: dict[str, Any]) -> ContactProblem:
+    return ill_posed_problem(spec["case"], **spec.get("params", {}))
+
+
+def _stored(spec: dict[str, Any]) -> ContactProblem:
+    return ContactProblem.load(spec["path"])
+
+
+#: the kinds of problem spec and how each is built
+PROBLEM_KINDS: dict[str, Callable[[dict[str, Any]], ContactProblem]] = {
+    "scene": _scene, "force-controlled": _force_controlled, "ill-posed": _ill_posed,
+    "stored": _stored,
+}
+
+
 def build_spec(spec: dict[str, Any]) -> ContactProblem:
     """The problem a spec describes (a JSON-able dict, so that a worker can rebuild it).
 
     ``{"kind": "scene", "scene", "params", "nondimensionalise"}``,
-    ``{"kind": "force-controlled", "params", "pressure", "regularisation"}`` or
-    ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`).
+    ``{"kind": "force-controlled", "params", "pressure", "regularisation"}``,
+    ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`) or
+    ``{"kind": "stored", "path"}`` (a problem :meth:`ContactProblem.save` stored).
     """
     kind = spec["kind"]
-    if kind == "scene":
-        return build_problem(spec["scene"], nondimensionalise=spec.get("nondimensionalise", True),
-                             **spec.get("params", {}))
-    if kind == "force-controlled":
-        problem = force_controlled_problem(spec.get("pressure", 0.01), **spec.get("params", {}))
-        epsilon = spec.get("regularisation", 0.0)
-        return regularise(problem, epsilon) if epsilon else problem
-    if kind == "ill-posed":
-        return ill_posed_problem(spec["case"], **spec.get("params", {}))
-    raise ValueError(f"unknown problem kind {kind!r}")
+    if kind not in PROBLEM_KINDS:
+        raise ValueError(f"unknown problem kind {kind!r}: one of {', '.join(PROBLEM_KINDS)}")
+    return PROBLEM_KINDS[kind](spec)
+
+
+def candidate_spacing(problem: ContactProblem) -> float:
+    """Median distance from each contact candidate to its nearest neighbour (physical units)."""
+    points = problem.contact_points * problem.scales.length
+    if len(points) < 2:
+        return float("nan")
+    distance, _ = cKDTree(points).query(points, k=2)
+    return float(np.median(distance[:, 1]))
 
 
 #: the ill-posed and infeasible inputs of axis 8
@@ -85,37 +136,116 @@ def ill_posed_problem(case: str, **values: Any) -> ContactProblem:
     return problem
 
 
+# --- reference policies -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ReferencePolicy:
+    """A way to the trusted exact answer of a problem.
+
+    ``attempt(problem, spec, other)`` returns the policy's answer, converged
+    or not (None when the policy has none); only a converged answer is
+    trusted (:func:`trusted`). ``method`` names the method whose answer it
+    is, so that a run of that very method (same tolerance, no options) can
+    serve as its own reference instead of being solved twice.
+    """
+
+    name: str
+    summary: str
+    attempt: Callable[[ContactProblem, dict[str, Any], ContactProblem | None],
+                      ContactSolution | None]
+    method: str | None = None
+
+
+def _converted(problem: ContactProblem, other: ContactProblem, solution: ContactSolution,
+               displacement_only: bool) -> ContactSolution:
+    """``other``'s answer in ``problem``'s units (the same mesh); λ left out if asked."""
+    if other.n != problem.n or (not displacement_only and other.m != problem.m):
+        raise ValueError("the reference problem has another mesh")
+    u_ratio = other.scales.displacement / problem.scales.displacement
+    if displacement_only:
+        return ContactSolution(method=solution.method, u=solution.u * u_ratio,
+                               lam=np.full(problem.m, np.nan), status="converged",
+                               message=f"{solution.method} displacement of another problem "
+                                       f"({solution.message})")
+    force_ratio = other.scales.force / problem.scales.force
+    return ContactSolution(method=solution.method, u=solution.u * u_ratio,
+                           lam=solution.lam * force_ratio, status="converged",
+                           message=f"{solution.method} in other units ({solution.message})")
+
+
+def _solved_by(method: str) -> Callable[..., ContactSolution]:
+    """A policy's attempt: ``method`` at ``spec["tol"]`` on the problem (or on ``other``, converted)."""
+
+    def attempt(problem: ContactProblem, spec: dict[str, Any],
+                other: ContactProblem | None) -> ContactSolution:
+        source = problem if other is None else other
+        try:
+            solution = solve(source, method, tol=spec.get("tol", REFERENCE_TOL))
+        except Exception as exc:  # the reference is optional: say so and go on
+            log.warning("no reference for %s: %s raised %s", problem.scene, method, exc)
+            return ContactSolution.failure(method, problem, "failed", f"{type(exc).__name__}: {exc}")
+        if other is None or solution.status != "converged":
+            return solution
+        return _converted(problem, other, solution, bool(spec.get("displacement_only")))
+
+    return attempt
+
+
+REFERENCE_POLICIES: dict[str, ReferencePolicy] = {p.name: p for p in (
+    ReferencePolicy("pdas", "PDAS (exact when it converges) at tol, REFERENCE_TOL unless given",
+                    _solved_by("pdas"), method="pdas"),
+    ReferencePolicy("nested", "the nested method (exact when it converges) at tol",
+                    _solved_by("nested"), method="nested"),
+    ReferencePolicy("force-controlled-exact", "the patch solution of the force-controlled block",
+                    lambda problem, spec, other: force_controlled_exact(problem)),
+    ReferencePolicy("none", "no exact answer: a run is judged by its certificate alone",
+                    lambda problem, spec, other: None),
+)}
+
+
+def reference_policy(spec: dict[str, Any]) -> ReferencePolicy:
+    """The policy a reference spec names; unknown names list the known ones."""
+    name = spec.get("kind")
+    if name not in REFERENCE_POLICIES:
+        raise ValueError(f"unknown reference policy {name!r}: one of {', '.join(REFERENCE_POLICIES)}")
+    return REFERENCE_POLICIES[name]
+
+
+def exact_attempt(problem: ContactProblem, spec: dict[str, Any], other: ContactProblem | None = None,
+                  own: ContactSolution | None = None) -> ContactSolution | None:
+    """The policy's answer for ``problem``, converged or not (None when it has none).
+
+    ``own`` is the run's answer when the run is the policy's own (see
+    :attr:`ReferencePolicy.method`): it is taken instead of solving again.
+    With ``spec["keep"]`` (a ``.npz`` path) a converged answer is stored
+    there, and read from there by later calls.
+    """
+    policy = reference_policy(spec)
+    keep = spec.get("keep")
+    if keep and Path(keep).exists():
+        stored = np.load(keep)
+        return ContactSolution(policy.method or policy.name, stored["u"], stored["lam"], "converged",
+                               message=f"read from {keep}")
+    answer = own if own is not None else policy.attempt(problem, spec, other)
+    if keep and answer is not None and answer.status == "converged":
+        buffer = io.BytesIO()
+        np.savez(buffer, u=answer.u, lam=answer.lam)
+        atomic_write_bytes(keep, buffer.getvalue())
+    return answer
+
+
+def trusted(answer: ContactSolution | None) -> ContactSolution | None:
+    """``answer`` when it converged, else None (nothing to hold a run to)."""
+    return answer if answer is not None and answer.status == "converged" else None
+
+
 def reference_solution(problem: ContactProblem, spec: dict[str, Any],
                        other: ContactProblem | None = None) -> ContactSolution | None:
     """The trusted exact answer for ``problem`` in its own units, or None when there is none.
 
-    ``spec["kind"]``: ``"pdas"`` (PDAS at :data:`REFERENCE_TOL` on ``problem``,
-    or on ``other`` — the same mesh in other units — converted), or
-    ``"force-controlled-exact"`` (the patch solution).
+    ``spec["kind"]`` names the policy (:data:`REFERENCE_POLICIES`); for a
+    method's policy, ``other`` is the same mesh in other units, solved and
+    converted (with ``spec["displacement_only"]``: its displacement alone).
     """
-    if spec["kind"] == "force-controlled-exact":
-        return force_controlled_exact(problem)
-    source = problem if other is None else other
-    try:
-        solution = solve(source, "pdas", tol=REFERENCE_TOL)
-    except Exception as exc:  # the reference is optional: say so and go on
-        log.warning("no reference for %s: pdas raised %s", problem.scene, exc)
-        return None
-    if solution.status != "converged":
-        return None
-    if other is not None and spec.get("displacement_only"):
-        if other.n != problem.n:
-            raise ValueError("the reference problem has another mesh")
-        u_ratio = other.scales.displacement / problem.scales.displacement
-        return ContactSolution(method="pdas", u=solution.u * u_ratio,
-                               lam=np.full(problem.m, np.nan), status="converged",
-                               message=f"pdas displacement of another problem ({solution.message})")
-    if other is not None:
-        if other.n != problem.n or other.m != problem.m:
-            raise ValueError("the reference problem has another mesh")
-        u_ratio = other.scales.displacement / problem.scales.displacement
-        force_ratio = other.scales.force / problem.scales.force
-        solution = ContactSolution(method="pdas", u=solution.u * u_ratio,
-                                   lam=solution.lam * force_ratio, status="converged",
-                                   message=f"pdas in other units ({solution.message})")
-    return solution
+    return trusted(exact_attempt(problem, spec, other))

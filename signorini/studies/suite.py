@@ -5,11 +5,16 @@ what the method said (status, iterations, times) and what the package
 measured independently (the KKT certificate, the distance from the exact
 ``pdas`` answer, the error against the analytic reference). Checks are the
 claims the suite stands behind; any failed check fails the suite.
+
+Every run goes through the study runner (:mod:`signorini.studies.runner`):
+one worker process rebuilds each case's problem from its spec, finds the
+exact answer once (the reference policy :data:`REFERENCE`: PDAS at
+:data:`TIGHT_TOL`) and runs every method on it, each within
+:data:`TIME_LIMIT`. A method that hangs or crashes costs its own row.
 """
 
 from __future__ import annotations
 
-import logging
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -17,21 +22,41 @@ from typing import Any, Callable
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.kkt import certificate, compare
 from signorini.pressure import contact_profile, radial_distance
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics
-from signorini.scenes import build_problem
-from signorini.solvers.registry import Method, get_method, methods, solve
-
-log = logging.getLogger(__name__)
+from signorini.solvers.registry import Method, get_method, methods
+from signorini.studies.measures import answer_from
+from signorini.studies.problems import build_spec
+from signorini.studies.runner import (
+    BUILD_ONLY,
+    ITERATION_CAPS,
+    Row,
+    Task,
+    measure_answer,
+    run_on,
+    run_tasks,
+    task_row,
+)
 
 REFERENCE_METHOD = "pdas"
 TIGHT_TOL = 1e-9
+#: the exact answer every run is held to (a reference policy, :mod:`signorini.studies.problems`)
+REFERENCE = {"kind": REFERENCE_METHOD, "tol": TIGHT_TOL}
+#: the label of the run that is the reference's own method at the tight tolerance
+REFERENCE_LABEL = f"{REFERENCE_METHOD}@{TIGHT_TOL:.0e}"
 #: methods also run at their backend's own default tolerance, to show what it gives
 DEFAULT_TOLERANCE_RUNS = ("qp-osqp", "qp-clarabel")
-#: iteration caps at the tight tolerance for methods that would otherwise run for minutes
-ITERATION_CAPS = {"qp-osqp": 20_000, "qp-scs": 20_000}
+#: seconds one run may take (its worker is then stopped and the run is a "timeout")
+TIME_LIMIT = 600.0
+#: what the suite measures of each run besides the runner's row
+MEASURES = ("kkt", "times", "vs_reference", "reference", "profile")
+#: the columns of a run in report.json, in order; a method that refused the problem is "skipped"
+RUN_COLUMNS = ("method", "label", "tol", "status", "claimed_status", "message", "iterations",
+               "build_s", "solve_s", "time_s", "kkt", "kkt_worst", "vs_reference", "reference",
+               "case", "scene", "dofs", "candidates")
+SKIPPED_COLUMNS = ("method", "label", "tol", "status", "message", "time_s", "kkt_worst", "case",
+                   "scene", "dofs", "candidates")
 
 #: the claims the suite checks, with their limits
 LIMITS = {
@@ -66,6 +91,11 @@ class Case:
     check_reference: bool = True  # hold the answer to the analytic reference's limits
     agrees_with: str | None = None  # a case modelling the same body otherwise: same a and p0
 
+    @property
+    def spec(self) -> dict[str, Any]:
+        """The case's problem as a spec a worker rebuilds (:func:`signorini.studies.problems.build_spec`)."""
+        return {"kind": "scene", "scene": self.scene, "params": dict(self.params)}
+
 
 DEFAULT_CASES = (
     Case("block", "block"),
@@ -96,62 +126,73 @@ class Check:
 
 @dataclass
 class CaseResult:
-    """A case's problem, the reference solution and every run."""
+    """A case's problem, the reference solution, every run and the pressure each answer gives."""
 
     case: Case
     problem: ContactProblem
     reference: ContactSolution
-    solutions: dict[str, ContactSolution]
-    runs: list[dict[str, Any]]
+    runs: list[Row]
+    profiles: dict[str, list[float]] = field(default_factory=dict)
+
+
+def label(method: str, tol: float | None) -> str:
+    """A run's name in the report: ``pdas@1e-09``, ``qp-osqp@default``."""
+    return f"{method}@{'default' if tol is None else f'{tol:.0e}'}"
+
+
+def run_task_of(case: Case, method: str, tol: float | None) -> Task:
+    """The task of one run: ``method`` at ``tol`` on the case, held to :data:`REFERENCE`."""
+    cap = ITERATION_CAPS.get(method) if tol is not None else None
+    return Task("validation", case.name, label(method, tol), case.spec, method, tol=tol,
+                max_iter=cap, reference=REFERENCE, measure=MEASURES)
+
+
+def case_tasks(case: Case, chosen: list[Method]) -> list[Task]:
+    """Build the case's problem and find its exact answer, then run every method on it."""
+    tasks = [Task("validation", case.name, "exact", case.spec, BUILD_ONLY, tol=TIGHT_TOL,
+                  reference=REFERENCE, measure=("exact", "mesh"))]
+    for method in chosen:
+        tolerances = [TIGHT_TOL] + ([None] if method.name in DEFAULT_TOLERANCE_RUNS else [])
+        tasks += [run_task_of(case, method.name, tol) for tol in tolerances]
+    return tasks
+
+
+def suite_row(row: Row, case: Case | None = None) -> Row:
+    """A runner row as the report writes a run (:data:`RUN_COLUMNS`); a refusal is ``skipped``."""
+    values = dict(row, label=row["value"])
+    if case is not None:
+        values.update(case=case.name, scene=case.scene)
+    if row["status"] == "refused":  # e.g. a dense backend refusing a large problem
+        values.update(status="skipped", time_s=0.0, kkt_worst=float("nan"))
+        return {k: values[k] for k in SKIPPED_COLUMNS if k in values}
+    return {k: values[k] for k in RUN_COLUMNS if k in values}
 
 
 def run_one(problem: ContactProblem, method: Method, tol: float | None,
-            reference: ContactSolution | None) -> tuple[dict[str, Any], ContactSolution | None]:
-    """Solve with one method at one tolerance and measure the answer."""
-    label = f"{method.name}@{'default' if tol is None else f'{tol:.0e}'}"
-    row: dict[str, Any] = {"method": method.name, "label": label, "tol": tol}
-    options = {"max_iter": ITERATION_CAPS[method.name]} if tol is not None and method.name in ITERATION_CAPS else {}
-    start = time.perf_counter()
-    try:
-        solution = solve(problem, method.name, tol=tol, **options)
-    except InputError as exc:  # e.g. a dense backend refusing a large problem
-        row.update(status="skipped", message=str(exc), time_s=0.0, kkt_worst=float("nan"))
-        return row, None
-    elapsed = time.perf_counter() - start
-    cert = certificate(problem, solution)
-    row.update(
-        status=solution.status, claimed_status=solution.own_status,
-        message=solution.message, iterations=solution.iterations,
-        build_s=solution.build_time, solve_s=solution.solve_time, time_s=elapsed,
-        kkt=cert.as_dict(), kkt_worst=cert.worst()[1])
-    if reference is not None:
-        row["vs_reference"] = compare(problem, reference, solution).as_dict()
-    row["reference"] = reference_metrics(problem, solution)
-    return row, solution
+            reference: ContactSolution | None) -> tuple[Row, ContactSolution | None]:
+    """Solve a built problem with one method at one tolerance in this process and measure it.
+
+    The runner's measurement of a suite run, for scripts that hold their own
+    problems (``docs/punch/punch_study.py``).
+    """
+    task = run_task_of(Case("", problem.scene), method.name, tol)
+    row = task_row(task)
+    solution = run_on(problem, task, row)
+    if solution is not None:
+        measure_answer(problem, task, row, solution, reference)
+    return suite_row(row), solution
 
 
-def run_case(case: Case, method_names: list[str] | None = None,
-             progress: Callable[[str], None] | None = None) -> CaseResult:
-    """Build the case's problem and run every requested method on it."""
-    say = progress or (lambda message: None)
-    problem = build_problem(case.scene, **case.params)
-    say(f"{case.name}: {problem.n} dofs, {problem.m} contact candidates "
-        f"(assembled in {problem.assemble_time:.2f} s)")
-    chosen = [get_method(name) for name in method_names] if method_names else \
-        [m for m in methods(installed_only=True) if m.family != "user"]
-    reference_row, reference = run_one(problem, get_method(REFERENCE_METHOD), TIGHT_TOL, None)
-    runs = []
-    solutions = {}
-    for method in chosen:
-        tolerances = [TIGHT_TOL] + ([None] if method.name in DEFAULT_TOLERANCE_RUNS else [])
-        for tol in tolerances:
-            row, solution = run_one(problem, method, tol, reference)
-            row.update(case=case.name, scene=case.scene, dofs=problem.n, candidates=problem.m)
-            runs.append(row)
-            if solution is not None:
-                solutions[row["label"]] = solution
-            say(f"  {row['label']:<26} {row['status']:<10} {row.get('time_s', 0):7.2f} s")
-    return CaseResult(case, problem, reference, solutions, runs)
+def case_result(case: Case, rows: list[Row]) -> CaseResult:
+    """A case's runs (``rows``: its exact answer first) with the problem rebuilt for the checks."""
+    problem = build_spec(case.spec)
+    exact = rows[0].get("exact")
+    reference = answer_from(exact) if exact else ContactSolution.failure(
+        REFERENCE_METHOD, problem, "failed", rows[0].get("message") or "no answer")
+    profiles = {row["value"]: row["profile"]["pressure"] for row in rows[1:]
+                if row.get("profile") and row["status"] != "failed"}
+    return CaseResult(case, problem, reference, [suite_row(row, case) for row in rows[1:]],
+                      profiles)
 
 
 def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
@@ -161,8 +202,9 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
     checks = [Check(case.name, "pdas converged", ref.status == "converged", None,
                     ref.status == "converged", ref.message)]
 
-    def limit(name: str, value: float, key: str, detail: str = "") -> None:
-        checks.append(Check(case.name, name, float(value), LIMITS[key],
+    def limit(name: str, value: float | None, key: str, detail: str = "") -> None:
+        value = float("nan") if value is None else float(value)  # None: not finite in a row
+        checks.append(Check(case.name, name, value, LIMITS[key],
                             bool(np.isfinite(value) and value <= LIMITS[key]), detail))
 
     metrics = reference_metrics(problem, ref) if case.check_reference else {}
@@ -212,7 +254,7 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
               "uniform_pressure_rel")
         limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
     for row in result.runs:
-        if row["tol"] == TIGHT_TOL and row["status"] == "converged":
+        if row["tol"] == TIGHT_TOL and row["status"] == "converged" and "vs_reference" in row:
             vs = row["vs_reference"]
             limit(f"{row['label']} converged: λ agrees with pdas", vs["lam_rel"], "lam_rel_vs_pdas")
             checks.append(Check(case.name, f"{row['label']} converged: same active set as pdas",
@@ -265,18 +307,34 @@ def select_cases(names: list[str] | None) -> tuple[Case, ...]:
 
 
 def run_suite(cases: tuple[Case, ...] = DEFAULT_CASES, method_names: list[str] | None = None,
-              progress: Callable[[str], None] | None = None) -> SuiteResult:
+              progress: Callable[[str], None] | None = None, *, isolate: bool = True,
+              time_limit: float = TIME_LIMIT) -> SuiteResult:
     """Run every case with every installed method (or ``method_names``) and check it.
 
     Methods named in ``method_names`` must converge at the tight tolerance on
     every case: a user's method that only claims success fails the suite.
+    The runs go to one worker process (``isolate``), each within ``time_limit`` seconds.
     """
     start = time.perf_counter()
+    say = progress or (lambda message: None)
+    chosen = [get_method(name) for name in method_names] if method_names else \
+        [m for m in methods(installed_only=True) if m.family != "user"]
+    tasks = [task for case in cases for task in case_tasks(case, chosen)]
+
+    def report(index: int, count: int, task: Task, row: Row) -> None:
+        if task.method == BUILD_ONLY:
+            say(f"{task.case}: {row.get('dofs')} dofs, {row.get('candidates')} contact candidates "
+                f"(assembled in {row.get('assemble_s', float('nan')):.2f} s)")
+        else:
+            time_s = 0.0 if row["status"] == "refused" else row.get("time_s", 0.0)
+            say(f"  {task.value:<26} {suite_row(row)['status']:<10} {time_s:7.2f} s")
+
+    rows = run_tasks(tasks, isolate=isolate, time_limit=time_limit, progress=report)
     results: list[CaseResult] = []
     by_name: dict[str, CaseResult] = {}
     checks: list[Check] = []
     for case in cases:
-        result = run_case(case, method_names, progress)
+        result = case_result(case, [row for task, row in zip(tasks, rows) if task.case == case.name])
         results.append(result)
         by_name[case.name] = result
         checks.extend(case_checks(result, by_name, tuple(method_names or ())))

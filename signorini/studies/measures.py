@@ -1,0 +1,121 @@
+"""What the study runner measures about one answer, beside the certificate's worst residual.
+
+Each function takes the problem and an answer (and the exact answer where
+it compares) and returns numbers for a row of :mod:`signorini.studies.runner`.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from signorini.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
+from signorini.numerics.factor import factorize, resolve_backend
+from signorini.numerics.lcp import delassus
+from signorini.pressure import compare_hertz, contact_profile
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.references import reference_of
+
+
+def certificate_of(problem: ContactProblem, solution: ContactSolution):
+    """The certificate; without the duality gap when K cannot be factorised."""
+    try:
+        return certificate(problem, solution)
+    except (np.linalg.LinAlgError, ArithmeticError, RuntimeError):
+        return certificate(problem, solution, duality_gap=False)
+
+
+def hertz_errors(problem: ContactProblem, solution: ContactSolution,
+                 prefix: str = "") -> dict[str, float]:
+    """Errors of a and p₀ (and the pressure's L2 error) against Hertz's cylinder; {} elsewhere."""
+    if problem.reference != "hertz-2d" or not np.all(np.isfinite(solution.lam)):
+        return {}
+    try:
+        h = compare_hertz(problem, solution)
+    except Exception:  # an answer too wrong to measure (no contact at all)
+        return {}
+    return {f"{prefix}a_rel": h.a_rel, f"{prefix}p0_rel": h.p0_rel,
+            f"{prefix}pressure_l2_rel": h.pressure_l2_rel}
+
+
+def bound_at_solution(problem: ContactProblem, reference: ContactSolution) -> float:
+    """``λ_max(W) / λ_max(W_AA)`` with A the exact active set: Uzawa's effective step bound.
+
+    Once the active set has settled, the iteration only sees the block
+    ``W_AA``, so steps up to ``2/λ_max(W_AA)`` (≥ ``2/λ_max(W)``) still
+    contract; returned as a multiple of the textbook bound ``2/λ_max(W)``.
+    """
+    W = delassus(problem.N, problem.factor())
+    active = active_set(problem, reference)
+    if not active.any():
+        return float("nan")
+    return float(np.linalg.eigvalsh(W)[-1] / np.linalg.eigvalsh(W[np.ix_(active, active)])[-1])
+
+
+def force_error(problem: ContactProblem, reference: ContactSolution,
+                solution: ContactSolution) -> float:
+    """``‖λ − λ*‖∞ / max(‖λ*‖∞, FORCE_FLOOR ‖f‖∞)``: the force error, judged as the certificate does.
+
+    The floor keeps the measure meaningful when the exact answer has no
+    contact force at all (λ* = 0), where a relative difference is 1 for any λ ≠ 0.
+    """
+    if not np.all(np.isfinite(solution.lam)):
+        return float("inf")
+    return float(np.max(np.abs(solution.lam - reference.lam), initial=0.0)
+                 / force_scale(problem, reference.lam))
+
+
+def weak_but_penetrating(problem: ContactProblem, solution: ContactSolution) -> int:
+    """Nodes :func:`signorini.kkt.classify` calls weakly active although they penetrate.
+
+    ``classify`` measures the gap as ``(d − Nu)⁺``, so a node with zero force
+    that overlaps the obstacle by more than the weak tolerance is labelled
+    weak and left out of :func:`signorini.kkt.compare` — a misclassification
+    the comparison does not count. The atlas counts it here.
+    """
+    if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
+        return 0
+    labels = classify(problem, solution)
+    violation = (problem.N @ solution.u - problem.d) / gap_scale(problem, solution.u)
+    return int(np.sum((labels == WEAK) & (violation > WEAK_TOL)))
+
+
+def factorisation_time(problem: ContactProblem) -> float:
+    """Seconds for one factorisation + solve of K with the backend a method would use.
+
+    The library is loaded first (on a 2 × 2 identity), so that its start-up
+    is not charged; nothing is cached on the problem.
+    """
+    backend = resolve_backend(None, problem.n)
+    factorize(sp.identity(2, format="csc"), backend).solve(np.ones(2))
+    start = time.perf_counter()
+    factorize(problem.K, backend).solve(problem.f)
+    return time.perf_counter() - start
+
+
+def pressure_profile(problem: ContactProblem, solution: ContactSolution) -> dict[str, Any]:
+    """The contact pressure along the candidates; with the reference's a and p₀ where it has a figure."""
+    profile = contact_profile(problem, solution)
+    out: dict[str, Any] = {"x": profile.x.tolist(), "pressure": profile.pressure.tolist()}
+    reference = reference_of(problem)
+    if reference is not None and reference.figure:
+        comparison = reference.compare(problem, solution)
+        out.update(a_ref=comparison.a_ref, p0_ref=comparison.p0_ref)
+    return out
+
+
+def answer_record(solution: ContactSolution) -> dict[str, Any]:
+    """An answer as plain data (for a row): method, status, message, iterations, u and λ."""
+    return {"method": solution.method, "status": solution.status, "message": solution.message,
+            "iterations": int(solution.iterations), "u": solution.u.tolist(),
+            "lam": solution.lam.tolist()}
+
+
+def answer_from(record: dict[str, Any]) -> ContactSolution:
+    """The answer :func:`answer_record` wrote (None entries, non-finite in JSON, become NaN)."""
+    return ContactSolution(method=record["method"], u=np.array(record["u"], dtype=float),
+                           lam=np.array(record["lam"], dtype=float), status=record["status"],
+                           message=record["message"], iterations=record["iterations"])

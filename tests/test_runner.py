@@ -1,0 +1,82 @@
+"""The one study runner: typed rows, named reference policies, fresh worker processes."""
+
+import textwrap
+
+import numpy as np
+import pytest
+
+from signorini.scenes import build_problem
+from signorini.studies import suite
+from signorini.studies.problems import (REFERENCE_POLICIES, exact_attempt, reference_solution,
+                                        trusted)
+from signorini.studies.runner import MEASURES, Row, Task, run_task, run_tasks
+
+TINY_BLOCK = {"nx": 4, "ny": 4}
+BLOCK = {"kind": "scene", "scene": "block", "params": TINY_BLOCK}
+
+
+def test_the_reference_policies_are_named_and_unknown_ones_are_refused():
+    assert set(REFERENCE_POLICIES) >= {"pdas", "nested", "force-controlled-exact", "none"}
+    with pytest.raises(ValueError, match="unknown reference policy 'newton'"):
+        Task("test", "block", 0, BLOCK, "pdas", reference={"kind": "newton"})
+    with pytest.raises(ValueError, match="unknown measure 'speed'"):
+        Task("test", "block", 0, BLOCK, "pdas", measure=("speed",))
+    assert {"factorisation", "exact", "kkt", "times"} <= set(MEASURES)
+
+
+def test_a_policy_without_an_exact_answer_compares_nothing():
+    row = run_task(Task("test", "block", 0, BLOCK, "pdas", reference={"kind": "none"},
+                        measure=("reference", "lam")))
+    assert row["status"] == "converged" and "lam_rel" not in row and "misclassified" not in row
+    assert row["reference"]["pressure_max_rel"] < 1e-10  # the block's uniform pressure
+    assert len(row["lam"]) == row["candidates"]
+    assert set(row) <= set(Row.__annotations__)
+
+
+def test_a_kept_exact_answer_is_stored_once_and_read_back(tmp_path):
+    problem = build_problem("block", **TINY_BLOCK)
+    keep = tmp_path / "block.reference.npz"
+    spec = {"kind": "nested", "tol": 1e-9, "keep": str(keep)}
+    first = reference_solution(problem, spec)
+    assert first is not None and keep.exists()
+    again = exact_attempt(problem, spec)
+    assert "read from" in again.message and np.array_equal(again.lam, first.lam)
+    assert trusted(exact_attempt(problem, {"kind": "none"})) is None
+
+
+def test_fresh_tasks_get_a_process_each_and_the_others_share_one(tmp_path):
+    whoami = tmp_path / "whoami.py"
+    whoami.write_text(textwrap.dedent("""
+        import os
+        from signorini.solvers.registry import solve as package_solve
+        def solve(problem, *, tol=None, max_iter=None, **options):
+            solution = package_solve(problem, "pdas", tol=tol)
+            solution.message = str(os.getpid())
+            return solution
+    """))
+    method = f"{whoami}:solve"
+
+    def task(fresh):
+        return Task("test", "block", 0, BLOCK, method, tol=1e-9, fresh=fresh,
+                    measure=("factorisation", "times"))
+
+    shared = run_tasks([task(False), task(False)], time_limit=60)
+    fresh = run_tasks([task(True), task(True)], time_limit=60)
+    assert shared[0]["message"] == shared[1]["message"]
+    assert fresh[0]["message"] != fresh[1]["message"]
+    for row in fresh:
+        assert row["status"] == "converged" and row["factor_s"] > 0
+        assert row["ratio_to_factor"] == pytest.approx(row["method_s"] / row["factor_s"])
+
+
+def test_the_suite_runs_in_a_worker_and_in_process_alike():
+    cases = tuple(c for c in suite.DEFAULT_CASES if c.name == "block")
+    isolated = suite.run_suite(cases, ["pdas", "uzawa"])
+    here = suite.run_suite(cases, ["pdas", "uzawa"], isolate=False)
+    assert isolated.passed and here.passed
+    assert [c.name for c in isolated.checks] == [c.name for c in here.checks]
+    for mine, theirs in zip(isolated.checks, here.checks):  # equal up to threaded round-off
+        assert mine.value == pytest.approx(theirs.value, rel=1e-6, abs=1e-12), mine.name
+    row = isolated.runs[0]
+    assert tuple(row) == suite.RUN_COLUMNS and row["vs_reference"]["misclassified"] == 0
+    assert isolated.results[0].reference.status == "converged"
