@@ -255,8 +255,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def cmd_stability(args: argparse.Namespace) -> int:
     import math
 
+    # each command loads what it needs (the atlas starts matplotlib and every backend)
     from signorini.files import writable_directory
-    from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report
+    from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report  # as above
 
     axes = select_axes(args.axis)
     try:

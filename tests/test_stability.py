@@ -13,14 +13,16 @@ import textwrap
 import numpy as np
 import pytest
 
+from signorini.diagnose import diagnose, regularise
 from signorini.errors import InputError
 from signorini.kkt import certificate, classify, compare
 from signorini.problem import ContactSolution
 from signorini.scenes import build_problem
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
 from signorini.solvers.registry import solve
-from signorini.diagnose import diagnose, regularise
-from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report
+from signorini.studies.atlas import AXES, atlas_methods, run_atlas, select_axes
+from signorini.studies.atlas.report import write_report
+from signorini.studies.atlas.summary import wrapper_record
 from signorini.studies.problems import ill_posed_problem
 from signorini.studies.runner import BUILD_ONLY, Task, _verdict, run_task, run_tasks
 
@@ -207,6 +209,20 @@ def test_a_hanging_method_costs_one_row(tmp_path):
     rows = run_tasks(tasks, isolate=True, time_limit=10.0)
     assert rows[0]["status"] == "timeout" and rows[0]["wrapper_right"]
     assert rows[1]["status"] == "converged" and rows[1]["outcome"] == "right"
+
+
+def test_each_axis_is_one_module_with_everything_about_it():
+    assert [a.number for a in AXES] == list(range(1, len(AXES) + 1))
+    # one module per axis, holding its tasks and its report together
+    assert len({a.tasks.__module__ for a in AXES}) == len(AXES)
+    assert all({f.__module__ for f in (a.findings, a.table, a.figure)} == {a.tasks.__module__}
+               for a in AXES)
+    methods = atlas_methods(quick=True)
+    for axis in AXES:
+        assert axis.setup and axis.advice and axis.legend.startswith(("Cells", "Mesh A"))
+        assert axis.tasks(True, methods), axis.name
+        assert {t.axis for t in axis.tasks(True, methods)} == {axis.name}
+    assert select_axes(["uzawa-step", "8", "1"]) == (AXES[0], AXES[7])
 
 
 def test_a_quick_axis_writes_its_files(tmp_path):

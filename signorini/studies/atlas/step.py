@@ -1,0 +1,116 @@
+"""Axis 1: Uzawa's step ρ on either side of the bound 2/λ_max(W)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from signorini.studies.atlas import figures
+from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, pivot, scene_spec
+from signorini.studies.task import Task
+
+STEP_FRACTIONS = (0.05, 0.1, 0.25, 0.5, 0.75, 0.9, 0.95, 0.99, 1.01, 1.05, 1.1, 1.15, 1.2, 1.25,
+                  1.5, 2.0, 2.5)
+STEP_SCENES = {"hertz-cylinder": {"n_contact": 16, "grading": 0.4}, "block": {"nx": 8, "ny": 8}}
+QUICK_STEP_SCENES = {"hertz-cylinder": TINY_HERTZ, "block": {"nx": 4, "ny": 4}}
+STEP_CAPS = {"uzawa": 60_000, "uzawa-nesterov": 20_000}
+
+
+def tasks(quick: bool, methods: list[str]) -> list[Task]:
+    fractions = (0.5, 0.95, 1.25) if quick else STEP_FRACTIONS
+    out = []
+    for scene, params in (QUICK_STEP_SCENES if quick else STEP_SCENES).items():
+        for method, cap in STEP_CAPS.items():
+            if method in methods:
+                out += [Task("uzawa-step", scene, fraction, scene_spec(scene, **params), method,
+                             options={"step_fraction": fraction}, max_iter=cap, measure=("bound",))
+                        for fraction in fractions]
+    return out
+
+
+def counts(row: dict[str, Any]) -> bool:
+    """Only steps inside the method's bound count (1× for Uzawa, 0.5× for its Nesterov variant)."""
+    return row["value"] <= (0.5 if row["method"] == "uzawa-nesterov" else 1.0)
+
+
+def _fraction_text(value: float) -> str:
+    return f"{value:g}×"
+
+
+def _beyond_text(beyond: Rows) -> str:
+    """The statuses past the last right step, a divergence told as a two-step cycle or growth."""
+    kinds: dict[str, list[float]] = {}
+    for r in beyond:
+        kind = r["status"]
+        if r["status"] == "diverged":
+            kind = "diverged: two-step cycle" if "cycle" in str(r["message"]) else "diverged: growth"
+        kinds.setdefault(kind, []).append(r["value"])
+    return "; beyond: " + "; ".join(f"{kind} at {', '.join(_fraction_text(v) for v in values)}"
+                                    for kind, values in kinds.items())
+
+
+def findings(rows: Rows) -> list[str]:
+    out = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        for method in dict.fromkeys(r["method"] for r in rows):
+            mine = sorted((r for r in rows if r["case"] == case and r["method"] == method),
+                          key=lambda r: r["value"])
+            if not mine:
+                continue
+            right = [r["value"] for r in mine if r["outcome"] == "right"]
+            failing = [r for r in mine if r["outcome"] != "right"]
+            text = f"**{case}, {method}** ({mine[0].get('dofs', 0):.0f} dofs): "
+            if right:
+                text += (f"right answer for ρ from {_fraction_text(min(right))} to "
+                         f"{_fraction_text(max(right))} the bound 2/λ_max(W)")
+                iters = {r["value"]: r["iterations"] for r in mine if r["outcome"] == "right"}
+                shown = [v for v in (0.05, 0.5, 0.95) if v in iters]
+                if shown:
+                    text += " (" + ", ".join(f"{iters[v]:,.0f} iterations at {_fraction_text(v)}"
+                                             for v in shown) + ")"
+            beyond = [r for r in failing if r["value"] > (max(right) if right else 0)]
+            if beyond:
+                text += _beyond_text(beyond)
+            inside = [r for r in failing if right and r["value"] < max(right)]
+            if inside:
+                text += "; not right inside that range at " + ", ".join(
+                    f"{_fraction_text(r['value'])} ({r['status']})" for r in inside)
+            bound = mine[0].get("bound_at_solution")
+            if method == "uzawa" and bound is not None and np.isfinite(bound):
+                text += (f". On the exact active set A the bound is 2/λ_max(W_AA) = "
+                         f"{bound:.3f} × 2/λ_max(W)")
+                if right and max(right) > 1.0:
+                    text += (" — steps past 2/λ_max(W) can still converge, but the iteration "
+                             "starts from λ = 0, far from A, so the slack is smaller")
+            out.append(text + ".")
+    return out
+
+
+def table(rows: Rows) -> list[str]:
+    columns = [dict(r, _column=f"{r['case']}, {r['method']}") for r in rows]
+    return pivot(columns, "value", "_column", lambda r: cell(r, f"{r.get('iterations', 0):,.0f}"),
+                 corner="ρ / (2/λ_max)")
+
+
+def figure(rows: Rows) -> Figure:
+    ax = figures.atlas_step_sweep(rows)
+    ax.set_title("Axis 1: Uzawa's step (filled: right answer)", fontsize=9)
+    return ax.figure
+
+
+AXIS = Axis(
+    1, "uzawa-step", "Uzawa's step ρ",
+    "Uzawa converges iff 0 < ρ < 2/λ_max(W): what happens on either side of the bound, and "
+    "does the package name a divergence or a two-step cycle?",
+    setup=f"Hertz's cylinder {STEP_SCENES['hertz-cylinder']} and the block "
+          f"{STEP_SCENES['block']}; `uzawa` and `uzawa-nesterov` with "
+          "`step_fraction` = ρ/(2/λ_max(W)) from 0.05 to 2.5, tol 1e-8, at most "
+          f"{STEP_CAPS['uzawa']:,} (uzawa) and {STEP_CAPS['uzawa-nesterov']:,} "
+          "(uzawa-nesterov) iterations.",
+    advice="keep `step_fraction` below 1 (the default 0.9); `uzawa-nesterov` needs at most "
+           "0.5 (its default). Past the bound the package says `diverged` and names the "
+           "two-step cycle or the growth; lower `rho` or `step_fraction`.",
+    legend="Cells: status and iterations.",
+    tasks=tasks, findings=findings, table=table, figure=figure, counts=counts, caps=STEP_CAPS)

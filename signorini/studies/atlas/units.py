@@ -1,0 +1,81 @@
+"""Axis 4: units and scaling, with and without the package's non-dimensionalisation."""
+
+from __future__ import annotations
+
+from matplotlib.figure import Figure
+
+from signorini.studies.atlas import figures
+from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot, scene_spec
+from signorini.studies.task import Task
+
+UNIT_SYSTEMS = (("E=1, R=1", 1.0, 1.0), ("E=1, R=0.01", 1.0, 0.01),
+                ("MPa, mm: E=2.1e5, R=10", 2.1e5, 10.0), ("Pa, m: E=2.1e11, R=0.01", 2.1e11, 0.01),
+                ("Pa, mm: E=2.1e11, R=10", 2.1e11, 10.0), ("E=2.1e11, R=1", 2.1e11, 1.0))
+UNITS_MESH = {"n_contact": 16, "grading": 0.4}
+
+
+def tasks(quick: bool, methods: list[str]) -> list[Task]:
+    systems = UNIT_SYSTEMS[2:4] if quick else UNIT_SYSTEMS
+    mesh = TINY_HERTZ if quick else UNITS_MESH
+    out = []
+    for label, E, R in systems:
+        scaled = scene_spec("hertz-cylinder", **mesh, E=E, R=R)
+        for nondimensionalise in (True, False):
+            problem = scene_spec("hertz-cylinder", nondimensionalise, **mesh, E=E, R=R)
+            case = f"{label}, {'scaled' if nondimensionalise else 'raw'}"
+            out += every_method("units", case, label, problem, methods,
+                                reference={"kind": "pdas", "problem": scaled})
+    return out
+
+
+def findings(rows: Rows) -> list[str]:
+    out = []
+    for scaling in ("scaled", "raw"):
+        mine = [r for r in rows if r["case"].endswith(scaling)]
+        systems = list(dict.fromkeys(r["value"] for r in mine))
+        counts = [f"{s}: {sum(r['outcome'] == 'right' for r in mine if r['value'] == s)}/"
+                  f"{sum(r['value'] == s for r in mine)}" for s in systems]
+        out.append(f"**{scaling}** — methods right per unit system: " + "; ".join(counts) + ".")
+    for method in dict.fromkeys(r["method"] for r in rows):
+        scaled = [r for r in rows if r["method"] == method and r["case"].endswith("scaled")]
+        raw = [r for r in rows if r["method"] == method and r["case"].endswith("raw")]
+        s_ok = sum(r["outcome"] == "right" for r in scaled)
+        r_ok = sum(r["outcome"] == "right" for r in raw)
+        if s_ok != r_ok or s_ok < len(scaled):
+            bad = [f"{r['value']} ({cell(r)}, λ off {num(r.get('lam_rel'))})"
+                   for r in raw if r["outcome"] != "right"]
+            text = f"**{method}**: right in {s_ok}/{len(scaled)} systems scaled, {r_ok}/{len(raw)} raw"
+            if bad:
+                text += "; raw units fail at " + "; ".join(bad)
+            out.append(text + ".")
+    return out
+
+
+def table(rows: Rows) -> list[str]:
+    return pivot(rows, "method", "case", lambda r: cell(r, num(r.get("lam_rel"), 0)), corner="method")
+
+
+def figure(rows: Rows) -> Figure:
+    figure = Figure(figsize=(11, 5.0), layout="constrained")
+    left, right = figure.subplots(1, 2, sharey=True)
+    for ax, scaling in ((left, "scaled"), (right, "raw")):
+        figures.atlas_outcomes([r for r in rows if r["case"].endswith(scaling)], column="value", ax=ax,
+                               title=f"{'non-dimensionalised' if scaling == 'scaled' else 'raw units'}")
+    figure.suptitle("Axis 4: units (green: right; orange: false 'solved' caught; grey: no claim; "
+                    "red: the package's status was wrong)", fontsize=9)
+    return figure
+
+
+AXIS = Axis(
+    4, "units", "Units and scaling",
+    "What do raw units (E up to 2.1e11, lengths in m or mm) do to each method, with and "
+    "without the package's non-dimensionalisation?",
+    setup=f"Hertz's cylinder {UNITS_MESH}, a/R = 0.05, in six unit systems; each assembled "
+          "non-dimensionalised (the default) and raw (`nondimensionalise=False`, "
+          "`--raw-units`); every method at tol 1e-8; the exact answer is PDAS on the scaled "
+          "problem, converted.",
+    advice="keep the default non-dimensionalisation. Raw units (`--raw-units`, "
+           "`nondimensionalise=False`) leave the exact methods unharmed but put the QP "
+           "backends' absolute tolerances at the mercy of E and the length unit.",
+    legend="Cells: status, λ error.",
+    tasks=tasks, findings=findings, table=table, figure=figure)
