@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from signorini.scenes import build_problem
+from signorini.solvers.registry import REGISTRY, Method, get_method
 from signorini.studies import suite
 from signorini.studies.problems import (REFERENCE_POLICIES, exact_attempt, reference_solution,
                                         trusted)
@@ -80,3 +81,20 @@ def test_the_suite_runs_in_a_worker_and_in_process_alike():
     row = isolated.runs[0]
     assert tuple(row) == suite.RUN_COLUMNS and row["vs_reference"]["misclassified"] == 0
     assert isolated.results[0].reference.status == "converged"
+    np.testing.assert_allclose(isolated.results[0].solutions["pdas@1e-09"].lam,
+                               here.results[0].solutions["pdas@1e-09"].lam, rtol=1e-10)
+
+
+def test_a_method_registered_here_only_keeps_the_suite_in_this_process(monkeypatch):
+    def pdas_again(problem, *, tol=None, max_iter=None, **options):
+        return get_method("pdas").function(problem, tol=tol, max_iter=max_iter, **options)
+
+    mine = Method(name="test-pdas-here", function=pdas_again, summary="pdas, registered here",
+                  family="user")
+    monkeypatch.setitem(REGISTRY, mine.name, mine)  # registered here, gone after the test
+    assert not suite.portable(mine) and suite.portable(get_method("pdas"))
+    cases = tuple(c for c in suite.DEFAULT_CASES if c.name == "block")
+    result = suite.run_suite(cases, ["test-pdas-here"])
+    assert result.passed and result.runs[0]["status"] == "converged"
+    answer = result.results[0].solutions["test-pdas-here@1e-09"]
+    np.testing.assert_allclose(answer.lam, result.results[0].reference.lam, rtol=1e-10)

@@ -155,8 +155,9 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
         if reference is not None and reference.figure and np.all(np.isfinite(ref.lam)):
             profile = contact_profile(problem, ref)
             hertz = reference.compare(problem, ref)
-            others = [(label, np.array(pressure, dtype=float))
-                      for label, pressure in result.profiles.items() if label != REFERENCE_LABEL]
+            others = [(label, contact_profile(problem, s).pressure)
+                      for label, s in result.solutions.items()
+                      if label != REFERENCE_LABEL and s.status != "failed" and np.all(np.isfinite(s.lam))]
             ax = plots.pressure_profile(profile.x, profile.pressure, a_ref=hertz.a_ref,
                                         p0_ref=hertz.p0_ref, label="pdas", others=others)
             ax.set_title(f"{name}: contact pressure, every method against Hertz", fontsize=9)

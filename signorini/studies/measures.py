@@ -108,9 +108,11 @@ def pressure_profile(problem: ContactProblem, solution: ContactSolution) -> dict
 
 
 def answer_record(solution: ContactSolution) -> dict[str, Any]:
-    """An answer as plain data (for a row): method, status, message, iterations, u and λ."""
-    return {"method": solution.method, "status": solution.status, "message": solution.message,
-            "iterations": int(solution.iterations), "u": solution.u.tolist(),
+    """An answer as plain data (for a row): method, statuses, message, iterations, times, u and λ."""
+    return {"method": solution.method, "status": solution.status,
+            "claimed_status": solution.claimed_status, "message": solution.message,
+            "iterations": int(solution.iterations), "build_time": solution.build_time,
+            "solve_time": solution.solve_time, "u": solution.u.tolist(),
             "lam": solution.lam.tolist()}
 
 
@@ -118,4 +120,6 @@ def answer_from(record: dict[str, Any]) -> ContactSolution:
     """The answer :func:`answer_record` wrote (None entries, non-finite in JSON, become NaN)."""
     return ContactSolution(method=record["method"], u=np.array(record["u"], dtype=float),
                            lam=np.array(record["lam"], dtype=float), status=record["status"],
-                           message=record["message"], iterations=record["iterations"])
+                           message=record["message"], iterations=record["iterations"],
+                           build_time=record["build_time"], solve_time=record["solve_time"],
+                           claimed_status=record["claimed_status"])

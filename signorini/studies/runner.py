@@ -250,6 +250,8 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
         row["profile"] = pressure_profile(problem, solution)
     if "lam" in task.measure:
         row["lam"] = solution.lam.tolist()
+    if "answer" in task.measure:
+        row["answer"] = answer_record(solution)
 
 
 # --- running many tasks: in this process or in a worker with a time limit ------------------------

@@ -15,6 +15,7 @@ exact answer once (the reference policy :data:`REFERENCE`: PDAS at
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -25,7 +26,7 @@ from signorini.errors import InputError
 from signorini.pressure import contact_profile, radial_distance
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics
-from signorini.solvers.registry import Method, get_method, methods
+from signorini.solvers.registry import BACKENDS, Method, get_method, methods
 from signorini.studies.measures import answer_from
 from signorini.studies.problems import build_spec
 from signorini.studies.runner import (
@@ -39,6 +40,8 @@ from signorini.studies.runner import (
     task_row,
 )
 
+log = logging.getLogger(__name__)
+
 REFERENCE_METHOD = "pdas"
 TIGHT_TOL = 1e-9
 #: the exact answer every run is held to (a reference policy, :mod:`signorini.studies.problems`)
@@ -50,7 +53,7 @@ DEFAULT_TOLERANCE_RUNS = ("qp-osqp", "qp-clarabel")
 #: seconds one run may take (its worker is then stopped and the run is a "timeout")
 TIME_LIMIT = 600.0
 #: what the suite measures of each run besides the runner's row
-MEASURES = ("kkt", "times", "vs_reference", "reference", "profile")
+MEASURES = ("kkt", "times", "vs_reference", "reference", "answer")
 #: the columns of a run in report.json, in order; a method that refused the problem is "skipped"
 RUN_COLUMNS = ("method", "label", "tol", "status", "claimed_status", "message", "iterations",
                "build_s", "solve_s", "time_s", "kkt", "kkt_worst", "vs_reference", "reference",
@@ -126,13 +129,13 @@ class Check:
 
 @dataclass
 class CaseResult:
-    """A case's problem, the reference solution, every run and the pressure each answer gives."""
+    """A case's problem, the reference solution, every run and its answer (by the run's label)."""
 
     case: Case
     problem: ContactProblem
     reference: ContactSolution
+    solutions: dict[str, ContactSolution]
     runs: list[Row]
-    profiles: dict[str, list[float]] = field(default_factory=dict)
 
 
 def label(method: str, tol: float | None) -> str:
@@ -189,10 +192,9 @@ def case_result(case: Case, rows: list[Row]) -> CaseResult:
     exact = rows[0].get("exact")
     reference = answer_from(exact) if exact else ContactSolution.failure(
         REFERENCE_METHOD, problem, "failed", rows[0].get("message") or "no answer")
-    profiles = {row["value"]: row["profile"]["pressure"] for row in rows[1:]
-                if row.get("profile") and row["status"] != "failed"}
-    return CaseResult(case, problem, reference, [suite_row(row, case) for row in rows[1:]],
-                      profiles)
+    solutions = {row["value"]: answer_from(row["answer"]) for row in rows[1:] if "answer" in row}
+    return CaseResult(case, problem, reference, solutions,
+                      [suite_row(row, case) for row in rows[1:]])
 
 
 def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
@@ -306,19 +308,34 @@ def select_cases(names: list[str] | None) -> tuple[Case, ...]:
     return tuple(chosen)
 
 
+def portable(method: Method) -> bool:
+    """A worker process finds this method by its name: a backend's, or ``module:function``.
+
+    A method :func:`~signorini.solvers.registry.register` added in this
+    process only (a function defined in a notebook) is not.
+    """
+    return ":" in method.name or any(method.name == m.name for b in BACKENDS for m in b.METHODS)
+
+
 def run_suite(cases: tuple[Case, ...] = DEFAULT_CASES, method_names: list[str] | None = None,
-              progress: Callable[[str], None] | None = None, *, isolate: bool = True,
+              progress: Callable[[str], None] | None = None, *, isolate: bool | None = None,
               time_limit: float = TIME_LIMIT) -> SuiteResult:
     """Run every case with every installed method (or ``method_names``) and check it.
 
     Methods named in ``method_names`` must converge at the tight tolerance on
     every case: a user's method that only claims success fails the suite.
-    The runs go to one worker process (``isolate``), each within ``time_limit`` seconds.
+    The runs go to one worker process, each within ``time_limit`` seconds;
+    ``isolate=False`` runs them in this process without a limit, as happens
+    by default when a method was registered in this process only (:func:`portable`).
     """
     start = time.perf_counter()
     say = progress or (lambda message: None)
     chosen = [get_method(name) for name in method_names] if method_names else \
         [m for m in methods(installed_only=True) if m.family != "user"]
+    if isolate is None:
+        isolate = all(portable(m) for m in chosen)
+        if not isolate:
+            log.info("a method registered in this process only: the suite runs here, no time limit")
     tasks = [task for case in cases for task in case_tasks(case, chosen)]
 
     def report(index: int, count: int, task: Task, row: Row) -> None:
