@@ -60,7 +60,7 @@ def _tol(text: str) -> float:
 
 
 def _write_json(path: str, text: str) -> None:
-    from signorini.files import atomic_write_text
+    from signorini.files import atomic_write_text  # per command (start-up)
 
     if path == "-":
         sys.stdout.write(text + "\n")
@@ -69,10 +69,10 @@ def _write_json(path: str, text: str) -> None:
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.files import to_json
-    from signorini.output.report import solve_record, solve_summary
-    from signorini.scenes import build_problem
-    from signorini.solvers.registry import solve
+    from signorini.files import to_json  # per command (start-up)
+    from signorini.output.report import solve_record, solve_summary  # per command (start-up)
+    from signorini.scenes import build_problem  # per command (start-up)
+    from signorini.solvers.registry import solve  # per command (start-up)
 
     params = _pairs(args.set, "--set")
     options = {k: _option_value(v) for k, v in _pairs(args.opt, "--opt").items()}
@@ -82,7 +82,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         raise InputError(f"--json {args.json!r} is a directory: give a file name, "
                          f"e.g. --json {Path(args.json) / 'result.json'}")
     if args.vtk:
-        from signorini.output.export import check_vtk_path
+        from signorini.output.export import check_vtk_path  # per command (start-up)
 
         check_vtk_path(args.vtk)  # a bad export path fails before the solve
     problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
@@ -93,7 +93,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.json != "-":
         print(solve_summary(record))
     if args.vtk:
-        from signorini.output.export import export_vtk
+        from signorini.output.export import export_vtk  # per command (start-up)
 
         if record["contact"] is None:
             print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
@@ -105,7 +105,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
     """Under mpirun only ``solve`` with a distributed (petsc-*) method makes sense."""
-    from signorini.solvers.registry import get_method
+    from signorini.solvers.registry import get_method  # per command (start-up)
 
     if args.run is not cmd_solve:
         raise InputError(f"under mpirun -n {ranks} only 'signorini solve' runs: run the other "
@@ -166,9 +166,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-    from signorini.scenes import build_problem
-    from signorini.studies.sweep import parse_loads, plot_sweep, sweep_loads
+    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory  # per command (start-up)
+    from signorini.scenes import build_problem  # per command (start-up)
+    from signorini.studies.sweep import parse_loads, plot_sweep, sweep_loads  # per command (start-up)
 
     loads = parse_loads(args.load)
     directory = writable_directory(args.out)
@@ -287,7 +287,7 @@ def cmd_stability(args: argparse.Namespace) -> int:
 
 
 def cmd_scenes(args: argparse.Namespace) -> int:
-    from signorini.scenes import SCENES
+    from signorini.scenes import SCENES  # per command (start-up)
 
     for family in SCENES.values():
         print(f"{family.name}: {family.summary}")
@@ -298,8 +298,8 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 
 
 def cmd_methods(args: argparse.Namespace) -> int:
-    from signorini.numerics.factor import available_backends, resolve_backend
-    from signorini.solvers.registry import methods
+    from signorini.numerics.factor import available_backends, resolve_backend  # per command (start-up)
+    from signorini.solvers.registry import methods  # per command (start-up)
 
     print(f"factorisation backend: {resolve_backend()} (installed: {', '.join(available_backends())}; "
           "set SIGNORINI_FACTOR to choose)")
@@ -400,7 +400,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    from signorini.solvers import cluster
+    from signorini.solvers import cluster  # per command (start-up)
 
     if cluster.launched_size() > 1:
         return _main_ranks(argv)
@@ -409,7 +409,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main_ranks(argv: Sequence[str] | None) -> int:
     """Under ``mpirun -n N``: rank 0 runs the command, the other ranks serve its solves."""
-    from signorini.solvers import cluster
+    from signorini.solvers import cluster  # per command (start-up)
 
     try:
         if cluster.rank() != 0:

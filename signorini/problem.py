@@ -356,7 +356,7 @@ class ContactSolution:
 
     ``status`` is one of :data:`STATUSES`. ``converged`` means the solver
     claims success *and* the package's KKT certificate agrees (the wrapper in
-    :func:`signorini.solvers.solve` enforces this). ``history`` maps a name to
+    :func:`signorini.solvers.registry.solve` enforces this). ``history`` maps a name to
     one value per iteration (``kkt``, ``primal``, ``dual``...).
     """
 

@@ -146,7 +146,7 @@ def force_controlled_problem(pressure: float = 0.01, nondimensionalise: bool = T
         p = q at every bottom node,  u_y = −q(1 − ν²) y / E,  u_x = q ν(1 + ν) x / E
 
     (exact for P1, see :func:`force_controlled_exact`). Methods that need
-    ``K⁻¹`` cannot solve it as it stands; :func:`signorini.studies.atlas.regularise`
+    ``K⁻¹`` cannot solve it as it stands; :func:`signorini.diagnose.regularise`
     adds a documented small stiffness.
 
     Parameters
