@@ -1,13 +1,29 @@
-"""signorini: frictionless contact of an elastic body with a rigid obstacle, as one QP."""
+"""signorini: frictionless contact of an elastic body with a rigid obstacle, as one QP.
+
+The public API (see the README's "Python" section)::
+
+    import signorini
+    result = signorini.solve("hertz-cylinder", params={"E": 2.1e11, "R": 0.01})
+    result.status, result.total_force, result.pressure, result.hertz
+
+:func:`solve` takes a scene name or a :class:`ContactProblem` (from
+:func:`build_problem`, :meth:`ContactProblem.from_qp` or
+:meth:`ContactProblem.load`) and returns a :class:`Result` in the problem's
+own units; :func:`certificate` judges any answer; :func:`methods` and
+:func:`scenes` list what there is.
+"""
 
 import logging
 
+from signorini.api import DEFAULT_METHOD, Result, build_problem, certificate, methods, scenes, solve
 from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
+from signorini.kkt import Certificate
 from signorini.problem import ContactProblem, ContactSolution, Scales
 
 __version__ = "0.1.0"
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
-__all__ = ["BackendNotInstalled", "ContactProblem", "ContactSolution", "InputError", "Scales",
-           "SignoriniError", "SolverError", "__version__"]
+__all__ = ["DEFAULT_METHOD", "BackendNotInstalled", "Certificate", "ContactProblem", "ContactSolution",
+           "InputError", "Result", "Scales", "SignoriniError", "SolverError", "__version__",
+           "build_problem", "certificate", "methods", "scenes", "solve"]

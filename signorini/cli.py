@@ -69,10 +69,8 @@ def _write_json(path: str, text: str) -> None:
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
+    from signorini.api import build_problem, solve  # per command (start-up)
     from signorini.files import to_json  # per command (start-up)
-    from signorini.output.report import solve_record, solve_summary  # per command (start-up)
-    from signorini.scenes import build_problem  # per command (start-up)
-    from signorini.solvers.registry import solve  # per command (start-up)
 
     params = _pairs(args.set, "--set")
     options = {k: _option_value(v) for k, v in _pairs(args.opt, "--opt").items()}
@@ -86,21 +84,21 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
         check_vtk_path(args.vtk)  # a bad export path fails before the solve
     problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
-    solution = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
-    record = solve_record(problem, solution)
+    result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
+    record = result.to_dict()
     if args.json:
         _write_json(args.json, to_json(record))
     if args.json != "-":
-        print(solve_summary(record))
+        print(result.summary())
     if args.vtk:
         from signorini.output.export import export_vtk  # per command (start-up)
 
         if record["contact"] is None:
             print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
             return EXIT_FAILED
-        export_vtk(problem, solution, args.vtk)
+        export_vtk(problem, result.solution, args.vtk)
         print(f"written: {args.vtk}", file=sys.stderr if args.json == "-" else sys.stdout)
-    return 0 if solution.status == "converged" else EXIT_FAILED
+    return 0 if result.converged else EXIT_FAILED
 
 
 def _check_distributed(args: argparse.Namespace, ranks: int) -> None:

@@ -60,7 +60,8 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
         x=radial_distance(problem.contact_points) * s.length,
         gap=problem.gap(solution.u) * s.displacement,
         force=force,
-        pressure=force / (problem.weights * s.weight),
+        pressure=(force / (problem.weights * s.weight) if problem.weights is not None
+                  else np.full_like(force, np.nan)),
         active=labels == ACTIVE,
         labels=labels,
         total_force=problem.total_contact_force(solution.lam) * s.force,

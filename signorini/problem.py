@@ -109,8 +109,9 @@ class ContactProblem:
     f : (n,) load on the free dofs (includes the lift of prescribed displacements).
     N : (m, n) sparse normal-gap rows, one per contact candidate node.
     d : (m,) initial gaps (lifted by prescribed displacements).
-    weights : (m,) lumped boundary weights ``wᵢ = ∫ φᵢ ds`` of the candidates.
-    contact_points : (m, dim) reference coordinates of the candidates.
+    weights : (m,) lumped boundary weights ``wᵢ = ∫ φᵢ ds`` of the candidates
+        (None when unknown: then there is no pressure, only forces).
+    contact_points : (m, dim) reference coordinates of the candidates (NaN when unknown).
     free_dofs : (n,) indices of the free dofs inside the full dof vector.
     prescribed : (n_full,) full dof vector holding the prescribed values (zero on free dofs).
     load_row, load_offset : the total applied load of the full body is
@@ -135,7 +136,7 @@ class ContactProblem:
     f: np.ndarray
     N: sp.csr_matrix
     d: np.ndarray
-    weights: np.ndarray
+    weights: np.ndarray | None
     contact_points: np.ndarray
     free_dofs: np.ndarray
     prescribed: np.ndarray
@@ -158,7 +159,8 @@ class ContactProblem:
         self.N = sp.csr_matrix(self.N)
         self.f = np.asarray(self.f, dtype=float)
         self.d = np.asarray(self.d, dtype=float)
-        self.weights = np.asarray(self.weights, dtype=float)
+        if self.weights is not None:
+            self.weights = np.asarray(self.weights, dtype=float)
         n, m = self.K.shape[0], self.N.shape[0]
         if self.K.shape != (n, n):
             raise InputError(f"K must be square, got shape {self.K.shape}")
@@ -168,22 +170,50 @@ class ContactProblem:
             raise InputError(f"N must have shape (m, {n}), got {self.N.shape}")
         if self.d.shape != (m,):
             raise InputError(f"d must have shape ({m},), got {self.d.shape}")
-        if self.weights.shape != (m,):
+        if self.weights is not None and self.weights.shape != (m,):
             raise InputError(f"weights must have shape ({m},), got {self.weights.shape}")
         if m == 0:
             raise InputError("the problem has no contact candidates: nothing can touch the obstacle")
         for name in ("f", "d", "weights"):
-            if not np.all(np.isfinite(getattr(self, name))):
+            if getattr(self, name) is not None and not np.all(np.isfinite(getattr(self, name))):
                 raise InputError(f"{name} contains non-finite values")
         if not np.all(np.isfinite(self.K.data)) or not np.all(np.isfinite(self.N.data)):
             raise InputError("K or N contains non-finite values")
-        if np.any(self.weights <= 0):
+        if self.weights is not None and np.any(self.weights <= 0):
             bad = int(np.argmin(self.weights))
             raise InputError(
                 f"contact candidate {bad} has weight {self.weights[bad]:g} ≤ 0: "
                 "every candidate must lie on a boundary edge of positive length")
         self._factor = None
         self._basis = None
+
+    @classmethod
+    def from_qp(cls, K: Any, f: Any, N: Any, d: Any, *, weights: Any = None,
+                contact_points: Any = None, force_multiplicity: float = 1.0,
+                name: str = "") -> "ContactProblem":
+        """A problem from the QP's own data, ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d``, in your units.
+
+        ``K`` (n × n, symmetric positive definite) and ``N`` (m × n) may be
+        dense or sparse; every unknown is free (no prescribed dofs, no mesh).
+        Without ``weights`` (the lumped boundary weight of each candidate) a
+        result has forces but no pressures; without ``contact_points`` no
+        positions; there is no analytic reference to compare with. Shapes
+        and values are checked (InputError names the array and the fix).
+        """
+        K = sp.csr_matrix(K)
+        n = K.shape[0]
+        if K.shape[0] != K.shape[1]:
+            raise InputError(f"K must be square, got shape {K.shape}")
+        if n and abs(K - K.T).max() > 1e-10 * abs(K).max():
+            raise InputError("K must be symmetric: pass the stiffness matrix itself, or ½(K + Kᵀ)")
+        N = sp.csr_matrix(np.atleast_2d(N) if not sp.issparse(N) else N)
+        m = N.shape[0]
+        if contact_points is None:
+            contact_points = np.full((m, 2), np.nan)
+        return cls(K=K, f=f, N=N, d=d, weights=weights,
+                   contact_points=np.asarray(contact_points, dtype=float),
+                   free_dofs=np.arange(n), prescribed=np.zeros(n),
+                   force_multiplicity=force_multiplicity, scene=name)
 
     @property
     def basis(self):
@@ -307,7 +337,8 @@ class ContactProblem:
         arrays = dict(
             K_data=K.data, K_indices=K.indices, K_indptr=K.indptr, N_data=N.data,
             N_indices=N.indices, N_indptr=N.indptr, shape=np.array([self.n, self.m]), f=self.f,
-            d=self.d, weights=self.weights, contact_points=self.contact_points,
+            d=self.d, weights=self.weights if self.weights is not None else np.zeros(0),
+            contact_points=self.contact_points,
             free_dofs=self.free_dofs, prescribed=self.prescribed,
             load_row=self.load_row if self.load_row is not None else np.zeros(0))
         if self.mesh is not None:  # node blocks and rigid modes for the petsc methods
@@ -341,7 +372,8 @@ class ContactProblem:
         return cls(
             K=sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]), shape=(n, n)),
             f=z["f"], N=sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
-            d=z["d"], weights=z["weights"], contact_points=z["contact_points"],
+            d=z["d"], weights=z["weights"] if z["weights"].size else None,
+            contact_points=z["contact_points"],
             free_dofs=z["free_dofs"], prescribed=z["prescribed"],
             load_row=z["load_row"] if z["load_row"].size else None,
             load_offset=meta["load_offset"], force_multiplicity=meta["force_multiplicity"],
@@ -358,6 +390,11 @@ class ContactSolution:
     claims success *and* the package's KKT certificate agrees (the wrapper in
     :func:`signorini.solvers.registry.solve` enforces this). ``history`` maps a name to
     one value per iteration (``kkt``, ``primal``, ``dual``...).
+
+    ``u`` and ``lam`` are in the problem's units, which are dimensionless for
+    a scene built with ``nondimensionalise=True`` (the default): multiply by
+    ``problem.scales`` or read :class:`signorini.api.Result`, which gives
+    displacements, gaps, forces and pressures in the scene's own units.
     """
 
     method: str

@@ -28,23 +28,39 @@ log = logging.getLogger(__name__)
 
 
 PairSolve = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+LoadPair = Callable[[np.ndarray], np.ndarray]
 
 
-def push_for_load(solve_pair: PairSolve, d0: np.ndarray, target: float, multiplicity: float = 1.0,
-                  max_iter: int = 100) -> tuple[float, np.ndarray]:
-    """The push ``s`` whose contact force ``μ Σλ`` is ``target``, and the contact forces then.
+def summed(multiplicity: float) -> LoadPair:
+    """The load of a model's contact forces: ``μ Σλ`` (μ copies of the model make the body)."""
+    return lambda lam: multiplicity * lam.sum(axis=0)
 
+
+def first_contact(d0: np.ndarray) -> np.ndarray:
+    """The candidates that touch first (smallest initial gap): where the iteration starts."""
+    return d0 <= np.min(d0)
+
+
+def push_for_load(solve_pair: PairSolve, active: np.ndarray, target: float, load: LoadPair,
+                  max_iter: int = 100, empty_allowed: bool = False) -> tuple[float, np.ndarray]:
+    """The push ``s`` at which the load is ``target``, and the contact forces then.
+
+    The one active-set iteration of the package's load targeting (the full
+    system, the condensed problem and the zone kernel's band all use it).
     ``solve_pair(A)`` returns, for the active set A, two columns of contact
     forces and two of constraint values ``Nu − d`` such that at push s they
-    are ``s·[:, 0] + [:, 1]``. Raises InputError when no push reaches the target.
+    are ``s·[:, 0] + [:, 1]``; ``load(λ pair)`` the two columns of the load
+    (per unit push, fixed), which is linear in λ. The iteration starts from
+    ``active`` and ends when the active set repeats (exact); an empty active
+    set ends it unless ``empty_allowed`` (something else then carries the
+    load). Raises InputError when no push reaches the target.
     """
     if not (np.isfinite(target) and target > 0):
         raise InputError(f"the target load must be a positive number, got {target!r}")
-    active = d0 <= np.min(d0)  # start from the first point(s) of contact
     seen: set[bytes] = set()
     for step in range(1, max_iter + 1):
         lam, violation = solve_pair(active)
-        per_push, fixed = multiplicity * lam.sum(axis=0)
+        per_push, fixed = load(lam)
         if not per_push > 0:
             raise InputError("pushing the body does not press it onto the obstacle: "
                              "check the scene's prescribed displacement and obstacle")
@@ -54,12 +70,27 @@ def push_for_load(solve_pair: PairSolve, d0: np.ndarray, target: float, multipli
         if np.array_equal(new_active, active):
             log.info("push found in %d active-set steps (s = %.6g)", step, s)
             return float(s), lam_s
-        if new_active.tobytes() in seen or not new_active.any():
+        if new_active.tobytes() in seen or not (new_active.any() or empty_allowed):
             break
         seen.add(active.tobytes())
         active = new_active
     raise InputError("the target load could not be matched by adjusting the prescribed "
                      "displacement (active set did not settle): try delta= instead of P=")
+
+
+def condensed_pair(W: np.ndarray, b_pair: np.ndarray) -> PairSolve:
+    """Pairs of the condensed problem ``Wλ − b ≥ 0`` (dense work only, no back-solve)."""
+
+    def solve_pair(active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        lam = np.zeros((len(b_pair), 2))
+        if active.any():
+            try:
+                lam[active] = sla.solve(W[np.ix_(active, active)], b_pair[active], assume_a="pos")
+            except sla.LinAlgError as exc:
+                raise ArithmeticError("the contact operator is singular on the active set") from exc
+        return lam, b_pair - W @ lam
+
+    return solve_pair
 
 
 def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.ndarray,
@@ -74,18 +105,11 @@ def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.nd
         u, lam = system.solve(active, f_pair, d_pair)
         return lam, N @ u - d_pair
 
-    return push_for_load(solve_pair, d0, target, multiplicity)
+    return push_for_load(solve_pair, first_contact(d0), target, summed(multiplicity))
 
 
 def push_for_load_condensed(W: np.ndarray, b1: np.ndarray, b0: np.ndarray, d0: np.ndarray,
                             target: float, multiplicity: float = 1.0) -> tuple[float, np.ndarray]:
     """The push on the condensed problem, ``b(s) = s b₁ + b₀``: dense work only, no back-solve."""
-    b_pair = np.column_stack([b1, b0])
-
-    def solve_pair(active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        lam = np.zeros((len(b1), 2))
-        if active.any():
-            lam[active] = sla.solve(W[np.ix_(active, active)], b_pair[active], assume_a="pos")
-        return lam, b_pair - W @ lam
-
-    return push_for_load(solve_pair, d0, target, multiplicity)
+    return push_for_load(condensed_pair(W, np.column_stack([b1, b0])), first_contact(d0), target,
+                         summed(multiplicity))

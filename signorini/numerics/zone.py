@@ -30,12 +30,12 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from signorini.numerics.factor import PinnedFactor, Pinning, resolve_backend, selection_dofs
 from signorini.numerics.lcp import solve_lcp
+from signorini.numerics.loading import condensed_pair, push_for_load
 
 log = logging.getLogger(__name__)
 
@@ -225,38 +225,15 @@ class ZoneSolver:
 
 
 def _band_push(W: np.ndarray, b: np.ndarray, R: np.ndarray, G: np.ndarray, target: float,
-               multiplicity: float, max_iter: int = 200) -> tuple[float, np.ndarray]:
-    """Primal-dual active set on the band with the push as one more unknown.
+               multiplicity: float) -> tuple[float, np.ndarray]:
+    """The band's share of load targeting: :func:`signorini.numerics.loading.push_for_load`.
 
-    Band gaps ``Wλ − (s b₁ + b₀) ≥ 0``, forces ``λ ≥ 0``, complementary; and
-    ``μ (Σλ + Σ core reactions) = target`` with core reactions ``s R₁ + R₀ + Gλ``.
+    Band gaps ``Wλ − (s b₁ + b₀) ≥ 0``, forces ``λ ≥ 0``, complementary; the
+    load is ``μ (Σλ + Σ core reactions)`` with core reactions ``s R₁ + R₀ + Gλ``
+    (so an empty band still carries a load). Starts from the band closed.
     """
-    k = W.shape[0]
-    weight = multiplicity * (1.0 + (G.sum(axis=0) if G.size else np.zeros(k)))
-    per_push, fixed = multiplicity * R.sum(axis=0)
-    active = np.ones(k, dtype=bool)  # start from the band closed
-    seen: set[bytes] = set()
-    for _ in range(max_iter):
-        A = np.nonzero(active)[0]
-        system = np.zeros((len(A) + 1, len(A) + 1))
-        system[:-1, :-1] = W[np.ix_(A, A)]
-        system[:-1, -1] = -b[A, 0]
-        system[-1, :-1] = weight[A]
-        system[-1, -1] = per_push
-        rhs = np.append(b[A, 1], target - fixed)
-        try:
-            solution = sla.solve(system, rhs)
-        except sla.LinAlgError as exc:
-            raise ArithmeticError("the push equation is singular: the load does not depend "
-                                  "on the push") from exc
-        s, lam = float(solution[-1]), np.zeros(k)
-        lam[A] = solution[:-1]
-        gap = W @ lam - (s * b[:, 0] + b[:, 1])
-        new_active = lam - gap > 0
-        if np.array_equal(new_active, active):
-            return s, np.maximum(lam, 0.0)
-        if new_active.tobytes() in seen:
-            raise ArithmeticError("the band's active set cycles while matching the load")
-        seen.add(active.tobytes())
-        active = new_active
-    raise ArithmeticError(f"the band's active set kept changing for {max_iter} steps")
+    weight = multiplicity * (1.0 + G.sum(axis=0))
+    fixed = multiplicity * R.sum(axis=0)
+    s, lam = push_for_load(condensed_pair(W, b), np.ones(W.shape[0], dtype=bool), target,
+                           lambda pair: fixed + weight @ pair, max_iter=200, empty_allowed=True)
+    return s, np.maximum(lam, 0.0)

@@ -44,77 +44,6 @@ def provenance() -> dict[str, Any]:
             "cpu": cpu, "cores": os.cpu_count(), "versions": versions}
 
 
-def _scalar_rows(value: Any) -> bool:
-    """A list of flat records (e.g. per-rank timings): kept in the JSON."""
-    return isinstance(value, list) and all(
-        isinstance(row, dict) and all(isinstance(x, (int, float, str, bool)) for x in row.values())
-        for row in value)
-
-
-def solve_record(problem: ContactProblem, solution: ContactSolution) -> dict[str, Any]:
-    """The JSON contract of ``signorini solve --json``."""
-    cert = certificate(problem, solution)
-    finite = bool(np.all(np.isfinite(solution.lam)) and np.all(np.isfinite(solution.u)))
-    record: dict[str, Any] = {
-        "scene": problem.scene, "params": problem.params, "method": solution.method,
-        "status": solution.status, "claimed_status": solution.own_status,
-        "message": solution.message,
-        "iterations": int(solution.iterations), "dofs": problem.n,
-        "contact_candidates": problem.m,
-        "time": {"assemble_s": problem.assemble_time, "build_s": solution.build_time,
-                 "solve_s": solution.solve_time},
-        "kkt": cert.as_dict(),
-    }
-    if finite:
-        profile = contact_profile(problem, solution)
-        record["total_force"] = profile.total_force
-        record["applied_load"] = profile.applied_load
-        record["contact"] = profile.as_dict()
-        reference = reference_of(problem)
-        if reference is not None:
-            if reference.resultant:  # curved or cornered obstacles: the vertical load
-                record["load_resultant"] = load_resultant(problem, solution.lam)
-            record[reference.key] = reference.compare(problem, solution).as_dict()
-    else:
-        record["total_force"] = None
-        record["contact"] = None
-    record["extras"] = {k: v for k, v in solution.extras.items()
-                        if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}
-    return record
-
-
-def solve_summary(record: dict[str, Any]) -> str:
-    """A few human lines about one solve."""
-    lines = [f"{record['scene']} with {record['method']}: {record['status']} "
-             f"after {record['iterations']} iterations ({record['message']})",
-             f"  {record['dofs']} dofs, {record['contact_candidates']} contact candidates; "
-             f"assemble {record['time']['assemble_s']:.2f} s, build {record['time']['build_s']:.2f} s, "
-             f"solve {record['time']['solve_s']:.2f} s"]
-    kkt = record["kkt"]
-    lines.append("  KKT (relative): " + ", ".join(f"{k} {v:.1e}" for k, v in kkt.items()))
-    if record.get("contact"):
-        active = sum(record["contact"]["active"])
-        lines.append(f"  total force {record['total_force']:.6g} (applied {record['applied_load']:.6g}), "
-                     f"{active} nodes in contact")
-    if record.get("hertz"):
-        h = record["hertz"]
-        lines.append(f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "
-                     f"p0 = {h['p0']:.6g} (ref {h['p0_ref']:.6g}, {100 * h['p0_rel']:.2f} %), "
-                     f"pressure L2 {100 * h['pressure_l2_rel']:.2f} %")
-    if record.get("punch"):
-        q = record["punch"]
-        lines.append(f"  punch: load {q['load']:.6g}; pressure vs P/(π√(a² − x²)) on |x| ≤ "
-                     f"{q['inner']:g}a: max {100 * q['pressure_max_rel']:.2f} %, "
-                     f"L2 {100 * q['pressure_l2_rel']:.2f} %; edge node p = {q['edge_pressure']:.4g} "
-                     f"(element {q['edge_h']:.3g} next to the edge)")
-    for rank in record["extras"].get("per_rank", []):
-        if "local_rows" in rank:
-            lines.append(f"  rank {rank['rank']}: {rank['local_rows']} rows, set-up "
-                         f"{rank['setup_s']:.2f} s, solve {rank['solve_s']:.2f} s, "
-                         f"peak memory {rank['peak_memory_mb']:.0f} MB")
-    return "\n".join(lines)
-
-
 def _fmt(value: Any, digits: int = 1) -> str:
     if value is None or (isinstance(value, float) and not np.isfinite(value)):
         return "–"
@@ -216,4 +145,49 @@ def checks_summary(suite: SuiteResult) -> str:
                      f"{'pass' if c.passed else 'FAIL ' + c.detail}")
     lines.append(f"{sum(c.passed for c in suite.checks)} of {len(suite.checks)} checks passed "
                  f"in {suite.elapsed_s:.1f} s")
+    return "\n".join(lines)
+
+
+def _status_cell(run: dict[str, Any]) -> str:
+    claimed = run.get("claimed_status")
+    return run["status"] if claimed in (None, run["status"]) else f"{run['status']} (claimed {claimed})"
+
+
+def readme_validation(report: dict[str, Any], case: str = "hertz-cylinder") -> str:
+    """The README's validation paragraph and table, from a suite's ``report.json``.
+
+    ``tests/test_readme_numbers.py`` holds the README to this text, and
+    ``tools/readme.py`` writes it there, so that a number the README prints is
+    one the committed report holds.
+    """
+    runs = [r for r in report["runs"] if r["case"] == case and r["status"] != "skipped"]
+    first = runs[0]
+    exact = next(r for r in runs if r["method"] == "pdas" and r["tol"] is not None)
+    ref = exact["reference"]
+    checks = report["checks"]
+    order = {"converged": 0, "inaccurate": 1}
+    runs.sort(key=lambda r: (order.get(r["status"], 2), (r.get("vs_reference") or {}).get("lam_rel", 1.0),
+                             r["label"]))
+    lines = [
+        f"**{sum(c['passed'] for c in checks)} of {len(checks)} checks passed in "
+        f"{report['elapsed_s']:.0f} s** ({report['provenance']['cpu']}, "
+        f"{report['provenance']['cores']} cores, {report['provenance']['date'][:10]}). "
+        f"On `{case}` ({first['dofs']:,} dofs, {first['candidates']} candidates) the exact "
+        f"answer (pdas) is within **{100 * ref['p0_rel']:.2f} %** of Hertz on p₀, "
+        f"**{100 * ref['a_rel']:.2f} %** on a, **{100 * ref['pressure_l2_rel']:.2f} %** in the L2 "
+        f"norm of the pressure, and the contact force balances the applied load to "
+        f"{ref['force_balance']:.0e}.",
+        "",
+        "| method @ tol | status | iterations | time [s] | worst KKT | λ vs pdas | misclassified nodes |",
+        "|---|---|---:|---:|---:|---:|---:|",
+    ]
+    for run in runs:
+        vs = run.get("vs_reference") or {}
+        tol = "defaults" if run["tol"] is None else f"{run['tol']:g}"
+        finite = run["status"] != "failed"
+        lines.append(
+            f"| {run['method']} @ {tol} | {_status_cell(run)} | {run['iterations']:,} | "
+            f"{run['time_s']:.2f} | {_fmt(run['kkt_worst'] if finite else None, 0)} | "
+            f"{_fmt(vs.get('lam_rel') if finite else None) if vs.get('lam_rel') != 0 else '0'} | "
+            f"{vs.get('misclassified', '–') if finite else '–'} |")
     return "\n".join(lines)

@@ -1,0 +1,260 @@
+"""The public Python API: build a problem, solve it, read the answer in your units.
+
+>>> import signorini
+>>> result = signorini.solve("hertz-cylinder", params={"E": 2.1e11, "R": 0.01})
+>>> result.status, result.total_force          # doctest: +SKIP
+('converged', 22512.3...)
+
+A :class:`Result` gives every quantity in the units of the problem's input
+(SI if the scene's parameters are SI): ``force`` in N (N/m per unit thickness
+in 2D, N per radian in axisymmetric models), ``pressure`` in Pa, ``gap`` and
+``displacement`` in m. The solver's own vectors ``result.solution.u`` and
+``result.solution.lam`` are dimensionless (see :class:`signorini.problem.Scales`).
+``Result.to_dict()`` is the JSON that ``signorini solve --json`` writes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from signorini.errors import InputError
+from signorini.kkt import Certificate, certificate
+from signorini.pressure import ContactProfile, contact_profile, load_resultant
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.references import Reference, reference_of
+from signorini.scenes import SCENES, SceneFamily, build_problem
+from signorini.solvers.registry import Method
+from signorini.solvers.registry import methods as _all_methods
+from signorini.solvers.registry import solve as _solve
+
+DEFAULT_METHOD = "pdas"
+
+
+def _scalar_rows(value: Any) -> bool:
+    """A list of flat records (e.g. per-rank timings): kept in the JSON."""
+    return isinstance(value, list) and all(
+        isinstance(row, dict) and all(isinstance(x, (int, float, str, bool)) for x in row.values())
+        for row in value)
+
+
+@dataclass
+class Result:
+    """One solve: the problem, the method's answer, its certificate, in the problem's units.
+
+    Attributes that hold arrays are per contact candidate, in the order of
+    ``problem.N``'s rows: ``x`` (horizontal distance from the first point of
+    contact, or the radius; NaN when the problem has no geometry), ``gap``,
+    ``force`` (the nodal contact force λ), ``pressure`` (λ over the lumped
+    boundary weight; NaN when the problem has no weights) and ``active``.
+    """
+
+    problem: ContactProblem
+    solution: ContactSolution
+    certificate: Certificate
+
+    # -- the method's verdict --------------------------------------------------------------
+    @property
+    def status(self) -> str:
+        """``converged`` only when the certificate agrees with the method's claim."""
+        return self.solution.status
+
+    @property
+    def claimed_status(self) -> str:
+        """What the method itself said (differs from ``status`` when the certificate overruled it)."""
+        return self.solution.own_status
+
+    @property
+    def converged(self) -> bool:
+        return self.solution.success
+
+    @property
+    def method(self) -> str:
+        return self.solution.method
+
+    @property
+    def message(self) -> str:
+        return self.solution.message
+
+    @property
+    def iterations(self) -> int:
+        return int(self.solution.iterations)
+
+    @property
+    def finite(self) -> bool:
+        """The method returned finite vectors (a failed run carries NaN)."""
+        return bool(np.all(np.isfinite(self.solution.lam)) and np.all(np.isfinite(self.solution.u)))
+
+    # -- the answer in physical units -------------------------------------------------------
+    @property
+    def profile(self) -> ContactProfile:
+        """Gaps, forces and pressures at the candidates (see :func:`signorini.pressure.contact_profile`)."""
+        if not hasattr(self, "_profile"):
+            self._profile = contact_profile(self.problem, self.solution)
+        return self._profile
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.profile.x
+
+    @property
+    def gap(self) -> np.ndarray:
+        return self.profile.gap
+
+    @property
+    def force(self) -> np.ndarray:
+        return self.profile.force
+
+    @property
+    def pressure(self) -> np.ndarray:
+        return self.profile.pressure
+
+    @property
+    def active(self) -> np.ndarray:
+        return self.profile.active
+
+    @property
+    def total_force(self) -> float:
+        """The contact force on the whole body (symmetry copies and 2π included)."""
+        return self.profile.total_force
+
+    @property
+    def applied_load(self) -> float:
+        """The same load measured as the reaction on the loaded boundary (NaN when unknown)."""
+        return self.profile.applied_load
+
+    @property
+    def displacement(self) -> np.ndarray:
+        """Every dof of the mesh (free and prescribed), in length units."""
+        return self.problem.expand(self.solution.u) * self.problem.scales.displacement
+
+    # -- theory -----------------------------------------------------------------------------
+    @property
+    def reference(self) -> Reference | None:
+        """The analytic reference the problem declares (None for none)."""
+        return reference_of(self.problem)
+
+    @property
+    def comparison(self) -> Any:
+        """The answer against the reference (e.g. :class:`signorini.pressure.HertzComparison`).
+
+        None when the problem declares no reference or the answer is not finite.
+        """
+        if self.reference is None or not self.finite:
+            return None
+        if not hasattr(self, "_comparison"):
+            self._comparison = self.reference.compare(self.problem, self.solution)
+        return self._comparison
+
+    @property
+    def hertz(self) -> Any:
+        """The comparison with Hertz's solution, when that is the problem's reference."""
+        return self.comparison if self.reference is not None and self.reference.key == "hertz" else None
+
+    # -- records ----------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The record ``signorini solve --json`` writes (arrays as NumPy until serialised)."""
+        problem, solution = self.problem, self.solution
+        record: dict[str, Any] = {
+            "scene": problem.scene, "params": problem.params, "method": solution.method,
+            "status": solution.status, "claimed_status": solution.own_status,
+            "message": solution.message,
+            "iterations": self.iterations, "dofs": problem.n,
+            "contact_candidates": problem.m,
+            "time": {"assemble_s": problem.assemble_time, "build_s": solution.build_time,
+                     "solve_s": solution.solve_time},
+            "kkt": self.certificate.as_dict(),
+        }
+        if self.finite:
+            record["total_force"] = self.total_force
+            record["applied_load"] = self.applied_load
+            record["contact"] = self.profile.as_dict()
+            if self.reference is not None:
+                if self.reference.resultant:  # curved or cornered obstacles: the vertical load
+                    record["load_resultant"] = load_resultant(problem, solution.lam)
+                record[self.reference.key] = self.comparison.as_dict()
+        else:
+            record["total_force"] = None
+            record["contact"] = None
+        record["extras"] = {k: v for k, v in solution.extras.items()
+                            if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}
+        return record
+
+    def summary(self) -> str:
+        """A few lines for people (what ``signorini solve`` prints)."""
+        return solve_summary(self.to_dict())
+
+
+def solve_summary(record: dict[str, Any]) -> str:
+    """A few human lines about one solve record (see :meth:`Result.to_dict`)."""
+    lines = [f"{record['scene'] or 'problem'} with {record['method']}: {record['status']} "
+             f"after {record['iterations']} iterations ({record['message']})",
+             f"  {record['dofs']} dofs, {record['contact_candidates']} contact candidates; "
+             f"assemble {record['time']['assemble_s']:.2f} s, build {record['time']['build_s']:.2f} s, "
+             f"solve {record['time']['solve_s']:.2f} s"]
+    kkt = record["kkt"]
+    lines.append("  KKT (relative): " + ", ".join(f"{k} {v:.1e}" for k, v in kkt.items()))
+    if record.get("contact"):
+        active = sum(record["contact"]["active"])
+        lines.append(f"  total force {record['total_force']:.6g} (applied {record['applied_load']:.6g}), "
+                     f"{active} nodes in contact")
+    if record.get("hertz"):
+        h = record["hertz"]
+        lines.append(f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "
+                     f"p0 = {h['p0']:.6g} (ref {h['p0_ref']:.6g}, {100 * h['p0_rel']:.2f} %), "
+                     f"pressure L2 {100 * h['pressure_l2_rel']:.2f} %")
+    if record.get("punch"):
+        q = record["punch"]
+        lines.append(f"  punch: load {q['load']:.6g}; pressure vs P/(π√(a² − x²)) on |x| ≤ "
+                     f"{q['inner']:g}a: max {100 * q['pressure_max_rel']:.2f} %, "
+                     f"L2 {100 * q['pressure_l2_rel']:.2f} %; edge node p = {q['edge_pressure']:.4g} "
+                     f"(element {q['edge_h']:.3g} next to the edge)")
+    for rank in record["extras"].get("per_rank", []):
+        if "local_rows" in rank:
+            lines.append(f"  rank {rank['rank']}: {rank['local_rows']} rows, set-up "
+                         f"{rank['setup_s']:.2f} s, solve {rank['solve_s']:.2f} s, "
+                         f"peak memory {rank['peak_memory_mb']:.0f} MB")
+    return "\n".join(lines)
+
+
+def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: float | None = None,
+          max_iter: int | None = None, params: dict[str, Any] | None = None,
+          **options: Any) -> Result:
+    """Solve a problem (or a scene by name) and judge the answer with the KKT certificate.
+
+    ``problem`` is a :class:`ContactProblem` (from :func:`build_problem`,
+    :meth:`ContactProblem.from_qp` or :meth:`ContactProblem.load`) or the name
+    of a scene (see :func:`scenes`), built with ``params`` in the scene's units.
+    ``method`` is one of :func:`methods` (default ``pdas``); ``tol`` the
+    relative KKT tolerance the answer must meet to be ``converged``; other
+    keyword arguments are the method's options. Bad input raises
+    :class:`signorini.InputError`; a method that fails returns a result whose
+    ``status`` says so.
+    """
+    if isinstance(problem, str):
+        problem = build_problem(problem, **(params or {}))
+    elif params:
+        raise InputError("params= builds a scene by name: give solve('hertz-cylinder', params=...) "
+                         "or build the problem with those parameters first")
+    elif not isinstance(problem, ContactProblem):
+        raise InputError(f"problem must be a ContactProblem or a scene name, got "
+                         f"{type(problem).__name__}: build one with signorini.build_problem(...) "
+                         "or ContactProblem.from_qp(K, f, N, d)")
+    solution = _solve(problem, method, tol=tol, max_iter=max_iter, **options)
+    return Result(problem, solution, certificate(problem, solution))
+
+
+def methods(installed_only: bool = False) -> list[Method]:
+    """The registered methods (name, summary, family, whether installed)."""
+    return _all_methods(installed_only)
+
+
+def scenes() -> dict[str, SceneFamily]:
+    """The built-in scene families by name (each lists its parameters and reference)."""
+    return dict(SCENES)
+
+
+__all__ = ["DEFAULT_METHOD", "Result", "build_problem", "certificate", "methods", "scenes", "solve",
+           "solve_summary"]
