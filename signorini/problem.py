@@ -72,9 +72,12 @@ class Scales:
 class Push:
     """How the load depends on the prescribed push ``s`` (dimensionless).
 
-    ``f(s) = s f1``, ``d(s) = d0 + s d1`` and the applied-load offset is
-    ``s · offset1``; ``scale`` is the push the problem was assembled with.
-    Load sweeps and load targeting use it without assembling again.
+    ``f(s) = s f1 + P f_load``, ``d(s) = d0 + s d1`` and the applied-load
+    offset is ``s · offset1 + P · offset_load``; ``scale`` is the push the
+    problem was assembled with and ``load`` the target load P (dimensionless,
+    full body) when the load is a traction on a cut (``f_load`` its nodal
+    forces per unit P; None when the push alone loads the body). Load
+    sweeps and load targeting use it without assembling again.
     """
 
     f1: np.ndarray
@@ -82,6 +85,18 @@ class Push:
     d1: np.ndarray
     offset1: float
     scale: float
+    f_load: np.ndarray | None = None
+    offset_load: float = 0.0
+    load: float = 0.0
+
+    def f(self, scale: float, load: float | None = None) -> np.ndarray:
+        """The load vector at push ``scale`` (and target ``load``, default the assembled one)."""
+        load = self.load if load is None else load
+        return scale * self.f1 + (load * self.f_load if self.f_load is not None else 0.0)
+
+    def offset(self, scale: float, load: float | None = None) -> float:
+        load = self.load if load is None else load
+        return scale * self.offset1 + load * self.offset_load
 
 
 @dataclass
@@ -89,7 +104,8 @@ class WarmStart:
     """What load targeting learnt about a problem, for a solver to start from.
 
     ``lam`` are the exact contact forces at the targeted load (None once the
-    load changes); ``zone_solver`` is the :class:`~signorini.numerics.zone.ZoneSolver`
+    load changes) and ``u`` the displacement with them (when load targeting
+    solved the full system; ``pdas`` starts from both); ``zone_solver`` is the :class:`~signorini.numerics.zone.ZoneSolver`
     that holds K's factorisation with its final ``zone`` (the ``nested``
     method reuses both while K is unchanged).
     """
@@ -97,6 +113,7 @@ class WarmStart:
     lam: np.ndarray | None = None
     zone_solver: Any = None
     zone: Any = None
+    u: np.ndarray | None = None
 
 
 @dataclass
@@ -299,18 +316,25 @@ class ContactProblem:
             return float("nan")
         return float(self.load_row @ u + self.load_offset)
 
-    def pushed(self, scale: float) -> "ContactProblem":
-        """The same body pushed by ``scale`` times the prescribed displacement."""
+    def pushed(self, scale: float, load: float | None = None) -> "ContactProblem":
+        """The same body pushed by ``scale`` times the prescribed displacement.
+
+        For a body loaded by a traction on a cut, ``load`` (dimensionless,
+        full body) sets the traction; by default it stays as assembled.
+        """
         if self.push is None:
             raise ValueError("this problem does not record how its load depends on the push")
         pu = self.push
         ratio = scale / pu.scale
+        load = pu.load if load is None else load
         params = dict(self.params)
         if isinstance(params.get("delta"), float):
             params["delta"] *= ratio
-        new = self.with_data(f=scale * pu.f1, d=pu.d0 + scale * pu.d1,
-                             load_offset=scale * pu.offset1, prescribed=self.prescribed * ratio,
-                             params=params, push=Push(pu.f1, pu.d0, pu.d1, pu.offset1, scale),
+        if pu.f_load is not None and isinstance(params.get("P"), float):
+            params["P"] = load * self.scales.force
+        new = self.with_data(f=pu.f(scale, load), d=pu.d0 + scale * pu.d1,
+                             load_offset=pu.offset(scale, load), prescribed=self.prescribed * ratio,
+                             params=params, push=dataclasses.replace(pu, scale=scale, load=load),
                              warm_start=WarmStart(zone_solver=self.warm_start.zone_solver,
                                                   zone=self.warm_start.zone))
         # K is unchanged: keep its factorisation, its basis and the zone solver (not the forces)
@@ -345,11 +369,14 @@ class ContactProblem:
             arrays.update(mesh_p=self.mesh.p, mesh_t=self.mesh.t)
         if pu is not None:
             arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
+            if pu.f_load is not None:
+                arrays.update(push_f_load=pu.f_load)
         meta = {"scene": self.scene, "params": self.params, "load_offset": self.load_offset,
                 "force_multiplicity": self.force_multiplicity, "scales": vars(self.scales),
                 "assemble_time": self.assemble_time, "axisymmetric": self.axisymmetric,
                 "reference": self.reference,
-                "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale}}
+                "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
+                                                 "offset_load": pu.offset_load, "load": pu.load}}
         arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
         buffer = io.BytesIO()
         np.savez(buffer, **arrays)
@@ -364,7 +391,8 @@ class ContactProblem:
         push = None
         if meta["push"] is not None:
             push = Push(z["push_f1"], z["push_d0"], z["push_d1"], meta["push"]["offset1"],
-                        meta["push"]["scale"])
+                        meta["push"]["scale"], z["push_f_load"] if "push_f_load" in z else None,
+                        meta["push"].get("offset_load", 0.0), meta["push"].get("load", 0.0))
         mesh = None
         if "mesh_p" in z:
             kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet

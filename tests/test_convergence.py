@@ -21,7 +21,8 @@ from signorini.studies.convergence import (
     write_study,
 )
 
-TINY = {"a_over_R": 0.2, "n_contact": 6, "grading": 0.8}
+# a/R = 0.05: at 0.2 Hertz's half-space theory itself is ~1 % off the exact cylinder (docs/accuracy.md)
+TINY = {"a_over_R": 0.05, "n_contact": 6, "grading": 0.8}
 
 
 def test_fitted_rate_recovers_a_power_law():
@@ -65,7 +66,7 @@ def test_punch_study_shows_the_edge_singularity():
 
 def test_grading_comparison_at_equal_dofs():
     graded = run_study("hertz-cylinder", 2, TINY, methods=["pdas"])
-    comparison = grading_comparison("hertz-cylinder", graded, 1, {"a_over_R": 0.2}, target=0.05)
+    comparison = grading_comparison("hertz-cylinder", graded, 1, {"a_over_R": 0.05}, target=0.05)
     assert comparison.uniform_dofs > comparison.graded_dofs > 0
     assert comparison.saving > 1
     for ax in (plot_grading(comparison), plot_convergence(graded)):

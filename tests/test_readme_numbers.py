@@ -10,10 +10,12 @@ spec.loader.exec_module(readme_tool)
 
 
 def test_every_generated_block_is_what_its_artefact_gives():
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    for name, body in readme_tool.blocks().items():
-        assert readme_tool.current(text, name) == body, (
-            f"README block '{name}' differs from its artefact: run .venv/bin/python tools/readme.py")
+    for document in readme_tool.DOCUMENTS:
+        text = document.read_text(encoding="utf-8")
+        for name, body in readme_tool.blocks(document).items():
+            assert readme_tool.current(text, name) == body, (
+                f"{document.name} block '{name}' differs from its artefact: "
+                "run .venv/bin/python tools/readme.py")
 
 
 def test_the_check_sees_a_changed_number():

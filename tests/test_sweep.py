@@ -17,7 +17,8 @@ SMALL = {"n_contact": 24, "grading": 0.3}
 
 def test_a_sweep_level_equals_a_full_solve_at_that_load():
     base = build_problem("hertz-cylinder", delta=0.003, **SMALL)  # pushed, not load-targeted
-    targeted = build_problem("hertz-cylinder", **SMALL)  # the same mesh, its P found by assembly
+    # the same mesh and model (the cut pushed flat), its P found by assembly
+    targeted = build_problem("hertz-cylinder", loading="displacement", **SMALL)
     loads = np.array([0.5, 2.0, 1.0]) * targeted.params["P"]
     levels = sweep_loads(base, loads)
     assert [lv.total_force for lv in levels] == pytest.approx(list(loads), rel=1e-9)
@@ -26,6 +27,19 @@ def test_a_sweep_level_equals_a_full_solve_at_that_load():
     assert levels[2].p0 == pytest.approx(profile.pressure[0], rel=1e-9)
     assert levels[2].a == pytest.approx(contact_half_width(profile), rel=1e-9)
     assert levels[2].delta == pytest.approx(targeted.params["delta"], rel=1e-9)
+
+
+def test_a_traction_loaded_sweep_level_equals_a_full_solve_at_that_load():
+    targeted = build_problem("hertz-cylinder", **SMALL)  # a traction on the cut, the centre pinned
+    assert targeted.push.f_load is not None
+    loads = np.array([2.0, 0.5, 1.0]) * targeted.params["P"]
+    levels = sweep_loads(targeted, loads)
+    assert [lv.total_force for lv in levels] == pytest.approx(list(loads), rel=1e-9)
+    profile = contact_profile(targeted, solve(targeted, "pdas"))
+    assert levels[2].p0 == pytest.approx(profile.pressure[0], rel=1e-9)
+    assert levels[2].a == pytest.approx(contact_half_width(profile), rel=1e-9)
+    assert levels[2].delta == pytest.approx(targeted.params["delta"], rel=1e-9)
+    assert profile.applied_load == pytest.approx(profile.total_force, rel=1e-9)  # the pin carries 0
 
 
 def test_half_width_grows_like_the_square_root_of_the_load():

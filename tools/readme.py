@@ -1,4 +1,4 @@
-"""Write the README's generated blocks from the committed artefacts they quote.
+"""Write the generated blocks of README.md and docs/accuracy.md from the committed artefacts they quote.
 
     .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`
 
@@ -13,16 +13,26 @@ import re
 import sys
 from pathlib import Path
 
-from signorini.files import atomic_write_text
-from signorini.output.report import readme_validation
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
+
+from signorini.files import atomic_write_text  # noqa: E402
+from signorini.output.report import readme_validation  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+ACCURACY = ROOT / "docs" / "accuracy.md"
+DOCUMENTS = (README, ACCURACY)
 
 
-def blocks() -> dict[str, str]:
-    report = json.loads((ROOT / "docs" / "validation" / "report.json").read_text())
-    return {"validation": readme_validation(report)}
+def blocks(document: Path = README) -> dict[str, str]:
+    """The generated blocks of ``document`` by name, from their artefacts."""
+    if document == README:
+        report = json.loads((ROOT / "docs" / "validation" / "report.json").read_text())
+        return {"validation": readme_validation(report)}
+    if document == ACCURACY:
+        return accuracy.tables(accuracy.load())
+    raise ValueError(f"no generated blocks for {document}")
 
 
 def pattern(name: str) -> re.Pattern:
@@ -35,13 +45,14 @@ def current(text: str, name: str) -> str | None:
 
 
 def main() -> int:
-    text = README.read_text(encoding="utf-8")
-    for name, body in blocks().items():
-        if current(text, name) is None:
-            print(f"README.md has no block '{name}'", file=sys.stderr)
-            return 1
-        text = pattern(name).sub(lambda m: m.group(1) + body + m.group(3), text)
-    atomic_write_text(README, text)
+    for document in DOCUMENTS:
+        text = document.read_text(encoding="utf-8")
+        for name, body in blocks(document).items():
+            if current(text, name) is None:
+                print(f"{document.name} has no block '{name}'", file=sys.stderr)
+                return 1
+            text = pattern(name).sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
+        atomic_write_text(document, text)
     return 0
 
 

@@ -265,17 +265,26 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
     K_II = K_full[free][:, free].tocsr()
     K_ID = K_full[free][:, fixed]
     N_free = N_full[:, free].tocsr()
+    target = None if model.target_load is None else model.target_load / force_unit
+    f_load, offset_load = cut_traction(model, mesh, dof_table, load_dofs)
+    if f_load is not None and target is None:
+        raise InputError("a load applied on a cut needs a target load: give P (or a_over_R)")
 
     def lifted(scale: float) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
         u_D = prescribed[fixed] * scale
         full = np.zeros(n_full)
         full[fixed] = u_D
-        return -(K_ID @ u_D), gaps - N_full[:, fixed] @ u_D, float(load_full[fixed] @ u_D), full
+        f = -(K_ID @ u_D)
+        offset = float(load_full[fixed] @ u_D)
+        if f_load is not None:  # the traction of the target load (fixed while the push varies)
+            f = f + target * f_load[free]
+            offset += target * offset_load
+        return f, gaps - N_full[:, fixed] @ u_D, offset, full
 
-    scale, zone_solver, calibration_lam = 1.0, None, None
-    if model.target_load is not None:
-        scale, calibration_lam, zone_solver = _calibrate(
-            K_II, N_free, lifted, model.target_load / force_unit, model.force_multiplicity, zone)
+    scale, zone_solver, calibration = 1.0, None, (None, None)
+    if target is not None:
+        scale, calibration, zone_solver = _calibrate(
+            K_II, N_free, lifted, target, model.force_multiplicity, zone, model.predicted_contact)
     f, d, load_offset, full = lifted(scale)
     params = dict(model.params)
     if model.target_load is not None:
@@ -287,30 +296,61 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
         free_dofs=free, prescribed=full, load_row=load_full[free], load_offset=load_offset,
         force_multiplicity=model.force_multiplicity,
         scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
-        params=params, mesh=mesh, push=_push(lifted, scale), axisymmetric=axisymmetric,
-        warm_start=WarmStart(calibration_lam, *(zone_solver or (None, None))))
+        params=params, mesh=mesh, axisymmetric=axisymmetric,
+        push=_push(lifted, scale, None if f_load is None else f_load[free], offset_load, target),
+        warm_start=WarmStart(calibration[0], *(zone_solver or (None, None)), u=calibration[1]))
     problem.assemble_time = time.perf_counter() - start
     log.info("assembled %d free dofs, %d contact candidates in %.2f s",
              problem.n, problem.m, problem.assemble_time)
     return problem
 
 
-def _push(lifted, scale: float) -> Push:
-    """How f, d and the load offset depend on the push (they are affine in it)."""
+def cut_traction(model: SceneModel, mesh: Any, dof_table: np.ndarray,
+                 load_dofs: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """Nodal forces of the cut's uniform traction per unit load of the full body, and its offset.
+
+    The traction is ``1 / (μ A)`` with A the cut's area (``∫ r ds`` per radian
+    in axisymmetric models), pointing towards the obstacle; its consistent
+    nodal forces are the cut's lumped weights times it (exact for P1 and a
+    uniform traction). The offset is the part of the load that the load
+    dofs' reactions do not see: the traction on every other node.
+    """
+    cut = model.cut_load
+    if cut is None:
+        return None, 0.0
+    weights = contact_weights(mesh, cut.facets, cut.nodes, bool(model.axisymmetric))
+    area = float(weights.sum())
+    if not area > 0:
+        raise InputError("the loaded cut has no area: check the scene's cut facets")
+    f_load = np.zeros(dof_table.size)
+    dofs = dof_table[cut.component, cut.nodes]
+    f_load[dofs] = -weights / (model.force_multiplicity * area)
+    others = ~np.isin(dofs, load_dofs)
+    return f_load, float(-model.force_multiplicity * f_load[dofs[others]].sum())
+
+
+def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
+          load: float | None) -> Push:
+    """How f, d and the load offset depend on the push and the load (they are affine in both)."""
     f0, d0, offset0, _ = lifted(0.0)
     f1, d_one, offset_one, _ = lifted(1.0)
-    return Push(f1=f1 - f0, d0=d0, d1=d_one - d0, offset1=offset_one - offset0, scale=scale)
+    return Push(f1=f1 - f0, d0=d0, d1=d_one - d0, offset1=offset_one - offset0, scale=scale,
+                f_load=f_load, offset_load=offset_load if f_load is not None else 0.0,
+                load=load if f_load is not None else 0.0)
 
 
 def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
-               multiplicity: float, zone=None) -> tuple[float, np.ndarray, Any]:
+               multiplicity: float, zone=None,
+               start: np.ndarray | None = None) -> tuple[float, tuple, Any]:
     """The factor on the prescribed displacement whose contact force is ``target``.
 
     The load is affine in the factor. With a predicted ``zone``,
     :class:`signorini.numerics.zone.ZoneSolver` finds it on one factorisation and
     returns itself with the final zone for reuse; otherwise (or should that
     fail) :func:`signorini.numerics.loading.calibrate_push` solves the augmented
-    active-set system (one factorisation per step).
+    active-set system (one factorisation per step) from the active set
+    ``start`` (the scene's analytic estimate, when it has one). Returns the
+    factor, ``(λ, u)`` at it (None from the zone) and the zone solver.
     """
     f0, d0 = lifted(0.0)[:2]
     f1, d_one = lifted(1.0)[:2]
@@ -318,11 +358,12 @@ def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
         try:
             system = ZoneSolver(K, N)
             scale, _, lam, final = system.push_for_load(f1 - f0, d0, d_one - d0, target,
-                                                        multiplicity, zone)
+                                                        multiplicity, zone, f0=f0)
             log.info("load targeted on a predicted zone (%s): %d factorisation(s), %d back-solves",
                      final.counts(), system.factorisations, system.back_solves)
-            return scale, lam, (system, final)
+            return scale, (lam, None), (system, final)
         except (ValueError, ArithmeticError) as exc:
             log.info("load targeting on the predicted zone failed (%s): full active set", exc)
-    scale, lam = calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity)
-    return scale, lam, None
+    scale, lam, u = calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity, f0=f0,
+                                   start=start)
+    return scale, (lam, u), None

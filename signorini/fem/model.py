@@ -32,6 +32,25 @@ class FlatObstacle3D:
         return normals, points[:, 2] - self.height
 
 
+@dataclass(frozen=True)
+class CutLoad:
+    """The load applied as a uniform traction on a cut of the body (as Hertz's theory loads it).
+
+    ``facets`` are the boundary facets of the cut, ``nodes`` their nodes;
+    ``component`` the direction of the push (1 = y in 2D, 2 = z in 3D),
+    towards the obstacle along its negative axis. The traction is whatever
+    makes the full body's load equal the scene's target (uniform over the
+    cut, per unit area; in axisymmetric models weighted by the radius), and a
+    prescribed displacement of the scene's load dofs (one reference node)
+    removes the rigid translation: assembly adjusts it until that dof carries
+    no force, so the body is loaded by the traction alone.
+    """
+
+    component: int
+    nodes: np.ndarray
+    facets: np.ndarray
+
+
 @dataclass
 class SceneModel:
     """A scene in physical units, ready for assembly.
@@ -58,3 +77,7 @@ class SceneModel:
     params: dict[str, Any] = field(default_factory=dict)
     #: the mesh is the meridian half-plane (r, z) of a body of revolution; forces per radian
     axisymmetric: bool = False
+    #: the target load as a traction on a cut (None: the load is the prescribed displacement's)
+    cut_load: CutLoad | None = None
+    #: per candidate: in contact by the scene's analytic estimate (load targeting starts there)
+    predicted_contact: np.ndarray | None = None

@@ -94,18 +94,28 @@ def condensed_pair(W: np.ndarray, b_pair: np.ndarray) -> PairSolve:
 
 
 def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.ndarray,
-                   d1: np.ndarray, target: float,
-                   multiplicity: float = 1.0) -> tuple[float, np.ndarray]:
-    """The push on the full sparse system (one factorisation per active set), and λ then."""
+                   d1: np.ndarray, target: float, multiplicity: float = 1.0,
+                   f0: np.ndarray | None = None,
+                   start: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray]:
+    """The push on the full sparse system (one factorisation per active set); λ and u then.
+
+    The load is ``s f1 + f0`` (``f0``, e.g. a traction, does not change with the
+    push). The iteration starts from the active set ``start`` (e.g. the zone an
+    analytic estimate predicts: a good guess leaves one or two steps) or from
+    the first point(s) of contact.
+    """
     system = ActiveSetSolver(K, N)
-    f_pair = np.column_stack([f1, np.zeros_like(f1)])
+    f_pair = np.column_stack([f1, np.zeros_like(f1) if f0 is None else f0])
     d_pair = np.column_stack([d1, d0])
+    last: dict[str, np.ndarray] = {}
 
     def solve_pair(active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        u, lam = system.solve(active, f_pair, d_pair)
-        return lam, N @ u - d_pair
+        last["u"], lam = system.solve(active, f_pair, d_pair)
+        return lam, N @ last["u"] - d_pair
 
-    return push_for_load(solve_pair, first_contact(d0), target, summed(multiplicity))
+    first = first_contact(d0) if start is None or not start.any() else start
+    s, lam = push_for_load(solve_pair, first, target, summed(multiplicity))
+    return s, lam, last["u"] @ [s, 1.0]
 
 
 def push_for_load_condensed(W: np.ndarray, b1: np.ndarray, b0: np.ndarray, d0: np.ndarray,

@@ -202,13 +202,13 @@ class ZoneSolver:
         raise ArithmeticError(f"the contact zone kept changing for {max_rounds} rounds")
 
     def push_for_load(self, f1: np.ndarray, d0: np.ndarray, d1: np.ndarray, target: float,
-                      multiplicity: float, zone: Zone,
-                      max_rounds: int = 100) -> tuple[float, np.ndarray, np.ndarray, Zone]:
-        """The push s with total contact force ``μ Σλ = target`` for ``f = s f1, d = d0 + s d1``.
+                      multiplicity: float, zone: Zone, max_rounds: int = 100,
+                      f0: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray, Zone]:
+        """The push s with total contact force ``μ Σλ = target`` for ``f = s f1 + f0, d = d0 + s d1``.
 
         Returns ``(s, u, λ, final zone)``.
         """
-        F = np.column_stack([f1, np.zeros_like(f1)])
+        F = np.column_stack([f1, np.zeros_like(f1) if f0 is None else f0])
         D = np.column_stack([d1, d0])
         zone = zone.copy()
         for _ in range(max_rounds):

@@ -71,6 +71,18 @@ def poisson_ratio(x: float) -> str | None:
     return None if -1.0 < x < 0.5 else "in (-1, 0.5) (0.5 is incompressible, which P1 cannot model)"
 
 
+def one_of(*choices: str) -> Callable[[str], str | None]:
+    return lambda x: None if x in choices else f"one of {', '.join(choices)}"
+
+
+#: how the Hertz scenes load their body (see :class:`signorini.fem.model.CutLoad`)
+LOADING = Param("loading", "traction",
+                "traction: a uniform traction on the cut through the centre, as Hertz's theory "
+                "loads the body (the centre node's push carries no force); displacement: the cut "
+                "pushed flat by a uniform displacement adjusted to the load (always so with delta=)", kind=str,
+                check=one_of("traction", "displacement"))
+
+
 def at_least(bound: float) -> Callable[[float], str | None]:
     return lambda x: None if x >= bound else f">= {bound:g}"
 

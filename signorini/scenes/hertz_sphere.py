@@ -24,8 +24,8 @@ import numpy as np
 from signorini.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
 from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
-from signorini.scenes.base import Param, SceneFamily, at_least, between, poisson_ratio, positive
-from signorini.scenes.meshing import graded_quarter_disc
+from signorini.scenes.base import LOADING, Param, SceneFamily, at_least, between, poisson_ratio, positive
+from signorini.scenes.meshing import disc_loading, graded_quarter_disc
 
 COMMON_PARAMS = (
     Param("R", 1.0, "sphere radius", check=positive),
@@ -47,6 +47,7 @@ PARAMS = COMMON_PARAMS + (
           check=at_least(1.2)),
     Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
           kind=int, check=lambda k: None if 0 <= k <= 6 else "in 0..6"),
+    LOADING,
 )
 
 
@@ -93,14 +94,16 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
                                p["candidates"])
     delta_nominal = p["delta"] if target is None else a_est ** 2 * R
+    pushed, cut_load = disc_loading(disc, p["loading"], target)
     return SceneModel(
         mesh=disc.mesh, E=p["E"], nu=p["nu"],
-        dirichlet=[(0, disc.axis, 0.0), (1, disc.top, -delta_nominal)],
+        dirichlet=[(0, disc.axis, 0.0), (1, pushed, -delta_nominal)],
         contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),
-        load_dofs=(1, disc.top), length_scale=R, force_multiplicity=2.0 * np.pi,
+        load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0 * np.pi,
         target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
-        axisymmetric=True)
+        axisymmetric=True, cut_load=cut_load,
+        predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 
 
 FAMILY = SceneFamily(

@@ -19,6 +19,8 @@ import numpy as np
 from scipy.spatial import Delaunay
 from skfem import Mesh, MeshTet, MeshTri
 
+from signorini.fem.model import CutLoad
+
 log = logging.getLogger(__name__)
 
 MAX_PASSES = 40
@@ -238,6 +240,29 @@ class GradedDisc:
     contact_facets: np.ndarray
     axis: np.ndarray
     top: np.ndarray
+    top_facets: np.ndarray
+
+    @property
+    def centre(self) -> int:
+        """The node at the disc's centre, where the axis meets the top cut."""
+        return int(np.intersect1d(self.axis, self.top)[0])
+
+
+def disc_loading(disc: GradedDisc, loading: str, target: float | None):
+    """The pushed nodes and the cut load of a disc: the whole top cut, or its centre and a traction.
+
+    With a prescribed displacement (no ``target``) the cut is always pushed flat.
+    """
+    if loading == "displacement" or target is None:
+        return disc.top, None
+    return np.array([disc.centre]), CutLoad(component=1, nodes=disc.top, facets=disc.top_facets)
+
+
+def facets_on(mesh: MeshTri, nodes: np.ndarray) -> np.ndarray:
+    """The boundary facets whose both ends are among ``nodes``."""
+    boundary = mesh.boundary_facets()
+    inside = np.isin(mesh.facets[:, boundary], nodes).all(axis=0)
+    return boundary[inside]
 
 
 def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: float,
@@ -271,10 +296,11 @@ def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: floa
     x, y = mesh.p
     candidates = chain[(x[chain] <= candidate_extent * a_over_R * R * (1 + 1e-9))
                        & (y[chain] < R * (1 - 1e-12))]
+    top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
     return GradedDisc(mesh=mesh, candidates=candidates[np.argsort(x[candidates])],
                       contact_facets=facet_indices(mesh, chain[:-2], chain[1:-1]),  # not the top corner
-                      axis=np.nonzero(np.abs(x) < 1e-12 * R)[0],
-                      top=np.nonzero(np.abs(y - R) < 1e-12 * R)[0])
+                      axis=np.nonzero(np.abs(x) < 1e-12 * R)[0], top=top,
+                      top_facets=facets_on(mesh, top))
 
 
 def _edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:

@@ -17,6 +17,9 @@ not the last one) is a cycle, and the method then finishes on the condensed
 LCP with Murty's least-index pivoting, which terminates for SPD W. After the
 first step ``c`` no longer matters (closed gaps are zero on A, forces zero
 off A), so ``c`` only weighs a warm start ``lam0`` against the gaps.
+Without ``lam0`` a load-targeted problem starts from the answer its load
+targeting found (``problem.warm_start``: the push is one more unknown of the
+same active-set iteration), so one step confirms it.
 
 Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 """
@@ -56,7 +59,10 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
     start = time.perf_counter()
     system = ActiveSetSolver(problem.K, problem.N, opts["backend"])
-    if opts["lam0"] is None:
+    warm = problem.warm_start
+    if opts["lam0"] is None and warm.lam is not None and warm.u is not None:
+        u, lam = warm.u, warm.lam  # load targeting solved this load: one step confirms it
+    elif opts["lam0"] is None:
         u, lam = system.solve(np.zeros(problem.m, dtype=bool), problem.f, problem.d)
     else:
         lam = np.maximum(np.asarray(opts["lam0"], dtype=float), 0.0)

@@ -1,7 +1,8 @@
 """Load sweeps at the cost of back-solves: one factorisation and one Delassus operator for all loads.
 
 For a body pushed by ``s`` times its prescribed displacement, ``b(s) = s b₁ + b₀``
-with ``b₁ = N K⁻¹ f₁ − d₁`` and ``b₀ = −d₀``. Each load level is then a small
+with ``b₁ = N K⁻¹ f₁ − d₁`` and ``b₀ = P N K⁻¹ f_load − d₀`` (``f_load`` the
+traction of a unit load P on a cut, when the scene loads the body so). Each load level is then a small
 dense problem on the candidates (:func:`signorini.numerics.loading.push_for_load_condensed`)
 and one back-solve for the displacement.
 """
@@ -63,15 +64,17 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
     W = delassus(problem.N, factor)
     pu = problem.push
     b1 = problem.N @ factor.solve(pu.f1) - pu.d1
-    b0 = -pu.d0
+    # a body loaded by a traction on a cut: the traction follows the load, the push is found
+    c = problem.N @ factor.solve(pu.f_load) if pu.f_load is not None else np.zeros(problem.m)
     log.info("sweep set-up (factorisation and %d × %d Delassus operator) in %.2f s",
              problem.m, problem.m, time.perf_counter() - start)
     hertz = problem.params.get("R") is not None and "E" in problem.params
     levels = []
     for i, load in enumerate(loads):
-        s, lam = push_for_load_condensed(W, b1, b0, pu.d0, load / problem.scales.force,
+        target = load / problem.scales.force
+        s, lam = push_for_load_condensed(W, b1, target * c - pu.d0, pu.d0, target,
                                          problem.force_multiplicity)
-        level_problem = problem.pushed(s)
+        level_problem = problem.pushed(s, load=target)
         u = factor.solve(level_problem.f - problem.N.T @ lam)
         solution = ContactSolution("condensed", u, lam, "converged")
         profile = contact_profile(level_problem, solution)

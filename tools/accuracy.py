@@ -1,0 +1,104 @@
+"""Where the Hertz scenes' difference to Hertz comes from: loading, mesh grading, ν, finite body.
+
+    .venv/bin/python tools/accuracy.py        # ~2 min here; writes docs/accuracy/runs.json
+
+Every run solves with pdas at tol 1e-10 through the public API; p₀ and a are
+Hertz's profile fitted to the nodal pressures (signorini.pressure.hertz_fit).
+docs/accuracy.md quotes the tables that ``tables`` renders from the JSON
+(tools/readme.py writes them there; tests/test_readme_numbers.py holds them).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import signorini
+from signorini.files import atomic_write_text, to_json
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs" / "accuracy" / "runs.json"
+NUS = (0.0, 0.3, 0.45)
+CYLINDER_MESHES = ((120, 0.15), (40, 0.1), (24, 0.05), (60, 0.05))
+SPHERE_MESHES = ((100, 0.15), (40, 0.1))
+RATIOS = (0.05, 0.025, 0.0125)
+
+
+def cases() -> list[dict]:
+    out = []
+    for loading in ("displacement", "traction"):
+        for n_contact, grading in CYLINDER_MESHES:
+            for nu in NUS:
+                out.append({"table": "cylinder", "scene": "hertz-cylinder", "loading": loading,
+                            "n_contact": n_contact, "grading": grading, "nu": nu, "a_over_R": 0.05})
+    for loading in ("displacement", "traction"):
+        for n_contact, grading in SPHERE_MESHES:
+            for nu in NUS:
+                out.append({"table": "sphere", "scene": "hertz-sphere", "loading": loading,
+                            "n_contact": n_contact, "grading": grading, "nu": nu, "a_over_R": 0.05})
+    for scene in ("hertz-cylinder", "hertz-sphere"):
+        for nu in NUS:
+            for ratio in RATIOS:
+                out.append({"table": "finite-body", "scene": scene, "loading": "traction",
+                            "n_contact": 40, "grading": 0.1, "nu": nu, "a_over_R": ratio})
+    return out
+
+
+def run() -> list[dict]:
+    rows = []
+    for i, case in enumerate(cases(), 1):
+        params = {k: case[k] for k in ("loading", "n_contact", "grading", "nu", "a_over_R")}
+        start = time.perf_counter()
+        result = signorini.solve(case["scene"], params=params, tol=1e-10)
+        hertz = result.hertz
+        rows.append({**case, "status": result.status, "dofs": result.problem.n,
+                     "a_err": hertz.a / hertz.a_ref - 1, "p0_err": hertz.p0 / hertz.p0_ref - 1,
+                     "p0_nodal_err": hertz.p0_nodal / hertz.p0_ref - 1,
+                     "l2": hertz.pressure_l2_rel, "seconds": time.perf_counter() - start})
+        print(f"{i}/{len(cases())} {case['scene']} {params}: {rows[-1]['a_err']:+.2e}",
+              file=sys.stderr)
+    return rows
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:+.3f} %"
+
+
+def tables(rows: list[dict]) -> dict[str, str]:
+    """Markdown tables by name: error of a and p₀ for ν = 0, 0.3, 0.45 per model."""
+    out = {}
+    for table, scene_rows in (("cylinder", [r for r in rows if r["table"] == "cylinder"]),
+                              ("sphere", [r for r in rows if r["table"] == "sphere"])):
+        lines = ["| loading | n_contact | grading | dofs | " + " | ".join(
+                     f"a, p₀ at ν = {nu:g}" for nu in NUS) + " |",
+                 "|---|---:|---:|---:|" + "---|" * len(NUS)]
+        keys = dict.fromkeys((r["loading"], r["n_contact"], r["grading"]) for r in scene_rows)
+        for loading, n_contact, grading in keys:
+            group = [r for r in scene_rows if (r["loading"], r["n_contact"], r["grading"])
+                     == (loading, n_contact, grading)]
+            cells = [f"{_pct(r['a_err'])}, {_pct(r['p0_err'])}" for r in group]
+            lines.append(f"| {loading} | {n_contact} | {grading:g} | {group[0]['dofs']:,} | "
+                         + " | ".join(cells) + " |")
+        out[table] = "\n".join(lines)
+    finite = [r for r in rows if r["table"] == "finite-body"]
+    lines = ["| scene | ν | " + " | ".join(f"a, p₀ at a/R = {x:g}" for x in RATIOS) + " |",
+             "|---|---:|" + "---|" * len(RATIOS)]
+    for scene in ("hertz-cylinder", "hertz-sphere"):
+        for nu in NUS:
+            group = [r for r in finite if r["scene"] == scene and r["nu"] == nu]
+            lines.append(f"| {scene} | {nu:g} | " + " | ".join(
+                f"{_pct(r['a_err'])}, {_pct(r['p0_err'])}" for r in group) + " |")
+    out["finite-body"] = "\n".join(lines)
+    return out
+
+
+def load() -> list[dict]:
+    return json.loads(OUT.read_text())["rows"]
+
+
+if __name__ == "__main__":
+    rows = run()
+    atomic_write_text(OUT, to_json({"command": "python tools/accuracy.py", "rows": rows}))
+    print(f"written: {OUT}", file=sys.stderr)
