@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import shlex
 import sys
 from pathlib import Path
@@ -190,7 +191,43 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _sizes(text: str) -> list[int]:
+    try:
+        return [int(x) for x in text.split(",")]
+    except ValueError:
+        raise InputError(f"--sizes {text!r} is not a comma-separated list of sizes, "
+                         "e.g. --sizes 0,1,2") from None
+
+
+def _bench_peer(args: argparse.Namespace) -> int:
+    # each command loads what it needs (the peer report starts matplotlib)
+    from signorini.output.report import provenance
+    from signorini.studies import peer  # as above
+
+    points = peer.ladder([args.scene] if args.scene else list(peer.SCENES),
+                         None if args.sizes is None else _sizes(args.sizes), _pairs(args.set, "--set"))
+    if args.repeat < 1:
+        raise InputError(f"--repeat {args.repeat} must be at least 1")
+    missing = peer.getfem_missing()
+    if missing:  # issue 16: skipped with a word where GetFEM is not installed
+        print(f"signorini: {missing}; the peer benchmark is skipped, nothing written")
+        return 0
+    out = args.out or "peer-report"
+    rows = peer.run_peer(points, repeat=args.repeat, timeout=args.time_limit,
+                         progress=lambda line: print(line, file=sys.stderr))
+    given = " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == ["bench"] else ""
+    meta = {"machine": provenance(), "repeat": args.repeat, "getfem_python": peer.system_python(),
+            "signorini_command": peer.our_command(), "PYTHONPATH": os.environ.get("PYTHONPATH"),
+            "getfem": next((r["versions"]["getfem"] for r in rows if "versions" in r), None)}
+    paths = peer.write_peer(rows, out, f"signorini bench {given or '--peer getfem'}", meta)
+    print("\n".join(peer.peer_table(rows)))
+    print(f"report: {paths['md']}")
+    return 0
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
+    if args.peer:
+        return _bench_peer(args)
     import math
 
     # each command loads what it needs (the benchmark's report starts matplotlib)
@@ -199,13 +236,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from signorini.solvers.registry import get_method, methods  # as above
     from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
 
-    out = writable_directory(args.out)
-    family = get_scene(args.scene)
-    try:
-        levels = [int(x) for x in args.sizes.split(",")]
-    except ValueError:
-        raise InputError(f"--sizes {args.sizes!r} is not a comma-separated list of refinement "
-                         "levels, e.g. --sizes 0,1,2") from None
+    out = writable_directory(args.out or "bench-report")
+    family = get_scene(args.scene or "hertz-cylinder")
+    levels = _sizes(args.sizes or "0,1")
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
                          "e.g. --time-limit 120")
@@ -235,7 +268,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
             few = args.default_only_from is not None and level >= args.default_only_from
             for tolerance in (["high"] if method.exact else ["default"] if few else tolerances):
                 for count in (ranks if method.family == "petsc" else [1]):
-                    runs.append(Run(args.scene, f"refine{level}", params, method.name, tolerance,
+                    runs.append(Run(family.name, f"refine{level}", params, method.name, tolerance,
                                     ranks=count))
 
     def progress(i, n, run, row):
@@ -362,8 +395,13 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.set_defaults(run=cmd_sweep)
 
     bench = sub.add_parser("bench", help="benchmark methods × sizes × tolerances (resumable CSV)")
-    bench.add_argument("--scene", default="hertz-cylinder")
-    bench.add_argument("--sizes", default="0,1", help="refinement levels, e.g. 0,1,2")
+    bench.add_argument("--scene", help="default hertz-cylinder (with --peer: both Hertz scenes)")
+    bench.add_argument("--sizes", help="refinement levels, e.g. 0,1,2 (default 0,1; with --peer: "
+                       "rungs of the peer ladder 0..4, default all)")
+    bench.add_argument("--peer", choices=["getfem"], help="the Hertz scenes by GetFEM (system "
+                       "python3-getfem) and this package side by side: accuracy, whole-process time")
+    bench.add_argument("--repeat", type=int, default=3,
+                       help="with --peer: runs per point, the fastest kept (default 3)")
     bench.add_argument("--method", action="append", default=[],
                        help="only this method (repeatable; default: every installed sparse one)")
     bench.add_argument("--tolerance", default="low,mid,high,default",
@@ -375,7 +413,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--time-limit", type=float, default=600.0, help="seconds per run")
     bench.add_argument("--ranks", default="1", help="MPI ranks for the petsc methods, e.g. 1,2 "
                        "(each count is one more run; never more than the cores)")
-    bench.add_argument("--out", default="bench-report")
+    bench.add_argument("--out", help="default bench-report (with --peer: peer-report)")
     bench.add_argument("--report-only", action="store_true", help="rewrite the report from the CSV")
     bench.set_defaults(run=cmd_bench)
 

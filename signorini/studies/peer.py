@@ -1,0 +1,328 @@
+"""A peer, side by side: Hertz's cylinder and sphere by GetFEM and by this package.
+
+``signorini bench --peer getfem`` (issue 16, item 6). GetFEM runs in the system
+Python (Debian's ``python3-getfem`` and ``python3-gmsh``) through our own script
+:mod:`signorini.studies.peer_getfem`; this package runs as ``signorini solve SCENE
+--json -``. Both are separate processes, timed from start to exit (whole-process
+wall time: interpreter, imports, meshing, assembly, solve, output), each point
+run ``repeat`` times and the fastest kept. Both codes' p₀ and a come from the
+same least-squares fit (:func:`fit_hertz`) of their nodal pressures, and are
+compared with Hertz's values for the applied load.
+
+The ladders differ by code: GetFEM refines its gmsh size field at the contact
+(``h_contact``, a fraction of a), this package its scene parameters
+(``n_contact``, ``refine``; ``grading`` the scene's default). Each ladder spans
+about 2k to 60k dofs; the charts put both on the same axes (dofs and wall time).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from signorini.analytic import (contact_modulus, hertz_cylinder_load, hertz_cylinder_peak,
+                                hertz_sphere_load, hertz_sphere_peak)
+from signorini.errors import InputError
+from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
+from signorini.output import plots
+from signorini.pressure import hertz_fit
+
+#: the standalone GetFEM script, run by the system Python
+SCRIPT = Path(__file__).with_name("peer_getfem.py")
+#: the interpreter that has GetFEM (override with SIGNORINI_GETFEM_PYTHON)
+SYSTEM_PYTHON = "/usr/bin/python3"
+INSTALL = "apt-get install python3-getfem python3-gmsh"
+#: the package's scene and the script's name for it
+SCENES = {"hertz-cylinder": "cylinder", "hertz-sphere": "sphere"}
+#: parameters both codes take (passed to the script and as --set to the package)
+SHARED = ("R", "E", "nu", "a_over_R")
+DEFAULTS = {"R": 1.0, "E": 1.0, "nu": 0.3, "a_over_R": 0.05}
+#: GetFEM's ladder: the element size at the contact, a fraction of a
+GETFEM_LADDER = ({"h_contact": 1 / 16}, {"h_contact": 1 / 24}, {"h_contact": 1 / 40},
+                 {"h_contact": 1 / 64}, {"h_contact": 1 / 112})
+#: this package's ladder per scene (the grading is the scene's default)
+OUR_LADDER = {
+    "hertz-cylinder": ({"n_contact": 10}, {"n_contact": 20}, {"n_contact": 40},
+                       {"n_contact": 80}, {"n_contact": 80, "refine": 1}),
+    "hertz-sphere": ({"n_contact": 12}, {"n_contact": 25}, {"n_contact": 50},
+                     {"n_contact": 100}, {"n_contact": 100, "refine": 1}),
+}
+#: accuracies at which the report compares the codes' fastest runs (issue 16: 0.3 % and 0.1 %)
+TARGETS = (0.003, 0.001)
+
+
+def fit_hertz(x, p, rel: float = 1e-9) -> tuple[float, float, int]:
+    """Hertz's p0 and a from nodal pressures, the same way for both codes.
+
+    :func:`signorini.pressure.hertz_fit` (least squares of p² = p0²(1 − x²/a²)
+    over the active nodes but the outermost) with the nodes counted active by
+    their pressure alone, p > rel · max p, since GetFEM returns no active set.
+    Returns (p0, a, active nodes). The GetFEM script carries the same formula
+    (:func:`signorini.studies.peer_getfem.fit_hertz`; a test holds them equal).
+    """
+    x, p = np.abs(np.asarray(x, dtype=float)), np.asarray(p, dtype=float)
+    active = p > rel * p.max()
+    p0, a = hertz_fit(x, p, active)
+    return p0, a, int(active.sum())
+
+
+def hertz_reference(scene: str, params: dict[str, float]) -> tuple[float, float, float]:
+    """(load P, p0, a) of Hertz's solution for ``a_over_R`` (P per unit thickness for the cylinder)."""
+    R, a = params["R"], params["a_over_R"] * params["R"]
+    E_star = contact_modulus(params["E"], params["nu"])
+    if scene == "hertz-cylinder":
+        P = hertz_cylinder_load(a, R, E_star)
+        return P, hertz_cylinder_peak(P, a), a
+    P = hertz_sphere_load(a, R, E_star)
+    return P, hertz_sphere_peak(P, a), a
+
+
+def system_python() -> str:
+    return os.environ.get("SIGNORINI_GETFEM_PYTHON", SYSTEM_PYTHON)
+
+
+def getfem_missing(python: str | None = None) -> str | None:
+    """None when ``python`` imports getfem and gmsh; otherwise one line saying what to install."""
+    python = python or system_python()
+    try:
+        done = subprocess.run([python, "-c", "import getfem, gmsh"], capture_output=True,
+                              text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        return f"GetFEM not found: {python} cannot run ({exc}); install it with `{INSTALL}`"
+    if done.returncode == 0:
+        return None
+    lines = done.stderr.strip().splitlines()
+    why = lines[-1] if lines else f"exit code {done.returncode}"
+    return f"GetFEM is not installed for {python} ({why}): install it with `{INSTALL}`"
+
+
+def our_command() -> list[str]:
+    """The package's command line in this environment (the ``signorini`` script beside Python)."""
+    script = Path(sys.executable).with_name("signorini")
+    return [str(script)] if script.is_file() else [sys.executable, "-m", "signorini.cli"]
+
+
+@dataclass
+class Point:
+    """One code at one rung of its ladder on one scene."""
+
+    scene: str
+    code: str                       # "getfem" or "signorini"
+    rung: int
+    mesh: dict[str, Any]
+    params: dict[str, float]
+    row: dict[str, Any] = field(default_factory=dict)
+    walls: list[float] = field(default_factory=list)
+
+    @property
+    def label(self) -> str:
+        if self.code == "getfem":
+            return f"h = a/{1 / self.mesh['h_contact']:.0f}"
+        return " ".join(f"{k}={v}" for k, v in self.mesh.items())
+
+
+def _timed(argv: list[str], timeout: float) -> tuple[subprocess.CompletedProcess | None, float, str]:
+    tic = time.perf_counter()
+    try:
+        done = subprocess.run(argv, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, time.perf_counter() - tic, f"killed after {timeout:g} s"
+    return done, time.perf_counter() - tic, ""
+
+
+def _decode(done: subprocess.CompletedProcess | None, why: str) -> tuple[dict | None, str]:
+    import json
+
+    if done is None:
+        return None, why
+    try:  # the package writes indented JSON, the script one line after GetFEM's own output
+        text = done.stdout.strip()
+        return json.loads(text if text.startswith("{") else text.splitlines()[-1]), ""
+    except (ValueError, IndexError):
+        tail = (done.stderr.strip().splitlines() or [f"exit code {done.returncode}"])[-1]
+        return None, f"no JSON (exit code {done.returncode}): {tail}"
+
+
+def run_point(point: Point, *, python: str, command: list[str], timeout: float) -> None:
+    """Run ``point`` once: whole-process wall time appended, the row filled on the first run."""
+    import json
+
+    if point.code == "getfem":
+        given = {**point.params, **point.mesh, "scene": SCENES[point.scene]}
+        argv = [python, str(SCRIPT), json.dumps(given)]
+    else:
+        sets = {**point.params, **point.mesh}
+        argv = [*command, "solve", point.scene, "--json", "-"]
+        argv += [arg for k, v in sets.items() for arg in ("--set", f"{k}={v!r}")]
+    done, wall, why = _timed(argv, timeout)
+    point.walls.append(wall)
+    if point.row:
+        return
+    record, message = _decode(done, why)
+    P, p0_ref, a_ref = hertz_reference(point.scene, point.params)
+    row: dict[str, Any] = {"scene": point.scene, "code": point.code, "rung": point.rung,
+                           "mesh": point.label, "p0_ref": p0_ref, "a_ref": a_ref, "load": P,
+                           "status": "failed", "message": message}
+    if record is not None:
+        if point.code == "getfem":
+            x, p = record["x"], record["pressure"]
+            row.update(dofs=record["dofs"], contact_nodes=record["contact_nodes"],
+                       total_force=record["total_force"], inner_s=record["time"]["total_s"],
+                       versions=record["versions"],
+                       status="converged" if record["converged"] else "not converged",
+                       message=f"{record['newton_iterations']} Newton iterations")
+        else:
+            x, p = record["contact"]["x"], record["contact"]["pressure"]
+            row.update(dofs=record["dofs"], contact_nodes=record["contact_candidates"],
+                       total_force=record["total_force"], status=record["status"],
+                       inner_s=sum(record["time"].values()), message=record["message"])
+        row["phases"] = record["time"]
+        p0, a, active = fit_hertz(x, p)
+        row.update(p0=p0, a=a, active_nodes=active, p0_rel=p0 / p0_ref - 1.0,
+                   a_rel=a / a_ref - 1.0, force_rel=row["total_force"] / P - 1.0)
+    point.row = row
+
+
+def ladder(scenes: list[str], sizes: list[int] | None,
+           params: dict[str, float]) -> list[Point]:
+    """The points to run: per scene, both codes at the chosen rungs (default: every rung)."""
+    unknown = [s for s in scenes if s not in SCENES]
+    if unknown:
+        raise InputError(f"--scene {unknown[0]!r} has no peer model: choose from {', '.join(SCENES)}")
+    extra = sorted(set(params) - set(SHARED))
+    if extra:
+        raise InputError(f"--set {extra[0]} is not shared by both codes: the peer benchmark "
+                         f"takes {', '.join(SHARED)}")
+    rungs = range(len(GETFEM_LADDER)) if sizes is None else sizes
+    bad = [i for i in rungs if not 0 <= i < len(GETFEM_LADDER)]
+    if bad:
+        raise InputError(f"--sizes {bad[0]} is not a rung of the peer ladder: give numbers in "
+                         f"0..{len(GETFEM_LADDER) - 1}")
+    values = {**DEFAULTS, **{k: float(v) for k, v in params.items()}}
+    return [Point(scene, code, i, dict(mesh), values)
+            for scene in scenes for i in rungs
+            for code, mesh in (("getfem", GETFEM_LADDER[i]), ("signorini", OUR_LADDER[scene][i]))]
+
+
+def run_peer(points: list[Point], *, repeat: int = 3, timeout: float = 600.0,
+             python: str | None = None, command: list[str] | None = None,
+             progress: Callable[[str], None] | None = None) -> list[dict[str, Any]]:
+    """Run every point ``repeat`` times (interleaved, so that load on the machine hits both
+    codes alike); rows with the fastest whole-process time ``wall_s`` and every run's in ``walls_s``."""
+    python, command = python or system_python(), command or our_command()
+    for turn in range(repeat):
+        for point in points:
+            run_point(point, python=python, command=command, timeout=timeout)
+            if progress:
+                row = point.row
+                progress(f"[{turn + 1}/{repeat}] {point.scene} {point.code} {point.label}: "
+                         f"{row['status']} {row.get('dofs', '–')} dofs, p0 "
+                         f"{100 * row.get('p0_rel', math.nan):+.3f} %, a "
+                         f"{100 * row.get('a_rel', math.nan):+.3f} %, {point.walls[-1]:.2f} s")
+    return [{**p.row, "wall_s": min(p.walls), "walls_s": list(p.walls)} for p in points]
+
+
+def _pct(value: Any) -> str:
+    return "–" if value is None or not np.isfinite(value) else f"{100 * value:+.3f} %"
+
+
+def _error(row: dict[str, Any]) -> float:
+    """The larger of the p₀ and a errors (inf when the run gave none)."""
+    worst = max(abs(row.get("p0_rel", math.nan)), abs(row.get("a_rel", math.nan)))
+    return worst if np.isfinite(worst) else math.inf
+
+
+NAMES = {"getfem": "GetFEM", "signorini": "signorini"}
+
+
+def at_accuracy(rows: list[dict[str, Any]], scene: str, target: float) -> dict[str, dict | None]:
+    """Per code, its fastest run (whole process) with p₀ and a both within ``target`` of Hertz."""
+    best: dict[str, dict | None] = {}
+    for code in NAMES:
+        good = [r for r in rows if r["scene"] == scene and r["code"] == code
+                and r["status"] == "converged" and _error(r) <= target]
+        best[code] = min(good, key=lambda r: r["wall_s"]) if good else None
+    return best
+
+
+def peer_table(rows: list[dict[str, Any]]) -> list[str]:
+    """The Markdown tables: every run, then both codes at the target accuracies."""
+    lines = ["| scene | code | mesh | dofs | contact nodes (active) | p₀ − Hertz | a − Hertz "
+             "| force − P | whole process [s] | inside [s] | status |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|"]
+    for r in rows:
+        lines.append(
+            f"| {r['scene']} | {NAMES[r['code']]} | {r['mesh']} | {r.get('dofs', 0):,} "
+            f"| {r.get('contact_nodes', '–')} ({r.get('active_nodes', '–')}) | {_pct(r.get('p0_rel'))} "
+            f"| {_pct(r.get('a_rel'))} | {_pct(r.get('force_rel'))} | {r['wall_s']:.2f} "
+            f"| {r.get('inner_s', math.nan):.2f} | {r['status']} |")
+    lines += ["", "| scene | p₀ and a within | GetFEM: fastest run | signorini: fastest run "
+              "| signorini / GetFEM (time) |", "|---|---:|---|---|---:|"]
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        for target in TARGETS:
+            best = at_accuracy(rows, scene, target)
+            cells = [f"{r['dofs']:,} dofs, {r['wall_s']:.2f} s" if r else "not reached"
+                     for r in best.values()]
+            ratio = (f"{best['signorini']['wall_s'] / best['getfem']['wall_s']:.2f}"
+                     if all(best.values()) else "–")
+            lines.append(f"| {scene} | {100 * target:g} % | {cells[0]} | {cells[1]} | {ratio} |")
+    return lines
+
+
+def peer_figure(rows: list[dict[str, Any]]):
+    """|error| of p₀ and a against dofs (left) and whole-process wall time (right), a row per scene."""
+    from matplotlib.figure import Figure
+
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    figure = Figure(figsize=(10, 3.6 * len(scenes)), layout="constrained")
+    grid = figure.subplots(len(scenes), 2, squeeze=False)
+    for scene, (left, right) in zip(scenes, grid):
+        mine = [r for r in rows if r["scene"] == scene]
+        plots.peer_errors(mine, x="dofs", ax=left).set_title(f"{scene}: error against dofs", fontsize=9)
+        plots.peer_errors(mine, x="wall_s", ax=right).set_title(
+            f"{scene}: error against whole-process time", fontsize=9)
+    return figure
+
+
+CSV_COLUMNS = ("scene", "code", "rung", "mesh", "dofs", "contact_nodes", "active_nodes", "p0",
+               "p0_ref", "p0_rel", "a", "a_ref", "a_rel", "total_force", "load", "force_rel",
+               "wall_s", "inner_s", "status", "message")
+
+
+def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
+               meta: dict[str, Any]) -> dict[str, Path]:
+    """peer.csv, peer.json, peer.md and peer.png in ``out``, each written whole or not at all."""
+    import csv
+    import io
+
+    directory = writable_directory(out)
+    paths = {k: directory / f"peer.{k}" for k in ("csv", "json", "md", "png")}
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore",
+                            lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(paths["csv"], buffer.getvalue())
+    atomic_write_text(paths["json"], to_json({"command": command, **meta, "rows": rows}) + "\n")
+    save_figure(peer_figure(rows), paths["png"])
+    machine = meta.get("machine", {})
+    head = [f"# Peer benchmark: GetFEM and signorini on Hertz's contact", "",
+            f"`{command}` — {machine.get('date', '')}, {machine.get('cpu', '')} "
+            f"({machine.get('cores', '?')} cores), GetFEM {meta.get('getfem', '?')}, "
+            f"signorini {machine.get('versions', {}).get('signorini', '?')}.", "",
+            f"Whole-process wall time: the fastest of {meta.get('repeat', '?')} runs, each from "
+            "process start to exit; 'inside' is the time the code reports for its own phases. "
+            "p₀ and a: one least-squares fit of each code's nodal pressures "
+            "(`signorini.studies.peer.fit_hertz`), against Hertz for the applied load. "
+            "GetFEM's dofs are all its displacement dofs; signorini's its free dofs.", ""]
+    atomic_write_text(paths["md"], "\n".join(head + peer_table(rows) + [
+        "", "![errors against dofs and time](peer.png)", ""]))
+    return paths

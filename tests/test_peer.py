@@ -1,0 +1,122 @@
+"""The peer benchmark against GetFEM: one fit for both codes, GetFEM's answer, the command."""
+
+from __future__ import annotations
+
+import csv
+import importlib
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from signorini.cli import main
+from signorini.studies import peer
+
+script = importlib.import_module("signorini.studies.peer_getfem")  # getfem is imported lazily
+
+
+
+def importable(module: str) -> bool:
+    try:
+        return subprocess.run([peer.system_python(), "-c", f"import {module}"],
+                              capture_output=True, timeout=120).returncode == 0
+    except OSError:
+        return False
+
+
+@pytest.fixture(scope="module")
+def getfem():
+    """Skips where the system Python cannot run the GetFEM script."""
+    if not importable("getfem"):
+        pytest.skip("GetFEM (python3-getfem for /usr/bin/python3) not installed")
+    if not importable("gmsh"):
+        pytest.skip("gmsh (python3-gmsh for /usr/bin/python3) not installed")
+
+
+def hertz_nodes(p0=2.5e8, a=3e-4, h=1.7e-5, extent=2.0):
+    """Nodal values of Hertz's pressure on an irregular grid past the contact's edge."""
+    x = np.cumsum(np.full(int(extent * a / h), h) * (1 + 0.3 * np.sin(np.arange(int(extent * a / h)))))
+    x = np.concatenate([[0.0], x])
+    return x, p0 * np.sqrt(np.clip(1 - (x / a) ** 2, 0, None))
+
+
+def test_the_fit_recovers_hertz_exactly():
+    x, p = hertz_nodes()
+    p0, a, active = peer.fit_hertz(x, p)
+    assert p0 == pytest.approx(2.5e8, rel=1e-12) and a == pytest.approx(3e-4, rel=1e-12)
+    assert active == np.count_nonzero(x < 3e-4)
+    shuffled = np.random.default_rng(0).permutation(x.size)  # order and sign do not matter
+    assert peer.fit_hertz(-x[shuffled], p[shuffled])[:2] == pytest.approx((p0, a), rel=1e-14)
+
+
+def test_the_fit_leaves_out_the_outermost_active_node():
+    x, p = hertz_nodes()
+    edge = np.flatnonzero(p > 0)[-1]
+    spoilt = p.copy()
+    spoilt[edge] *= 5.0
+    assert peer.fit_hertz(x, spoilt)[:2] == pytest.approx(peer.fit_hertz(x, p)[:2], rel=1e-12)
+    assert np.isnan(peer.fit_hertz(x[:2], p[:2])[0])  # too few nodes: no fit
+
+
+def test_the_getfem_script_fits_with_the_same_formula():
+    x, p = hertz_nodes()
+    noisy = p * (1 + 0.01 * np.random.default_rng(1).standard_normal(p.size))
+    assert script.fit_hertz(x, noisy) == peer.fit_hertz(x, noisy)
+    assert script.fit_hertz(x, p) == peer.fit_hertz(x, p)
+
+
+@pytest.mark.usefixtures("getfem")
+@pytest.mark.parametrize("scene, tolerance", [("cylinder", 0.01), ("sphere", 0.02)])
+def test_getfem_solves_hertz_on_a_coarse_mesh(scene, tolerance):
+    given = {"scene": scene, "h_contact": 1 / 16, "E": 2.1e11, "R": 0.01}  # SI units
+    done = subprocess.run([peer.system_python(), str(peer.SCRIPT), json.dumps(given)],
+                          capture_output=True, text=True, timeout=300, check=True)
+    record = json.loads(done.stdout.strip().splitlines()[-1])
+    assert record["converged"] and record["dofs"] > 1000
+    assert abs(record["p0_rel"]) < tolerance and abs(record["a_rel"]) < tolerance
+    assert record["total_force"] == pytest.approx(record["load"], rel=1e-6)
+    assert record["a_ref"] == pytest.approx(5e-4)
+    # the row's p0 is the shared fit of the nodal pressures it returns
+    assert peer.fit_hertz(record["x"], record["pressure"])[:2] == pytest.approx(
+        (record["p0"], record["a"]), rel=1e-12)
+    assert set(record["time"]) >= {"mesh_s", "setup_s", "solve_s", "total_s"}
+
+
+@pytest.mark.usefixtures("getfem")
+def test_the_command_writes_the_table_on_a_tiny_ladder(tmp_path, capsys):
+    out = tmp_path / "peer"
+    code = main(["bench", "--peer", "getfem", "--scene", "hertz-cylinder", "--sizes", "0",
+                 "--repeat", "1", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert code == 0 and "report:" in printed
+    assert {p.name for p in out.iterdir()} == {"peer.csv", "peer.json", "peer.md", "peer.png"}
+    rows = list(csv.DictReader((out / "peer.csv").open()))
+    assert [r["code"] for r in rows] == ["getfem", "signorini"]
+    assert all(r["status"] == "converged" and abs(float(r["p0_rel"])) < 0.02 for r in rows)
+    table = (out / "peer.md").read_text()
+    assert "| hertz-cylinder | GetFEM | h = a/16 |" in table and "| signorini |" in table
+    assert "0.3 %" in table
+    record = json.loads((out / "peer.json").read_text())
+    assert record["repeat"] == 1 and len(record["rows"][0]["walls_s"]) == 1
+
+
+def test_without_getfem_the_command_says_so_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("SIGNORINI_GETFEM_PYTHON", str(tmp_path / "no-such-python"))
+    out = tmp_path / "peer"
+    code = main(["bench", "--peer", "getfem", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert code == 0 and not out.exists()
+    assert len(printed.strip().splitlines()) == 1 and "apt-get install python3-getfem" in printed
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--sizes", "7"], "--sizes 7"),
+    (["--set", "n_contact=30"], "--set n_contact"),
+    (["--scene", "block"], "--scene 'block'"),
+    (["--repeat", "0"], "--repeat 0"),
+])
+def test_bad_peer_input_is_one_line(capsys, tmp_path, argv, word):
+    code = main(["bench", "--peer", "getfem", "--out", str(tmp_path / "x"), *argv])
+    err = capsys.readouterr().err
+    assert code == 2 and word in err and len(err.strip().splitlines()) == 1
