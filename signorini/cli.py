@@ -212,11 +212,13 @@ def _bench_peer(args: argparse.Namespace) -> int:
     if missing:  # issue 16: skipped with a word where GetFEM is not installed
         print(f"signorini: {missing}; the peer benchmark is skipped, nothing written")
         return 0
-    out = args.out or "peer-report"
+    out, load = args.out or "peer-report", {"before": os.getloadavg()}
     rows = peer.run_peer(points, repeat=args.repeat, timeout=args.time_limit,
                          progress=lambda line: print(line, file=sys.stderr))
+    load["after"] = os.getloadavg()
     given = " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == ["bench"] else ""
     meta = {"machine": provenance(), "repeat": args.repeat, "getfem_python": peer.system_python(),
+            "load_average": load,
             "signorini_command": peer.our_command(), "PYTHONPATH": os.environ.get("PYTHONPATH"),
             "getfem": next((r["versions"]["getfem"] for r in rows if "versions" in r), None)}
     paths = peer.write_peer(rows, out, f"signorini bench {given or '--peer getfem'}", meta)
