@@ -275,6 +275,11 @@ class ContactProblem:
             self._factor = factorize(self.K)
         return self._factor
 
+    @property
+    def cached_factor(self):
+        """The factorisation of K :meth:`factor` made, or None when none was asked for yet."""
+        return self._factor
+
     def displacement_for(self, lam: np.ndarray) -> np.ndarray:
         """``u(λ) = K⁻¹ (f − Nᵀλ)``, the minimiser of the Lagrangian."""
         return self.factor().solve(self.f - self.N.T @ lam)
@@ -282,10 +287,13 @@ class ContactProblem:
     def inverse_energy(self, r: np.ndarray) -> float:
         """``rᵀ K⁻¹ r``: by the cached factorisation, or by conjugate gradients on big problems.
 
-        From :data:`ITERATIVE_ENERGY_FROM` dofs, when no factorisation is at
-        hand (a distributed solve never makes one), Jacobi-preconditioned CG
-        to ``ITERATIVE_ENERGY_RTOL`` replaces a serial factorisation that
-        would cost more than the solve; without convergence it factorises.
+        The certificate comes here only when the method held no factorisation
+        of K (see :func:`signorini.kkt.primal_dual_gap`). From
+        :data:`ITERATIVE_ENERGY_FROM` dofs, when no factorisation is at hand
+        (a distributed solve never makes one), Jacobi-preconditioned CG to
+        ``ITERATIVE_ENERGY_RTOL`` replaces a serial factorisation; it is slow
+        on stiff 2D meshes (about 3 minutes on the 1M-dof cylinder), the last
+        resort; without convergence it factorises.
         """
         if self._factor is None and self.n >= ITERATIVE_ENERGY_FROM and np.any(r):
             from scipy.sparse.linalg import cg
@@ -437,6 +445,9 @@ class ContactSolution:
     extras: dict[str, Any] = field(default_factory=dict)
     #: the method's own status when the package's certificate disagreed with it ("" otherwise)
     claimed_status: str = ""
+    #: a factorisation of the problem's K the method holds (a PinnedFactor, possibly with
+    #: contact dofs pinned), which the certificate reuses for its duality gap and then lets go
+    factor: Any = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:

@@ -9,6 +9,7 @@ import scipy.sparse as sp
 from signorini.kkt import (
     ACTIVE,
     INACTIVE,
+    MAX_RELEASED,
     WEAK,
     WEAK_TOL,
     active_set,
@@ -16,8 +17,11 @@ from signorini.kkt import (
     classify,
     compare,
     gap_scale,
+    primal_dual_gap,
 )
+from signorini.numerics.factor import COUNTS, factorize
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.scenes import build as scene_build
 from signorini.scenes import build_problem
 from signorini.solvers import registry
 
@@ -305,3 +309,102 @@ def test_duality_gap_by_conjugate_gradients_equals_the_factorised_one(hertz, exa
     by_cg = certificate(fresh, rough).duality_gap
     assert fresh._factor is None
     assert expected > 1e-9 and by_cg == pytest.approx(expected, rel=1e-4)
+
+
+# --- the duality gap on the method's own factorisation ----------------------------------------
+
+
+@pytest.fixture(scope="module")
+def zoned():
+    """A cylinder load-targeted on a predicted zone (nested then reuses that factorisation)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(scene_build, "NESTED_FROM_DOFS", 0)
+        return build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4)
+
+
+def refuse_the_fallback(monkeypatch):
+    """Fail on any use of the problem's own way to K⁻¹ (a factorisation, or CG on K)."""
+    def refuse(self, r):
+        raise AssertionError("the certificate did not reuse the method's factorisation")
+    monkeypatch.setattr(ContactProblem, "inverse_energy", refuse)
+
+
+def spent(step):
+    """Factorisations and back-solves ``step()`` performed, and what it returned."""
+    before = dict(COUNTS)
+    out = step()
+    return {name: COUNTS[name] - before[name] for name in COUNTS}, out
+
+
+def textbook_gap(problem, u, lam):
+    """``λ⁺ᵀ(d − Nu) + ½ rᵀK⁻¹r`` with a factorisation of K of its own."""
+    lam = np.maximum(lam, 0.0)
+    r = problem.K @ u - problem.f + problem.N.T @ lam
+    return float(lam @ problem.gap(u)) + 0.5 * float(r @ factorize(problem.K).solve(r))
+
+
+def perturbed(solution, size, seed=0):
+    rng = np.random.default_rng(seed)
+    return (solution.u * (1 + size * rng.standard_normal(solution.u.size)),
+            solution.lam * (1 + size * rng.standard_normal(solution.lam.size)))
+
+
+@pytest.mark.parametrize("method", ["pdas", "nested", "condensed"])
+def test_the_certificate_costs_one_back_solve_of_the_method_factorisation(zoned, method,
+                                                                          monkeypatch):
+    """After the solve, the certificate factorises nothing and back-solves once (never CG)."""
+    assert zoned.cached_factor is None
+    solution = registry.get_method(method).function(zoned)
+    assert solution.factor is not None
+    if method == "nested":
+        assert "coarse" in solution.message or "load targeting" in solution.message
+        assert len(solution.factor.fixed) > 0  # the core is pinned
+    refuse_the_fallback(monkeypatch)
+    cost, cert = spent(lambda: certificate(zoned, solution))
+    assert cost["factorisations"] == 0 and cost["back_solves"] <= 2, cost
+    assert cert.worst()[1] < 1e-10
+    assert solution.factor is None  # let go once used
+    assert spent(lambda: certificate(zoned, solution))[0] == {"factorisations": 0, "back_solves": 0}
+
+
+def test_the_gap_on_a_pinned_factorisation_is_the_textbook_one_or_tighter(zoned, monkeypatch):
+    """Re-optimising the pinned nodes' forces only raises the dual bound, and it stays a bound."""
+    exact = registry.get_method("nested").function(zoned)
+    factor = exact.factor
+    refuse_the_fallback(monkeypatch)
+    for size in (1e-3, 1e-6):
+        u, lam = perturbed(exact, size)
+        cost, pinned = spent(lambda: primal_dual_gap(zoned, u, lam, [factor]))
+        textbook = textbook_gap(zoned, u, lam)
+        assert cost == {"factorisations": 0, "back_solves": 1}
+        assert pinned <= textbook + 1e-12 * abs(textbook)
+        assert pinned == pytest.approx(textbook, rel=1e-3)
+        assert pinned >= zoned.energy(u) - zoned.energy(exact.u) - 1e-12 * abs(zoned.energy(u))
+
+
+def test_pinned_nodes_that_would_pull_are_released(zoned, monkeypatch):
+    """A factorisation pinned on a wider zone than the answer's (the same K pushed less)."""
+    wide = registry.get_method("pdas").function(zoned).factor
+    lighter = zoned.pushed(0.9 * zoned.push.scale)
+    exact = registry.solve(lighter, "pdas")
+    assert 0 < len(wide.fixed) - (exact.lam > 0).sum() <= MAX_RELEASED
+    refuse_the_fallback(monkeypatch)
+    for size in (0.0, 1e-6):
+        u, lam = perturbed(exact, size)
+        cost, gap = spent(lambda: primal_dual_gap(lighter, u, lam, [wide]))
+        assert cost["factorisations"] == 0 and cost["back_solves"] > 1
+        textbook = textbook_gap(lighter, u, lam)
+        assert gap == pytest.approx(textbook, rel=1e-3, abs=1e-14 * abs(lighter.energy(u)))
+        assert gap <= textbook + 1e-12 * abs(lighter.energy(u))
+
+
+def test_a_factorisation_of_another_matrix_is_not_used(hertz, exact):
+    u, lam = perturbed(exact, 1e-4)
+    stiffer = factorize(2.0 * hertz.K)
+    assert primal_dual_gap(hertz, u, lam, [stiffer]) == pytest.approx(textbook_gap(hertz, u, lam),
+                                                                      rel=1e-9)
+    # the same matrix under another name (CSC, or a copy) is recognised
+    same = factorize(hertz.K)
+    same.matrix = sp.csc_matrix(hertz.K, copy=True)
+    cost, _ = spent(lambda: primal_dual_gap(hertz.with_data(), u, lam, [same]))
+    assert cost == {"factorisations": 0, "back_solves": 1}

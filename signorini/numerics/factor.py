@@ -12,6 +12,11 @@ the environment variable ``SIGNORINI_FACTOR`` overrides it. Measured here
 one solve, PARDISO vs CHOLMOD vs SuperLU: 0.037/0.056/0.091 s at 17k dofs,
 0.18/0.28/0.73 s at 66k, 1.0/1.9/24.5 s at 261k, 5.4/11.3 s at 1.04M (where the
 whole end-to-end run peaked at 4.1 GB with PARDISO; see docs/speed.md).
+
+Every factorisation knows the matrix it factorised (``matrix``) and the dofs it
+pinned (``fixed``; none for a plain one), so that the certificate can reuse a
+method's factorisation of the same K; :data:`COUNTS` counts the factorisations
+and back-solves done in this process, so that tests can count what a step costs.
 """
 
 from __future__ import annotations
@@ -27,6 +32,17 @@ from signorini.errors import BackendNotInstalled, InputError
 
 BACKENDS = ("pardiso", "cholmod", "superlu")
 _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
+
+#: factorisations (of K, of K with dofs pinned, of a saddle-point matrix) and back-solves
+#: (one per right-hand side) done in this process by every class here: read it before and
+#: after a step to count what the step cost
+COUNTS = {"factorisations": 0, "back_solves": 0}
+NO_DOFS = np.zeros(0, dtype=int)
+
+
+def _count_solve(b: np.ndarray) -> np.ndarray:
+    COUNTS["back_solves"] += 1 if b.ndim == 1 else b.shape[1]
+    return b
 
 
 def available_backends() -> list[str]:
@@ -58,18 +74,24 @@ def resolve_backend(backend: str | None = None, n: int | None = None) -> str:
 
 
 class Factor:
-    """``K⁻¹`` applied to a vector or an (n, k) block of right-hand sides."""
+    """``K⁻¹`` applied to a vector or an (n, k) block of right-hand sides.
+
+    ``matrix`` is K as given (kept by reference: a certificate checks that a
+    factorisation it is offered is one of its problem's K); ``fixed`` the
+    pinned dofs, none here (see :class:`PinnedFactor`, which solves alike).
+    """
 
     backend = "superlu"
+    fixed = NO_DOFS
 
     def __init__(self, K: sp.spmatrix):
-        K = sp.csc_matrix(K)
-        self.shape = K.shape
-        self._lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+        self.matrix, self.shape = K, K.shape
+        COUNTS["factorisations"] += 1
+        self._lu = spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                              options={"SymmetricMode": True})
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._lu.solve(np.asarray(b, dtype=float))
+        return self._lu.solve(_count_solve(np.asarray(b, dtype=float)))
 
 
 #: from this many dofs CHOLMOD orders by nested dissection (METIS) instead of AMD: measured on
@@ -85,14 +107,14 @@ def cholmod_ordering(n: int) -> str:
 
 def cholmod_analysis(K: sp.csc_matrix):
     """CHOLMOD's symbolic analysis (ordering, supernodes) of the pattern of K."""
-    from sksparse.cholmod import analyze
+    from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
 
     return analyze(K, mode="supernodal", ordering_method=cholmod_ordering(K.shape[0]))
 
 
 def cholmod_numeric(symbolic, K: sp.csc_matrix):
     """The numeric factorisation of K on a symbolic analysis of its pattern."""
-    from sksparse.cholmod import CholmodNotPositiveDefiniteError
+    from sksparse.cholmod import CholmodNotPositiveDefiniteError  # as above
 
     try:
         return symbolic.cholesky(K)
@@ -101,17 +123,18 @@ def cholmod_numeric(symbolic, K: sp.csc_matrix):
 
 
 class CholmodFactor(Factor):
-    """CHOLMOD's supernodal ``K = LLᵀ`` (scikit-sparse)."""
+    """CHOLMOD's supernodal ``K = LLᵀ`` (scikit-sparse), on a given symbolic analysis or its own."""
 
     backend = "cholmod"
 
-    def __init__(self, K: sp.spmatrix):
+    def __init__(self, K: sp.spmatrix, symbolic=None):
+        self.matrix, self.shape = K, K.shape
         K = sp.csc_matrix(K)
-        self.shape = K.shape
-        self._factor = cholmod_numeric(cholmod_analysis(K), K)
+        COUNTS["factorisations"] += 1
+        self._factor = cholmod_numeric(cholmod_analysis(K) if symbolic is None else symbolic, K)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._factor(np.asarray(b, dtype=float))
+        return self._factor(_count_solve(np.asarray(b, dtype=float)))
 
 
 class PardisoFactor(Factor):
@@ -120,9 +143,10 @@ class PardisoFactor(Factor):
     backend = "pardiso"
 
     def __init__(self, K: sp.spmatrix):
-        import pypardiso
+        import pypardiso  # MKL: 0.2 s to import, only for a matrix PARDISO factorises
 
-        self.shape = K.shape
+        self.matrix, self.shape = K, K.shape
+        COUNTS["factorisations"] += 1
         self._upper = sp.triu(K, format="csr")
         self._solver = pypardiso.PyPardisoSolver(mtype=2)
         # pypardiso searches sys.prefix for MKL on every new solver (0.2-0.4 s) unless told where
@@ -131,8 +155,7 @@ class PardisoFactor(Factor):
         self._solver.factorize(self._upper)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        b = np.asarray(b, dtype=float)
-        return self._solver.solve(self._upper, b)
+        return self._solver.solve(self._upper, _count_solve(np.asarray(b, dtype=float)))
 
 
 _CLASSES = {"superlu": Factor, "cholmod": CholmodFactor, "pardiso": PardisoFactor}
@@ -159,7 +182,7 @@ def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
 
 
 class ActiveSetSolver:
-    """Solutions of ``Ku + N_Aᵀλ_A = f, N_A u = d_A`` (``λ`` zero off A), active set after active set.
+    """Solutions of ``Ku + N_Aᵀλ_A = f, N_A u = d`` (``λ`` zero off A), active set after active set.
 
     When each row of N bounds one dof, the active dofs are pinned
     (:class:`PinnedFactor`: a fixed dof's row and column become the
@@ -168,6 +191,11 @@ class ActiveSetSolver:
     the numeric factorisation repeated). Otherwise the saddle-point matrix, with
     its constraint rows scaled by ``s = mean |diag K|`` (both blocks of one
     size in any units; ``λ = s μ``), is factorised by LU.
+
+    ``factor`` is the factorisation of K (with the last active set's dofs
+    pinned, or none) that the last solve used, for the certificate to reuse;
+    None after a saddle-point solve. It is let go before the next one is made,
+    so that two never live at once.
     """
 
     def __init__(self, K: sp.csr_matrix, N: sp.csr_matrix, backend: str | None = None):
@@ -181,26 +209,32 @@ class ActiveSetSolver:
         self._pinning = None
         if self._dofs is not None:
             self._pinning = Pinning(self.K, analyse=self.backend == "cholmod")
+        self.factor: Factor | PinnedFactor | None = None
 
     def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k)."""
         active = np.asarray(active, dtype=bool)
         f, d = np.asarray(f, float), np.asarray(d, float)
         lam = np.zeros((self.m,) + f.shape[1:])
+        self.factor = None
         if self._dofs is not None:
             fixed = self._dofs[active]
             coef = self._coef[active] if f.ndim == 1 else self._coef[active][:, None]
             rhs = np.array(f)
             rhs[fixed] = d[active] / coef
-            u = PinnedFactor(self.K, fixed, self.backend, self._pinning).solve(rhs)
+            self.factor = PinnedFactor(self.K, fixed, self.backend, self._pinning)
+            u = self.factor.solve(rhs)
             lam[active] = (f[fixed] - self.K[fixed] @ u) / coef
             return u, lam
         N_A = self.N[active]
         if N_A.shape[0] == 0:
-            return factorize(self.K, self.backend).solve(f), lam
+            self.factor = factorize(self.K, self.backend)
+            return self.factor.solve(f), lam
         scale = float(np.mean(np.abs(self.K.diagonal()))) or 1.0
         system = sp.bmat([[self.K, scale * N_A.T], [scale * N_A, None]], format="csc")
-        solution = spla.splu(system).solve(np.concatenate([f, scale * d[active]]))
+        COUNTS["factorisations"] += 1
+        rhs = _count_solve(np.concatenate([f, scale * d[active]]))
+        solution = spla.splu(system).solve(rhs)
         lam[active] = scale * solution[self.n:]
         return solution[:self.n], lam
 
@@ -229,9 +263,9 @@ class Pinning:
         data = np.where(touched, (self._rows == self._cols).astype(float), self.K.data)
         return sp.csc_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape)
 
-    def factor(self, fixed: np.ndarray):
+    def factor(self, fixed: np.ndarray) -> CholmodFactor:
         """CHOLMOD's factor of K with the ``fixed`` dofs' rows and columns made the identity's."""
-        return cholmod_numeric(self._symbolic, self.matrix(fixed))
+        return CholmodFactor(self.matrix(fixed), self._symbolic)
 
 
 class PinnedFactor:
@@ -241,6 +275,8 @@ class PinnedFactor:
     The pinned matrix (K with the fixed dofs' rows and columns made the
     identity's, K's own pattern) is factorised: CHOLMOD on a shared
     :class:`Pinning`'s symbolic analysis, other backends from scratch.
+    ``matrix`` is K itself (unpinned). With no dof fixed it solves as a
+    :class:`Factor` of K does.
     """
 
     def __init__(self, K: sp.csc_matrix, fixed: np.ndarray, backend: str | None = None,
@@ -250,9 +286,10 @@ class PinnedFactor:
         self.backend = resolve_backend(backend, self.n)
         if pinning is None:
             pinning = Pinning(K, analyse=self.backend == "cholmod")
+        self.matrix = pinning.K
         self._coupling = pinning.K[:, self.fixed]
         if self.backend == "cholmod":
-            self._factor = pinning.factor(self.fixed).solve_A
+            self._factor = pinning.factor(self.fixed).solve
         else:
             self._factor = factorize(pinning.matrix(self.fixed), self.backend).solve
 

@@ -115,6 +115,11 @@ class ZoneSolver:
         self.factorisations = 0
         self.back_solves = 0
 
+    @property
+    def factor(self) -> PinnedFactor | None:
+        """The factorisation of K with the core pinned now in use (the certificate reuses it)."""
+        return self._factor
+
     # --- linear algebra on the pinned factorisation -------------------------------------------
 
     def _use_core(self, core: np.ndarray) -> None:

@@ -43,7 +43,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                 f"({factor.backend} factorisation)",
         iterations=steps, build_time=build_time,
         solve_time=time.perf_counter() - start - build_time,
-        extras={"backend": factor.backend})
+        extras={"backend": factor.backend}, factor=factor)
 
 
 METHODS = (

@@ -108,7 +108,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                  f"{system.back_solves - back_solves} back-solves"),
         iterations=1, build_time=build_time, solve_time=time.perf_counter() - start - build_time,
         extras={"backend": system.backend, "core": int(final.core.sum()),
-                "band": int(final.band.sum())})
+                "band": int(final.band.sum())}, factor=system.factor)
 
 
 METHODS = (

@@ -97,7 +97,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         u, lam = system.solve(active, problem.f, problem.d)
     return ContactSolution(method="pdas", u=u, lam=lam, status=status, message=message,
                            iterations=iteration, solve_time=time.perf_counter() - start,
-                           history=history)
+                           history=history, factor=system.factor)
 
 
 METHODS = (

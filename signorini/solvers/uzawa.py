@@ -201,7 +201,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     return ContactSolution(
         method=_name, u=u, lam=lam, status=status, message=message, iterations=iteration,
         build_time=build_time, solve_time=time.perf_counter() - start - build_time,
-        history=history,
+        history=history, factor=factor,
         extras={"rho": rho, "lambda_max": lam_max, "power_steps": power_steps,
                 "rho_over_bound": rho * lam_max / 2.0, "operator": choice,
                 "acceleration": opts["acceleration"], "restarts": restarts})
