@@ -151,26 +151,36 @@ def bench_time_vs_dofs(rows: list[dict], *, axes=None):
     return left, slopes
 
 
-def peer_errors(rows: list[dict], *, x: str = "dofs", ax=None):
+def peer_errors(rows: list[dict], *, x: str = "dofs", targets: Iterable[float] = (0.003, 0.001),
+                ax=None):
     """|relative error| of Hertz's p₀ (solid) and a (dashed) against ``x``, one colour per code.
 
     ``rows`` are the peer benchmark's (:mod:`signorini.studies.peer`): ``code``,
-    ``p0_rel``, ``a_rel`` and ``x`` (``dofs`` or ``wall_s``, whole-process time);
-    hollow markers where the code did not report convergence.
+    ``dofs``, ``p0_rel``, ``a_rel`` and ``x`` (``dofs`` or ``wall_s``, the
+    whole-process time). Points join in the order of the code's ladder (dofs);
+    ▲ an error above Hertz, ▼ below; hollow where the code did not report
+    convergence; dotted lines at the ``targets``.
     """
+    from matplotlib.ticker import NullFormatter
+
     ax = axes(ax)
+    for target in targets:
+        ax.axhline(target, color="0.5", ls=":", lw=1)
     for i, code in enumerate(sorted({r["code"] for r in rows})):
         mine = sorted((r for r in rows if r["code"] == code and np.isfinite(r.get("p0_rel", np.nan))),
-                      key=lambda r: r[x])
+                      key=lambda r: r["dofs"])
         if not mine:
             continue
         xs = np.array([r[x] for r in mine], dtype=float)
         good = np.array([r["status"] == "converged" for r in mine])
         for key, style, name in (("p0_rel", "-", "p₀"), ("a_rel", "--", "a")):
-            ys = np.maximum(np.abs([r[key] for r in mine]), 1e-6)
+            signed = np.array([r[key] for r in mine])
+            ys = np.maximum(np.abs(signed), 1e-6)
             ax.loglog(xs, ys, style, color=f"C{i}", lw=1, label=f"{code}: {name}")
-            ax.loglog(xs[good], ys[good], "o", color=f"C{i}", ms=4)
-            ax.loglog(xs[~good], ys[~good], "o", mfc="none", color=f"C{i}", ms=4)
+            for sign, marker in ((signed >= 0, "^"), (signed < 0, "v")):
+                ax.loglog(xs[good & sign], ys[good & sign], marker, color=f"C{i}", ms=5)
+                ax.loglog(xs[~good & sign], ys[~good & sign], marker, mfc="none", color=f"C{i}", ms=5)
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel({"dofs": "dofs", "wall_s": "whole-process wall time [s]"}.get(x, x))
     ax.set_ylabel("|relative error| against Hertz")
     ax.grid(alpha=0.3, which="both")

@@ -287,8 +287,9 @@ def peer_figure(rows: list[dict[str, Any]]):
     grid = figure.subplots(len(scenes), 2, squeeze=False)
     for scene, (left, right) in zip(scenes, grid):
         mine = [r for r in rows if r["scene"] == scene]
-        plots.peer_errors(mine, x="dofs", ax=left).set_title(f"{scene}: error against dofs", fontsize=9)
-        plots.peer_errors(mine, x="wall_s", ax=right).set_title(
+        plots.peer_errors(mine, x="dofs", targets=TARGETS, ax=left).set_title(
+            f"{scene}: error against dofs (▲ above Hertz, ▼ below)", fontsize=9)
+        plots.peer_errors(mine, x="wall_s", targets=TARGETS, ax=right).set_title(
             f"{scene}: error against whole-process time", fontsize=9)
     return figure
 
