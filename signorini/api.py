@@ -178,6 +178,8 @@ class Result:
         else:
             record["total_force"] = None
             record["contact"] = None
+        if "adequacy" in solution.extras:  # the boundary beyond the candidates (signorini.adequacy)
+            record["adequacy"] = solution.extras["adequacy"]
         record["extras"] = {k: v for k, v in solution.extras.items()
                             if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}
         return record

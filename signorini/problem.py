@@ -30,7 +30,8 @@ from signorini.files import atomic_write_bytes
 from signorini.numerics.factor import factorize
 
 #: the statuses a :class:`ContactSolution` can carry
-STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed")
+STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed",
+            "model_inadequate")
 
 
 #: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
@@ -116,6 +117,29 @@ class WarmStart:
     u: np.ndarray | None = None
 
 
+@dataclass(frozen=True)
+class Watch:
+    """The boundary beyond the contact candidates, checked after every solve.
+
+    ``rows`` (k × all dofs) are the obstacle's normal rows at the k boundary
+    nodes that are not candidates and ``gaps`` their initial gaps, so that
+    their gaps at a state are ``gaps − rows · expand(u)``; ``edge`` indexes the
+    candidates that share a boundary facet facing the obstacle with one of
+    them; ``candidate_gaps`` are the candidates' gaps before any push;
+    ``remedy`` says what to change when the contact outgrows the candidates
+    (see :mod:`signorini.adequacy`).
+    """
+
+    rows: sp.csr_matrix
+    gaps: np.ndarray
+    edge: np.ndarray
+    candidate_gaps: np.ndarray
+    remedy: str = "extend the scene's contact candidates or lower the load"
+
+    def gap(self, problem: "ContactProblem", u: np.ndarray) -> np.ndarray:
+        return self.gaps - self.rows @ problem.expand(u)
+
+
 @dataclass
 class ContactProblem:
     """Data of ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` (dimensionless).
@@ -147,6 +171,7 @@ class ContactProblem:
     coarse_model : a function of this problem returning a model of the same
         scene about 16 times coarser (or None), for the ``nested`` method.
     warm_start : what load targeting learnt (see :class:`WarmStart`).
+    watch : the boundary beyond the candidates, checked after a solve (see :class:`Watch`).
     """
 
     K: sp.csr_matrix
@@ -170,6 +195,7 @@ class ContactProblem:
     reference: str = ""
     coarse_model: Callable[["ContactProblem"], "ContactProblem | None"] | None = None
     warm_start: WarmStart = field(default_factory=WarmStart)
+    watch: Watch | None = None
 
     def __post_init__(self) -> None:
         self.K = sp.csr_matrix(self.K)

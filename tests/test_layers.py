@@ -4,7 +4,7 @@ Layers, low to high (a module may import its own layer and the layers below):
 
 0. ``errors``, ``files``                 exceptions, atomic writes
 1. ``numerics``                          factorisations, dense LCP, zone kernel, load targeting
-2. ``problem``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``fem``
+2. ``problem``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
 3. ``solvers``                           the registry collects each backend's METHODS
 4. ``scenes``                            families, meshing, scene files, building problems
 5. ``api`` and the package itself        the public Python API
@@ -30,6 +30,7 @@ LAYERS = {
     "errors": 0, "files": 0,
     "numerics": 1,
     "problem": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
+    "adequacy": 2,
     "fem": 2,
     "solvers": 3,
     "scenes": 4,

@@ -42,7 +42,7 @@ from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.numerics.loading import calibrate_push
 from signorini.numerics.zone import ZoneSolver
-from signorini.problem import ContactProblem, Push, Scales, WarmStart
+from signorini.problem import ContactProblem, Push, Scales, WarmStart, Watch
 
 log = logging.getLogger(__name__)
 
@@ -298,6 +298,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
         scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
         params=params, mesh=mesh, axisymmetric=axisymmetric,
         push=_push(lifted, scale, None if f_load is None else f_load[free], offset_load, target),
+        watch=boundary_watch(model, dof_table, U),
         warm_start=WarmStart(calibration[0], *(zone_solver or (None, None)), u=calibration[1]))
     problem.assemble_time = time.perf_counter() - start
     log.info("assembled %d free dofs, %d contact candidates in %.2f s",
@@ -327,6 +328,58 @@ def cut_traction(model: SceneModel, mesh: Any, dof_table: np.ndarray,
     f_load[dofs] = -weights / (model.force_multiplicity * area)
     others = ~np.isin(dofs, load_dofs)
     return f_load, float(-model.force_multiplicity * f_load[dofs[others]].sum())
+
+
+def _facing_normals(mesh: Any, facets: np.ndarray) -> np.ndarray:
+    """Outward unit normals (dim, k) of boundary ``facets`` (edges in 2D, triangles in 3D)."""
+    p = mesh.p
+    ends = mesh.facets[:, facets]
+    if p.shape[0] == 2:
+        tangent = p[:, ends[1]] - p[:, ends[0]]
+        normal = np.array([tangent[1], -tangent[0]])
+    else:
+        normal = np.cross(p[:, ends[1]] - p[:, ends[0]], p[:, ends[2]] - p[:, ends[0]], axis=0)
+    inside = p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
+    outward = np.sign(np.einsum("ij,ij->j", normal, p[:, ends].mean(axis=1) - inside))
+    return normal * outward / np.linalg.norm(normal, axis=0)
+
+
+def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch | None:
+    """The boundary nodes beyond the candidates and the candidates at their edge (see Watch).
+
+    Gaps are asked of the obstacle at the physical coordinates (a scene-unit
+    wrapper is unwrapped); an obstacle that cannot answer there leaves the
+    problem unwatched.
+    """
+    mesh = model.mesh
+    facets = mesh.boundary_facets()
+    nodes = np.unique(mesh.facets[:, facets])
+    watched = np.setdiff1d(nodes, model.contact_nodes)
+    obstacle = getattr(model.obstacle, "obstacle", model.obstacle)
+    try:
+        normals, gaps = obstacle.normals_and_gaps(mesh.p[:, watched].T)
+        _, candidate_gaps = obstacle.normals_and_gaps(mesh.p[:, model.contact_nodes].T)
+    except (ValueError, TypeError):
+        return None
+    dim = mesh.p.shape[0]
+    rows = sp.csr_matrix((np.asarray(normals, dtype=float).ravel(),
+                          (np.repeat(np.arange(len(watched)), dim), dof_table[:, watched].T.ravel())),
+                         shape=(len(watched), dof_table.size))
+    # candidates on a facet that faces the obstacle and reaches a node beyond the candidates
+    is_candidate = np.zeros(mesh.p.shape[1], dtype=bool)
+    is_candidate[model.contact_nodes] = True
+    ends = mesh.facets[:, facets]
+    mixed = is_candidate[ends].any(axis=0) & ~is_candidate[ends].all(axis=0)
+    edge_nodes = np.array([], dtype=int)
+    if mixed.any():
+        outward = _facing_normals(mesh, facets[mixed])
+        towards, _ = obstacle.normals_and_gaps(mesh.p[:, ends[:, mixed]].mean(axis=1).T)
+        facing = np.einsum("ij,ji->i", np.asarray(towards, dtype=float), outward) > 0.1
+        edge_nodes = np.unique(ends[:, mixed][:, facing])
+    edge = np.nonzero(np.isin(model.contact_nodes, edge_nodes))[0]
+    return Watch(rows=rows, gaps=np.asarray(gaps, dtype=float) / U, edge=edge,
+                 candidate_gaps=np.asarray(candidate_gaps, dtype=float) / U,
+                 remedy=model.candidate_remedy)
 
 
 def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,

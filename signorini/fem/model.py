@@ -81,3 +81,5 @@ class SceneModel:
     cut_load: CutLoad | None = None
     #: per candidate: in contact by the scene's analytic estimate (load targeting starts there)
     predicted_contact: np.ndarray | None = None
+    #: what to change when the contact outgrows the candidates (signorini.adequacy)
+    candidate_remedy: str = "extend the scene's contact candidates or lower the load"

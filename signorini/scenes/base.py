@@ -83,6 +83,11 @@ LOADING = Param("loading", "traction",
                 check=one_of("traction", "displacement"))
 
 
+#: what a scene with a ``candidates`` parameter says when the contact outgrows its candidates
+CANDIDATE_REMEDY = ("raise the scene parameter candidates (now {candidates:g}, in contact half-widths) "
+                    "or lower the load")
+
+
 def at_least(bound: float) -> Callable[[float], str | None]:
     return lambda x: None if x >= bound else f">= {bound:g}"
 

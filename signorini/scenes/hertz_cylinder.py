@@ -26,7 +26,7 @@ from typing import Any
 from signorini.analytic import hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
-from signorini.scenes.base import LOADING, Param, SceneFamily, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import CANDIDATE_REMEDY, LOADING, Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc
 
 PARAMS = (
@@ -92,6 +92,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
         obstacle=FlatObstacle(0.0),
         load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0,
         target_load=target, params=params, cut_load=cut_load,
+        candidate_remedy=CANDIDATE_REMEDY.format(**p),
         predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 
 

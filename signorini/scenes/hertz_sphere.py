@@ -24,7 +24,7 @@ import numpy as np
 from signorini.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
 from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
-from signorini.scenes.base import LOADING, Param, SceneFamily, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import CANDIDATE_REMEDY, LOADING, Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc
 
 COMMON_PARAMS = (
@@ -102,7 +102,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
         obstacle=FlatObstacle(0.0),
         load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0 * np.pi,
         target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
-        axisymmetric=True, cut_load=cut_load,
+        axisymmetric=True, cut_load=cut_load, candidate_remedy=CANDIDATE_REMEDY.format(**p),
         predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 
 

@@ -16,6 +16,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from signorini.adequacy import adequacy, warnings
 from signorini.errors import InputError
 from signorini.kkt import certificate
 from signorini.problem import ContactProblem, ContactSolution
@@ -77,7 +78,13 @@ def check_max_iter(max_iter: Any) -> int | None:
 
 def judge(problem: ContactProblem, solution: ContactSolution,
           tol: float | None) -> ContactSolution:
-    """Downgrade a claim of convergence that the certificate does not back."""
+    """Downgrade a claim of convergence that the certificate does not back, or the model cannot.
+
+    An answer the certificate accepts becomes ``model_inadequate`` when the
+    boundary beyond the contact candidates shows that the contact outgrew
+    them (:func:`signorini.adequacy.adequacy`); warnings about the model are
+    appended to the message.
+    """
     if solution.status != "converged":
         return solution
     accept = ACCEPT_FACTOR * tol if tol is not None else DEFAULT_ACCEPT
@@ -93,4 +100,14 @@ def judge(problem: ContactProblem, solution: ContactSolution,
             f"{solution.message}; the method claimed success but the KKT certificate's "
             f"{worst_name} residual is {worst:.1e} > {accept:.0e}: tighten the tolerance "
             "or use an exact method (pdas)").lstrip("; ")
+        return solution
+    found = adequacy(problem, solution, accept)
+    if found is not None:
+        solution.extras["adequacy"] = found.as_dict()
+        if found.inadequate(accept):
+            solution.claimed_status = "converged"
+            solution.status = "model_inadequate"
+            solution.message = f"{solution.message}; {found.message()}".lstrip("; ")
+    for warning in warnings(problem):
+        solution.message = f"{solution.message}; warning: {warning}".lstrip("; ")
     return solution
