@@ -6,8 +6,10 @@ Backends for the SPD stiffness (one interface, ``factorize(K).solve(b)``):
 - ``cholmod``: CHOLMOD's supernodal Cholesky through scikit-sparse (optional).
 - ``pardiso``: MKL PARDISO through pypardiso (optional).
 
-``auto`` (the default) takes the first installed of pardiso, cholmod, superlu;
-the environment variable ``SIGNORINI_FACTOR`` overrides it. Measured here
+``auto`` (the default) takes the first installed of pardiso, cholmod, superlu
+(leaving PARDISO, 0.2 s to import, the small matrices where it does not pay:
+:data:`PARDISO_OVER_CHOLMOD_FROM`); the environment variable ``SIGNORINI_FACTOR``
+overrides it. Measured here
 (2 cores) on the Hertz cylinder by examples/factorisations.py, factorisation +
 one solve, PARDISO vs CHOLMOD vs SuperLU: 0.037/0.056/0.091 s at 17k dofs,
 0.18/0.28/0.73 s at 66k, 1.0/1.9/24.5 s at 261k, 5.4/11.3 s at 1.04M (where the
@@ -54,15 +56,24 @@ def available_backends() -> list[str]:
 #: there, and on the 6-dof bogie of the tutorials PARDISO's solve left a 1.0e-12 primal
 #: residual where CHOLMOD's and SuperLU's met 1e-12
 PARDISO_FROM = 5_000
+#: with CHOLMOD installed, ``auto`` leaves it the matrices below this many dofs. Measured whole
+#: process here (2 cores shared with other work, 3 runs each), ``signorini solve hertz-cylinder``
+#: at 8k, 20k, 31k, 42k and 59k dofs took 0.3-0.9 s less with CHOLMOD (median 0.60 s against
+#: 0.90 s at the default 8k; importing pypardiso and MKL alone takes 0.2 s) in 45-80 % of the
+#: memory; at 125k both took 10.3 s (PARDISO in 4x the memory). Only a solve of many
+#: factorisations on an idle machine went the other way (31k dofs, nine: 1.95 s against 2.3 s).
+PARDISO_OVER_CHOLMOD_FROM = 50_000
 
 
 def resolve_backend(backend: str | None = None, n: int | None = None) -> str:
     """Pick the backend: an explicit name, ``SIGNORINI_FACTOR``, or the first installed
-    (PARDISO only from :data:`PARDISO_FROM` dofs when the size ``n`` is given)."""
+    (when the size ``n`` is given, PARDISO only from :data:`PARDISO_OVER_CHOLMOD_FROM` dofs
+    when CHOLMOD is installed, from :data:`PARDISO_FROM` when it is not)."""
     name = backend or os.environ.get("SIGNORINI_FACTOR") or "auto"
     if name == "auto":
         installed = available_backends()
-        if n is not None and n < PARDISO_FROM and len(installed) > 1:
+        start = PARDISO_OVER_CHOLMOD_FROM if "cholmod" in installed else PARDISO_FROM
+        if n is not None and n < start and len(installed) > 1:
             installed = [b for b in installed if b != "pardiso"]
         return installed[0]
     if name not in BACKENDS:

@@ -136,7 +136,7 @@ def candidate_nodes(problem: ContactProblem) -> np.ndarray:
 def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed: bool = True,
                 axisymmetric: bool | None = None):
     """The solved scene as a :class:`meshio.Mesh` (physical units; see the module's docstring)."""
-    import meshio
+    import meshio  # meshio: only when a file is written
 
     mesh = problem.mesh
     if mesh is None:
@@ -210,7 +210,7 @@ def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | o
         raise InputError(f"--vtk {str(target)!r} cannot be written ({exc.strerror})") from None
     os.close(fd)
     try:
-        import meshio
+        import meshio  # as above
 
         meshio.write(tmp, data, file_format=file_format)
         umask = os.umask(0)

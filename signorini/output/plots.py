@@ -16,7 +16,7 @@ from signorini.analytic import hertz_pressure
 def axes(ax):
     """``ax``, or the Axes of a new figure (pyplot's global state untouched)."""
     if ax is None:
-        from matplotlib.figure import Figure
+        from matplotlib.figure import Figure  # matplotlib (0.4 s to import): only when a figure is drawn
         ax = Figure(figsize=(6.4, 4.2), layout="constrained").add_subplot()
     return ax
 
@@ -72,7 +72,7 @@ def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None
     envelope is the Pareto front.
     """
     if ax is None:
-        from matplotlib.figure import Figure
+        from matplotlib.figure import Figure  # as above
         ax = Figure(figsize=(10, 5), layout="constrained").add_subplot()
     markers = {"low": "v", "mid": "s", "high": "o", "default": "D"}
     methods = sorted({r["method"] for r in rows})
@@ -102,7 +102,7 @@ def bench_time_vs_dofs(rows: list[dict], *, axes=None):
     Returns the left Axes and the fitted slopes ``{label: slope}`` of time against dofs.
     """
     if axes is None:
-        from matplotlib.figure import Figure
+        from matplotlib.figure import Figure  # as above
         axes = Figure(figsize=(11, 4.4), layout="constrained").subplots(1, 2)
     left, right = axes
     slopes: dict[str, float] = {}
@@ -117,7 +117,7 @@ def bench_time_vs_dofs(rows: list[dict], *, axes=None):
         right.axhline(1.0, color="k", ls="--", lw=1)
         if dofs.size >= 2:
             slopes["one factorisation + solve"] = float(np.polyfit(np.log(dofs), np.log(series_f), 1)[0])
-    import matplotlib
+    import matplotlib  # as above
 
     for i, method in enumerate(sorted({r["method"] for r in rows})):
         mine = [r for r in rows if r["method"] == method]
@@ -161,7 +161,7 @@ def peer_errors(rows: list[dict], *, x: str = "dofs", targets: Iterable[float] =
     ▲ an error above Hertz, ▼ below; hollow where the code did not report
     convergence; dotted lines at the ``targets``.
     """
-    from matplotlib.ticker import NullFormatter
+    from matplotlib.ticker import NullFormatter  # as above
 
     ax = axes(ax)
     for target in targets:

@@ -64,7 +64,7 @@ def mpirun_command(ranks: int, argv: list[str]) -> tuple[list[str], dict[str, st
 
 
 def _comm():
-    from mpi4py import MPI
+    from mpi4py import MPI  # optional (MPI): only under mpirun
 
     return MPI.COMM_WORLD
 

@@ -46,7 +46,7 @@ _NOT_FOR_QP = ("ECOS_BB",)  # branch and bound for mixed-integer problems
 
 def qp_solvers() -> list[str]:
     """Installed cvxpy solvers that accept a convex QP (natively or as an SOCP)."""
-    import cvxpy as cp
+    import cvxpy as cp  # optional backend, 0.6 s to import: only when a cvxpy method runs
     from cvxpy.constraints import SOC
     from cvxpy.reductions.solvers import defines
 
@@ -113,7 +113,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         raise InputError(f"method 'cvxpy' does not accept option(s) "
                          f"{', '.join(repr(u) for u in unknown)}; accepted options: "
                          f"{', '.join(OPTIONS)}")
-    import cvxpy as cp
+    import cvxpy as cp  # as above
 
     solver = _check_solver(options.get("solver", DEFAULT_SOLVER))
     opts = solver_options(solver, tol, max_iter)

@@ -63,7 +63,7 @@ ROUND_OFF_FLOOR = 1e-13
 
 def _petsc():
     """petsc4py's PETSc module, initialised once (MPI first, through mpi4py when launched)."""
-    import petsc4py
+    import petsc4py  # optional backend (0.3 s, and MPI): only when a petsc method runs
 
     if not getattr(petsc4py, "_signorini_ready", False):
         try:
@@ -199,7 +199,7 @@ def _stationarity_test(PETSc, lower, upper, b, job: dict[str, Any]):
     lifted loads dwarf the contact forces) or never fired on small curved ones
     (round-off above it). Target ``SAFETY_RELATIVE · tol``, floored at round-off.
     """
-    from mpi4py import MPI
+    from mpi4py import MPI  # as above
 
     reason = PETSc.SNES.ConvergedReason
     lo, hi = lower.getArray(readonly=True), upper.getArray(readonly=True)

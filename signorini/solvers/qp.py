@@ -189,7 +189,7 @@ def _scs_status(raw: str) -> str:
 
 def _mosek_nest(settings: dict[str, Any]) -> dict[str, Any]:
     """MOSEK (through CVXOPT) takes its parameters as one dict keyed by ``mosek.*param``."""
-    import mosek
+    import mosek  # optional backend: only when MOSEK runs
 
     params = dict(settings.pop("mosek", {}))
     for name, value in settings.items():
@@ -426,7 +426,7 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
             f"method {spec.method_name!r} builds dense n × n matrices and n = {problem.n} "
             f"exceeds max_dense_dofs = {max_dense_dofs}: pick a sparse backend or raise "
             "the option max_dense_dofs")
-    import qpsolvers
+    import qpsolvers  # optional backend: only when a qp-* method runs
 
     if spec.name not in qpsolvers.available_solvers:
         missing = [m for m in spec.modules if importlib.util.find_spec(m) is None]

@@ -120,7 +120,7 @@ def atlas_outcomes(rows: list[dict], *, column: str = "case", ax=None, title: st
 
 
 def _rectangle(x: float, y: float, colour: str):
-    from matplotlib.patches import Rectangle
+    from matplotlib.patches import Rectangle  # matplotlib: only when a figure is drawn
 
     return Rectangle((x, y), 1.0, 1.0, facecolor=colour, edgecolor="white", lw=0.8)
 

@@ -1,0 +1,67 @@
+"""Start-up: heavy optional backends are imported only when a method or a command needs them.
+
+Each check runs in a fresh interpreter (this one has imported everything by now).
+"""
+
+import importlib.util
+import json
+import subprocess
+import sys
+
+import pytest
+
+from signorini.numerics.factor import PARDISO_OVER_CHOLMOD_FROM, available_backends
+from signorini.solvers.registry import methods
+
+#: optional backends a plain solve or ``signorini methods`` must not import
+HEAVY = ("cvxpy", "petsc4py", "mpi4py", "qpsolvers", "osqp", "clarabel", "matplotlib")
+
+
+def fresh(code: str) -> dict:
+    """Run ``code`` in a new interpreter; the JSON object it prints last is the answer."""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def loaded_after(statements: str, modules=HEAVY) -> str:
+    """Code that runs ``statements`` and prints which of ``modules`` it imported."""
+    return (f"import json, sys\n{statements}\n"
+            f"print(json.dumps({{'loaded': [m for m in {tuple(modules)!r} if m in sys.modules]}}))")
+
+
+def test_a_solve_imports_no_optional_backend():
+    answer = fresh(loaded_after(
+        "import signorini\n"
+        "result = signorini.solve('hertz-cylinder', params={'n_contact': 16, 'grading': 0.4})\n"
+        "assert result.status == 'converged', result.solution.message"))
+    assert answer["loaded"] == []
+
+
+@pytest.mark.skipif(not {"cholmod", "pardiso"} <= set(available_backends()),
+                    reason="needs both CHOLMOD and PARDISO installed")
+def test_the_default_cylinder_is_factorised_without_pardiso():
+    """Importing pypardiso and MKL costs 0.2 s: not worth it below PARDISO_OVER_CHOLMOD_FROM."""
+    answer = fresh(loaded_after(
+        "import signorini\n"
+        "result = signorini.solve('hertz-cylinder')\n"
+        f"assert result.problem.n < {PARDISO_OVER_CHOLMOD_FROM}, result.problem.n",
+        modules=HEAVY + ("pypardiso",)))
+    assert answer["loaded"] == []
+
+
+def test_methods_lists_what_is_installed_without_importing_it():
+    answer = fresh(
+        "import contextlib, io, json, sys\n"
+        "from signorini.cli import main\n"
+        "out = io.StringIO()\n"
+        "with contextlib.redirect_stdout(out):\n"
+        "    main(['methods'])\n"
+        f"loaded = [m for m in {HEAVY!r} if m in sys.modules]\n"
+        "print(json.dumps({'loaded': loaded, 'lines': out.getvalue().splitlines()}))")
+    assert answer["loaded"] == []
+    listed = {line.split()[0]: line.split()[1] for line in answer["lines"][1:]}
+    assert set(listed) == {m.name for m in methods()}
+    for method in methods():
+        installed = all(importlib.util.find_spec(module) is not None for module in method.requires)
+        assert listed[method.name] == ("installed" if installed else "not"), method.name
