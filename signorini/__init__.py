@@ -10,12 +10,20 @@ The public API (see the README's "Python" section)::
 :func:`build_problem`, :meth:`ContactProblem.from_qp` or
 :meth:`ContactProblem.load`) and returns a :class:`Result` in the problem's
 own units; :func:`certificate` judges any answer; :func:`methods` and
-:func:`scenes` list what there is.
+:func:`scene_families` list what there is.
 """
 
 import logging
 
-from signorini.api import DEFAULT_METHOD, Result, build_problem, certificate, methods, scenes, solve
+from signorini.api import (
+    DEFAULT_METHOD,
+    Result,
+    build_problem,
+    certificate,
+    methods,
+    scene_families,
+    solve,
+)
 from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
 from signorini.kkt import Certificate
 from signorini.problem import ContactProblem, ContactSolution, Scales
@@ -26,4 +34,4 @@ logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 __all__ = ["DEFAULT_METHOD", "BackendNotInstalled", "Certificate", "ContactProblem", "ContactSolution",
            "InputError", "Result", "Scales", "SignoriniError", "SolverError", "__version__",
-           "build_problem", "certificate", "methods", "scenes", "solve"]
+           "build_problem", "certificate", "methods", "scene_families", "solve"]

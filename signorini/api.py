@@ -253,10 +253,13 @@ def methods(installed_only: bool = False) -> list[Method]:
     return _all_methods(installed_only)
 
 
-def scenes() -> dict[str, SceneFamily]:
-    """The built-in scene families by name (each lists its parameters and reference)."""
+def scene_families() -> dict[str, SceneFamily]:
+    """The built-in scene families by name (each lists its parameters and reference).
+
+    (Not ``scenes``: that name is the subpackage :mod:`signorini.scenes`.)
+    """
     return dict(SCENES)
 
 
-__all__ = ["DEFAULT_METHOD", "Result", "build_problem", "certificate", "methods", "scenes", "solve",
-           "solve_summary"]
+__all__ = ["DEFAULT_METHOD", "Result", "build_problem", "certificate", "methods", "scene_families",
+           "solve", "solve_summary"]

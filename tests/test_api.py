@@ -121,5 +121,15 @@ def test_bad_input_is_one_clear_error(build, words):
 def test_the_listings():
     names = {m.name for m in signorini.methods()}
     assert {"pdas", "uzawa", "nested", "qp-osqp", "qp-clarabel", "cvxpy"} <= names
-    assert {"hertz-cylinder", "block", "punch"} <= set(signorini.scenes())
+    assert {"hertz-cylinder", "block", "punch"} <= set(signorini.scene_families())
     assert all(name in dir(signorini) for name in signorini.__all__)
+
+
+def test_no_public_name_hides_a_subpackage():
+    import pkgutil
+
+    modules = {m.name for m in pkgutil.iter_modules(signorini.__path__)}
+    assert not modules & set(signorini.__all__)
+    import signorini.scenes.hertz_cylinder as cylinder  # was shadowed by a function `scenes`
+
+    assert cylinder.FAMILY.name == "hertz-cylinder"
