@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.kkt import Certificate, certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem, ContactSolution
@@ -153,6 +154,19 @@ class Result:
         """The comparison with Hertz's solution, when that is the problem's reference."""
         return self.comparison if self.reference is not None and self.reference.key == "hertz" else None
 
+    @property
+    def estimate(self) -> ErrorEstimate | None:
+        """The a posteriori estimate of the discretisation error in the energy norm.
+
+        ``total`` (physical units, √(force · length)), ``relative`` = η / ‖u_h‖_E
+        and ``elements`` (η_K per element, in the problem's units); see
+        :mod:`signorini.fem.estimate`. None for problems without a mesh
+        (:meth:`ContactProblem.from_qp`) or an answer that is not finite.
+        """
+        if not hasattr(self, "_estimate"):
+            self._estimate = estimate(self.problem, self.solution) if self.finite else None
+        return self._estimate
+
     # -- records ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """The record ``signorini solve --json`` writes (arrays as NumPy until serialised)."""
@@ -166,6 +180,7 @@ class Result:
             "time": {"assemble_s": problem.assemble_time, "build_s": solution.build_time,
                      "solve_s": solution.solve_time},
             "kkt": self.certificate.as_dict(),
+            "estimate": None if self.estimate is None else self.estimate.as_dict(),
         }
         if self.finite:
             record["total_force"] = self.total_force
@@ -202,6 +217,9 @@ def solve_summary(record: dict[str, Any]) -> str:
         active = sum(record["contact"]["active"])
         lines.append(f"  total force {record['total_force']:.6g} (applied {record['applied_load']:.6g}), "
                      f"{active} nodes in contact")
+    if record.get("estimate"):
+        lines.append(f"  error estimate (energy norm, ZZ): {100 * record['estimate']['relative']:.2f} % "
+                     f"of ‖u_h‖ over {record['estimate']['elements']} elements")
     if record.get("hertz"):
         h = record["hertz"]
         lines.append(f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "

@@ -1,4 +1,5 @@
-"""Write the generated blocks of README.md and docs/accuracy.md from the committed artefacts they quote.
+"""Write the generated blocks of README.md, docs/accuracy.md and docs/estimate.md from the committed
+artefacts they quote.
 
     .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`
 
@@ -15,6 +16,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
+import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 
 from signorini.files import atomic_write_text  # noqa: E402
 from signorini.output.report import readme_validation  # noqa: E402
@@ -22,7 +24,8 @@ from signorini.output.report import readme_validation  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 ACCURACY = ROOT / "docs" / "accuracy.md"
-DOCUMENTS = (README, ACCURACY)
+ESTIMATE = ROOT / "docs" / "estimate.md"
+DOCUMENTS = (README, ACCURACY, ESTIMATE)
 
 
 def blocks(document: Path = README) -> dict[str, str]:
@@ -32,6 +35,8 @@ def blocks(document: Path = README) -> dict[str, str]:
         return {"validation": readme_validation(report)}
     if document == ACCURACY:
         return accuracy.tables(accuracy.load())
+    if document == ESTIMATE:
+        return estimate_study.tables(estimate_study.load())
     raise ValueError(f"no generated blocks for {document}")
 
 

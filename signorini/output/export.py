@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.fem.estimate import candidate_nodes as mesh_nodes_at
 from signorini.pressure import contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -125,12 +126,7 @@ def project_to_nodes(points: np.ndarray, elements: np.ndarray, cell_values: np.n
 
 def candidate_nodes(problem: ContactProblem) -> np.ndarray:
     """The mesh node of each contact candidate (matched by coordinates)."""
-    from scipy.spatial import cKDTree
-
-    distance, nodes = cKDTree(problem.mesh.p.T).query(problem.contact_points)
-    if np.any(distance > 1e-9 * max(1.0, float(np.max(np.abs(problem.mesh.p))))):
-        raise ValueError("a contact candidate is not a mesh node")
-    return nodes
+    return mesh_nodes_at(problem.mesh, problem.contact_points)
 
 
 def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed: bool = True,

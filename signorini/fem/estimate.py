@@ -1,0 +1,278 @@
+"""A posteriori estimate of the discretisation error in the energy norm (recovery, ZZ).
+
+The P1 strain ``ε_h = ε(u_h)`` is discontinuous from element to element; the
+exact strain is continuous. Zienkiewicz & Zhu's estimator (O. C. Zienkiewicz,
+J. Z. Zhu, "A simple error estimator and adaptive procedure for practical
+engineering analysis", IJNME 24 (1987) 337–357) measures the error by the
+distance between ``ε_h`` and a continuous strain ``ε*`` recovered from it:
+
+    η_K² = ∫_K (ε* − ε_h) : C : (ε* − ε_h) dx        (× r in axisymmetric models)
+
+with C the elasticity tensor, so ``η = (Σ η_K²)^½`` estimates ``‖u − u_h‖_E``,
+``‖v‖_E² = a(v, v)`` the elastic energy. Recovering the strain or the stress
+is the same thing here (C is constant, the averaging linear). ``ε*`` is the
+lumped L² projection of ``ε_h`` onto continuous P1, component by component —
+ZZ's nodal averaging, each element weighted by ``∫_K φᵢ dx`` (``∫_K φᵢ r dx``
+axisymmetric): at node i, ``ε*ᵢ = Σ_K ∫_K ε_h φᵢ / Σ_K ∫_K φᵢ``. In the
+axisymmetric model (see :func:`signorini.fem.assembly.axisymmetric_elasticity`)
+the strain has the hoop part ``ε_θθ = u_r / r``, which varies inside an element
+and is recovered like the others; integrals are by quadrature
+(:data:`QUADRATURE_ORDER`, :data:`AXISYMMETRIC_ORDER`). 3D tetrahedra work the same way (six components).
+
+**Contact term.** P1 contact holds the Signorini conditions at the nodes only:
+on an edge of the contact boundary from an active node (pressure p > 0, gap
+0) to an inactive one (p = 0, gap g > 0) the interpolated pressure and gap
+are both positive, and ``∫ p_h g_h ds`` is the energy this mismatch carries.
+It is the complementarity term of the residual estimators for Signorini
+contact (the term ``∫_Γc λ_h u_hn`` in P. Hild, S. Nicaise, "Residual a
+posteriori error estimators for contact problems in elasticity", M2AN 41
+(2007) 897–923, written with the gap). It is non-zero only on the edges at
+the edge of the contact zone; :func:`contact_term` gives it per edge (2D models), and
+:func:`estimate` adds it to the element that holds the edge. docs/estimate.md
+measures what each part contributes and the estimate's effectivity.
+
+Everything here is in the problem's (dimensionless) units: energies in
+``force · displacement`` of :class:`signorini.problem.Scales`, per unit
+thickness in plane strain and per radian in axisymmetric models.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.spatial import cKDTree
+from skfem.quadrature import get_quadrature
+
+from signorini.problem import ContactProblem, ContactSolution
+
+#: quadrature order of the element integrals: 2 integrates the plane-strain and 3D ones
+#: exactly (a linear field squared); the axisymmetric ones are rational (the hoop strain
+#: u_r / r, times r), integrated to order 4
+QUADRATURE_ORDER = 2
+AXISYMMETRIC_ORDER = 4
+
+
+@dataclass(frozen=True)
+class ErrorEstimate:
+    """The estimated energy-norm error of one solution, per element and in total.
+
+    ``elements`` are the per-element indicators ``η_K`` (recovery part, and the
+    contact term of the element's contact edges), ``recovery`` and ``contact``
+    the two parts of ``total = (Σ η_K²)^½``, ``energy_norm`` is ``‖u_h‖_E``;
+    ``scale`` turns them into physical units (√(force · length)).
+    """
+
+    elements: np.ndarray
+    recovery: float
+    contact: float
+    energy_norm: float
+    scale: float = 1.0
+
+    @property
+    def total(self) -> float:
+        """η in physical units: ``(Σ η_K²)^½``."""
+        return float(np.sqrt(np.sum(self.elements ** 2))) * self.scale
+
+    @property
+    def relative(self) -> float:
+        """η / ‖u_h‖_E (the same in every unit system)."""
+        return float(np.sqrt(np.sum(self.elements ** 2)) / self.energy_norm) \
+            if self.energy_norm > 0 else float("nan")
+
+    def as_dict(self) -> dict[str, float | int]:
+        """Scalars only (the JSON of a result): total, relative, elements and the largest one."""
+        return {"total": self.total, "relative": self.relative,
+                "elements": int(self.elements.size),
+                "max_element": float(np.max(self.elements)) * self.scale,
+                "recovery": self.recovery * self.scale, "contact": self.contact * self.scale,
+                "energy_norm": self.energy_norm * self.scale}
+
+
+@dataclass(frozen=True)
+class Quadrature:
+    """Points and weights of a rule on every simplex of a mesh.
+
+    ``bary`` (d + 1, q) are the barycentric coordinates of the q points,
+    ``points`` (dim, elements, q) their positions, ``dx`` (elements, q) the
+    weights times the element's measure (times r when axisymmetric) and
+    ``gradients`` (elements, d + 1, dim) those of the barycentric coordinates.
+    """
+
+    bary: np.ndarray
+    points: np.ndarray
+    dx: np.ndarray
+    gradients: np.ndarray
+
+
+def quadrature(mesh: Any, axisymmetric: bool = False, order: int | None = None) -> Quadrature:
+    """The quadrature of order ``order`` on every simplex of ``mesh`` (triangles or tetrahedra);
+    by default :data:`QUADRATURE_ORDER`, or :data:`AXISYMMETRIC_ORDER` when axisymmetric."""
+    if order is None:
+        order = AXISYMMETRIC_ORDER if axisymmetric else QUADRATURE_ORDER
+    X, W = get_quadrature(mesh.refdom, order)
+    bary = np.vstack([1.0 - X.sum(axis=0), X])
+    corners = mesh.p[:, mesh.t]  # (dim, d + 1, elements)
+    J = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)  # (elements, dim, d): columns edges
+    inverse = np.linalg.inv(J)  # rows: gradients of the barycentric coordinates 1..d
+    gradients = np.concatenate([-inverse.sum(axis=1, keepdims=True), inverse], axis=1)
+    points = np.einsum("dke,kq->deq", corners, bary)
+    dx = np.abs(np.linalg.det(J))[:, None] * W[None, :]
+    if axisymmetric:
+        dx = dx * points[0]
+    return Quadrature(bary=bary, points=points, dx=dx, gradients=gradients)
+
+
+def strains(mesh: Any, u: np.ndarray, rule: Quadrature, axisymmetric: bool = False) -> np.ndarray:
+    """The strain of the P1 field ``u`` (nodes, dim) at the quadrature points.
+
+    Returns (components, elements, q): ``xx, yy, xy`` in 2D (``zz, yz, xz``
+    added in 3D), then the hoop strain ``u_r / r`` when axisymmetric; tensor
+    (not engineering) shears.
+    """
+    values = u[mesh.t]  # (d + 1, elements, dim)
+    grad = np.einsum("kei,ekj->eij", values, rule.gradients)  # ∂u_i/∂x_j per element
+    dim = grad.shape[1]
+    pairs = [(0, 0), (1, 1), (0, 1)] if dim == 2 else \
+        [(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)]
+    q = rule.bary.shape[1]
+    parts = [np.repeat((0.5 * (grad[:, i, j] + grad[:, j, i]))[:, None], q, axis=1)
+             for i, j in pairs]
+    if axisymmetric:
+        u_r = np.einsum("ke,kq->eq", values[:, :, 0], rule.bary)
+        parts.append(u_r / rule.points[0])
+    return np.array(parts)
+
+
+def energy_density(eps: np.ndarray, Lambda: float, Mu: float, dim: int) -> np.ndarray:
+    """``ε : C : ε = 2μ ε : ε + λ (tr ε)²`` of strains laid out as :func:`strains` gives them.
+
+    The first ``dim`` components are the diagonal, the next ``dim (dim − 1) / 2``
+    the shears (counted twice in ``ε : ε``) and one more, if any, the hoop strain.
+    """
+    shears = dim * (dim - 1) // 2
+    diagonal = np.concatenate([eps[:dim], eps[dim + shears:]])
+    trace = diagonal.sum(axis=0)
+    squares = np.sum(diagonal ** 2, axis=0) + 2.0 * np.sum(eps[dim:dim + shears] ** 2, axis=0)
+    return 2.0 * Mu * squares + Lambda * trace ** 2
+
+
+def recover(mesh: Any, eps: np.ndarray, rule: Quadrature) -> np.ndarray:
+    """ZZ's recovered strain at the quadrature points: the lumped L² projection onto P1."""
+    n = mesh.p.shape[1]
+    mass = np.zeros(n)
+    moments = np.zeros((len(eps), n))
+    for k, nodes in enumerate(mesh.t):
+        weight = rule.dx * rule.bary[k]  # φ_k times the weights, per element and point
+        mass += np.bincount(nodes, weight.sum(axis=1), minlength=n)
+        for c, component in enumerate(np.einsum("ceq,eq->ce", eps, weight)):
+            moments[c] += np.bincount(nodes, component, minlength=n)
+    nodal = moments / mass
+    return np.einsum("cke,kq->ceq", nodal[:, mesh.t], rule.bary)
+
+
+def lame(E: float, nu: float) -> tuple[float, float]:
+    """Lamé's λ and μ of Young's modulus and Poisson's ratio."""
+    return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+
+
+def element_energies(mesh: Any, u: np.ndarray, E: float, nu: float,
+                     axisymmetric: bool = False) -> np.ndarray:
+    """``a_K(u, u)`` on every element of ``mesh`` for the nodal field ``u`` (nodes, dim)."""
+    rule = quadrature(mesh, axisymmetric)
+    density = energy_density(strains(mesh, u, rule, axisymmetric), *lame(E, nu), mesh.p.shape[0])
+    return np.sum(density * rule.dx, axis=1)
+
+
+def candidate_nodes(mesh: Any, points: np.ndarray) -> np.ndarray:
+    """The mesh node at each contact point (matched by coordinates; ValueError if one is not)."""
+    distance, nodes = cKDTree(mesh.p.T).query(points)
+    if np.any(distance > 1e-9 * max(1.0, float(np.max(np.abs(mesh.p))))):
+        raise ValueError("a contact candidate is not a mesh node")
+    return nodes
+
+
+def contact_term(mesh: Any, nodes: np.ndarray, pressure: np.ndarray, gap: np.ndarray,
+                 axisymmetric: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``∫_E p_h g_h ds`` (``× r`` axisymmetric) on the boundary edges between two candidates.
+
+    ``nodes`` are the candidates' mesh nodes, ``pressure`` and ``gap`` their
+    nodal values, interpolated linearly along each edge (negative parts cut:
+    the term measures where both are positive). Returns the edges' elements
+    and the integrals (three-point Gauss, exact for the cubic integrand).
+    2D meshes only; 3D models get no contact term.
+    """
+    if mesh.p.shape[0] != 2:
+        return np.zeros(0, dtype=int), np.zeros(0)
+    facets = mesh.boundary_facets()
+    ends = mesh.facets[:, facets]
+    local = np.full(mesh.p.shape[1], -1)
+    local[nodes] = np.arange(len(nodes))
+    both = (local[ends] >= 0).all(axis=0)
+    facets, ends = facets[both], ends[:, both]
+    a, b = local[ends]
+    pa, pb = np.maximum(pressure[a], 0.0), np.maximum(pressure[b], 0.0)
+    ga, gb = np.maximum(gap[a], 0.0), np.maximum(gap[b], 0.0)
+    length = np.linalg.norm(mesh.p[:, ends[1]] - mesh.p[:, ends[0]], axis=0)
+    s = 0.5 + np.array([-1.0, 0.0, 1.0]) * 0.5 * np.sqrt(0.6)
+    w = np.array([5.0, 8.0, 5.0]) / 18.0
+    integrand = ((1 - s)[:, None] * pa + s[:, None] * pb) * ((1 - s)[:, None] * ga + s[:, None] * gb)
+    if axisymmetric:
+        r = mesh.p[0]
+        integrand = integrand * ((1 - s)[:, None] * r[ends[0]] + s[:, None] * r[ends[1]])
+    return mesh.f2t[0, facets], length * (w @ integrand)
+
+
+def material_units(problem: ContactProblem) -> tuple[float, float] | None:
+    """Young's modulus in the problem's units and Poisson's ratio (None without a material).
+
+    Assembly divides E by a stress scale ``force / (displacement · length^k)``
+    (k = 1 in axisymmetric and 3D models), which is E itself for a scene made
+    dimensionless and 1 otherwise.
+    """
+    params = problem.params
+    if problem.mesh is None or "E" not in params or "nu" not in params:
+        return None
+    s = problem.scales
+    k = 1 if (problem.axisymmetric or problem.mesh.p.shape[0] == 3) else 0
+    stress = s.force / (s.displacement * s.length ** k)
+    return float(params["E"]) / stress, float(params["nu"])
+
+
+def estimate(problem: ContactProblem, solution: ContactSolution,
+             contact: bool = True) -> ErrorEstimate | None:
+    """The ZZ estimate of ``solution``'s energy-norm error (None without a mesh or a material).
+
+    ``contact`` adds the complementarity term at the edge of the contact zone
+    (2D models with pressures; see the module's docstring).
+    """
+    material = material_units(problem)
+    if material is None or not np.all(np.isfinite(solution.u)):
+        return None
+    mesh, axisymmetric = problem.mesh, bool(problem.axisymmetric)
+    E, nu = material
+    Lambda, Mu = lame(E, nu)
+    dim = mesh.p.shape[0]
+    u = problem.expand(solution.u).reshape(-1, dim)
+    rule = quadrature(mesh, axisymmetric)
+    eps = strains(mesh, u, rule, axisymmetric)
+    energy = np.sum(energy_density(eps, Lambda, Mu, dim) * rule.dx, axis=1)
+    squares = np.sum(energy_density(recover(mesh, eps, rule) - eps, Lambda, Mu, dim) * rule.dx,
+                     axis=1)
+    recovery = float(np.sqrt(squares.sum()))
+    contact_squares = np.zeros_like(squares)
+    if contact and problem.weights is not None and np.all(np.isfinite(solution.lam)):
+        try:
+            nodes = candidate_nodes(mesh, problem.contact_points)
+        except ValueError:
+            nodes = None
+        if nodes is not None:
+            elements, values = contact_term(mesh, nodes, solution.lam / problem.weights,
+                                            problem.gap(solution.u), axisymmetric)
+            contact_squares += np.bincount(elements, values, minlength=len(squares))
+    s = problem.scales
+    return ErrorEstimate(elements=np.sqrt(squares + contact_squares), recovery=recovery,
+                         contact=float(np.sqrt(contact_squares.sum())),
+                         energy_norm=float(np.sqrt(energy.sum())),
+                         scale=float(np.sqrt(s.force * s.displacement)))
