@@ -1,6 +1,6 @@
 """Where the Hertz scenes' difference to Hertz comes from: loading, mesh grading, ν, finite body.
 
-    .venv/bin/python tools/accuracy.py        # ~2 min here; writes docs/accuracy/runs.json
+    .venv/bin/python tools/accuracy.py        # ~3 min here; writes docs/accuracy/runs.json
 
 Every run solves with pdas at tol 1e-10 through the public API; p₀ and a are
 Hertz's profile fitted to the nodal pressures (signorini.pressure.hertz_fit).
@@ -21,35 +21,39 @@ from signorini.files import atomic_write_text, to_json
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "accuracy" / "runs.json"
 NUS = (0.0, 0.3, 0.45)
-CYLINDER_MESHES = ((120, 0.15), (40, 0.1), (24, 0.05), (60, 0.05))
-SPHERE_MESHES = ((100, 0.15), (40, 0.1))
+#: (loading, mesher, n_contact, grading): the former default first, the current default marked
+CYLINDER_MESHES = (("displacement", "bisection", 120, 0.15), ("traction", "bisection", 120, 0.15),
+                   ("traction", "bisection", 40, 0.1), ("traction", "bisection", 60, 0.05),
+                   ("traction", "relaxed", 16, 0.15), ("traction", "relaxed", 40, 0.15),
+                   ("traction", "relaxed", 48, 0.12))
+SPHERE_MESHES = (("displacement", "bisection", 100, 0.15), ("traction", "bisection", 100, 0.15),
+                 ("traction", "relaxed", 40, 0.15), ("traction", "relaxed", 60, 0.15),
+                 ("traction", "relaxed", 100, 0.15))
+DEFAULTS = {"hertz-cylinder": (40, 0.15), "hertz-sphere": (60, 0.15)}
 RATIOS = (0.05, 0.025, 0.0125)
 
 
 def cases() -> list[dict]:
     out = []
-    for loading in ("displacement", "traction"):
-        for n_contact, grading in CYLINDER_MESHES:
+    for table, scene, meshes in (("cylinder", "hertz-cylinder", CYLINDER_MESHES),
+                                 ("sphere", "hertz-sphere", SPHERE_MESHES)):
+        for loading, mesher, n_contact, grading in meshes:
             for nu in NUS:
-                out.append({"table": "cylinder", "scene": "hertz-cylinder", "loading": loading,
+                out.append({"table": table, "scene": scene, "loading": loading, "mesher": mesher,
                             "n_contact": n_contact, "grading": grading, "nu": nu, "a_over_R": 0.05})
-    for loading in ("displacement", "traction"):
-        for n_contact, grading in SPHERE_MESHES:
-            for nu in NUS:
-                out.append({"table": "sphere", "scene": "hertz-sphere", "loading": loading,
-                            "n_contact": n_contact, "grading": grading, "nu": nu, "a_over_R": 0.05})
-    for scene in ("hertz-cylinder", "hertz-sphere"):
+    for scene, (n_contact, grading) in DEFAULTS.items():
         for nu in NUS:
             for ratio in RATIOS:
                 out.append({"table": "finite-body", "scene": scene, "loading": "traction",
-                            "n_contact": 40, "grading": 0.1, "nu": nu, "a_over_R": ratio})
+                            "mesher": "relaxed", "n_contact": n_contact, "grading": grading,
+                            "nu": nu, "a_over_R": ratio})
     return out
 
 
 def run() -> list[dict]:
     rows = []
     for i, case in enumerate(cases(), 1):
-        params = {k: case[k] for k in ("loading", "n_contact", "grading", "nu", "a_over_R")}
+        params = {k: case[k] for k in ("loading", "mesher", "n_contact", "grading", "nu", "a_over_R")}
         start = time.perf_counter()
         result = signorini.solve(case["scene"], params=params, tol=1e-10)
         hertz = result.hertz
@@ -71,16 +75,19 @@ def tables(rows: list[dict]) -> dict[str, str]:
     out = {}
     for table, scene_rows in (("cylinder", [r for r in rows if r["table"] == "cylinder"]),
                               ("sphere", [r for r in rows if r["table"] == "sphere"])):
-        lines = ["| loading | n_contact | grading | dofs | " + " | ".join(
+        lines = ["| loading | mesher | n_contact | grading | dofs | " + " | ".join(
                      f"a, p₀ at ν = {nu:g}" for nu in NUS) + " |",
-                 "|---|---:|---:|---:|" + "---|" * len(NUS)]
-        keys = dict.fromkeys((r["loading"], r["n_contact"], r["grading"]) for r in scene_rows)
-        for loading, n_contact, grading in keys:
-            group = [r for r in scene_rows if (r["loading"], r["n_contact"], r["grading"])
-                     == (loading, n_contact, grading)]
+                 "|---|---|---:|---:|---:|" + "---|" * len(NUS)]
+        keys = dict.fromkeys((r["loading"], r["mesher"], r["n_contact"], r["grading"])
+                             for r in scene_rows)
+        for key in keys:
+            group = [r for r in scene_rows
+                     if (r["loading"], r["mesher"], r["n_contact"], r["grading"]) == key]
             cells = [f"{_pct(r['a_err'])}, {_pct(r['p0_err'])}" for r in group]
-            lines.append(f"| {loading} | {n_contact} | {grading:g} | {group[0]['dofs']:,} | "
-                         + " | ".join(cells) + " |")
+            default = " (default)" if (key[0], key[1]) == ("traction", "relaxed") and \
+                DEFAULTS[group[0]["scene"]] == (key[2], key[3]) else ""
+            lines.append(f"| {key[0]} | {key[1]}{default} | {key[2]} | {key[3]:g} | "
+                         f"{group[0]['dofs']:,} | " + " | ".join(cells) + " |")
         out[table] = "\n".join(lines)
     finite = [r for r in rows if r["table"] == "finite-body"]
     lines = ["| scene | ν | " + " | ".join(f"a, p₀ at a/R = {x:g}" for x in RATIOS) + " |",

@@ -83,6 +83,12 @@ LOADING = Param("loading", "traction",
                 check=one_of("traction", "displacement"))
 
 
+#: how the Hertz scenes mesh their disc (signorini.scenes.meshing.graded_quarter_disc)
+MESHER = Param("mesher", "relaxed",
+               "relaxed: the graded mesh's nodes moved into near-equilateral triangles (more "
+               "accurate per dof: docs/accuracy.md); bisection: the graded mesh as refined",
+               kind=str, check=one_of("relaxed", "bisection"))
+
 #: what a scene with a ``candidates`` parameter says when the contact outgrows its candidates
 CANDIDATE_REMEDY = ("raise the scene parameter candidates (now {candidates:g}, in contact half-widths) "
                     "or lower the load")

@@ -24,8 +24,18 @@ import numpy as np
 from signorini.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
 from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
-from signorini.scenes.base import CANDIDATE_REMEDY, LOADING, Param, SceneFamily, at_least, between, poisson_ratio, positive
-from signorini.scenes.meshing import disc_loading, graded_quarter_disc
+from signorini.scenes.base import (
+    CANDIDATE_REMEDY,
+    LOADING,
+    MESHER,
+    Param,
+    SceneFamily,
+    at_least,
+    between,
+    poisson_ratio,
+    positive,
+)
+from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on
 
 COMMON_PARAMS = (
     Param("R", 1.0, "sphere radius", check=positive),
@@ -39,7 +49,7 @@ COMMON_PARAMS = (
 )
 
 PARAMS = COMMON_PARAMS + (
-    Param("n_contact", 100, "elements across the contact radius (mesh fineness)", kind=int,
+    Param("n_contact", 60, "elements across the contact radius (mesh fineness)", kind=int,
           check=at_least(4)),
     Param("grading", 0.15, "growth of the element size with distance from the contact zone",
           check=between(0.0, 2.0)),
@@ -48,6 +58,7 @@ PARAMS = COMMON_PARAMS + (
     Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
           kind=int, check=lambda k: None if 0 <= k <= 6 else "in 0..6"),
     LOADING,
+    MESHER,
 )
 
 
@@ -86,13 +97,16 @@ def recorded_params(p: dict[str, Any], target: float | None, a_over_R: float,
     return params
 
 
-def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
+def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
     """The axisymmetric model of Hertz's sphere in physical units (meridian plane (r, z))."""
     given = set() if given is None else given
     R = p["R"]
     target, a_est = load_choice(p, given)
-    disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
-                               p["candidates"])
+    if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
+        disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
+    else:
+        disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
+                                   p["candidates"], relaxed=p["mesher"] == "relaxed")
     delta_nominal = p["delta"] if target is None else a_est ** 2 * R
     pushed, cut_load = disc_loading(disc, p["loading"], target)
     return SceneModel(

@@ -20,6 +20,7 @@ from scipy.spatial import Delaunay
 from skfem import Mesh, MeshTet, MeshTri
 
 from signorini.fem.model import CutLoad
+from signorini.scenes.relax import relax
 
 log = logging.getLogger(__name__)
 
@@ -265,13 +266,32 @@ def facets_on(mesh: MeshTri, nodes: np.ndarray) -> np.ndarray:
     return boundary[inside]
 
 
+def quarter_disc_distance(p: np.ndarray) -> np.ndarray:
+    """Signed distance (negative inside) to the quarter disc x ≥ 0, y ≤ 1 of the unit disc at (0, 1)."""
+    return np.maximum.reduce([np.hypot(p[0], p[1] - 1.0) - 1.0, -p[0], p[1] - 1.0])
+
+
+def snap_quarter_disc(p: np.ndarray, tol: float) -> np.ndarray:
+    """Points within ``tol`` of the axis, the cut or the arc, put exactly on it."""
+    p = p.copy()
+    p[0, np.abs(p[0]) < tol] = 0.0
+    p[1, np.abs(p[1] - 1.0) < tol] = 1.0
+    radius = np.hypot(p[0], p[1] - 1.0)
+    on_arc = (np.abs(radius - 1.0) < tol) & (p[0] > 0) & (p[1] < 1.0)
+    p[:, on_arc] = np.array([[0.0], [1.0]]) + (p[:, on_arc] - np.array([[0.0], [1.0]])) / radius[on_arc]
+    return p
+
+
 def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: float,
-                        refine: int = 0, candidate_extent: float = 2.0) -> GradedDisc:
+                        refine: int = 0, candidate_extent: float = 2.0,
+                        relaxed: bool = True) -> GradedDisc:
     """Mesh a quarter disc with ``n_contact`` elements across the expected half-width a.
 
     The element size is ``a/n_contact`` on the zone [0, 1.25 a] of the arc and
     grows by ``grading`` per unit distance from it; ``refine`` uniform
     refinements follow, each with the arc's new nodes moved onto the circle.
+    ``relaxed`` moves the nodes of the graded mesh into near-equilateral
+    triangles first (:func:`signorini.scenes.relax.relax`): more accurate per dof.
     """
     h_contact = a_over_R / n_contact
     zone_end = np.array([1.25 * a_over_R, 0.0])
@@ -282,6 +302,9 @@ def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: floa
 
     snap = snap_to_circle((0.0, 1.0), 1.0)
     mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
+    if relaxed:
+        corners = [int(np.argmin(np.hypot(mesh.p[0] - x, mesh.p[1] - y))) for x, y in ((0, 0), (0, 1), (1, 1))]
+        mesh = relax(mesh.p, quarter_disc_distance, target_size, corners, snap_quarter_disc)
     arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
     ends = np.nonzero((np.hypot(*mesh.p) < 1e-12)  # the first point of contact, the top corner
                       | (np.hypot(mesh.p[0] - 1.0, mesh.p[1] - 1.0) < 1e-12))[0]
@@ -341,3 +364,27 @@ def facet_indices(mesh: MeshTri, first: np.ndarray, second: np.ndarray) -> np.nd
     if not np.array_equal(keys[found], wanted):
         raise ValueError("an edge of the chain is not an edge of the mesh")
     return found
+
+
+def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
+                    candidate_extent: float = 2.0) -> GradedDisc:
+    """The parts of any triangulation of the quarter disc of radius R below (0, R), by position.
+
+    The arc is every boundary node off the two cuts, ordered from the first
+    point of contact; what :func:`graded_quarter_disc` returns for its own
+    mesh, for a mesh refined elsewhere (:mod:`signorini.scenes.adapt`).
+    """
+    unit = MeshTri(mesh.p / R, mesh.t)
+    arc = on_circle_arc(unit, (0.0, 1.0), 1.0)
+    ends = np.nonzero((np.hypot(*unit.p) < 1e-9)
+                      | (np.hypot(unit.p[0] - 1.0, unit.p[1] - 1.0) < 1e-9))[0]
+    chain = np.union1d(arc, ends)
+    chain = chain[np.argsort(np.arctan2(unit.p[1, chain] - 1.0, unit.p[0, chain]))]
+    x, y = mesh.p
+    candidates = chain[(x[chain] <= candidate_extent * a_over_R * R * (1 + 1e-9))
+                       & (y[chain] < R * (1 - 1e-12))]
+    top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
+    return GradedDisc(mesh=mesh, candidates=candidates[np.argsort(x[candidates])],
+                      contact_facets=facet_indices(mesh, chain[:-2], chain[1:-1]),
+                      axis=np.nonzero(np.abs(x) < 1e-12 * R)[0], top=top,
+                      top_facets=facets_on(mesh, top))

@@ -1,0 +1,32 @@
+"""The default Hertz cylinder is within 0.1 % of Hertz for ν up to 0.45 in any units (docs/accuracy.md)."""
+
+from __future__ import annotations
+
+import pytest
+
+import signorini
+
+UNITS = [{"E": 1.0, "R": 1.0}, {"E": 7e10, "R": 0.02}, {"E": 2.1e11, "R": 10.0}]  # m or mm
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])
+@pytest.mark.parametrize("units", UNITS, ids=["unit", "aluminium-m", "steel-mm"])
+def test_the_default_cylinder_is_within_a_tenth_of_a_percent(nu, units):
+    result = signorini.solve("hertz-cylinder", params={"nu": nu, **units})
+    assert result.converged, result.message
+    assert result.problem.n < 10_000
+    assert result.hertz.a_rel < 1e-3 and result.hertz.p0_rel < 1e-3
+
+
+def test_relaxed_triangles_beat_bisection_at_equal_mesh_parameters():
+    params = {"n_contact": 16, "grading": 0.15}
+    relaxed = signorini.solve("hertz-cylinder", params=params).hertz
+    bisected = signorini.solve("hertz-cylinder", params={**params, "mesher": "bisection"}).hertz
+    assert max(relaxed.a_rel, relaxed.p0_rel) < 0.5 * max(bisected.a_rel, bisected.p0_rel)
+
+
+def test_the_traction_beats_the_flat_push_on_the_former_default_mesh():
+    params = {"n_contact": 120, "grading": 0.15, "mesher": "bisection"}
+    traction = signorini.solve("hertz-cylinder", params=params).hertz
+    flat = signorini.solve("hertz-cylinder", params={**params, "loading": "displacement"}).hertz
+    assert traction.a_rel < 0.7 * flat.a_rel and traction.p0_rel < 0.7 * flat.p0_rel
