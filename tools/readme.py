@@ -20,6 +20,7 @@ import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimat
 
 from signorini.files import atomic_write_text  # noqa: E402
 from signorini.output.report import readme_validation  # noqa: E402
+from signorini.studies.peer import peer_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
@@ -32,7 +33,9 @@ def blocks(document: Path = README) -> dict[str, str]:
     """The generated blocks of ``document`` by name, from their artefacts."""
     if document == README:
         report = json.loads((ROOT / "docs" / "validation" / "report.json").read_text())
-        return {"validation": readme_validation(report)}
+        peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
+        return {"validation": readme_validation(report),
+                "peer": "\n".join(peer[peer.index("") + 1:])}  # the summary of docs/peer/peer.md
     if document == ACCURACY:
         return accuracy.tables(accuracy.load())
     if document == ESTIMATE:
