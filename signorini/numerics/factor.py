@@ -168,6 +168,16 @@ class PardisoFactor(Factor):
     def solve(self, b: np.ndarray) -> np.ndarray:
         return self._solver.solve(self._upper, _count_solve(np.asarray(b, dtype=float)))
 
+    def __del__(self) -> None:
+        # MKL keeps a factorisation until told to drop it: without this every PARDISO factor
+        # leaked its memory (measured: +16 MB per factorisation at 19k dofs, +260 MB at 261k)
+        solver = getattr(self, "_solver", None)
+        if solver is not None:
+            try:
+                solver.free_memory(everything=True)
+            except Exception:  # interpreter shutdown: MKL may already be gone
+                pass
+
 
 _CLASSES = {"superlu": Factor, "cholmod": CholmodFactor, "pardiso": PardisoFactor}
 
