@@ -27,6 +27,7 @@ from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import Reference, reference_of
 from signorini.scenes import SCENES, SceneFamily, build_problem
+from signorini.scenes.adapt import parse_target, solve_adaptive
 from signorini.solvers.registry import Method
 from signorini.solvers.registry import methods as _all_methods
 from signorini.solvers.registry import solve as _solve
@@ -241,6 +242,7 @@ def solve_summary(record: dict[str, Any]) -> str:
 
 def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: float | None = None,
           max_iter: int | None = None, params: dict[str, Any] | None = None,
+          target_error: float | str | None = None, max_dofs: int | None = None,
           **options: Any) -> Result:
     """Solve a problem (or a scene by name) and judge the answer with the KKT certificate.
 
@@ -252,7 +254,26 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     keyword arguments are the method's options. Bad input raises
     :class:`signorini.InputError`; a method that fails returns a result whose
     ``status`` says so.
+
+    ``target_error`` (a scene by name; ``0.001`` or ``"0.1%"``) refines the
+    scene's mesh adaptively until the estimated relative error in the energy
+    norm (``result.estimate.relative``) is at most that, or the next mesh
+    would exceed ``max_dofs`` (default 100,000); the message says which, and
+    ``result.solution.extras["adaptive"]`` lists the steps
+    (:mod:`signorini.scenes.adapt`).
     """
+    if target_error is not None:
+        if not isinstance(problem, str):
+            raise InputError("target_error= refines a scene's mesh: give the scene by name, "
+                             "solve('hertz-cylinder', target_error=0.01)")
+        run = solve_adaptive(problem, params or {}, parse_target(target_error), method=method,
+                             tol=tol, max_iter=max_iter, max_dofs=max_dofs, **options)
+        result = Result(run.problem, run.solution, certificate(run.problem, run.solution))
+        result._estimate = run.estimate
+        return result
+    if max_dofs is not None:
+        raise InputError("max_dofs (--max-dofs) bounds adaptive refinement: give target_error "
+                         "(--target-error) with it")
     if isinstance(problem, str):
         problem = build_problem(problem, **(params or {}))
     elif params:

@@ -84,8 +84,16 @@ def cmd_solve(args: argparse.Namespace) -> int:
         from signorini.output.export import check_vtk_path  # per command (start-up)
 
         check_vtk_path(args.vtk)  # a bad export path fails before the solve
-    problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
-    result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
+    if args.target_error is not None:  # adaptive refinement of the scene (signorini.scenes.adapt)
+        if args.raw_units:
+            raise InputError("--target-error refines a non-dimensionalised scene: drop --raw-units")
+        result = solve(args.scene, args.method, tol=tol, max_iter=max_iter, params=params,
+                       target_error=args.target_error, max_dofs=args.max_dofs, **options)
+        problem = result.problem
+    else:
+        problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
+        result = solve(problem, args.method, tol=tol, max_iter=max_iter, max_dofs=args.max_dofs,
+                       **options)
     record = result.to_dict()
     if args.json:
         _write_json(args.json, to_json(record))
@@ -362,6 +370,10 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--vtk", metavar="FILE",
                        help="write the deformed mesh with displacement, stress, gap and pressure "
                             "(.vtu or .vtk, for ParaView)")
+    solve.add_argument("--target-error", metavar="ETA", help="refine adaptively until the estimated "
+                       "relative energy-norm error is at most ETA (0.01 or 1%%)")
+    solve.add_argument("--max-dofs", type=int, metavar="N", help="with --target-error: no mesh "
+                       "beyond N dofs (default 100000)")
     solve.set_defaults(run=cmd_solve)
 
     converge = sub.add_parser("converge", help="refine a scene k times: errors, rates, figures")

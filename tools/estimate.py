@@ -1,6 +1,8 @@
-"""Effectivity of the a posteriori estimate (signorini.fem.estimate) on the Hertz scenes.
+"""Effectivity of the a posteriori estimate (signorini.fem.estimate) on the Hertz scenes, and
+what adaptive refinement (signorini.scenes.adapt) reaches against uniform and hand-graded meshes.
 
-    .venv/bin/python tools/estimate.py        # ~5 min here; writes docs/estimate/runs.json
+    .venv/bin/python tools/estimate.py [effectivity] [adaptive]   # both: ~6 min here;
+                                                                  # writes docs/estimate/runs.json
 
 For each scene and base mesh, the scene is solved at ``refine`` = 0, 1, ...
 (uniform refinements of the graded mesh) and at two more levels. The true
@@ -28,20 +30,30 @@ import signorini
 from signorini.fem.estimate import element_energies, estimate, material_units
 from signorini.fem.transfer import uniform_prolongation
 from signorini.files import atomic_write_text, to_json
+from signorini.references import reference_of
+from signorini.scenes.adapt import solve_adaptive
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "estimate" / "runs.json"
 SCENES = ("hertz-cylinder", "hertz-sphere")
-#: (n_contact, grading, levels): a coarse base with three levels, the default cylinder mesh with two
-BASES = ((16, 0.2, 3), (40, 0.1, 2))
+#: (n_contact, grading, levels): a coarse base with three levels, each scene's default mesh with two
+BASES = ((16, 0.2, 3), (None, None, 2))
 REFERENCE_STEPS = 2
+#: the adaptive runs: targets (relative, energy norm), the dof limit, and what they are held against
+TARGETS = (0.003, 0.001)
+MAX_DOFS = 250_000
+UNIFORM_LEVELS = 3
+HAND_GRADED = ((40, 0.1), (60, 0.05), (120, 0.05))
 
 
-def solve(scene: str, n_contact: int, grading: float, refine: int):
+def solve(scene: str, n_contact: int | None, grading: float | None, refine: int):
+    """The scene at ``refine`` (mesh parameters None: the scene's defaults), exactly; and the time."""
     method = "nested" if refine >= 2 else "pdas"
+    mesh = {"n_contact": n_contact, "grading": grading}
     start = time.perf_counter()
     result = signorini.solve(scene, method=method, tol=1e-10,
-                             params={"n_contact": n_contact, "grading": grading, "refine": refine})
+                             params={**{k: v for k, v in mesh.items() if v is not None},
+                                     "refine": refine})
     seconds = time.perf_counter() - start
     if result.status != "converged":
         raise RuntimeError(f"{scene} refine={refine}: {result.status} ({result.message})")
@@ -88,7 +100,8 @@ def run() -> list[dict]:
                 error_finest, _ = true_error(result, results[finest][0], finest - refine)
                 hertz = result.hertz
                 rows.append({
-                    "scene": scene, "n_contact": n_contact, "grading": grading, "refine": refine,
+                    "scene": scene, "n_contact": result.problem.params["n_contact"],
+                    "grading": result.problem.params["grading"], "refine": refine,
                     "dofs": result.problem.n, "estimate": found.total, "relative": found.relative,
                     "recovery": found.recovery * found.scale, "contact": found.contact * found.scale,
                     "energy_norm": found.energy_norm * found.scale,
@@ -107,7 +120,7 @@ def _pct(x: float, digits: int = 3) -> str:
     return f"{100 * x:+.{digits}f} %"
 
 
-def tables(rows: list[dict]) -> dict[str, str]:
+def tables(rows: list[dict], adaptive: list[dict] | None = None) -> dict[str, str]:
     """Markdown tables by name: effectivity per level, and η against the Hertz errors."""
     lines = ["| scene | mesh (n_contact, grading) | refine | dofs | η / ‖u_h‖ | ‖e‖ / ‖u_h‖ "
              "| η / ‖e‖ | recovery part alone | η / ‖e‖ against the finest | contact share of η² |",
@@ -131,14 +144,62 @@ def tables(rows: list[dict]) -> dict[str, str]:
             f"| {2 * r['complementarity'] / r['error'] ** 2:+.3f} "
             f"| {1e3 * r['estimate_s']:.0f} ms | {r['solve_s']:.2f} s |")
     out["estimate-hertz"] = "\n".join(lines)
+    if adaptive:
+        out["adaptive"] = adaptive_table(adaptive)
     return out
 
 
-def load() -> list[dict]:
-    return json.loads(OUT.read_text())["rows"]
+def _hertz_row(problem, solution, found, **fields) -> dict:
+    hertz = reference_of(problem).compare(problem, solution)
+    return {**fields, "dofs": problem.n, "relative": found.relative,
+            "p0_err": hertz.p0 / hertz.p0_ref - 1, "a_err": hertz.a / hertz.a_ref - 1}
+
+
+def run_adaptive() -> list[dict]:
+    """Every step of one adaptive run per scene (to the smaller target), uniform and hand-graded."""
+    rows = []
+    for scene in SCENES:
+        start = time.perf_counter()
+
+        def step(problem, solution, found, scene=scene, start=start):
+            rows.append(_hertz_row(problem, solution, found, scene=scene, mesh="adaptive",
+                                   seconds=time.perf_counter() - start))
+            print(f"{scene} adaptive: {problem.n} dofs, η {100 * found.relative:.2f} %",
+                  file=sys.stderr)
+
+        run = solve_adaptive(scene, {}, min(TARGETS), tol=1e-10, max_dofs=MAX_DOFS, on_step=step)
+        rows[-1]["reason"] = run.reason
+        for refine in range(UNIFORM_LEVELS + 1):
+            result, seconds = solve(scene, None, None, refine)
+            rows.append(_hertz_row(result.problem, result.solution, result.estimate, scene=scene,
+                                   mesh=f"uniform, refine {refine}", seconds=seconds))
+        for n_contact, grading in HAND_GRADED:
+            result, seconds = solve(scene, n_contact, grading, 0)
+            rows.append(_hertz_row(result.problem, result.solution, result.estimate, scene=scene,
+                                   mesh=f"graded ({n_contact}, {grading:g})", seconds=seconds))
+    return rows
+
+
+def adaptive_table(rows: list[dict]) -> str:
+    lines = ["| scene | mesh | dofs | η / ‖u_h‖ | a | p₀ | time |", "|---|---|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        label = r["mesh"] if r["mesh"] != "adaptive" else "adaptive, step"
+        lines.append(f"| {r['scene']} | {label} | {r['dofs']:,} | {100 * r['relative']:.2f} % "
+                     f"| {_pct(r['a_err'])} | {_pct(r['p0_err'])} | {r['seconds']:.1f} s |")
+    return "\n".join(lines)
+
+
+def load(part: str = "rows") -> list[dict]:
+    return json.loads(OUT.read_text()).get(part, [])
 
 
 if __name__ == "__main__":
-    rows = run()
-    atomic_write_text(OUT, to_json({"command": "python tools/estimate.py", "rows": rows}))
+    parts = sys.argv[1:] or ["effectivity", "adaptive"]
+    record = json.loads(OUT.read_text()) if OUT.exists() else {}
+    record["command"] = "python tools/estimate.py " + " ".join(parts)
+    if "effectivity" in parts:
+        record["rows"] = run()
+    if "adaptive" in parts:
+        record["adaptive"] = run_adaptive()
+    atomic_write_text(OUT, to_json(record))
     print(f"written: {OUT}", file=sys.stderr)

@@ -57,7 +57,7 @@ def blocks(document: Path = README) -> dict[str, str]:
     if document == ACCURACY:
         return accuracy.tables(accuracy.load())
     if document == ESTIMATE:
-        return estimate_study.tables(estimate_study.load())
+        return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"))
     raise ValueError(f"no generated blocks for {document}")
 
 

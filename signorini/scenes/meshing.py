@@ -315,15 +315,7 @@ def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: floa
         p, t, chain = refine_uniformly(p, t, chain)
         offset = p[:, chain] - np.array([[0.0], [1.0]])
         p[:, chain] = np.array([[0.0], [1.0]]) + offset / np.linalg.norm(offset, axis=0)
-    mesh = MeshTri(p * R, t)
-    x, y = mesh.p
-    candidates = chain[(x[chain] <= candidate_extent * a_over_R * R * (1 + 1e-9))
-                       & (y[chain] < R * (1 - 1e-12))]
-    top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
-    return GradedDisc(mesh=mesh, candidates=candidates[np.argsort(x[candidates])],
-                      contact_facets=facet_indices(mesh, chain[:-2], chain[1:-1]),  # not the top corner
-                      axis=np.nonzero(np.abs(x) < 1e-12 * R)[0], top=top,
-                      top_facets=facets_on(mesh, top))
+    return quarter_disc_on(MeshTri(p * R, t), R, a_over_R, candidate_extent)
 
 
 def _edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
@@ -371,8 +363,8 @@ def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
     """The parts of any triangulation of the quarter disc of radius R below (0, R), by position.
 
     The arc is every boundary node off the two cuts, ordered from the first
-    point of contact; what :func:`graded_quarter_disc` returns for its own
-    mesh, for a mesh refined elsewhere (:mod:`signorini.scenes.adapt`).
+    point of contact: how :func:`graded_quarter_disc` finds the parts of its
+    own mesh, and how :mod:`signorini.scenes.adapt` finds them on a refined one.
     """
     unit = MeshTri(mesh.p / R, mesh.t)
     arc = on_circle_arc(unit, (0.0, 1.0), 1.0)
@@ -385,6 +377,6 @@ def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
                        & (y[chain] < R * (1 - 1e-12))]
     top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
     return GradedDisc(mesh=mesh, candidates=candidates[np.argsort(x[candidates])],
-                      contact_facets=facet_indices(mesh, chain[:-2], chain[1:-1]),
+                      contact_facets=facet_indices(mesh, chain[:-2], chain[1:-1]),  # not the top corner
                       axis=np.nonzero(np.abs(x) < 1e-12 * R)[0], top=top,
                       top_facets=facets_on(mesh, top))

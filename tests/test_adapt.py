@@ -1,0 +1,104 @@
+"""Adaptive refinement (signorini.scenes.adapt): solve, estimate, mark, refine, until the target."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import signorini
+from signorini.errors import InputError
+from signorini.scenes.adapt import dorfler, parse_target
+from signorini.scenes.families import get_scene
+from signorini.scenes.meshing import graded_quarter_disc, quarter_disc_on
+
+
+def test_dorfler_marks_the_fewest_elements_that_carry_the_fraction():
+    assert list(dorfler(np.array([1.0, 3.0, 1.0, 1.0]), 0.5)) == [1]
+    two = dorfler(np.array([1.0, 3.0, 1.0, 1.0]), 0.8)  # 9 + 1 ≥ 0.8 · 12; the ones tie
+    assert len(two) == 2 and 1 in two
+    assert len(dorfler(np.ones(10), 1.0)) == 10
+
+
+@pytest.mark.parametrize("value, expected", [("0.1%", 0.001), (0.001, 0.001), ("2e-3", 0.002)])
+def test_targets_are_fractions_or_percentages(value, expected):
+    assert parse_target(value) == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("value", ["abc", "150%", 0, -0.1, 2])
+def test_bad_targets_are_input_errors(value):
+    with pytest.raises(InputError):
+        parse_target(value)
+
+
+def test_the_quarter_disc_is_found_again_on_its_own_mesh():
+    disc = graded_quarter_disc(0.01, 0.05, 16, 0.2, 1, 2.0)
+    again = quarter_disc_on(disc.mesh, 0.01, 0.05, 2.0)
+    for part in ("candidates", "contact_facets", "axis", "top", "top_facets"):
+        assert np.array_equal(np.sort(getattr(disc, part)), np.sort(getattr(again, part)))
+
+
+def test_the_cylinder_refines_until_the_target():
+    result = signorini.solve("hertz-cylinder", target_error="2%")
+    steps = result.solution.extras["adaptive"]
+    assert result.status == "converged" and "target error 2 % met" in result.message
+    assert result.estimate.relative <= 0.02 and result.problem.n < 30_000
+    estimates = [s["estimate"] for s in steps]
+    assert all(later < earlier for earlier, later in zip(estimates, estimates[1:]))
+    assert steps[-1]["action"] == "target met" and steps[-1]["dofs"] == result.problem.n
+    # the refined arc nodes lie on the cylinder (radius R = 1 about (0, 1))
+    mesh = result.problem.mesh
+    boundary = mesh.boundary_nodes()
+    x, y = mesh.p[:, boundary]
+    arc = (x > 1e-9) & (y < 1 - 1e-9)
+    assert np.max(np.abs(np.hypot(x[arc], y[arc] - 1.0) - 1.0)) < 1e-12
+    assert abs(result.hertz.p0_rel) < 2e-3 and abs(result.hertz.a_rel) < 2e-3
+
+
+def test_the_dof_limit_stops_the_loop_and_says_so():
+    result = signorini.solve("hertz-sphere", target_error=0.001, max_dofs=10_000)
+    assert result.status == "converged"
+    assert "max dofs 10000 reached" in result.message
+    assert result.problem.n <= 10_000 and result.estimate.relative > 0.001
+
+
+def test_the_candidates_grow_with_the_contact():
+    """Pushed much further than the default a/R = 0.05: the contact outgrows the candidates."""
+    result = signorini.solve("hertz-cylinder", target_error=0.05, params={"delta": 0.02})
+    actions = [s["action"] for s in result.solution.extras["adaptive"]]
+    assert actions[0] == "candidates widened"
+    assert result.status == "converged"
+    assert result.to_dict()["adequacy"]["penetrating_nodes"] == 0
+    assert abs(result.hertz.a_rel) < 0.01
+
+
+def test_what_cannot_be_refined_says_so():
+    with pytest.raises(InputError, match="cannot be refined adaptively"):
+        signorini.solve("block", target_error=0.01)
+    problem = signorini.build_problem("hertz-cylinder")
+    with pytest.raises(InputError, match="by name"):
+        signorini.solve(problem, target_error=0.01)
+    with pytest.raises(InputError, match="target_error"):
+        signorini.solve("hertz-cylinder", max_dofs=1000)
+
+
+def test_the_adaptive_families_take_a_mesh():
+    for name in ("hertz-cylinder", "hertz-sphere"):
+        family = get_scene(name)
+        model = family.build(family.parse({}), set())
+        again = family.build(family.parse({}), set(), mesh=model.mesh)
+        assert np.array_equal(model.contact_nodes, again.contact_nodes)
+
+
+def test_the_command_line_refines_and_reports(tmp_path):
+    out = tmp_path / "adaptive.json"
+    run = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",
+                          "--target-error", "3%", "--json", str(out)], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    record = json.loads(out.read_text())
+    assert record["estimate"]["relative"] <= 0.03
+    assert record["extras"]["adaptive"][-1]["action"] == "target met"
+    bad = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",
+                          "--max-dofs", "1000"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "--target-error" in bad.stderr
