@@ -72,3 +72,15 @@ def test_active_set_solver_paths_agree(hertz, backend):
                         np.column_stack([hertz.d, 2 * hertz.d]))
     np.testing.assert_allclose(U[:, 1], 2 * u, rtol=1e-9, atol=1e-14)
     np.testing.assert_allclose(L[:, 0], lam, rtol=1e-9, atol=1e-14)
+
+
+def test_auto_counts_nonzeros_so_that_3d_gets_pardiso_early():
+    from signorini.numerics.factor import available_backends, resolve_backend
+
+    installed = available_backends()
+    if not {"cholmod", "pardiso"} <= set(installed):
+        pytest.skip("needs both CHOLMOD and PARDISO installed (pip install 'signorini[fast]')")
+    # a 2D K of 40k dofs (~14 nonzeros per row) stays with CHOLMOD, a 3D one (~37) goes to PARDISO
+    assert resolve_backend(None, 40_000, 560_000) == "cholmod"
+    assert resolve_backend(None, 40_000, 1_480_000) == "pardiso"
+    assert resolve_backend(None, 40_000) == "cholmod"  # size alone: the dof threshold

@@ -63,17 +63,27 @@ PARDISO_FROM = 5_000
 #: memory; at 125k both took 10.3 s (PARDISO in 4x the memory). Only a solve of many
 #: factorisations on an idle machine went the other way (31k dofs, nine: 1.95 s against 2.3 s).
 PARDISO_OVER_CHOLMOD_FROM = 50_000
+#: ... counted in nonzeros of K when they are known (a 2D K has about 14 per row, a 3D one 35-80):
+#: in 3D CHOLMOD was 3-4 times slower than PARDISO from 12k dofs on (0.22 s against 0.05 s at
+#: 12k, 4.1 s against 1.0 s at 47k on the 3D sphere), where 2D reached that ratio only at 75k
+PARDISO_OVER_CHOLMOD_FROM_NNZ = 750_000
 
 
-def resolve_backend(backend: str | None = None, n: int | None = None) -> str:
+def resolve_backend(backend: str | None = None, n: int | None = None,
+                    nnz: int | None = None) -> str:
     """Pick the backend: an explicit name, ``SIGNORINI_FACTOR``, or the first installed
-    (when the size ``n`` is given, PARDISO only from :data:`PARDISO_OVER_CHOLMOD_FROM` dofs
-    when CHOLMOD is installed, from :data:`PARDISO_FROM` when it is not)."""
+    (when the size is given, PARDISO only from :data:`PARDISO_OVER_CHOLMOD_FROM` dofs — or
+    :data:`PARDISO_OVER_CHOLMOD_FROM_NNZ` nonzeros of K when ``nnz`` is given — when CHOLMOD
+    is installed, from :data:`PARDISO_FROM` dofs when it is not)."""
     name = backend or os.environ.get("SIGNORINI_FACTOR") or "auto"
     if name == "auto":
         installed = available_backends()
-        start = PARDISO_OVER_CHOLMOD_FROM if "cholmod" in installed else PARDISO_FROM
-        if n is not None and n < start and len(installed) > 1:
+        if "cholmod" in installed and nnz is not None:
+            small = nnz < PARDISO_OVER_CHOLMOD_FROM_NNZ
+        else:
+            start = PARDISO_OVER_CHOLMOD_FROM if "cholmod" in installed else PARDISO_FROM
+            small = n is not None and n < start
+        if small and len(installed) > 1:
             installed = [b for b in installed if b != "pardiso"]
         return installed[0]
     if name not in BACKENDS:
@@ -184,7 +194,7 @@ _CLASSES = {"superlu": Factor, "cholmod": CholmodFactor, "pardiso": PardisoFacto
 
 def factorize(K: sp.spmatrix, backend: str | None = None) -> Factor:
     """Factorise the SPD matrix ``K`` once for repeated solves."""
-    return _CLASSES[resolve_backend(backend, K.shape[0])](K)
+    return _CLASSES[resolve_backend(backend, K.shape[0], K.nnz)](K)
 
 
 def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
@@ -224,7 +234,7 @@ class ActiveSetSolver:
         self.K.sort_indices()
         self.N.eliminate_zeros()
         self.n, self.m = self.K.shape[0], self.N.shape[0]
-        self.backend = resolve_backend(backend, self.n)
+        self.backend = resolve_backend(backend, self.n, self.K.nnz)
         self._dofs = selection_dofs(self.N)
         self._coef = self.N.data if self._dofs is not None else None
         self._pinning = None
@@ -304,7 +314,7 @@ class PinnedFactor:
                  pinning: Pinning | None = None):
         self.n = K.shape[0]
         self.fixed = np.asarray(fixed, dtype=int)
-        self.backend = resolve_backend(backend, self.n)
+        self.backend = resolve_backend(backend, self.n, K.nnz)
         if pinning is None:
             pinning = Pinning(K, analyse=self.backend == "cholmod")
         self.matrix = pinning.K

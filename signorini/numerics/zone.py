@@ -107,7 +107,7 @@ class ZoneSolver:
         rows.sort_indices()
         self.dofs, self.coef = dofs, rows.data.copy()
         self.n, self.m = self.K.shape[0], self.N.shape[0]
-        self.backend = resolve_backend(backend, self.n)
+        self.backend = resolve_backend(backend, self.n, self.K.nnz)
         self._pinning = Pinning(self.K, analyse=self.backend == "cholmod")
         self._core: np.ndarray | None = None
         self._factor: PinnedFactor | None = None

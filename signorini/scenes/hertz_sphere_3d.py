@@ -24,10 +24,11 @@ from typing import Any
 import numpy as np
 from skfem import MeshTet
 
-from signorini.fem.model import FlatObstacle3D, SceneModel
-from signorini.scenes.base import Param, SceneFamily, at_least, between
+from signorini.fem.model import CutLoad, FlatObstacle3D, SceneModel
+from signorini.scenes.base import CANDIDATE_REMEDY, LOADING, Param, SceneFamily, at_least, between
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, load_choice, recorded_params
 from signorini.scenes.meshing import (
+    facets_on,
     coarse_ball_octant,
     curved_boundary_facets,
     distance_to_disc,
@@ -45,6 +46,7 @@ PARAMS = COMMON_PARAMS + (
           check=at_least(1.2)),
     Param("refine", 0, "uniform refinements of the graded mesh (each multiplies the dofs by "
           "about 8)", kind=int, check=lambda k: None if 0 <= k <= 3 else "in 0..3"),
+    LOADING,
 )
 
 #: largest element edge anywhere (unit sphere)
@@ -77,16 +79,22 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     tol = 1e-12 * R
     delta_nominal = p["delta"] if target is None else a_est ** 2 * R
     top = np.nonzero(np.abs(z - R) < tol)[0]
+    pushed, cut_load = top, None
+    if p["loading"] == "traction" and target is not None:  # as the disc scenes (CutLoad)
+        pushed = np.array([top[np.argmin(rho[top])]])
+        cut_load = CutLoad(component=2, nodes=top, facets=facets_on(mesh, top))
+    candidates = candidates[np.lexsort((x[candidates], rho[candidates]))]
     return SceneModel(
         mesh=mesh, E=p["E"], nu=p["nu"],
         dirichlet=[(0, np.nonzero(np.abs(x) < tol)[0], 0.0),
                    (1, np.nonzero(np.abs(y) < tol)[0], 0.0),
-                   (2, top, -delta_nominal)],
-        contact_nodes=candidates[np.lexsort((x[candidates], rho[candidates]))],
-        contact_facets=curved,
+                   (2, pushed, -delta_nominal)],
+        contact_nodes=candidates, contact_facets=curved,
         obstacle=FlatObstacle3D(0.0),
-        load_dofs=(2, top), length_scale=R, force_multiplicity=4.0,
-        target_load=target, params=recorded_params(p, target, a_est, delta_nominal))
+        load_dofs=(2, pushed), length_scale=R, force_multiplicity=4.0,
+        target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
+        cut_load=cut_load, predicted_contact=rho[candidates] < a_est * R,
+        candidate_remedy=CANDIDATE_REMEDY.format(**p))
 
 
 FAMILY = SceneFamily(

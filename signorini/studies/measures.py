@@ -89,7 +89,7 @@ def factorisation_time(problem: ContactProblem) -> float:
     The library is loaded first (on a 2 × 2 identity), so that its start-up
     is not charged; nothing is cached on the problem.
     """
-    backend = resolve_backend(None, problem.n)
+    backend = resolve_backend(None, problem.n, problem.K.nnz)
     factorize(sp.identity(2, format="csc"), backend).solve(np.ones(2))
     start = time.perf_counter()
     factorize(problem.K, backend).solve(problem.f)
