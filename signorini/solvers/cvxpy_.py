@@ -1,8 +1,10 @@
-"""The primal QP written as a cvxpy model (teaching, cross-checks).
+"""The contact QP written as a cvxpy model (teaching, cross-checks).
 
-``minimise ½ xᵀKx − fᵀx  subject to  N x ≤ d`` with ``K`` symmetrised. cvxpy's
-``dual_value`` of the constraint ``N @ x <= d`` of a minimisation is the
-multiplier ``λ ≥ 0`` of the Lagrangian ``½xᵀKx − fᵀx + λᵀ(Nx − d)``, so
+``minimise ½ xᵀKx − fᵀx  subject to  N x ≤ d`` with ``K`` symmetrised, or the
+same in the other formulations of :mod:`signorini.solvers.forms` (option
+``form``: ``shifted`` in ``u − K⁻¹f``, ``dual`` over ``λ ≥ 0``). cvxpy's
+``dual_value`` of the constraint ``G @ x <= h`` of a minimisation is the
+multiplier ``λ ≥ 0`` of the Lagrangian ``½xᵀPx + qᵀx + λᵀ(Gx − h)``, so
 ``λ = dual_value`` with no sign change (the tests check it for every solver).
 
 Build time is model construction plus canonicalisation
@@ -18,18 +20,18 @@ import warnings
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from signorini.errors import InputError, SolverError
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers import forms
 from signorini.solvers.base import Method
-from signorini.solvers.qp import BACKEND_BY_NAME
+from signorini.solvers.qp import BACKEND_BY_NAME, DEFAULT_MAX_DENSE_DOFS
 
 log = logging.getLogger(__name__)
 
 METHOD = "cvxpy"
 DEFAULT_SOLVER = "CLARABEL"
-OPTIONS = ("solver",)
+OPTIONS = ("solver", "form", "polish", "max_dense_dofs")
 
 #: cvxpy status → ours (anything else is ``failed``)
 STATUS_MAP = {"optimal": "converged", "optimal_inaccurate": "inaccurate",
@@ -101,6 +103,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     max_iter : iteration limit, translated likewise.
     solver : (option) cvxpy solver name, default ``"CLARABEL"``; any installed
         solver that accepts a QP.
+    form, polish, max_dense_dofs : (options) as for the ``qp-*`` methods
+        (:mod:`signorini.solvers.forms`); default ``form="primal"``.
 
     Returns
     -------
@@ -113,16 +117,21 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         raise InputError(f"method 'cvxpy' does not accept option(s) "
                          f"{', '.join(repr(u) for u in unknown)}; accepted options: "
                          f"{', '.join(OPTIONS)}")
+    form = forms.check_form(METHOD, options.get("form", "primal"))
+    polishing = forms.check_polish(METHOD, options.get("polish", False))
+    if form == "dual":
+        limit = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
+        forms.check_dual_size(METHOD, problem, limit)
     import cvxpy as cp  # as above
 
     solver = _check_solver(options.get("solver", DEFAULT_SOLVER))
     opts = solver_options(solver, tol, max_iter)
 
     start = time.perf_counter()
-    K = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
-    x = cp.Variable(problem.n)
-    contact = problem.N @ x <= problem.d
-    model = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, K, assume_PSD=True) - problem.f @ x),
+    qp = forms.formulate(problem, form)
+    x = cp.Variable(qp.q.size)
+    contact = x >= 0 if qp.bounds else qp.G @ x <= qp.h
+    model = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, qp.P, assume_PSD=True) + qp.q @ x),
                        [contact])
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
@@ -152,15 +161,19 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     raw_status = str(model.status)
     status = STATUS_MAP.get(raw_status, "failed")
     iterations = model.solver_stats.num_iters if model.solver_stats is not None else None
-    common = dict(message=f"cvxpy/{solver}: {raw_status}", iterations=int(iterations or 0),
-                  build_time=build_time, solve_time=solve_time,
-                  extras={"raw_status": raw_status, "solver": solver, "backend_warnings": caught})
-    if x.value is None or contact.dual_value is None:
+    common = dict(message=f"cvxpy/{solver}: {raw_status}" + ("" if form == "primal" else
+                                                             f" ({form} form)"),
+                  iterations=int(iterations or 0), build_time=build_time, solve_time=solve_time,
+                  extras={"raw_status": raw_status, "solver": solver, "backend_warnings": caught,
+                          "form": form, "form_work": qp.work, "form_s": qp.seconds})
+    if x.value is None or (contact.dual_value is None and not qp.bounds):
         return ContactSolution.failure(METHOD, problem, "failed" if status == "converged"
                                        else status, **common)
-    lam = np.asarray(contact.dual_value, dtype=float).reshape(problem.m).copy()
-    return ContactSolution(method=METHOD, u=np.asarray(x.value, dtype=float).copy(), lam=lam,
-                           status=status, **common)
+    z = None if qp.bounds else np.reshape(contact.dual_value, problem.m)
+    u, lam = qp.answer(problem, x.value, z)
+    solution = ContactSolution(method=METHOD, u=u, lam=lam, status=status, factor=qp.factor,
+                               **common)
+    return forms.polish(problem, qp, solution, tol) if polishing else solution
 
 
 METHODS = (

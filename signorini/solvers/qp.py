@@ -1,9 +1,11 @@
-"""The primal QP through qpsolvers: one method ``qp-<backend>`` per backend.
+"""The contact QP through qpsolvers: one method ``qp-<backend>`` per backend.
 
 ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` is handed to :func:`qpsolvers.solve_problem`
-as ``P = ½(K + Kᵀ)``, ``q = −f``, ``G = N``, ``h = d``. qpsolvers' multiplier
-``z`` of ``Gx ≤ h`` is non-negative and satisfies ``Px + q + Gᵀz = 0``, which
-is our ``K u − f + Nᵀλ = 0`` with ``λ = z``: no sign change.
+in the formulation of the option ``form`` (:mod:`signorini.solvers.forms`):
+``primal`` as ``P = ½(K + Kᵀ)``, ``q = −f``, ``G = N``, ``h = d`` (qpsolvers'
+multiplier ``z`` of ``Gx ≤ h`` is non-negative and satisfies
+``Px + q + Gᵀz = 0``, our ``K u − f + Nᵀλ = 0`` with ``λ = z``: no sign change),
+``shifted`` in ``u − K⁻¹f``, ``dual`` over ``λ ≥ 0`` with ``W = N K⁻¹ Nᵀ``.
 
 Every backend is one row of :data:`BACKENDS`: which modules it needs, whether
 qpsolvers feeds it dense matrices, how a relative tolerance ``tol`` and an
@@ -19,14 +21,16 @@ import logging
 import time
 import warnings
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping, NamedTuple
+from typing import Any, Callable, Mapping
 
 import numpy as np
-import scipy.sparse as sp
 
 from signorini.errors import BackendNotInstalled, InputError, SolverError
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers import forms
 from signorini.solvers.base import Method
+from signorini.solvers.qp_reports import (Reader, read_clarabel, read_cvxopt, read_ecos, read_found,
+                                          read_gurobi, read_info, read_quadprog, read_scs)
 
 log = logging.getLogger(__name__)
 
@@ -34,21 +38,10 @@ log = logging.getLogger(__name__)
 DEFAULT_MAX_DENSE_DOFS = 3000
 
 #: options every ``qp-*`` method accepts besides its backend's own
-COMMON_OPTIONS = ("max_dense_dofs",)
+COMMON_OPTIONS = ("max_dense_dofs", "form", "polish")
 
 CONVERGED, INACCURATE, MAX_ITER, INFEASIBLE, FAILED = (
     "converged", "inaccurate", "max_iter", "infeasible", "failed")
-
-
-class Report(NamedTuple):
-    """What a backend said about its run: raw status, iterations, other facts."""
-
-    raw_status: str
-    iterations: int | None = None
-    details: dict[str, Any] = {}
-
-
-Reader = Callable[[Any, list[str]], Report]
 
 
 @dataclass(frozen=True)
@@ -61,7 +54,8 @@ class Backend:
     list is ``failed``), or is a function doing so. ``read`` extracts the raw
     status from a :class:`qpsolvers.Solution` and the warnings it raised.
     ``fixed`` are settings always passed; ``nest`` rewrites the settings
-    before the call (MOSEK takes its parameters inside one dict).
+    before the call (MOSEK takes its parameters inside one dict); ``form`` is
+    the default formulation (:data:`signorini.solvers.forms.FORMS`).
     """
 
     name: str
@@ -77,6 +71,7 @@ class Backend:
     extra: str = "backends"
     fixed: Mapping[str, Any] = field(default_factory=dict)
     nest: Callable[[dict[str, Any]], dict[str, Any]] | None = None
+    form: str = "primal"
 
     @property
     def method_name(self) -> str:
@@ -106,74 +101,6 @@ class Backend:
         if callable(self.statuses):
             return self.statuses(raw)
         return self.statuses.get(raw, FAILED)
-
-
-# --- reading what a backend reported ------------------------------------------------------
-
-
-def _read_info(solution: Any, caught: list[str]) -> Report:
-    """OSQP, ProxQP, PIQP, QPALM: ``extras["info"]`` with ``status`` and ``iter``."""
-    info = solution.extras["info"]
-    status = info.status
-    raw = getattr(status, "name", None) or str(status)
-    details = {}
-    if hasattr(info, "status_polish"):  # OSQP: polishing can fail silently (osqp#790)
-        details["polish_status"] = int(info.status_polish)
-    return Report(raw, int(info.iter), details)
-
-
-def _read_clarabel(solution: Any, caught: list[str]) -> Report:
-    return Report(str(solution.extras["status"]))  # qpsolvers drops the iteration count
-
-
-def _read_scs(solution: Any, caught: list[str]) -> Report:
-    info = solution.extras
-    return Report(str(info["status"]), int(info["iter"]), {"status_val": int(info["status_val"])})
-
-
-_ECOS_FLAGS = {0: "OPTIMAL", 1: "PINF", 2: "DINF", 10: "OPTIMAL_INACC", 11: "PINF_INACC",
-               12: "DINF_INACC", -1: "MAXIT", -2: "NUMERICS", -3: "OUTCONE", -4: "SIGINT",
-               -7: "FATAL"}
-
-
-def _read_ecos(solution: Any, caught: list[str]) -> Report:
-    info = solution.extras
-    flag = int(info["exitFlag"])
-    return Report(_ECOS_FLAGS.get(flag, f"exitFlag {flag}"), int(info["iter"]),
-                  {"exit_flag": flag, "infostring": info.get("infostring", "")})
-
-
-def _read_found(ok: str, not_ok: str) -> Reader:
-    """Backends whose status qpsolvers does not pass on: only ``found`` is known."""
-    def read(solution: Any, caught: list[str]) -> Report:
-        return Report(ok if solution.found else not_ok)
-    return read
-
-
-def _read_quadprog(solution: Any, caught: list[str]) -> Report:
-    if solution.found:
-        return Report("solved", int(solution.extras["iterations"][0]))
-    # qpsolvers swallows quadprog's "constraints are inconsistent, no solution"
-    # silently and warns about every other ValueError
-    complaints = [c for c in caught if "quadprog raised" in c]
-    return Report(complaints[0] if complaints else "no solution")
-
-
-def _read_cvxopt(solution: Any, caught: list[str]) -> Report:
-    res = solution.extras
-    iterations = res.get("iterations")
-    return Report(str(res.get("status")), None if iterations is None else int(iterations))
-
-
-_GUROBI_CODES = {1: "LOADED", 2: "OPTIMAL", 3: "INFEASIBLE", 4: "INF_OR_UNBD", 5: "UNBOUNDED",
-                 6: "CUTOFF", 7: "ITERATION_LIMIT", 8: "NODE_LIMIT", 9: "TIME_LIMIT",
-                 10: "SOLUTION_LIMIT", 11: "INTERRUPTED", 12: "NUMERIC", 13: "SUBOPTIMAL",
-                 14: "INPROGRESS", 15: "USER_OBJ_LIMIT", 16: "WORK_LIMIT", 17: "MEM_LIMIT"}
-
-
-def _read_gurobi(solution: Any, caught: list[str]) -> Report:
-    code = int(solution.extras["status"])
-    return Report(_GUROBI_CODES.get(code, f"status {code}"), None, {"status_code": code})
 
 
 def _scs_status(raw: str) -> str:
@@ -226,7 +153,7 @@ def _highs_tolerance(tol: float) -> dict[str, Any]:
 BACKENDS: tuple[Backend, ...] = (
     Backend(
         "osqp", "OSQP", "OSQP (ADMM, first-order) through qpsolvers", ("osqp",),
-        _read_info,
+        read_info,
         {"solved": CONVERGED, "solved inaccurate": INACCURATE,
          "maximum iterations reached": MAX_ITER, "primal infeasible": INFEASIBLE},
         options=("rho", "sigma", "alpha", "delta", "scaling", "adaptive_rho",
@@ -238,7 +165,7 @@ BACKENDS: tuple[Backend, ...] = (
         extra="", fixed={"raise_error": False}),
     Backend(
         "clarabel", "Clarabel", "Clarabel (interior point) through qpsolvers", ("clarabel",),
-        _read_clarabel,
+        read_clarabel,
         {"Solved": CONVERGED, "AlmostSolved": INACCURATE, "MaxIterations": MAX_ITER,
          "PrimalInfeasible": INFEASIBLE},
         options=("max_iter", "time_limit", "max_step_fraction", "tol_gap_abs", "tol_gap_rel",
@@ -259,7 +186,7 @@ BACKENDS: tuple[Backend, ...] = (
         max_iter_option="max_iter", extra=""),
     Backend(
         "proxqp", "ProxQP", "ProxQP (proximal augmented Lagrangian) through qpsolvers",
-        ("proxsuite",), _read_info,
+        ("proxsuite",), read_info,
         {"PROXQP_SOLVED": CONVERGED, "PROXQP_MAX_ITER_REACHED": MAX_ITER,
          "PROXQP_PRIMAL_INFEASIBLE": INFEASIBLE},
         options=("eps_abs", "eps_rel", "rho", "mu_eq", "mu_in", "max_iter",
@@ -271,7 +198,7 @@ BACKENDS: tuple[Backend, ...] = (
         max_iter_option="max_iter"),
     Backend(
         "piqp", "PIQP", "PIQP (proximal interior point) through qpsolvers", ("piqp",),
-        _read_info,
+        read_info,
         {"PIQP_SOLVED": CONVERGED, "PIQP_MAX_ITER_REACHED": MAX_ITER,
          "PIQP_PRIMAL_INFEASIBLE": INFEASIBLE},
         options=("rho_init", "delta_init", "eps_abs", "eps_rel", "check_duality_gap",
@@ -289,7 +216,7 @@ BACKENDS: tuple[Backend, ...] = (
         max_iter_option="max_iter"),
     Backend(
         "scs", "SCS", "SCS (ADMM on the conic form, first-order) through qpsolvers", ("scs",),
-        _read_scs, _scs_status,
+        read_scs, _scs_status,
         options=("max_iters", "time_limit_secs", "eps_abs", "eps_rel", "eps_infeas", "normalize",
                  "scale", "adaptive_scale", "rho_x", "alpha", "acceleration_lookback",
                  "acceleration_interval", "linear_solver", "write_data_filename",
@@ -297,7 +224,7 @@ BACKENDS: tuple[Backend, ...] = (
         tolerance=_each("eps_abs", "eps_rel"), max_iter_option="max_iters"),
     Backend(
         "ecos", "ECOS", "ECOS (interior point on an SOCP reformulation) through qpsolvers",
-        ("ecos",), _read_ecos,
+        ("ecos",), read_ecos,
         {"OPTIMAL": CONVERGED, "OPTIMAL_INACC": INACCURATE, "MAXIT": MAX_ITER,
          "PINF": INFEASIBLE},
         options=("feastol", "abstol", "reltol", "feastol_inacc", "abstol_inacc",
@@ -306,7 +233,7 @@ BACKENDS: tuple[Backend, ...] = (
         dense=True),  # qpsolvers densifies P and G and takes a Cholesky factor of P
     Backend(
         "highs", "HiGHS", "HiGHS (active set QP) through qpsolvers", ("highspy",),
-        _read_found("kOptimal", "not optimal (qpsolvers does not pass HiGHS's model status on)"),
+        read_found("kOptimal", "not optimal (qpsolvers does not pass HiGHS's model status on)"),
         {"kOptimal": CONVERGED},
         options=("primal_feasibility_tolerance", "dual_feasibility_tolerance",
                  "optimality_tolerance", "kkt_tolerance", "qp_iteration_limit",
@@ -315,7 +242,7 @@ BACKENDS: tuple[Backend, ...] = (
         tolerance=_highs_tolerance, max_iter_option="qp_iteration_limit"),
     Backend(
         "daqp", "DAQP", "DAQP (dual active set, dense) through qpsolvers", ("daqp",),
-        _read_found("exitflag > 0", "exitflag <= 0 (qpsolvers does not pass the flag on)"),
+        read_found("exitflag > 0", "exitflag <= 0 (qpsolvers does not pass the flag on)"),
         {"exitflag > 0": CONVERGED},
         options=("primal_tol", "dual_tol", "zero_tol", "pivot_tol", "progress_tol", "cycle_tol",
                  "iter_limit", "fval_bound", "eps_prox", "eta_prox", "sing_tol", "refactor_tol",
@@ -323,12 +250,12 @@ BACKENDS: tuple[Backend, ...] = (
         tolerance=_each("primal_tol", "dual_tol"), max_iter_option="iter_limit", dense=True),
     Backend(
         "quadprog", "quadprog", "quadprog (Goldfarb-Idnani dual active set, dense) through "
-        "qpsolvers", ("quadprog",), _read_quadprog,
+        "qpsolvers", ("quadprog",), read_quadprog,
         {"solved": CONVERGED, "no solution": INFEASIBLE},
         dense=True),  # no tolerance and no iteration limit to set
     Backend(
         "qpalm", "QPALM", "QPALM (proximal augmented Lagrangian) through qpsolvers", ("qpalm",),
-        _read_info,
+        read_info,
         {"solved": CONVERGED, "maximum iterations reached": MAX_ITER,
          "primal infeasible": INFEASIBLE},
         options=("max_iter", "inner_max_iter", "eps_abs", "eps_rel", "eps_abs_in", "eps_rel_in",
@@ -340,12 +267,12 @@ BACKENDS: tuple[Backend, ...] = (
         tolerance=_each("eps_abs", "eps_rel"), max_iter_option="max_iter"),
     Backend(
         "cvxopt", "CVXOPT", "CVXOPT (interior point) through qpsolvers", ("cvxopt",),
-        _read_cvxopt, {"optimal": CONVERGED},
+        read_cvxopt, {"optimal": CONVERGED},
         options=("abstol", "reltol", "feastol", "maxiters", "refinement"),
         tolerance=_each("abstol", "reltol", "feastol"), max_iter_option="maxiters"),
     Backend(
         "gurobi", "Gurobi", "Gurobi (barrier) through qpsolvers", ("gurobipy",),
-        _read_gurobi,
+        read_gurobi,
         {"OPTIMAL": CONVERGED, "SUBOPTIMAL": INACCURATE, "ITERATION_LIMIT": MAX_ITER,
          "INFEASIBLE": INFEASIBLE},
         options=("FeasibilityTol", "OptimalityTol", "BarConvTol", "PSDTol", "TimeLimit",
@@ -355,7 +282,7 @@ BACKENDS: tuple[Backend, ...] = (
         max_iter_option="BarIterLimit"),
     Backend(
         "mosek", "MOSEK", "MOSEK (interior point) through qpsolvers and CVXOPT",
-        ("mosek", "cvxopt"), _read_cvxopt,
+        ("mosek", "cvxopt"), read_cvxopt,
         {"optimal": CONVERGED, "primal infeasible": INFEASIBLE},
         options=("mosek",),
         tolerance=_each("intpnt_qo_tol_rel_gap", "intpnt_qo_tol_pfeas", "intpnt_qo_tol_dfeas"),
@@ -376,19 +303,7 @@ def _check_options(backend: Backend, options: Mapping[str, Any]) -> int:
             f"method {backend.method_name!r} does not accept option(s) "
             f"{', '.join(repr(name) for name in unknown)}; accepted options: "
             f"{', '.join(backend.accepted_options)}")
-    limit = options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS)
-    if isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 1:
-        raise InputError(f"max_dense_dofs must be a positive integer, got {limit!r}")
-    return int(limit)
-
-
-def _qp_data(problem: ContactProblem, dense: bool) -> tuple[Any, np.ndarray, Any, np.ndarray]:
-    """``(P, q, G, h)`` as qpsolvers wants them: csc matrices, or arrays for dense backends."""
-    P = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
-    G = sp.csc_matrix(problem.N)
-    if dense:
-        return P.toarray(), -problem.f, G.toarray(), problem.d.copy()
-    return P, -problem.f, G, problem.d.copy()
+    return forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
 
 
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
@@ -403,7 +318,10 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         (``None`` leaves the backend's defaults untouched).
     max_iter : iteration limit, translated likewise (quadprog has none).
     **options : backend options, passed through after ``tol`` and ``max_iter``
-        (so they win); ``max_dense_dofs`` (default 3000) caps ``n`` for dense backends.
+        (so they win); ``max_dense_dofs`` (default 3000) caps ``n`` for dense backends
+        and ``m`` for ``form="dual"``; ``form`` (:data:`~signorini.solvers.forms.FORMS`,
+        default the backend's ``form``) and ``polish`` (default False) are explained in
+        :mod:`signorini.solvers.forms`.
 
     Returns
     -------
@@ -413,7 +331,8 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
     Raises
     ------
     InputError
-        Unknown option, or a dense backend asked to solve more than ``max_dense_dofs`` dofs.
+        Unknown option or form, a dense backend asked to solve more than ``max_dense_dofs``
+        dofs, or the dual form more than ``max_dense_dofs`` candidates.
     BackendNotInstalled
         qpsolvers cannot load the backend.
     SolverError
@@ -421,7 +340,11 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
     """
     spec = BACKEND_BY_NAME[backend]
     max_dense_dofs = _check_options(spec, options)
-    if spec.dense and problem.n > max_dense_dofs:
+    form = forms.check_form(spec.method_name, options.get("form", spec.form))
+    polishing = forms.check_polish(spec.method_name, options.get("polish", False))
+    if form == "dual":
+        forms.check_dual_size(spec.method_name, problem, max_dense_dofs)
+    elif spec.dense and problem.n > max_dense_dofs:
         raise InputError(
             f"method {spec.method_name!r} builds dense n × n matrices and n = {problem.n} "
             f"exceeds max_dense_dofs = {max_dense_dofs}: pick a sparse backend or raise "
@@ -440,8 +363,9 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         settings = spec.nest(settings)
 
     start = time.perf_counter()
-    P, q, G, h = _qp_data(problem, spec.dense)
-    qp = qpsolvers.Problem(P, q, G, h)
+    data = forms.formulate(problem, form, spec.dense)
+    qp = (qpsolvers.Problem(data.P, data.q, lb=np.zeros(problem.m)) if data.bounds
+          else qpsolvers.Problem(data.P, data.q, data.G, data.h))
     build_time = time.perf_counter() - start
     try:
         with warnings.catch_warnings(record=True) as record:
@@ -467,15 +391,19 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         build_time += result.build_time
         elapsed = result.solve_time
     extras = {"raw_status": report.raw_status, "backend": spec.name,
-              "backend_warnings": caught, **report.details}
-    common = dict(message=f"{spec.label}: {report.raw_status}",
+              "backend_warnings": caught, **report.details, "form": form,
+              "form_work": data.work, "form_s": data.seconds}
+    common = dict(message=f"{spec.label}: {report.raw_status}" + ("" if form == "primal" else
+                                                                  f" ({form} form)"),
                   iterations=report.iterations or 0, build_time=build_time,
                   solve_time=elapsed, extras=extras)
-    if result.x is None or result.z is None:
+    if result.x is None or (result.z is None and not data.bounds):
         return ContactSolution.failure(spec.method_name, problem,
                                        FAILED if status == CONVERGED else status, **common)
-    return ContactSolution(method=spec.method_name, u=np.asarray(result.x, dtype=float).copy(),
-                           lam=np.asarray(result.z, dtype=float).copy(), status=status, **common)
+    u, lam = data.answer(problem, result.x, result.z)
+    solution = ContactSolution(method=spec.method_name, u=u, lam=lam, status=status,
+                               factor=data.factor, **common)
+    return forms.polish(problem, data, solution, tol) if polishing else solution
 
 
 def _method_function(backend: Backend) -> Callable[..., ContactSolution]:

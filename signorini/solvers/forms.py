@@ -1,0 +1,203 @@
+"""Formulations of the contact QP handed to a QP backend: primal, shifted, dual.
+
+Every ``qp-*`` method (and ``cvxpy``) takes the option ``form``; the backend
+always solves ``min ½xᵀPx + qᵀx`` subject to ``Gx ≤ h`` (or ``x ≥ 0``), and
+the answer comes back in the problem's own variables ``(u, λ)``, so that the
+package's certificate judges it as it judges every method.
+
+- ``primal``: ``P = ½(K + Kᵀ)``, ``q = −f``, ``G = N``, ``h = d``; ``u = x``,
+  ``λ = z`` (qpsolvers' ``z ≥ 0`` of ``Gx ≤ h``). No factorisation.
+- ``shifted``: the same QP in ``v = u − u₀`` with ``K u₀ = f``: ``q = 0``,
+  ``h = d − N u₀``, so that the objective is the contact's own energy and a
+  backend's relative tests speak about the contact rather than about the
+  elastic energy of the whole body. Cost: one factorisation of K and one
+  back-solve; ``u = u₀ + x``, ``λ = z``.
+- ``dual``: the condensed dual over ``λ ≥ 0`` with the Delassus operator
+  ``W = N K⁻¹ Nᵀ`` (dense m × m): ``P = W``, ``q = −(N K⁻¹ f − d)``, the very
+  problem Uzawa ascends. Cost: one factorisation, m back-solves for W (in
+  blocks), one for ``N K⁻¹ f`` and one for ``u = K⁻¹(f − Nᵀλ)``; memory m².
+  Refused when m exceeds ``max_dense_dofs`` (default 3000).
+
+The shifted and dual forms keep their factorisation of K on the solution
+(:attr:`ContactSolution.factor`) for the certificate's duality gap.
+
+``polish=True`` (:func:`polish`): the active set guessed from the backend's
+answer, the equality-constrained KKT system on it solved once (by the form's
+factorisation of K when it has one, else one factorisation of K with the
+active dofs pinned), and the polished point kept only when its certificate
+is better than the backend's; ``extras["polish"]`` records both.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from signorini.errors import InputError
+from signorini.kkt import ACTIVE, certificate, classify
+from signorini.numerics.factor import COUNTS, ActiveSetSolver, factorize
+from signorini.numerics.lcp import delassus
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.base import ACCEPT_FACTOR, DEFAULT_ACCEPT
+
+FORMS = ("primal", "shifted", "dual")
+
+
+@dataclass
+class Formulation:
+    """One QP for a backend, ``min ½xᵀPx + qᵀx`` s.t. ``Gx ≤ h`` (``G`` None: ``x ≥ 0``).
+
+    ``factor`` is the factorisation of K the form made (None for ``primal``),
+    ``u0`` the unconstrained displacement (``shifted``), ``b = N K⁻¹ f − d``
+    and ``W`` (``dual``); ``work`` the factorisations and back-solves it cost
+    (building it and mapping the answer back) and ``seconds`` the time to build it.
+    """
+
+    name: str
+    P: Any
+    q: np.ndarray
+    G: Any = None
+    h: np.ndarray | None = None
+    factor: Any = None
+    u0: np.ndarray | None = None
+    W: np.ndarray | None = None
+    b: np.ndarray | None = None
+    work: dict[str, int] = field(default_factory=dict)
+    seconds: float = 0.0
+
+    @property
+    def bounds(self) -> bool:
+        """The constraint is ``x ≥ 0`` (the dual), not ``Gx ≤ h``."""
+        return self.G is None
+
+    def answer(self, problem: ContactProblem, x: np.ndarray,
+               z: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """``(u, λ)`` of the contact problem from the backend's ``x`` and multiplier ``z``
+        of ``Gx ≤ h`` (unused by the dual, whose ``x`` is λ)."""
+        x = np.asarray(x, dtype=float).copy()
+        if self.name == "dual":  # one more back-solve, counted with the form's work
+            self.work["back_solves"] = self.work.get("back_solves", 0) + 1
+            return self.factor.solve(problem.f - problem.N.T @ x), x
+        z = np.asarray(z, dtype=float).copy()
+        return (x + self.u0 if self.name == "shifted" else x), z
+
+
+def check_form(method: str, form: Any) -> str:
+    """``form`` as one of :data:`FORMS`, or InputError naming them."""
+    if form not in FORMS:
+        raise InputError(f"method {method!r}: option form={form!r} is not one of "
+                         f"{', '.join(FORMS)}: e.g. --opt form=shifted")
+    return form
+
+
+def check_polish(method: str, polish: Any) -> bool:
+    if not isinstance(polish, (bool, np.bool_)):
+        raise InputError(f"method {method!r}: option polish={polish!r} must be true or false")
+    return bool(polish)
+
+
+def dense_limit(value: Any) -> int:
+    """The option ``max_dense_dofs`` as a positive integer, or InputError."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InputError(f"max_dense_dofs must be a positive integer, got {value!r}")
+    return int(value)
+
+
+def check_dual_size(method: str, problem: ContactProblem, limit: int) -> None:
+    """The dual's dense W: refuse m above ``limit`` before any work is done."""
+    if problem.m > limit:
+        raise InputError(
+            f"method {method!r} with form='dual' builds the dense m × m Delassus operator "
+            f"W = N K⁻¹ Nᵀ ({problem.m} back-solves, {8 * problem.m ** 2 / 1e6:.0f} MB) and "
+            f"m = {problem.m} exceeds max_dense_dofs = {limit}: use form=shifted, or raise "
+            "the option max_dense_dofs")
+
+
+def formulate(problem: ContactProblem, form: str, dense: bool = False) -> Formulation:
+    """The QP of ``form`` for ``problem``; ``dense`` gives numpy arrays instead of csc matrices."""
+    start = time.perf_counter()
+    before = dict(COUNTS)
+    K = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
+    out: Formulation
+    if form == "primal":
+        out = Formulation(form, K, -problem.f, sp.csc_matrix(problem.N), problem.d.copy())
+    else:
+        factor = factorize(problem.K)
+        if form == "shifted":
+            u0 = factor.solve(problem.f)
+            out = Formulation(form, K, np.zeros(problem.n), sp.csc_matrix(problem.N),
+                              problem.d - problem.N @ u0, factor=factor, u0=u0)
+        else:
+            W = delassus(problem.N, factor)
+            b = problem.N @ factor.solve(problem.f) - problem.d
+            out = Formulation(form, W if dense else sp.csc_matrix(W), -b, factor=factor,
+                              W=W, b=b)
+    if dense and sp.issparse(out.P):
+        out.P = out.P.toarray()
+    if dense and out.G is not None:
+        out.G = out.G.toarray()
+    out.work = {key: COUNTS[key] - before[key] for key in COUNTS}
+    out.seconds = time.perf_counter() - start
+    return out
+
+
+def _kkt_on(problem: ContactProblem, form: Formulation, active: np.ndarray):
+    """``(u, λ, factor)`` of the equality-constrained KKT system on ``active``."""
+    lam = np.zeros(problem.m)
+    if form.factor is None:  # primal: one factorisation with the active dofs pinned
+        solver = ActiveSetSolver(problem.K, problem.N)
+        u, lam = solver.solve(active, problem.f, problem.d)
+        return u, lam, solver.factor
+    if active.any():  # a Schur complement on the active rows: W from the dual, or |A| back-solves
+        if form.W is not None:
+            W_AA, b_A = form.W[np.ix_(active, active)], form.b[active]
+        else:
+            N_A = problem.N[active]
+            W_AA = N_A @ form.factor.solve(sp.csc_matrix(N_A.T).toarray())
+            b_A = N_A @ form.u0 - problem.d[active]
+        lam[active] = sla.solve(0.5 * (W_AA + W_AA.T), b_A, assume_a="pos")
+    u = form.factor.solve(problem.f - problem.N.T @ lam)
+    return u, lam, form.factor
+
+
+def polish(problem: ContactProblem, form: Formulation, raw: ContactSolution,
+           tol: float | None) -> ContactSolution:
+    """The backend's answer polished on its guessed active set, when that certifies better.
+
+    The polished point replaces the raw one only when its worst certificate
+    residual is smaller; a polished point within the tolerance the registry
+    accepts is claimed ``converged`` (the registry's judge checks it again). Both
+    certificates and which answer is returned go to ``extras["polish"]``.
+    """
+    if not (np.all(np.isfinite(raw.u)) and np.all(np.isfinite(raw.lam))):
+        raw.extras["polish"] = {"kept": False, "reason": "no finite answer to polish"}
+        return raw
+    start = time.perf_counter()
+    active = classify(problem, raw) == ACTIVE
+    u, lam, factor = _kkt_on(problem, form, active)
+    polished = ContactSolution(method=raw.method, u=u, lam=lam, status="converged",
+                               factor=factor)
+    raw.factor = factor
+    raw_cert, new_cert = certificate(problem, raw), certificate(problem, polished)
+    raw_worst, new_worst = raw_cert.worst()[1], new_cert.worst()[1]
+    kept = bool(new_worst < raw_worst)
+    record = {"kept": kept, "active": int(active.sum()), "raw_status": raw.status,
+              "raw": raw_cert.as_dict(), "polished": new_cert.as_dict(),
+              "seconds": time.perf_counter() - start}
+    raw.extras["polish"] = record
+    raw.factor = factor
+    if not kept:
+        raw.message += f"; polish on {int(active.sum())} active nodes did not improve the " \
+                       f"certificate ({new_worst:.1e} ≥ {raw_worst:.1e}): the backend's answer"
+        return raw
+    raw.u, raw.lam = u, lam
+    if new_worst <= (ACCEPT_FACTOR * tol if tol is not None else DEFAULT_ACCEPT):
+        raw.status = "converged"
+    raw.message += f"; polished on {int(active.sum())} active nodes (certificate " \
+                   f"{raw_worst:.1e} → {new_worst:.1e}): the polished answer"
+    return raw

@@ -1,0 +1,86 @@
+"""What a qpsolvers backend reported: its raw status, iterations and other facts.
+
+One reader per backend (or family of backends) takes the :class:`qpsolvers.Solution`
+and the warnings the run raised, and returns a :class:`Report`; the backend table
+in :mod:`signorini.solvers.qp` names which reader each backend uses.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, NamedTuple
+
+
+class Report(NamedTuple):
+    """What a backend said about its run: raw status, iterations, other facts."""
+
+    raw_status: str
+    iterations: int | None = None
+    details: dict[str, Any] = {}
+
+
+Reader = Callable[[Any, list[str]], Report]
+
+
+def read_info(solution: Any, caught: list[str]) -> Report:
+    """OSQP, ProxQP, PIQP, QPALM: ``extras["info"]`` with ``status`` and ``iter``."""
+    info = solution.extras["info"]
+    status = info.status
+    raw = getattr(status, "name", None) or str(status)
+    details = {}
+    if hasattr(info, "status_polish"):  # OSQP: polishing can fail silently (osqp#790)
+        details["polish_status"] = int(info.status_polish)
+    return Report(raw, int(info.iter), details)
+
+
+def read_clarabel(solution: Any, caught: list[str]) -> Report:
+    return Report(str(solution.extras["status"]))  # qpsolvers drops the iteration count
+
+
+def read_scs(solution: Any, caught: list[str]) -> Report:
+    info = solution.extras
+    return Report(str(info["status"]), int(info["iter"]), {"status_val": int(info["status_val"])})
+
+
+ECOS_FLAGS = {0: "OPTIMAL", 1: "PINF", 2: "DINF", 10: "OPTIMAL_INACC", 11: "PINF_INACC",
+               12: "DINF_INACC", -1: "MAXIT", -2: "NUMERICS", -3: "OUTCONE", -4: "SIGINT",
+               -7: "FATAL"}
+
+
+def read_ecos(solution: Any, caught: list[str]) -> Report:
+    info = solution.extras
+    flag = int(info["exitFlag"])
+    return Report(ECOS_FLAGS.get(flag, f"exitFlag {flag}"), int(info["iter"]),
+                  {"exit_flag": flag, "infostring": info.get("infostring", "")})
+
+
+def read_found(ok: str, not_ok: str) -> Reader:
+    """Backends whose status qpsolvers does not pass on: only ``found`` is known."""
+    def read(solution: Any, caught: list[str]) -> Report:
+        return Report(ok if solution.found else not_ok)
+    return read
+
+
+def read_quadprog(solution: Any, caught: list[str]) -> Report:
+    if solution.found:
+        return Report("solved", int(solution.extras["iterations"][0]))
+    # qpsolvers swallows quadprog's "constraints are inconsistent, no solution"
+    # silently and warns about every other ValueError
+    complaints = [c for c in caught if "quadprog raised" in c]
+    return Report(complaints[0] if complaints else "no solution")
+
+
+def read_cvxopt(solution: Any, caught: list[str]) -> Report:
+    res = solution.extras
+    iterations = res.get("iterations")
+    return Report(str(res.get("status")), None if iterations is None else int(iterations))
+
+
+GUROBI_CODES = {1: "LOADED", 2: "OPTIMAL", 3: "INFEASIBLE", 4: "INF_OR_UNBD", 5: "UNBOUNDED",
+                 6: "CUTOFF", 7: "ITERATION_LIMIT", 8: "NODE_LIMIT", 9: "TIME_LIMIT",
+                 10: "SOLUTION_LIMIT", 11: "INTERRUPTED", 12: "NUMERIC", 13: "SUBOPTIMAL",
+                 14: "INPROGRESS", 15: "USER_OBJ_LIMIT", 16: "WORK_LIMIT", 17: "MEM_LIMIT"}
+
+
+def read_gurobi(solution: Any, caught: list[str]) -> Report:
+    code = int(solution.extras["status"])
+    return Report(GUROBI_CODES.get(code, f"status {code}"), None, {"status_code": code})
