@@ -23,3 +23,30 @@ def test_the_check_sees_a_changed_number():
     body = readme_tool.blocks()["validation"]
     changed = text.replace(body, body.replace("checks passed", "checks passed!"))
     assert readme_tool.current(changed, "validation") != body
+
+
+def test_the_readme_atlas_table_is_the_reports():
+    table = readme_tool.blocks()["stability-table"]
+    assert table in (ROOT / "docs" / "stability.md").read_text(encoding="utf-8")
+
+
+def test_the_readme_counts_the_atlas_axes():
+    data = readme_tool.stability.load()
+    words = {8: "eight"}
+    assert f"{words[len(data['axes'])]} sweeps" in (ROOT / "README.md").read_text(encoding="utf-8")
+
+
+def test_a_finding_the_atlas_no_longer_shows_stops_the_tool():
+    import copy
+
+    import pytest
+
+    stability = readme_tool.stability
+    data = stability.load()
+    assert stability.tables(data)  # the committed run shows every finding
+    grown = copy.deepcopy(data)
+    for row in grown["rows"]:
+        if row["method"] == "uzawa" and row["status"] == "diverged":
+            row["message"] = "diverged: λ grew by 1e6"  # "growth is never seen" is then false
+    with pytest.raises(stability.StaleFinding, match="two-step cycle"):
+        stability.tables(grown)

@@ -1,7 +1,8 @@
 """Write the generated blocks of README.md, docs/accuracy.md and docs/estimate.md from the committed
 artefacts they quote.
 
-    .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`
+    .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`,
+                                              # `signorini stability --out docs`, ...
 
 Each block sits between ``<!-- generated: NAME -->`` and ``<!-- end generated -->``;
 ``tests/test_readme_numbers.py`` fails when a block differs from what this writes.
@@ -17,6 +18,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
+import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 
 from signorini.files import atomic_write_text  # noqa: E402
 from signorini.output.report import readme_validation  # noqa: E402
@@ -53,7 +55,8 @@ def blocks(document: Path = README) -> dict[str, str]:
         peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
         return {"validation": readme_validation(report),
                 "peer": "\n".join(peer[peer.index("") + 1:]),  # the summary of docs/peer/peer.md
-                "one-million": one_million(ROOT / "docs" / "speed" / "one-million")}
+                "one-million": one_million(ROOT / "docs" / "speed" / "one-million"),
+                **stability.tables(stability.load())}
     if document == ACCURACY:
         return accuracy.tables(accuracy.load())
     if document == ESTIMATE:

@@ -166,17 +166,25 @@ def _package_status(result: AtlasResult) -> list[str]:
     return md
 
 
-def _method_by_axis(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]:
+def method_axis_table(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]:
+    """The method × axis verdicts (:func:`verdicts`) as Markdown lines, one row per method.
+
+    ``stability.md`` prints it under "Method × axis"; the README quotes it (tools/readme.py).
+    """
     table = verdicts(rows, axes)
     methods = list(dict.fromkeys(r["method"] for r in method_rows(rows)))
-    md = ["## Method × axis", "",
-          ("Right answers among the runs that count (inside the step bound on axis 1; not "
-           "refused for size): works = all, degrades = some, fails = none."), "",
-          "| method | " + " | ".join(f"{a.number}. {a.name}" for a in axes) + " |",
+    md = ["| method | " + " | ".join(f"{a.number}. {a.name}" for a in axes) + " |",
           "|---|" + "---|" * len(axes)]
     for method in methods:
         md.append(f"| {method} | " + " | ".join(table.get((method, a.name), "–") for a in axes) + " |")
     return md
+
+
+def _method_by_axis(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]:
+    return ["## Method × axis", "",
+            ("Right answers among the runs that count (inside the step bound on axis 1; not "
+             "refused for size): works = all, degrades = some, fails = none."), ""
+            ] + method_axis_table(rows, axes)
 
 
 def _axis_section(result: AtlasResult, axis: Axis) -> list[str]:
