@@ -93,3 +93,15 @@ def test_petsc_runs_under_one_and_two_ranks(tmp_path):
     for row in rows:
         assert row["status"] == "converged", row["message"]
         assert row["lam_rel"] <= 1e-6 and row["misclassified"] == 0
+
+
+def test_a_stored_problem_keeps_nested_s_coarse_model(tmp_path):
+    from signorini.studies.problems import PROBLEM_KINDS
+
+    path = tmp_path / "p.npz"
+    build_problem("hertz-cylinder", refine=1, n_contact=16, grading=0.3).save(path)
+    problem = PROBLEM_KINDS["stored"]({"path": str(path)})
+    from signorini.solvers.registry import solve
+
+    result = solve(problem, "nested")
+    assert result.status == "converged" and "zone from coarse model" in result.message, result.message

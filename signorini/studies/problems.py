@@ -36,7 +36,7 @@ from signorini.fem.assembly import assemble
 from signorini.fem.model import FlatObstacle
 from signorini.files import atomic_write_bytes
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.scenes import block, build_problem
+from signorini.scenes import block, build_problem, coarse_problem
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
 from signorini.solvers.registry import solve
 
@@ -65,7 +65,9 @@ def _ill_posed(spec: dict[str, Any]) -> ContactProblem:
 
 
 def _stored(spec: dict[str, Any]) -> ContactProblem:
-    return ContactProblem.load(spec["path"])
+    problem = ContactProblem.load(spec["path"])
+    problem.coarse_model = coarse_problem  # nested's coarse model is the scene's, not stored
+    return problem
 
 
 #: the kinds of problem spec and how each is built
