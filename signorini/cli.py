@@ -51,13 +51,13 @@ def _option_value(text: str) -> Any:
 
 
 def _tol(text: str) -> float:
+    from signorini.solvers.base import check_tol  # per command (start-up)
+
     try:
         value = float(text)
     except ValueError:
         raise InputError(f"--tol {text!r} is not a number: give e.g. --tol 1e-9") from None
-    if not 0 < value < 1:
-        raise InputError(f"--tol {text!r} must be in (0, 1): give e.g. --tol 1e-9")
-    return value
+    return check_tol(value, "--tol")  # the API's rule, said about the option
 
 
 def _write_json(path: str, text: str) -> None:

@@ -133,3 +133,11 @@ def test_no_public_name_hides_a_subpackage():
     import signorini.scenes.hertz_cylinder as cylinder  # was shadowed by a function `scenes`
 
     assert cylinder.FAMILY.name == "hertz-cylinder"
+
+
+@pytest.mark.parametrize("tol", [1e-15, 1e-20])
+def test_a_tolerance_double_precision_cannot_certify_is_refused(tol, capsys):
+    with pytest.raises(signorini.InputError, match="below what double precision can certify"):
+        signorini.solve("block", tol=tol)
+    assert main(["solve", "block", "--tol", f"{tol:g}"]) == 2
+    assert "--tol" in capsys.readouterr().err

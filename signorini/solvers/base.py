@@ -56,12 +56,20 @@ class Method:
         return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
 
 
-def check_tol(tol: Any) -> float | None:
+#: relative KKT residuals cannot be certified below a few hundred times double precision's ε
+MIN_TOL = 1e-14
+
+
+def check_tol(tol: Any, name: str = "tol") -> float | None:
+    """``tol`` as a float, or InputError naming ``name`` (the API's argument or the CLI's option)."""
     if tol is None:
         return None
     if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
             or not (np.isfinite(tol) and 0 < tol < 1):
-        raise InputError(f"tol must be a number in (0, 1), got {tol!r}: e.g. tol=1e-9")
+        raise InputError(f"{name} must be a number in (0, 1), got {tol!r}: e.g. {name} 1e-9")
+    if tol < MIN_TOL:
+        raise InputError(f"{name} {tol:g} is below what double precision can certify (relative "
+                         f"residuals of order 1e-16 times the conditioning): give {name} ≥ {MIN_TOL:g}")
     return float(tol)
 
 
