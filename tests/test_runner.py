@@ -83,6 +83,10 @@ def test_the_suite_runs_in_a_worker_and_in_process_alike():
     assert isolated.results[0].reference.status == "converged"
     np.testing.assert_allclose(isolated.results[0].solutions["pdas@1e-09"].lam,
                                here.results[0].solutions["pdas@1e-09"].lam, rtol=1e-10)
+    # pdas@1e-09 is the reference's own method: it is run and reported, never checked against itself
+    names = [c.name for c in isolated.checks]
+    assert not [n for n in names if n.startswith(suite.REFERENCE_LABEL)], names
+    assert "uzawa@1e-09 converged: λ agrees with pdas" in names
 
 
 def test_a_method_registered_here_only_keeps_the_suite_in_this_process(monkeypatch):

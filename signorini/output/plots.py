@@ -13,6 +13,20 @@ import numpy as np
 from signorini.analytic import hertz_pressure
 
 
+#: markers that go with the ten default colours (eleven: see :func:`series_style`)
+MARKERS = "osD^v<>phP*"
+
+
+def series_style(i: int) -> tuple[str, str]:
+    """The colour and marker of a figure's ``i``-th series.
+
+    Colours cycle through the ten default ones and markers through the eleven
+    of :data:`MARKERS` together, so the first 110 series all differ in
+    colour-and-marker (two series that share a colour never share a marker).
+    """
+    return f"C{i % 10}", MARKERS[i % len(MARKERS)]
+
+
 def axes(ax):
     """``ax``, or the Axes of a new figure (pyplot's global state untouched)."""
     if ax is None:
@@ -36,9 +50,12 @@ def pressure_profile(x: np.ndarray, pressure: np.ndarray, *, a_ref: float | None
     if a_ref is not None and p0_ref is not None:
         grid = np.linspace(0.0, float(x.max()), 800)
         ax.plot(grid / xs, hertz_pressure(grid, a_ref, p0_ref) / ps, "k-", lw=1.5, label="Hertz")
-    ax.plot(x / xs, pressure / ps, "o", ms=3, mfc="none", label=label)
-    for i, (name, values) in enumerate(others):
-        ax.plot(x / xs, values / ps, ".", ms=2, label=name, alpha=0.7, zorder=2 + i)
+    ax.plot(x / xs, pressure / ps, series_style(0)[1], color=series_style(0)[0], ms=3, mfc="none",
+            label=label)
+    for i, (name, values) in enumerate(others, start=1):  # series 0 is the numeric one above
+        colour, marker = series_style(i)
+        ax.plot(x / xs, values / ps, marker, color=colour, ms=3, mfc="none", label=name,
+                alpha=0.7, zorder=2 + i)
     ax.set_xlabel("x / a (Hertz)" if a_ref is not None else "x")
     ax.set_ylabel("p / p₀ (Hertz)" if p0_ref is not None else "p")
     ax.set_xlim(left=0.0)
@@ -48,14 +65,19 @@ def pressure_profile(x: np.ndarray, pressure: np.ndarray, *, a_ref: float | None
 
 
 def kkt_against_time(rows: list[dict], *, ax=None, title: str = ""):
-    """Worst relative KKT residual against solve time, one marker per run (log–log)."""
+    """Worst relative KKT residual against solve time, one marker per run (log–log).
+
+    Each run has its own colour-and-marker (:func:`series_style`); filled where the
+    package says converged, hollow otherwise.
+    """
     ax = axes(ax)
-    for row in rows:
-        time_s, kkt = row["time_s"], row["kkt_worst"]
-        if not (np.isfinite(kkt) and kkt > 0 and time_s > 0):
-            continue
-        marker = "o" if row["status"] == "converged" else "x"
-        ax.loglog(time_s, max(kkt, 1e-17), marker, label=f"{row['label']} ({row['status']})")
+    shown = [row for row in rows if np.isfinite(row["kkt_worst"]) and row["kkt_worst"] > 0
+             and row["time_s"] > 0]
+    for i, row in enumerate(shown):
+        colour, marker = series_style(i)
+        ax.loglog(row["time_s"], max(row["kkt_worst"], 1e-17), marker, color=colour, ms=6,
+                  mfc=colour if row["status"] == "converged" else "none",
+                  label=f"{row['label']} ({row['status']})")
     ax.set_xlabel("build + solve time [s]")
     ax.set_ylabel("worst relative KKT residual")
     ax.grid(alpha=0.3, which="both")
@@ -68,9 +90,12 @@ def kkt_against_time(rows: list[dict], *, ax=None, title: str = ""):
 def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None):
     """Benchmark runs: time against an accuracy measure, one marker per method and tolerance.
 
-    Filled markers are runs the package calls ``converged``; the lower-left
-    envelope is the Pareto front.
+    One colour per method (twenty), one marker per tolerance level; filled
+    markers are runs the package calls ``converged``; the lower-left envelope
+    is the Pareto front.
     """
+    import matplotlib  # as in axes(): only when a figure is drawn
+
     if ax is None:
         from matplotlib.figure import Figure  # as above
         ax = Figure(figsize=(10, 5), layout="constrained").add_subplot()
@@ -84,7 +109,7 @@ def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None
                 continue
             ok = [r["status"] == "converged" for r in mine]
             ax.loglog([r["time_s"] for r in mine], [max(r[metric], 1e-16) for r in mine], marker,
-                      color=f"C{i % 10}", mfc=None if all(ok) else "none",
+                      color=matplotlib.colormaps["tab20"](i % 20), mfc=None if all(ok) else "none",
                       label=f"{method} @ {tolerance}", ms=5)
     ax.set_xlabel("time [s]")
     ax.set_ylabel({"kkt_worst": "worst relative KKT residual",

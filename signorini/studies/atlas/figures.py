@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from signorini.output.plots import axes
+from signorini.output.plots import axes, series_style
 
 #: colours of the atlas's outcomes
 OUTCOME_COLOURS = {"right": "#4daf4a", "conservative": "#a6d96a", "caught": "#fdae61",
@@ -25,7 +25,7 @@ def atlas_step_sweep(rows: list[dict], *, ax=None):
     for i, (case, method) in enumerate(groups):
         mine = sorted((r for r in rows if (r["case"], r["method"]) == (case, method)),
                       key=lambda r: r["value"])
-        colour = f"C{i % 10}"
+        colour = series_style(i)[0]  # the marker tells the status
         ax.plot([r["value"] for r in mine], [max(r["iterations"], 1) for r in mine], "-",
                 color=colour, lw=1, alpha=0.6, label=f"{case}, {method}")
         for r in mine:
@@ -68,7 +68,7 @@ def atlas_series(rows: list[dict], x: str, y: str, *, ax=None, xlabel: str = "",
         if not mine:
             continue
         mine.sort(key=lambda r: r[x])
-        colour, marker = f"C{i % 10}", "osv^D<>ph*"[i // 10 % 10]
+        colour, marker = series_style(i)
         values = [max(r[y], floor) if logy else r[y] for r in mine]
         ax.plot([r[x] for r in mine], values, "-", color=colour, lw=1, alpha=0.7, label=name)
         for r, value in zip(mine, values):
