@@ -9,6 +9,7 @@ import signorini
 UNITS = [{"E": 1.0, "R": 1.0}, {"E": 7e10, "R": 0.02}, {"E": 2.1e11, "R": 10.0}]  # m or mm
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])
 @pytest.mark.parametrize("units", UNITS, ids=["unit", "aluminium-m", "steel-mm"])
 def test_the_default_cylinder_is_within_a_tenth_of_a_percent(nu, units):

@@ -39,6 +39,7 @@ def test_the_quarter_disc_is_found_again_on_its_own_mesh():
         assert np.array_equal(np.sort(getattr(disc, part)), np.sort(getattr(again, part)))
 
 
+@pytest.mark.slow
 def test_the_cylinder_refines_until_the_target():
     result = signorini.solve("hertz-cylinder", target_error="2%")
     steps = result.solution.extras["adaptive"]
@@ -56,6 +57,7 @@ def test_the_cylinder_refines_until_the_target():
     assert abs(result.hertz.p0_rel) < 2e-3 and abs(result.hertz.a_rel) < 2e-3
 
 
+@pytest.mark.slow
 def test_the_dof_limit_stops_the_loop_and_says_so():
     result = signorini.solve("hertz-sphere", target_error=0.001, max_dofs=10_000)
     assert result.status == "converged"
@@ -63,6 +65,7 @@ def test_the_dof_limit_stops_the_loop_and_says_so():
     assert result.problem.n <= 10_000 and result.estimate.relative > 0.001
 
 
+@pytest.mark.slow
 def test_the_candidates_grow_with_the_contact():
     """Pushed much further than the default a/R = 0.05: the contact outgrows the candidates."""
     result = signorini.solve("hertz-cylinder", target_error=0.05, params={"delta": 0.02})
@@ -83,6 +86,7 @@ def test_what_cannot_be_refined_says_so():
         signorini.solve("hertz-cylinder", max_dofs=1000)
 
 
+@pytest.mark.slow
 def test_the_adaptive_families_take_a_mesh():
     for name in ("hertz-cylinder", "hertz-sphere"):
         family = get_scene(name)
@@ -91,6 +95,7 @@ def test_the_adaptive_families_take_a_mesh():
         assert np.array_equal(model.contact_nodes, again.contact_nodes)
 
 
+@pytest.mark.slow
 def test_the_command_line_refines_and_reports(tmp_path):
     out = tmp_path / "adaptive.json"
     run = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",

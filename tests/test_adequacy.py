@@ -38,6 +38,7 @@ def test_more_candidates_make_the_same_push_adequate():
 
 @pytest.mark.parametrize("scene", ["hertz-cylinder", "hertz-sphere", "hertz-sphere-3d", "block",
                                    "punch", "reverse-hertz"])
+@pytest.mark.slow
 def test_the_default_scenes_are_adequate_and_watched(scene):
     result = signorini.solve(scene)
     assert result.converged, result.message

@@ -220,6 +220,7 @@ def test_hertz_force_balance(hertz):
 # --- units -----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_dimensionless_problem_does_not_depend_on_units(hertz, hertz_steel):
     assert (hertz.n, hertz.m) == (hertz_steel.n, hertz_steel.m)
     assert rel_diff(hertz.K.toarray(), hertz_steel.K.toarray()) < 1e-12
@@ -250,6 +251,7 @@ def test_physical_pressure_scales_with_E(hertz, hertz_steel):
     pytest.param({"E": 1.0, "R": 1.0}, id="E=1,R=1"),
     pytest.param(STEEL, id="steel-SI"),
 ])
+@pytest.mark.slow
 def test_nondimensionalise_false_gives_the_same_physical_answer(units):
     scaled = build_problem("hertz-cylinder", **HERTZ, **units)
     raw = build_problem("hertz-cylinder", nondimensionalise=False, **HERTZ, **units)
@@ -334,6 +336,7 @@ def test_vectorised_plane_strain_stiffness_is_scikit_fems():
     assert difference <= 1e-12 * abs(expected).max()
 
 
+@pytest.mark.slow
 def test_vectorised_solid_stiffness_is_scikit_fems(monkeypatch):
     from skfem import Basis, ElementVector, MeshTet, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity

@@ -165,6 +165,7 @@ def test_json_onto_a_directory_is_one_line(capsys, tmp_path):
     assert_one_line_exit_2(code, err, ["--json", str(tmp_path)])
 
 
+@pytest.mark.slow
 def test_the_installed_command_gives_no_traceback_for_a_bad_stability_flag(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "signorini.cli", "stability", "--time-limit", "-1",
                            "--out", str(tmp_path / "out")], capture_output=True, text=True)

@@ -34,6 +34,7 @@ def test_problem_cache_round_trip(tmp_path):
     assert np.array_equal(again.mesh.p, problem.mesh.p)  # node blocks for the petsc methods
 
 
+@pytest.mark.slow
 def test_rows_resume_and_time_limit(tmp_path):
     first = runs(("pdas", "high"), ("uzawa", "low"))
     csv_path = run_benchmark(first, tmp_path)
@@ -52,6 +53,7 @@ def test_rows_resume_and_time_limit(tmp_path):
         assert len(list(csv.DictReader(handle))) == 4  # a valid CSV, one row per run
 
 
+@pytest.mark.slow
 def test_summary_metrics(tmp_path):
     csv_path = run_benchmark(runs(("pdas", "high"), ("qp-osqp", "default")), tmp_path)
     table = {s["method"]: s for s in summary(read_rows(csv_path))}
@@ -79,6 +81,7 @@ def test_bench_ranks_are_checked(tmp_path, capsys):
     assert "ranks" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_petsc_runs_under_one_and_two_ranks(tmp_path):
     """A petsc method is one row per rank count, labelled, and agrees with the exact answer."""
     import os

@@ -114,6 +114,7 @@ def test_unwritable_outputs_are_input_errors(capsys, tmp_path):
     assert code == 2 and "--out" in err
 
 
+@pytest.mark.slow
 def test_validate_writes_a_passing_report(capsys, tmp_path):
     out_dir = tmp_path / "report"
     code, out, err = run(capsys, "validate", "--method", "pdas", "--method", "uzawa",

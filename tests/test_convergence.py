@@ -45,6 +45,7 @@ def hertz_study():
     return run_study("hertz-cylinder", 2, TINY)
 
 
+@pytest.mark.slow
 def test_exact_methods_coincide_and_errors_fall(hertz_study):
     study = hertz_study
     assert set(study.methods) >= {"pdas"}
@@ -64,6 +65,7 @@ def test_punch_study_shows_the_edge_singularity():
     assert study.rates["pdas"]["pressure_max_rel"] > 0.5
 
 
+@pytest.mark.slow
 def test_grading_comparison_at_equal_dofs():
     graded = run_study("hertz-cylinder", 2, TINY, methods=["pdas"])
     comparison = grading_comparison("hertz-cylinder", graded, 1, {"a_over_R": 0.05}, target=0.05)
@@ -100,6 +102,7 @@ def test_bad_studies_are_input_errors():
         run_study("hertz-cylinder", 1, {"refine": 2})
 
 
+@pytest.mark.slow
 def test_cli_converge(tmp_path, capsys):
     out = tmp_path / "conv"
     code = main(["converge", "punch", "--levels", "1", "--set", "n_contact=4", "--set", "grading=0.8",

@@ -87,6 +87,7 @@ def test_the_relative_estimate_does_not_depend_on_the_units():
                                                                        rel=1e-6)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene", ["hertz-cylinder", "hertz-sphere"])
 def test_effectivity_against_a_finer_solution(scene):
     """η / ‖u_ref − u_h‖_E with u_ref two uniform refinements finer, as tools/estimate.py measures."""

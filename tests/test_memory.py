@@ -19,6 +19,7 @@ def resident_mb() -> float:
     pytest.skip("no /proc/self/status: resident memory cannot be read here")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", available_backends())
 def test_repeated_factorisations_do_not_grow_resident_memory(backend):
     K = signorini.build_problem("hertz-cylinder", refine=1).K  # ~19k dofs
@@ -37,6 +38,7 @@ def test_repeated_factorisations_do_not_grow_resident_memory(backend):
     assert grown < 20, f"{backend}: resident memory grew by {grown:.0f} MB over 6 factorisations"
 
 
+@pytest.mark.slow
 def test_a_freed_factorisation_leaves_the_others_intact():
     K = signorini.build_problem("hertz-cylinder", refine=1).K
     b = np.ones(K.shape[0])

@@ -83,6 +83,7 @@ def test_getfem_solves_hertz_on_a_coarse_mesh(scene, tolerance):
     assert set(record["time"]) >= {"mesh_s", "setup_s", "solve_s", "total_s"}
 
 
+@pytest.mark.slow
 @pytest.mark.usefixtures("getfem")
 def test_the_command_writes_the_table_on_a_tiny_ladder(tmp_path, capsys):
     out = tmp_path / "peer"

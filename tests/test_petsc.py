@@ -25,6 +25,9 @@ from signorini.solvers.cluster import mpirun_command
 from signorini.solvers.registry import solve
 from signorini.teaching.synthetic import random_problem
 
+#: PETSc, MUMPS and mpirun: 25–100 s together here; `pytest -m "not slow"` leaves them out
+pytestmark = pytest.mark.slow
+
 SCENES = ("hertz-cylinder", "hertz-sphere-3d")
 
 

@@ -86,6 +86,7 @@ def test_methods_agree_with_pdas(punch, method):
     assert difference.lam_rel < 1e-6 and difference.misclassified == 0
 
 
+@pytest.mark.slow
 def test_rounded_corners_spread_the_contact_and_bound_the_pressure():
     def peaks(radius):
         out = []

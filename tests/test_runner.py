@@ -45,6 +45,7 @@ def test_a_kept_exact_answer_is_stored_once_and_read_back(tmp_path):
     assert trusted(exact_attempt(problem, {"kind": "none"})) is None
 
 
+@pytest.mark.slow
 def test_fresh_tasks_get_a_process_each_and_the_others_share_one(tmp_path):
     whoami = tmp_path / "whoami.py"
     whoami.write_text(textwrap.dedent("""

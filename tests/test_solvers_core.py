@@ -89,6 +89,7 @@ def test_uzawa_step_bound_is_the_largest_eigenvalue_of_W(block):
     assert uzawa.extras["lambda_max"] <= largest * (1 + 1e-12)  # Rayleigh quotient: a lower bound
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["block", "hertz"])
 def test_uzawa_operators_give_the_same_iterates(name, block, hertz):
     problem = {"block": block, "hertz": hertz}[name]

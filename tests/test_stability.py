@@ -197,6 +197,7 @@ def test_ill_posed_inputs_are_refused_or_diagnosed(block):
 # --- the machinery -------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_hanging_method_costs_one_row(tmp_path):
     slow = tmp_path / "slow.py"
     slow.write_text(textwrap.dedent("""

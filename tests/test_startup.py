@@ -40,6 +40,7 @@ def test_a_solve_imports_no_optional_backend():
 
 @pytest.mark.skipif(not {"cholmod", "pardiso"} <= set(available_backends()),
                     reason="needs both CHOLMOD and PARDISO installed")
+@pytest.mark.slow
 def test_the_default_cylinder_is_factorised_without_pardiso():
     """Importing pypardiso and MKL costs 0.2 s: not worth it below PARDISO_OVER_CHOLMOD_FROM."""
     answer = fresh(loaded_after(

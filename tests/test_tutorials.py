@@ -56,6 +56,7 @@ def test_notebook_is_valid_and_saved_without_outputs(name):
     assert notebook.cells[0].cell_type == "markdown" and notebook.cells[0].source.startswith("# ")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NOTEBOOKS)
 def test_notebook_runs_headless(name, monkeypatch):
     monkeypatch.setenv("MPLBACKEND", BACKEND)
@@ -109,6 +110,7 @@ def test_run_suite_runs_a_solver_file_and_reports_where_it_is_wrong():
     assert not result.passed
 
 
+@pytest.mark.slow
 def test_cli_validate_accepts_a_solver_file(tmp_path, monkeypatch, capsys):
     """``signorini validate --method path/to/file.py:solve``, on the two small default cases."""
     out = tmp_path / "report"
