@@ -78,9 +78,15 @@ class Axis:
 # --- tasks ---------------------------------------------------------------------------------------
 
 
-def scene_spec(scene: str, nondimensionalise: bool = True, **params: Any) -> dict[str, Any]:
-    """The problem spec of a scene of the package (:func:`signorini.studies.problems.build_spec`)."""
-    return {"kind": "scene", "scene": scene, "params": params, "nondimensionalise": nondimensionalise}
+def scene_spec(scene: str, nondimensionalise: bool = True, cold: bool = False,
+               **params: Any) -> dict[str, Any]:
+    """The problem spec of a scene of the package (:func:`signorini.studies.problems.build_spec`).
+
+    ``cold`` drops what load targeting learnt (its answer, its zone), so that a method starts
+    from nothing and its own iterations are measured.
+    """
+    return {"kind": "scene", "scene": scene, "params": params, "nondimensionalise": nondimensionalise,
+            "cold": cold}
 
 
 def capped(method: str, tol: float | None) -> int | None:
