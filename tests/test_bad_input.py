@@ -79,7 +79,8 @@ CASES = [
     (["solve", "block", "--opt", "novalue"], ["--opt", "key=value"]),
     (["solve", "block", "--method", "nofile.py:solve"], ["nofile.py", "path/to/file.py:function"]),
     (["solve", "block", "--method", "os:no_such_function"], ["'os'", "no_such_function"]),
-    (["solve", "hertz-cylinder", "--method", "qp-daqp"], ["qp-daqp", "max_dense_dofs"]),
+    (["solve", "hertz-cylinder", "--method", "qp-daqp", "--opt", "form=primal"],
+     ["qp-daqp", "max_dense_dofs"]),
     (["solve", "block", "--set", "W=inf"], ["W=", "finite"]),
     (["solve", "block", "--set", "delta=-inf"], ["delta="]),
     # the block's degenerate variant

@@ -51,11 +51,45 @@ def test_every_form_gives_the_exact_answer(scene, method, form):
     assert polished.extras["polish"]["kept"] or raw.status == "converged"
 
 
+#: the default forms docs/formulations.md chose by measurement (the rest stay primal)
+DUAL_BY_DEFAULT = {"osqp", "highs", "daqp", "quadprog", "ecos"}
+
+
 def test_the_default_form_is_the_backends_own():
+    assert {b.name for b in qp.BACKENDS if b.form == "dual"} == DUAL_BY_DEFAULT
+    assert all(b.form == "primal" for b in qp.BACKENDS if b.name not in DUAL_BY_DEFAULT)
     require("qp-osqp")
     problem = signorini.build_problem("block")
-    assert solve(problem, "qp-osqp", tol=1e-9).extras["form"] == qp.BACKEND_BY_NAME["osqp"].form
-    assert all(backend.form in forms.FORMS for backend in qp.BACKENDS)
+    sol = solve(problem, "qp-osqp", tol=1e-9)
+    assert sol.extras["form"] == "dual" and "(dual form)" in sol.message
+
+
+def test_a_default_dual_falls_back_to_primal_where_it_cannot_be_built():
+    """K singular (a body held by contact alone), or more candidates than max_dense_dofs: the
+    default dual becomes the primal form and says why; asked for by name, it fails instead."""
+    require("qp-osqp")
+    from signorini.scenes.block import force_controlled_problem
+
+    floating = force_controlled_problem(0.01)
+    sol = solve(floating, "qp-osqp", tol=1e-9)
+    assert sol.status == "converged", sol.message
+    assert sol.extras["form"] == "primal" and "needs K⁻¹" in sol.extras["form_note"]
+    asked = solve(floating, "qp-osqp", tol=1e-9, form="dual")
+    assert asked.status == "failed" and "form=primal" in asked.message
+    problem = signorini.build_problem("block")
+    sol = solve(problem, "qp-osqp", tol=1e-9, max_dense_dofs=problem.m - 1)
+    assert sol.extras["form"] == "primal" and "max_dense_dofs" in sol.message
+    with pytest.raises(InputError, match="form='dual' builds the dense"):
+        solve(problem, "qp-osqp", tol=1e-9, form="dual", max_dense_dofs=problem.m - 1)
+
+
+def test_superlu_on_a_singular_k_is_caught(monkeypatch):
+    """SuperLU factorises a singular K without a word: K u₀ = f is checked."""
+    from signorini.scenes.block import force_controlled_problem
+
+    monkeypatch.setenv("SIGNORINI_FACTOR", "superlu")
+    with pytest.raises(np.linalg.LinAlgError, match="singular"):
+        forms.formulate(force_controlled_problem(0.01), "shifted")
 
 
 def counted(function, *args, **kwargs):
@@ -118,9 +152,9 @@ def test_dense_backends_solve_the_dual_beyond_their_dof_limit():
     problem = signorini.build_problem("hertz-cylinder", **SCENES["hertz-cylinder"])
     exact = solve(problem, "pdas", tol=1e-10)
     with pytest.raises(InputError, match="max_dense_dofs"):
-        solve(problem, "qp-daqp", tol=1e-9, max_dense_dofs=500)
-    sol = solve(problem, "qp-daqp", tol=1e-9, form="dual", max_dense_dofs=500)
-    assert sol.status == "converged", sol.message
+        solve(problem, "qp-daqp", tol=1e-9, form="primal", max_dense_dofs=500)
+    sol = solve(problem, "qp-daqp", tol=1e-9, max_dense_dofs=500)  # its default: the dual
+    assert sol.status == "converged" and sol.extras["form"] == "dual", sol.message
     assert compare(problem, sol, exact).lam_rel <= 1e-9
 
 

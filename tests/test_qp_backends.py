@@ -275,7 +275,7 @@ def test_cvxpy_refuses_unknown_solver():
 def test_dense_backend_refuses_large_problems(method):
     assert get_method(method).dense
     with pytest.raises(InputError, match="max_dense_dofs"):
-        get_method(method).function(case(8, 3, 0), max_dense_dofs=5)
+        get_method(method).function(case(8, 3, 0), max_dense_dofs=5, form="primal")
 
 
 def big_sparse_problem(n: int) -> ContactProblem:
@@ -290,7 +290,7 @@ def big_sparse_problem(n: int) -> ContactProblem:
 @pytest.mark.parametrize("method", DENSE_METHODS)
 def test_dense_guard_default_is_3000_dofs(method):
     with pytest.raises(InputError, match="max_dense_dofs = 3000"):
-        get_method(method).function(big_sparse_problem(3001))
+        get_method(method).function(big_sparse_problem(3001), form="primal")
 
 
 def test_sparse_backend_accepts_max_dense_dofs_and_ignores_it():

@@ -31,6 +31,8 @@ log = logging.getLogger(__name__)
 
 METHOD = "cvxpy"
 DEFAULT_SOLVER = "CLARABEL"
+#: measured by tools/formulations.py (docs/formulations.md): no form wins clearly with Clarabel
+DEFAULT_FORM = "primal"
 OPTIONS = ("solver", "form", "polish", "max_dense_dofs")
 
 #: cvxpy status → ours (anything else is ``failed``)
@@ -117,18 +119,16 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         raise InputError(f"method 'cvxpy' does not accept option(s) "
                          f"{', '.join(repr(u) for u in unknown)}; accepted options: "
                          f"{', '.join(OPTIONS)}")
-    form = forms.check_form(METHOD, options.get("form", "primal"))
+    limit = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
+    form, note = forms.resolve(METHOD, problem, options.get("form"), DEFAULT_FORM, limit)
     polishing = forms.check_polish(METHOD, options.get("polish", False))
-    if form == "dual":
-        limit = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
-        forms.check_dual_size(METHOD, problem, limit)
     import cvxpy as cp  # as above
 
     solver = _check_solver(options.get("solver", DEFAULT_SOLVER))
     opts = solver_options(solver, tol, max_iter)
 
     start = time.perf_counter()
-    qp = forms.formulate(problem, form)
+    qp = forms.formulate(problem, form, fallback=options.get("form") is None)
     x = cp.Variable(qp.q.size)
     contact = x >= 0 if qp.bounds else qp.G @ x <= qp.h
     model = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, qp.P, assume_PSD=True) + qp.q @ x),
@@ -161,11 +161,12 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     raw_status = str(model.status)
     status = STATUS_MAP.get(raw_status, "failed")
     iterations = model.solver_stats.num_iters if model.solver_stats is not None else None
-    common = dict(message=f"cvxpy/{solver}: {raw_status}" + ("" if form == "primal" else
-                                                             f" ({form} form)"),
+    extras = {"raw_status": raw_status, "solver": solver, "backend_warnings": caught,
+              "form": qp.name, "form_work": qp.work, "form_s": qp.seconds,
+              "form_note": note or qp.note}
+    common = dict(message=f"cvxpy/{solver}: {raw_status}" + forms.said(qp.name, extras),
                   iterations=int(iterations or 0), build_time=build_time, solve_time=solve_time,
-                  extras={"raw_status": raw_status, "solver": solver, "backend_warnings": caught,
-                          "form": form, "form_work": qp.work, "form_s": qp.seconds})
+                  extras=extras)
     if x.value is None or (contact.dual_value is None and not qp.bounds):
         return ContactSolution.failure(METHOD, problem, "failed" if status == "converged"
                                        else status, **common)

@@ -46,6 +46,8 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers.base import ACCEPT_FACTOR, DEFAULT_ACCEPT
 
 FORMS = ("primal", "shifted", "dual")
+#: ``‖K K⁻¹f − f‖∞ / ‖f‖∞`` above this means K is singular (SuperLU does not say so itself)
+SINGULAR = 1e-6
 
 
 @dataclass
@@ -53,9 +55,10 @@ class Formulation:
     """One QP for a backend, ``min ½xᵀPx + qᵀx`` s.t. ``Gx ≤ h`` (``G`` None: ``x ≥ 0``).
 
     ``factor`` is the factorisation of K the form made (None for ``primal``),
-    ``u0`` the unconstrained displacement (``shifted``), ``b = N K⁻¹ f − d``
-    and ``W`` (``dual``); ``work`` the factorisations and back-solves it cost
-    (building it and mapping the answer back) and ``seconds`` the time to build it.
+    ``u0 = K⁻¹f`` the unconstrained displacement
+    (``shifted``, ``dual``), ``b = N u₀ − d`` and ``W`` (``dual``); ``work`` the
+    factorisations and back-solves it cost (building it and mapping the answer back),
+    ``seconds`` the time to build it and ``note`` why it is not the form asked for.
     """
 
     name: str
@@ -69,6 +72,7 @@ class Formulation:
     b: np.ndarray | None = None
     work: dict[str, int] = field(default_factory=dict)
     seconds: float = 0.0
+    note: str = ""
 
     @property
     def bounds(self) -> bool:
@@ -101,11 +105,36 @@ def check_polish(method: str, polish: Any) -> bool:
     return bool(polish)
 
 
+def said(form: str, extras: dict[str, Any]) -> str:
+    """What a method's message adds about its form: nothing for primal asked for."""
+    note = extras.get("form_note")
+    if note:
+        return f" ({note})"
+    return "" if form == "primal" else f" ({form} form)"
+
+
 def dense_limit(value: Any) -> int:
     """The option ``max_dense_dofs`` as a positive integer, or InputError."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise InputError(f"max_dense_dofs must be a positive integer, got {value!r}")
     return int(value)
+
+
+def resolve(method: str, problem: ContactProblem, given: Any, default: str,
+            limit: int) -> tuple[str, str]:
+    """The form to build and why, before any work: ``(form, note)``.
+
+    A ``form`` the caller gave is checked (InputError for an unknown one, or for
+    the dual with more than ``limit`` candidates); the method's default dual
+    falls back to ``primal`` above ``limit`` instead, and ``note`` says so.
+    """
+    form = check_form(method, default if given is None else given)
+    if form == "dual" and problem.m > limit and given is None:
+        return "primal", (f"the default dual form needs a dense {problem.m} × {problem.m} W, "
+                          f"over max_dense_dofs = {limit}: primal form instead")
+    if form == "dual":
+        check_dual_size(method, problem, limit)
+    return form, ""
 
 
 def check_dual_size(method: str, problem: ContactProblem, limit: int) -> None:
@@ -118,25 +147,55 @@ def check_dual_size(method: str, problem: ContactProblem, limit: int) -> None:
             "the option max_dense_dofs")
 
 
-def formulate(problem: ContactProblem, form: str, dense: bool = False) -> Formulation:
-    """The QP of ``form`` for ``problem``; ``dense`` gives numpy arrays instead of csc matrices."""
+def _unconstrained(problem: ContactProblem):
+    """A factorisation of K and ``u₀ = K⁻¹f``; LinAlgError when K is singular.
+
+    CHOLMOD and PARDISO refuse a singular K; SuperLU may not, so ``K u₀ = f``
+    is checked (one product).
+    """
+    try:
+        factor = factorize(problem.K)
+    except Exception as exc:  # CHOLMOD's LinAlgError, PARDISO's PyPardisoError
+        raise np.linalg.LinAlgError(f"K cannot be factorised ({exc})") from exc
+    u0 = factor.solve(problem.f)
+    scale = max(float(np.max(np.abs(problem.f), initial=0.0)), 1e-300)
+    if not np.all(np.isfinite(u0)) or np.max(np.abs(problem.K @ u0 - problem.f)) > SINGULAR * scale:
+        raise np.linalg.LinAlgError("K is singular (K⁻¹f does not solve K u = f)")
+    return factor, u0
+
+
+def formulate(problem: ContactProblem, form: str, dense: bool = False,
+              fallback: bool = False) -> Formulation:
+    """The QP of ``form`` for ``problem``; ``dense`` gives numpy arrays instead of csc matrices.
+
+    The shifted and dual forms need K⁻¹: on a singular K (a body held by
+    contact alone) they raise LinAlgError, or with ``fallback`` give the primal
+    form with a ``note`` saying why.
+    """
     start = time.perf_counter()
     before = dict(COUNTS)
     K = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
+    note = ""
+    if form != "primal":
+        try:
+            factor, u0 = _unconstrained(problem)
+        except np.linalg.LinAlgError as exc:
+            if not fallback:
+                raise np.linalg.LinAlgError(f"form={form!r} needs K⁻¹: {exc}; the primal "
+                                            "form needs none (form=primal)") from exc
+            form, note = "primal", f"the default {form} form needs K⁻¹: {exc}; primal form instead"
     out: Formulation
     if form == "primal":
         out = Formulation(form, K, -problem.f, sp.csc_matrix(problem.N), problem.d.copy())
+    elif form == "shifted":
+        out = Formulation(form, K, np.zeros(problem.n), sp.csc_matrix(problem.N),
+                          problem.d - problem.N @ u0, factor=factor, u0=u0)
     else:
-        factor = factorize(problem.K)
-        if form == "shifted":
-            u0 = factor.solve(problem.f)
-            out = Formulation(form, K, np.zeros(problem.n), sp.csc_matrix(problem.N),
-                              problem.d - problem.N @ u0, factor=factor, u0=u0)
-        else:
-            W = delassus(problem.N, factor)
-            b = problem.N @ factor.solve(problem.f) - problem.d
-            out = Formulation(form, W if dense else sp.csc_matrix(W), -b, factor=factor,
-                              W=W, b=b)
+        W = delassus(problem.N, factor)
+        b = problem.N @ u0 - problem.d
+        out = Formulation(form, W if dense else sp.csc_matrix(W), -b, factor=factor,
+                          u0=u0, W=W, b=b)
+    out.note = note
     if dense and sp.issparse(out.P):
         out.P = out.P.toarray()
     if dense and out.G is not None:
@@ -147,22 +206,22 @@ def formulate(problem: ContactProblem, form: str, dense: bool = False) -> Formul
 
 
 def _kkt_on(problem: ContactProblem, form: Formulation, active: np.ndarray):
-    """``(u, λ, factor)`` of the equality-constrained KKT system on ``active``."""
-    lam = np.zeros(problem.m)
-    if form.factor is None:  # primal: one factorisation with the active dofs pinned
+    """``(u, λ, factor)`` of the equality-constrained KKT system on ``active``.
+
+    The dual holds W: ``W_AA λ_A = b_A`` and one back-solve. The other forms
+    factorise K once with the active dofs pinned (the saddle-point matrix when
+    a row of N bounds more than one dof): measured at 75k dofs, cheaper than
+    the |A| ≈ 260 back-solves of a Schur complement on the shifted form's factor.
+    """
+    if form.W is None:
         solver = ActiveSetSolver(problem.K, problem.N)
         u, lam = solver.solve(active, problem.f, problem.d)
-        return u, lam, solver.factor
-    if active.any():  # a Schur complement on the active rows: W from the dual, or |A| back-solves
-        if form.W is not None:
-            W_AA, b_A = form.W[np.ix_(active, active)], form.b[active]
-        else:
-            N_A = problem.N[active]
-            W_AA = N_A @ form.factor.solve(sp.csc_matrix(N_A.T).toarray())
-            b_A = N_A @ form.u0 - problem.d[active]
-        lam[active] = sla.solve(0.5 * (W_AA + W_AA.T), b_A, assume_a="pos")
-    u = form.factor.solve(problem.f - problem.N.T @ lam)
-    return u, lam, form.factor
+        return u, lam, solver.factor or form.factor
+    lam = np.zeros(problem.m)
+    if active.any():
+        W_AA = form.W[np.ix_(active, active)]
+        lam[active] = sla.solve(0.5 * (W_AA + W_AA.T), form.b[active], assume_a="pos")
+    return form.factor.solve(problem.f - problem.N.T @ lam), lam, form.factor
 
 
 def polish(problem: ContactProblem, form: Formulation, raw: ContactSolution,

@@ -55,7 +55,9 @@ class Backend:
     status from a :class:`qpsolvers.Solution` and the warnings it raised.
     ``fixed`` are settings always passed; ``nest`` rewrites the settings
     before the call (MOSEK takes its parameters inside one dict); ``form`` is
-    the default formulation (:data:`signorini.solvers.forms.FORMS`).
+    the default formulation (:data:`signorini.solvers.forms.FORMS`), chosen by
+    tools/formulations.py's measurements (docs/formulations.md); a default dual
+    falls back to primal when it cannot be built (K singular, m > max_dense_dofs).
     """
 
     name: str
@@ -162,7 +164,8 @@ BACKENDS: tuple[Backend, ...] = (
                  "scaled_termination", "check_termination", "check_dualgap", "time_limit",
                  "polishing", "polish_refine_iter", "warm_starting", "linsys_solver"),
         tolerance=_each("eps_abs", "eps_rel", "eps_prim_inf"), max_iter_option="max_iter",
-        extra="", fixed={"raise_error": False}),
+        extra="", fixed={"raise_error": False},
+        form="dual"),  # primal: never converged in 12 runs, dual 7 (docs/formulations.md)
     Backend(
         "clarabel", "Clarabel", "Clarabel (interior point) through qpsolvers", ("clarabel",),
         read_clarabel,
@@ -230,7 +233,8 @@ BACKENDS: tuple[Backend, ...] = (
         options=("feastol", "abstol", "reltol", "feastol_inacc", "abstol_inacc",
                  "reltol_inacc", "max_iters", "nitref"),
         tolerance=_each("abstol", "reltol", "feastol"), max_iter_option="max_iters",
-        dense=True),  # qpsolvers densifies P and G and takes a Cholesky factor of P
+        dense=True,  # qpsolvers densifies P and G and takes a Cholesky factor of P
+        form="dual"),  # so the m × m dual, as DAQP (never converged raw; polished 6 of 10)
     Backend(
         "highs", "HiGHS", "HiGHS (active set QP) through qpsolvers", ("highspy",),
         read_found("kOptimal", "not optimal (qpsolvers does not pass HiGHS's model status on)"),
@@ -239,7 +243,8 @@ BACKENDS: tuple[Backend, ...] = (
                  "optimality_tolerance", "kkt_tolerance", "qp_iteration_limit",
                  "qp_nullspace_limit", "qp_regularization_value", "time_limit", "presolve",
                  "solver", "threads", "random_seed", "objective_bound"),
-        tolerance=_highs_tolerance, max_iter_option="qp_iteration_limit"),
+        tolerance=_highs_tolerance, max_iter_option="qp_iteration_limit",
+        form="dual"),  # primal and shifted: a wrong answer or none; dual 10 of 12 exact
     Backend(
         "daqp", "DAQP", "DAQP (dual active set, dense) through qpsolvers", ("daqp",),
         read_found("exitflag > 0", "exitflag <= 0 (qpsolvers does not pass the flag on)"),
@@ -247,12 +252,13 @@ BACKENDS: tuple[Backend, ...] = (
         options=("primal_tol", "dual_tol", "zero_tol", "pivot_tol", "progress_tol", "cycle_tol",
                  "iter_limit", "fval_bound", "eps_prox", "eta_prox", "sing_tol", "refactor_tol",
                  "time_limit", "eq_reduction"),
-        tolerance=_each("primal_tol", "dual_tol"), max_iter_option="iter_limit", dense=True),
+        tolerance=_each("primal_tol", "dual_tol"), max_iter_option="iter_limit", dense=True,
+        form="dual"),  # dense: the m × m dual, not n × n (exact in 10 of 12 runs)
     Backend(
         "quadprog", "quadprog", "quadprog (Goldfarb-Idnani dual active set, dense) through "
         "qpsolvers", ("quadprog",), read_quadprog,
         {"solved": CONVERGED, "no solution": INFEASIBLE},
-        dense=True),  # no tolerance and no iteration limit to set
+        dense=True, form="dual"),  # no tolerance or iteration limit to set; dual as DAQP
     Backend(
         "qpalm", "QPALM", "QPALM (proximal augmented Lagrangian) through qpsolvers", ("qpalm",),
         read_info,
@@ -340,11 +346,11 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
     """
     spec = BACKEND_BY_NAME[backend]
     max_dense_dofs = _check_options(spec, options)
-    form = forms.check_form(spec.method_name, options.get("form", spec.form))
+    form, note = forms.resolve(spec.method_name, problem, options.get("form"), spec.form,
+                               max_dense_dofs)
     polishing = forms.check_polish(spec.method_name, options.get("polish", False))
-    if form == "dual":
-        forms.check_dual_size(spec.method_name, problem, max_dense_dofs)
-    elif spec.dense and problem.n > max_dense_dofs:
+    dense_n = spec.dense and problem.n > max_dense_dofs
+    if form != "dual" and dense_n:
         raise InputError(
             f"method {spec.method_name!r} builds dense n × n matrices and n = {problem.n} "
             f"exceeds max_dense_dofs = {max_dense_dofs}: pick a sparse backend or raise "
@@ -363,7 +369,8 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         settings = spec.nest(settings)
 
     start = time.perf_counter()
-    data = forms.formulate(problem, form, spec.dense)
+    fallback = options.get("form") is None and not dense_n  # the default form may fall back
+    data = forms.formulate(problem, form, spec.dense, fallback=fallback)
     qp = (qpsolvers.Problem(data.P, data.q, lb=np.zeros(problem.m)) if data.bounds
           else qpsolvers.Problem(data.P, data.q, data.G, data.h))
     build_time = time.perf_counter() - start
@@ -391,10 +398,9 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         build_time += result.build_time
         elapsed = result.solve_time
     extras = {"raw_status": report.raw_status, "backend": spec.name,
-              "backend_warnings": caught, **report.details, "form": form,
-              "form_work": data.work, "form_s": data.seconds}
-    common = dict(message=f"{spec.label}: {report.raw_status}" + ("" if form == "primal" else
-                                                                  f" ({form} form)"),
+              "backend_warnings": caught, **report.details, "form": data.name,
+              "form_work": data.work, "form_s": data.seconds, "form_note": note or data.note}
+    common = dict(message=f"{spec.label}: {report.raw_status}" + forms.said(data.name, extras),
                   iterations=report.iterations or 0, build_time=build_time,
                   solve_time=elapsed, extras=extras)
     if result.x is None or (result.z is None and not data.bounds):
