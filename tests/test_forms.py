@@ -187,3 +187,22 @@ def test_polish_on_a_wrong_active_set_is_not_kept():
     assert record["active"] == int((exact.lam > 0).sum()) + 1
     assert not record["kept"] and "did not improve" in out.message
     assert out.lam is lam and max(record["polished"].values()) >= max(record["raw"].values())
+
+
+def test_the_formulations_doc_is_its_runs():
+    """docs/formulations.md's tables are what tools/formulations.py renders from the committed
+    JSON (``python tools/formulations.py --doc``), and its defaults are the code's."""
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("formulations_tool", root / "tools" / "formulations.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    text = tool.DOC.read_text(encoding="utf-8")
+    blocks = tool.tables(tool.load())
+    assert set(blocks) >= {"summary", *tool.CASES}
+    for name, body in blocks.items():
+        found = tool.pattern(name).search(text)
+        assert found and found.group(2) == body, (
+            f"docs/formulations.md block '{name}' differs: run python tools/formulations.py --doc")
