@@ -1,0 +1,124 @@
+"""``signorini bench``: methods × sizes × tolerances, or a peer side by side (``--peer``)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shlex
+import sys
+from pathlib import Path
+
+from signorini.errors import InputError
+from signorini.cli.common import pairs, parse_sizes
+
+
+def _bench_peer(args: argparse.Namespace) -> int:
+    # each command loads what it needs (the peer report starts matplotlib)
+    from signorini.output.report import provenance
+    from signorini.studies import peer  # as above
+
+    points = peer.ladder([args.scene] if args.scene else list(peer.SCENES),
+                         None if args.sizes is None else parse_sizes(args.sizes), pairs(args.set, "--set"))
+    if args.repeat < 1:
+        raise InputError(f"--repeat {args.repeat} must be at least 1")
+    missing = peer.getfem_missing()
+    if missing:  # issue 16: skipped with a word where GetFEM is not installed
+        print(f"signorini: {missing}; the peer benchmark is skipped, nothing written")
+        return 0
+    out, load = args.out or "peer-report", {"before": os.getloadavg()}
+    rows = peer.run_peer(points, repeat=args.repeat, timeout=args.time_limit,
+                         progress=lambda line: print(line, file=sys.stderr))
+    load["after"] = os.getloadavg()
+    given = " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == ["bench"] else ""
+    meta = {"machine": provenance(), "repeat": args.repeat, "getfem_python": peer.system_python(),
+            "load_average": load,
+            "signorini_command": peer.our_command(), "PYTHONPATH": os.environ.get("PYTHONPATH"),
+            "getfem": next((r["versions"]["getfem"] for r in rows if "versions" in r), None)}
+    paths = peer.write_peer(rows, out, f"signorini bench {given or '--peer getfem'}", meta)
+    print("\n".join(peer.peer_table(rows)))
+    print(f"report: {paths['md']}")
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    if args.peer:
+        return _bench_peer(args)
+    import math
+
+    # each command loads what it needs (the benchmark's report starts matplotlib)
+    from signorini.files import writable_directory
+    from signorini.scenes import get_scene  # as above
+    from signorini.solvers.registry import get_method, methods  # as above
+    from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
+
+    out = writable_directory(args.out or "bench-report")
+    family = get_scene(args.scene or "hertz-cylinder")
+    levels = parse_sizes(args.sizes or "0,1")
+    if not (math.isfinite(args.time_limit) and args.time_limit > 0):
+        raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
+                         "e.g. --time-limit 120")
+    tolerances = args.tolerance.split(",")
+    unknown = [t for t in tolerances if t not in TOLERANCES]
+    if unknown:
+        raise InputError(f"--tolerance {unknown[0]!r} is not one of {', '.join(TOLERANCES)}")
+    chosen = [get_method(m) for m in args.method] if args.method else \
+        [m for m in methods(installed_only=True) if not m.dense and m.family != "user"]
+    try:
+        ranks = sorted({int(x) for x in args.ranks.split(",")})
+    except ValueError:
+        ranks = [0]
+    if ranks[0] < 1:
+        raise InputError(f"--ranks {args.ranks!r} must be a comma-separated list of positive "
+                         "rank counts, e.g. --ranks 1,2")
+    if ranks[-1] > 1:
+        from signorini.solvers.cluster import mpirun_command  # only when ranks are asked for
+
+        mpirun_command(ranks[-1], [])  # no mpirun, or more ranks than cores: fail before any run
+    base = pairs(args.set, "--set")
+    runs = []
+    for level in levels:
+        params = {**base, "refine": level}
+        family.parse(params)  # bad scene parameters fail here, before any run
+        for method in chosen:
+            few = args.default_only_from is not None and level >= args.default_only_from
+            for tolerance in (["high"] if method.exact else ["default"] if few else tolerances):
+                for count in (ranks if method.family == "petsc" else [1]):
+                    runs.append(Run(family.name, f"refine{level}", params, method.name, tolerance,
+                                    ranks=count))
+
+    def progress(i, n, run, row):
+        print(f"[{i}/{n}] {run.size} {run.label}@{run.tolerance}: {row['status']} "
+              f"{row.get('time_s', float('nan')):.3g} s", file=sys.stderr)
+
+    if not args.report_only:
+        run_benchmark(runs, Path(out), time_limit=args.time_limit, progress=progress)
+    given = [a for a in sys.argv[2:] if a != "--report-only"]  # the command that made the CSV
+    command = "signorini bench " + " ".join(given) if given else "signorini bench"
+    print(f"report: {write_report(Path(out) / 'bench.csv', command)}")
+    return 0
+
+
+def add_parsers(sub) -> None:
+    """Register ``bench``."""
+    bench = sub.add_parser("bench", help="benchmark methods × sizes × tolerances (resumable CSV)")
+    bench.add_argument("--scene", help="default hertz-cylinder (with --peer: both Hertz scenes)")
+    bench.add_argument("--sizes", help="refinement levels, e.g. 0,1,2 (default 0,1; with --peer: "
+                       "rungs of the peer ladder 0..4, default all)")
+    bench.add_argument("--peer", choices=["getfem"], help="the Hertz scenes by GetFEM (system "
+                       "python3-getfem) and this package side by side: accuracy, whole-process time")
+    bench.add_argument("--repeat", type=int, default=3,
+                       help="with --peer: runs per point, the fastest kept (default 3)")
+    bench.add_argument("--method", action="append", default=[],
+                       help="only this method (repeatable; default: every installed sparse one)")
+    bench.add_argument("--tolerance", default="low,mid,high,default",
+                       help="tolerance levels: low (1e-3), mid (1e-6), high (1e-9), default")
+    bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    bench.add_argument("--default-only-from", type=int, default=None, metavar="LEVEL",
+                       help="from this refinement level on, iterative methods run at their "
+                            "default tolerance only (large sizes)")
+    bench.add_argument("--time-limit", type=float, default=600.0, help="seconds per run")
+    bench.add_argument("--ranks", default="1", help="MPI ranks for the petsc methods, e.g. 1,2 "
+                       "(each count is one more run; never more than the cores)")
+    bench.add_argument("--out", help="default bench-report (with --peer: peer-report)")
+    bench.add_argument("--report-only", action="store_true", help="rewrite the report from the CSV")
+    bench.set_defaults(run=cmd_bench)

@@ -1,0 +1,74 @@
+"""``signorini solve``: one scene, one method."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from signorini.errors import InputError
+from signorini.cli.common import EXIT_FAILED, pairs, option_value, parse_tol, write_json
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    from signorini.api import build_problem, solve  # per command (start-up)
+    from signorini.files import to_json  # per command (start-up)
+
+    params = pairs(args.set, "--set")
+    options = {k: option_value(v) for k, v in pairs(args.opt, "--opt").items()}
+    max_iter = options.pop("max_iter", None)
+    tol = parse_tol(args.tol) if args.tol is not None else None
+    if args.json not in (None, "-") and Path(args.json).is_dir():
+        raise InputError(f"--json {args.json!r} is a directory: give a file name, "
+                         f"e.g. --json {Path(args.json) / 'result.json'}")
+    if args.vtk:
+        from signorini.output.export import check_vtk_path  # per command (start-up)
+
+        check_vtk_path(args.vtk)  # a bad export path fails before the solve
+    if args.target_error is not None:  # adaptive refinement of the scene (signorini.scenes.adapt)
+        if args.raw_units:
+            raise InputError("--target-error refines a non-dimensionalised scene: drop --raw-units")
+        result = solve(args.scene, args.method, tol=tol, max_iter=max_iter, params=params,
+                       target_error=args.target_error, max_dofs=args.max_dofs, **options)
+        problem = result.problem
+    else:
+        problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
+        result = solve(problem, args.method, tol=tol, max_iter=max_iter, max_dofs=args.max_dofs,
+                       **options)
+    record = result.to_dict()
+    if args.json:
+        write_json(args.json, to_json(record))
+    if args.json != "-":
+        print(result.summary())
+    if args.vtk:
+        from signorini.output.export import export_vtk  # per command (start-up)
+
+        if record["contact"] is None:
+            print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
+            return EXIT_FAILED
+        export_vtk(problem, result.solution, args.vtk)
+        print(f"written: {args.vtk}", file=sys.stderr if args.json == "-" else sys.stdout)
+    return 0 if result.converged else EXIT_FAILED
+
+
+def add_parsers(sub) -> None:
+    """Register ``solve``."""
+    solve = sub.add_parser("solve", help="solve one scene with one method")
+    solve.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
+    solve.add_argument("--method", default="pdas", help="method name (see 'signorini methods')")
+    solve.add_argument("--tol", help="the method's tolerance (default: the method's own)")
+    solve.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="scene parameter, e.g. --set a_over_R=0.05")
+    solve.add_argument("--opt", action="append", default=[], metavar="KEY=VALUE",
+                       help="method option, e.g. --opt step_fraction=0.5")
+    solve.add_argument("--json", metavar="FILE", help="write the result as JSON ('-' for stdout)")
+    solve.add_argument("--raw-units", action="store_true",
+                       help="solve in the user's units instead of non-dimensionalising")
+    solve.add_argument("--vtk", metavar="FILE",
+                       help="write the deformed mesh with displacement, stress, gap and pressure "
+                            "(.vtu or .vtk, for ParaView)")
+    solve.add_argument("--target-error", metavar="ETA", help="refine adaptively until the estimated "
+                       "relative energy-norm error is at most ETA (0.01 or 1%%)")
+    solve.add_argument("--max-dofs", type=int, metavar="N", help="with --target-error: no mesh "
+                       "beyond N dofs (default 100000)")
+    solve.set_defaults(run=cmd_solve)

@@ -1,0 +1,168 @@
+"""The study commands: ``converge``, ``validate``, ``sweep``, ``stability``."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+from signorini.errors import InputError
+from signorini.cli.common import EXIT_FAILED, pairs
+
+
+def cmd_converge(args: argparse.Namespace) -> int:
+    # each command loads what it needs (the studies start matplotlib)
+    from signorini.files import writable_directory
+    from signorini.studies.convergence import grading_comparison, run_study, study_table, write_study  # as above
+
+    writable_directory(args.out)
+    if args.levels < 0 or args.levels > 6:
+        raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
+    if args.uniform_levels is not None and not 0 <= args.uniform_levels <= 4:
+        raise InputError(f"--uniform-levels {args.uniform_levels} must be in 0..4")
+    params = pairs(args.set, "--set")
+    say = (lambda line: print(line, file=sys.stderr))
+    study = run_study(args.scene, args.levels, params, methods=args.method or None,
+                      fit_from=args.fit_from, progress=say)
+    comparison = None
+    if args.uniform_levels is not None:
+        comparison = grading_comparison(args.scene, study, args.uniform_levels, params, progress=say)
+    command = "signorini converge " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
+        if len(sys.argv) > 2 and sys.argv[1] == "converge" else f"signorini converge {args.scene} --levels {args.levels}"
+    paths = write_study(study, args.out, command, comparison)
+    print("\n".join(study_table(study)))
+    if comparison is not None:
+        print(f"{comparison.metric} {100 * comparison.target:g} %: graded {comparison.graded_dofs:,.0f} dofs "
+              f"({comparison.graded_how}), uniform {comparison.uniform_dofs:,.0f} dofs "
+              f"({comparison.uniform_how}): grading saves {comparison.saving:,.0f}×")
+    print(f"report: {paths['markdown']}")
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    # each command loads what it needs (the report starts matplotlib)
+    from signorini.files import writable_directory
+    from signorini.output.report import checks_summary, write_suite_report  # as above
+    from signorini.studies.suite import run_suite, select_cases  # as above
+
+    writable_directory(args.out)
+    methods = args.method or None
+    suite = run_suite(select_cases(args.case), method_names=methods,
+                      progress=lambda line: print(line, file=sys.stderr))
+    command = "signorini validate" + "".join(f" --method {m}" for m in args.method)
+    command += "".join(f" --case {c}" for c in args.case)
+    if args.out != "validation-report":
+        command += f" --out {shlex.quote(args.out)}"
+    paths = write_suite_report(suite, args.out, command)
+    print(checks_summary(suite))
+    print(f"report: {paths['report.md']}")
+    return 0 if suite.passed else EXIT_FAILED
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory  # per command (start-up)
+    from signorini.scenes import build_problem  # per command (start-up)
+    from signorini.studies.sweep import parse_loads, plot_sweep, sweep_loads  # per command (start-up)
+
+    loads = parse_loads(args.load)
+    directory = writable_directory(args.out)
+    problem = build_problem(args.scene, **pairs(args.set, "--set"))
+    levels = sweep_loads(problem, loads, progress=lambda i, n: print(
+        f"\r  load level {i}/{n}", end="" if i < n else "\n", file=sys.stderr))
+    rows = [vars(level) for level in levels]
+    header = list(rows[0])
+    csv = "\n".join([",".join(header)] + [",".join(f"{row[k]}" for k in header) for row in rows])
+    atomic_write_text(directory / "sweep.csv", csv + "\n")
+    atomic_write_text(directory / "sweep.json", to_json({"scene": args.scene, "params": problem.params,
+                                                         "levels": rows}))
+    ax = plot_sweep(levels)
+    ax.set_title(f"{args.scene}: {len(levels)} loads, one factorisation", fontsize=9)
+    save_figure(ax.figure, directory / "sweep.png")
+    print(f"{'load':>12} {'a':>12} {'a Hertz':>12} {'p0':>12} {'p0 Hertz':>12}")
+    for lv in levels:
+        print(f"{lv.total_force:12.6g} {lv.a:12.6g} {lv.a_ref or float('nan'):12.6g} "
+              f"{lv.p0:12.6g} {lv.p0_ref or float('nan'):12.6g}")
+    print(f"written: {directory / 'sweep.csv'}, sweep.json, sweep.png")
+    return 0
+
+
+def cmd_stability(args: argparse.Namespace) -> int:
+    import math
+
+    # each command loads what it needs (the atlas starts matplotlib and every backend)
+    from signorini.files import writable_directory
+    from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report  # as above
+
+    axes = select_axes(args.axis)
+    try:
+        time_limit = float(args.time_limit)
+    except ValueError:
+        time_limit = float("nan")
+    if not (math.isfinite(time_limit) and time_limit > 0):
+        raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
+                         "e.g. --time-limit 30")
+    writable_directory(Path(args.out) / "stability")
+
+    def progress(axis, i, n, task, row):
+        print(f"[axis {axis.number} {axis.name} {i}/{n}] {task.case} {task.method}: {row['status']} "
+              f"({row.get('outcome')}) {row.get('time_s', float('nan')):.2f} s", file=sys.stderr)
+
+    result = run_atlas(axes, quick=args.quick, isolate=not args.in_process,
+                       time_limit=time_limit, progress=progress)
+    command = "signorini stability" + "".join(f" --axis {a}" for a in args.axis)
+    command += " --quick" * args.quick + (f" --out {shlex.quote(args.out)}"
+                                          if args.out != "stability-report" else "")
+    paths = write_report(result, args.out, command)
+    right, runs, _ = wrapper_record(result.rows)
+    print(f"{runs} runs in {result.elapsed_s:.0f} s; the package's status was right in "
+          f"{right} of {runs}")
+    print(f"report: {paths['report']}")
+    return 0
+
+
+def add_parsers(sub) -> None:
+    """Register the study commands."""
+    converge = sub.add_parser("converge", help="refine a scene k times: errors, rates, figures")
+    converge.add_argument("scene", help="a scene with a 'refine' parameter (see 'signorini scenes')")
+    converge.add_argument("--levels", type=int, default=3, help="refinements: levels 0..k (default 3)")
+    converge.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                          help="scene parameter of level 0, e.g. --set n_contact=15")
+    converge.add_argument("--method", action="append", default=[],
+                          help="only this method (repeatable; default: every installed exact one)")
+    converge.add_argument("--fit-from", type=int, default=0,
+                          help="fit the rates on levels >= this one (default 0)")
+    converge.add_argument("--uniform-levels", type=int, default=None, metavar="K",
+                          help="also solve uniform meshes at K+1 levels and compare at equal dofs")
+    converge.add_argument("--out", default="convergence-report", help="output directory")
+    converge.set_defaults(run=cmd_converge)
+
+    validate = sub.add_parser("validate", help="run the validation suite on the default scenes")
+    validate.add_argument("--out", default="validation-report", help="report directory")
+    validate.add_argument("--method", action="append", default=[],
+                          help="only this method (repeatable; default: every installed one); "
+                               "a method named here must converge on every case")
+    validate.add_argument("--case", action="append", default=[],
+                          help="only this case (repeatable; default: all)")
+    validate.set_defaults(run=cmd_validate)
+
+    sweep = sub.add_parser("sweep", help="solve many load levels with one factorisation")
+    sweep.add_argument("scene", help="scene name (see 'signorini scenes')")
+    sweep.add_argument("--load", required=True, metavar="P1:P2:n",
+                       help="n loads from P1 to P2 (per unit thickness of the full body)")
+    sweep.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="scene parameter, e.g. --set n_contact=80")
+    sweep.add_argument("--out", default="sweep-report", help="output directory")
+    sweep.set_defaults(run=cmd_sweep)
+
+    stability = sub.add_parser("stability", help="the stability atlas: where each method fails")
+    stability.add_argument("--out", default="stability-report",
+                           help="writes OUT/stability.md and OUT/stability/ (runs, figures)")
+    stability.add_argument("--axis", action="append", default=[],
+                           help="only this axis, by number or name (repeatable; default: all 8)")
+    stability.add_argument("--quick", action="store_true",
+                           help="tiny meshes, few points and methods: a smoke test in seconds")
+    stability.add_argument("--time-limit", default="30", help="seconds per run (default 30)")
+    stability.add_argument("--in-process", action="store_true",
+                           help="run in this process, without worker processes or time limits")
+    stability.set_defaults(run=cmd_stability)
