@@ -221,6 +221,8 @@ def solve_summary(record: dict[str, Any]) -> str:
     if record.get("estimate"):
         lines.append(f"  error estimate (energy norm, ZZ): {100 * record['estimate']['relative']:.2f} % "
                      f"of ‖u_h‖ over {record['estimate']['elements']} elements")
+        if record["estimate"].get("pressure") is not None:
+            lines[-1] += f"; contact pressure {100 * record['estimate']['pressure']:.2f} % (L2)"
     if record.get("hertz"):
         h = record["hertz"]
         lines.append(f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "
@@ -243,7 +245,7 @@ def solve_summary(record: dict[str, Any]) -> str:
 def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: float | None = None,
           max_iter: int | None = None, params: dict[str, Any] | None = None,
           target_error: float | str | None = None, max_dofs: int | None = None,
-          **options: Any) -> Result:
+          target_on: str | None = None, **options: Any) -> Result:
     """Solve a problem (or a scene by name) and judge the answer with the KKT certificate.
 
     ``problem`` is a :class:`ContactProblem` (from :func:`build_problem`,
@@ -256,9 +258,12 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     ``status`` says so.
 
     ``target_error`` (a scene by name; ``0.001`` or ``"0.1%"``) refines the
-    scene's mesh adaptively until the estimated relative error in the energy
-    norm (``result.estimate.relative``) is at most that, or the next mesh
-    would exceed ``max_dofs`` (default 100,000); the message says which, and
+    scene's mesh adaptively until the estimated relative error is at most
+    that, or the next mesh would exceed ``max_dofs`` (default 100,000): with
+    ``target_on="pressure"`` (the default for 2D scenes with contact
+    pressures) the error of the contact pressure in L² over the candidates
+    (``result.estimate.pressure.relative``), with ``"energy"`` the energy
+    norm's (``result.estimate.relative``). The message says which stopped it, and
     ``result.solution.extras["adaptive"]`` lists the steps
     (:mod:`signorini.scenes.adapt`).
     """
@@ -267,12 +272,14 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
             raise InputError("target_error= refines a scene's mesh: give the scene by name, "
                              "solve('hertz-cylinder', target_error=0.01)")
         run = solve_adaptive(problem, params or {}, parse_target(target_error), method=method,
-                             tol=tol, max_iter=max_iter, max_dofs=max_dofs, **options)
+                             tol=tol, max_iter=max_iter, max_dofs=max_dofs, quantity=target_on,
+                             **options)
         result = Result(run.problem, run.solution, certificate(run.problem, run.solution))
         result._estimate = run.estimate
         return result
-    if max_dofs is not None:
-        raise InputError("max_dofs (--max-dofs) bounds adaptive refinement: give target_error "
+    if max_dofs is not None or target_on is not None:
+        given = "max_dofs (--max-dofs)" if max_dofs is not None else "target_on (--target-on)"
+        raise InputError(f"{given} steers adaptive refinement: give target_error "
                          "(--target-error) with it")
     if isinstance(problem, str):
         problem = build_problem(problem, **(params or {}))

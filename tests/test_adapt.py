@@ -40,10 +40,10 @@ def test_the_quarter_disc_is_found_again_on_its_own_mesh():
 
 
 @pytest.mark.slow
-def test_the_cylinder_refines_until_the_target():
-    result = signorini.solve("hertz-cylinder", target_error="2%")
+def test_the_cylinder_refines_until_the_energy_target():
+    result = signorini.solve("hertz-cylinder", target_error="2%", target_on="energy")
     steps = result.solution.extras["adaptive"]
-    assert result.status == "converged" and "target error 2 % met" in result.message
+    assert result.status == "converged" and "target energy-norm error 2 % met" in result.message
     assert result.estimate.relative <= 0.02 and result.problem.n < 30_000
     estimates = [s["estimate"] for s in steps]
     assert all(later < earlier for earlier, later in zip(estimates, estimates[1:]))
@@ -62,7 +62,7 @@ def test_the_dof_limit_stops_the_loop_and_says_so():
     result = signorini.solve("hertz-sphere", target_error=0.001, max_dofs=10_000)
     assert result.status == "converged"
     assert "max dofs 10000 reached" in result.message
-    assert result.problem.n <= 10_000 and result.estimate.relative > 0.001
+    assert result.problem.n <= 10_000 and result.estimate.pressure.relative > 0.001
 
 
 @pytest.mark.slow
@@ -84,6 +84,50 @@ def test_what_cannot_be_refined_says_so():
         signorini.solve(problem, target_error=0.01)
     with pytest.raises(InputError, match="target_error"):
         signorini.solve("hertz-cylinder", max_dofs=1000)
+    with pytest.raises(InputError, match="target_error"):
+        signorini.solve("hertz-cylinder", target_on="pressure")
+    with pytest.raises(InputError, match="target quantity"):
+        signorini.solve("hertz-cylinder", target_error=0.01, target_on="stress")
+
+
+#: issue 15's done-when on the default Hertz scenes (a/R = 0.05): the pressure target met within
+#: these dofs, p₀ and a then within these distances of Hertz. The sphere's p₀ carries the finite
+#: body's difference to Hertz's half-space (docs/accuracy.md: ≈ 0.1 % at ν = 0.3, more at ν = 0),
+#: which no mesh removes.
+DONE_WHEN = [("hertz-cylinder", "0.3%", 20_000, 0.003, 0.003),
+             ("hertz-cylinder", "0.1%", 60_000, 0.001, 0.001),
+             ("hertz-sphere", "0.3%", 20_000, 0.003, 0.003),
+             ("hertz-sphere", "0.1%", 60_000, 0.001, 0.0016)]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene, target, dofs, a_within, p0_within", DONE_WHEN)
+def test_the_pressure_target_is_met_within_its_dofs(scene, target, dofs, a_within, p0_within):
+    result = signorini.solve(scene, target_error=target)
+    assert result.status == "converged" and f"target pressure error {target[:-1]} % met" in result.message
+    assert result.problem.n <= dofs
+    assert result.estimate.pressure.relative <= float(target[:-1]) / 100
+    assert abs(result.hertz.a_rel) <= a_within and abs(result.hertz.p0_rel) <= p0_within
+
+
+@pytest.mark.slow
+def test_the_pressure_target_does_not_depend_on_the_units():
+    default = signorini.solve("hertz-cylinder", target_error="0.3%")
+    aluminium = signorini.solve("hertz-cylinder", target_error="0.3%",
+                                params={"E": 70e9, "R": 25.0})
+    assert aluminium.problem.n == default.problem.n
+    assert aluminium.hertz.p0_rel == pytest.approx(default.hertz.p0_rel, abs=1e-6)
+    assert aluminium.estimate.pressure.relative == pytest.approx(default.estimate.pressure.relative,
+                                                                 rel=1e-6)
+
+
+@pytest.mark.slow
+def test_a_harder_push_ends_converged_within_its_target():
+    """`signorini solve hertz-cylinder --set delta=0.02 --target-error 0.5%` (issue 15)."""
+    result = signorini.solve("hertz-cylinder", target_error="0.5%", params={"delta": 0.02})
+    assert result.status == "converged" and "target pressure error 0.5 % met" in result.message
+    assert result.to_dict()["adequacy"]["penetrating_nodes"] == 0
+    assert abs(result.hertz.a_rel) <= 0.005 and abs(result.hertz.p0_rel) <= 0.005
 
 
 @pytest.mark.slow
@@ -102,7 +146,7 @@ def test_the_command_line_refines_and_reports(tmp_path):
                           "--target-error", "3%", "--json", str(out)], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     record = json.loads(out.read_text())
-    assert record["estimate"]["relative"] <= 0.03
+    assert record["estimate"]["pressure"] <= 0.03
     assert record["extras"]["adaptive"][-1]["action"] == "target met"
     bad = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",
                           "--max-dofs", "1000"], capture_output=True, text=True)

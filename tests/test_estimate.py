@@ -127,3 +127,32 @@ def test_the_estimate_costs_less_than_the_solve():
     start = time.perf_counter()
     estimate(result.problem, result.solution)
     assert time.perf_counter() - start < max(0.1, result.problem.assemble_time)
+
+
+def test_a_uniform_pressure_has_no_pressure_error():
+    """The block on the flat: uniform stress, exact in P1, so p_h and the recovered p* agree."""
+    result = signorini.solve("block")
+    assert result.estimate.pressure.relative < 1e-12
+
+
+def test_the_body_normals_follow_the_arc():
+    from signorini.fem.estimate import boundary_normals, candidate_nodes
+
+    problem = signorini.build_problem("hertz-cylinder")
+    nodes = candidate_nodes(problem.mesh, problem.contact_points)
+    normals = boundary_normals(problem.mesh, nodes)
+    x, y = problem.mesh.p[:, nodes]
+    radial = np.array([x, y - 1.0]) / np.hypot(x, y - 1.0)  # the quarter disc's centre is (0, R = 1)
+    assert np.all(np.sum(normals * radial, axis=0) > 1 - 1e-5)
+    first = np.argmin(x)  # the corner on the symmetry axis: its axis edge does not count, so its
+    # normal is its one arc edge's, tilted from the vertical by half that edge's angle
+    assert normals[:, first] == pytest.approx([0.0, -1.0], abs=1e-3)
+    assert normals[0, first] > 0
+
+
+def test_the_pressure_estimate_shrinks_with_the_mesh_and_tracks_the_error():
+    coarse = signorini.solve("hertz-cylinder", params=COARSE)
+    fine = signorini.solve("hertz-cylinder", params={**COARSE, "refine": 1})
+    assert fine.estimate.pressure.relative < 0.7 * coarse.estimate.pressure.relative
+    error = tool.pressure_error(coarse, fine)  # the finer mesh's pressure as the reference
+    assert 0.5 < coarse.estimate.pressure.relative / error < 3.0

@@ -29,12 +29,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
         if args.raw_units:
             raise InputError("--target-error refines a non-dimensionalised scene: drop --raw-units")
         result = solve(args.scene, args.method, tol=tol, max_iter=max_iter, params=params,
-                       target_error=args.target_error, max_dofs=args.max_dofs, **options)
+                       target_error=args.target_error, max_dofs=args.max_dofs,
+                       target_on=args.target_on, **options)
         problem = result.problem
     else:
         problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
         result = solve(problem, args.method, tol=tol, max_iter=max_iter, max_dofs=args.max_dofs,
-                       **options)
+                       target_on=args.target_on, **options)
     record = result.to_dict()
     if args.json:
         write_json(args.json, to_json(record))
@@ -68,7 +69,10 @@ def add_parsers(sub) -> None:
                        help="write the deformed mesh with displacement, stress, gap and pressure "
                             "(.vtu or .vtk, for ParaView)")
     solve.add_argument("--target-error", metavar="ETA", help="refine adaptively until the estimated "
-                       "relative energy-norm error is at most ETA (0.01 or 1%%)")
+                       "relative error is at most ETA (0.01 or 1%%): of the contact pressure, or "
+                       "see --target-on")
+    solve.add_argument("--target-on", choices=["pressure", "energy"], help="with --target-error: "
+                       "the contact pressure's L2 error (default, 2D scenes) or the energy norm's")
     solve.add_argument("--max-dofs", type=int, metavar="N", help="with --target-error: no mesh "
                        "beyond N dofs (default 100000)")
     solve.set_defaults(run=cmd_solve)

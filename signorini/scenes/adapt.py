@@ -8,14 +8,20 @@ Each step (:func:`solve_adaptive`):
    obstacle, or the outermost candidate in contact: the solution is
    ``model_inadequate``, :mod:`signorini.adequacy`), widen the candidates by
    :data:`GROWTH` on the same mesh and solve again;
-3. estimate the error (:func:`signorini.fem.estimate.estimate`); stop when
-   ``η / ‖u_h‖_E ≤ target``;
+3. estimate the error (:func:`signorini.fem.estimate.estimate`) and stop when
+   the estimate of the chosen quantity meets the target: ``"pressure"`` (the
+   default where the model has contact pressures: the relative L² error of
+   the contact pressure, :class:`signorini.fem.estimate.PressureEstimate`) or
+   ``"energy"`` (``η / ‖u_h‖_E``);
 4. mark the fewest elements that carry a fraction :data:`THETA` of η²
    (Dörfler's bulk criterion: W. Dörfler, "A convergent adaptive algorithm
-   for Poisson's equation", SINUM 33 (1996) 1106–1124), refine them
-   conformingly (scikit-fem's red-green-blue ``MeshTri.refined(marked)``),
-   move new boundary nodes onto the curved boundary, and stop instead when
-   the refined mesh would exceed ``max_dofs``.
+   for Poisson's equation", SINUM 33 (1996) 1106–1124) — for the pressure,
+   the fewest candidates carrying :data:`THETA` of its estimate, with every
+   element within :data:`REACH` element sizes of them, and the elements
+   carrying :data:`THETA_BULK` of η² so that the body's far field keeps up —
+   refine them conformingly (scikit-fem's red-green-blue
+   ``MeshTri.refined(marked)``), move new boundary nodes onto the curved
+   boundary, and stop instead when the refined mesh would exceed ``max_dofs``.
 
 A family takes part when its ``build`` accepts ``mesh=`` (the scene rebuilt
 on a given mesh: boundary sets found by position) and :data:`CURVED` says
@@ -31,6 +37,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
@@ -45,6 +52,10 @@ log = logging.getLogger(__name__)
 
 #: Dörfler's bulk parameter: refine the fewest elements that carry this fraction of η²
 THETA = 0.5
+#: for the pressure: the fraction of η² refined besides the contact's neighbourhood, and the
+#: neighbourhood's radius around a marked candidate in units of its largest element edge
+THETA_BULK, REACH = 0.3, 3.0
+QUANTITIES = ("pressure", "energy")
 #: the candidates widen by this factor when the contact outgrows them
 GROWTH = 1.5
 MAX_GROWTH = 8
@@ -96,6 +107,39 @@ def dorfler(indicators: np.ndarray, theta: float = THETA) -> np.ndarray:
     return np.sort(order[:min(count, len(order))])
 
 
+def node_sizes(mesh: Any) -> np.ndarray:
+    """The longest edge at each node of a triangle mesh."""
+    sizes = np.zeros(mesh.p.shape[1])
+    for a, b in ((0, 1), (1, 2), (0, 2)):
+        length = np.linalg.norm(mesh.p[:, mesh.t[a]] - mesh.p[:, mesh.t[b]], axis=0)
+        np.maximum.at(sizes, mesh.t[a], length)
+        np.maximum.at(sizes, mesh.t[b], length)
+    return sizes
+
+
+def elements_near(mesh: Any, nodes: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """Elements with a vertex within ``radius[i]`` of ``nodes[i]``, for some i."""
+    near = np.zeros(mesh.p.shape[1], dtype=bool)
+    for found in cKDTree(mesh.p.T).query_ball_point(mesh.p[:, nodes].T, radius):
+        near[found] = True
+    return np.nonzero(near[mesh.t].any(axis=0))[0]
+
+
+def mark(mesh: Any, found: ErrorEstimate, quantity: str, theta: float = THETA) -> np.ndarray:
+    """The elements to refine for ``quantity`` (see the module's docstring)."""
+    if quantity == "energy":
+        return dorfler(found.elements, theta)
+    pressure = found.pressure
+    nodes = pressure.nodes[dorfler(np.sqrt(pressure.indicators), theta)]
+    near = elements_near(mesh, nodes, REACH * node_sizes(mesh)[nodes])
+    return np.union1d(near, dorfler(found.elements, THETA_BULK))
+
+
+def measured(found: ErrorEstimate, quantity: str) -> float:
+    """The estimate of ``quantity`` (relative)."""
+    return found.relative if quantity == "energy" else found.pressure.relative
+
+
 def refine(mesh: Any, marked: np.ndarray, snap: Callable | None) -> Any:
     """``mesh`` refined conformingly at ``marked`` elements, new boundary nodes snapped."""
     refined = mesh.refined(marked)
@@ -122,11 +166,14 @@ def _contact_extent(model: SceneModel, problem: ContactProblem,
 
 def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: str = "pdas",
                    tol: float | None = None, max_iter: int | None = None,
-                   max_dofs: int | None = None, theta: float = THETA,
+                   max_dofs: int | None = None, theta: float = THETA, quantity: str | None = None,
                    on_step: Callable[[ContactProblem, ContactSolution, ErrorEstimate | None], None]
                    | None = None, **options: Any) -> AdaptiveRun:
-    """Refine scene ``name`` adaptively until ``η / ‖u_h‖_E ≤ target`` or ``max_dofs``.
+    """Refine scene ``name`` adaptively until the estimate of ``quantity`` meets ``target``
+    or the next mesh would exceed ``max_dofs``.
 
+    ``quantity`` is ``"pressure"`` (the default where the scene has contact
+    pressures) or ``"energy"``.
     Returns the last step's problem, solution and estimate; ``reason`` says
     why the loop stopped (the target met, the dof limit, or a solve that did
     not converge) and is appended to the solution's message. ``on_step`` is
@@ -136,6 +183,8 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
     if name not in CURVED or "mesh" not in inspect.signature(family.build).parameters:
         raise InputError(f"scene {name!r} cannot be refined adaptively: target error works for "
                          f"{', '.join(sorted(CURVED))}")
+    if quantity is not None and quantity not in QUANTITIES:
+        raise InputError(f"target quantity {quantity!r} is not one of {', '.join(QUANTITIES)}")
     max_dofs = DEFAULT_MAX_DOFS if max_dofs is None else int(max_dofs)
     if max_dofs <= 0:
         raise InputError(f"max dofs {max_dofs} must be positive")
@@ -169,16 +218,22 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
             run.reason = f"adaptive refinement stopped: the solve ended {solution.status}"
             steps.append(_row(step, problem, solution, None, 0, seconds, "stopped"))
             break
-        if found.relative <= target:
-            run.reason = (f"target error {100 * target:.3g} % met: estimate {100 * found.relative:.3g} % "
+        if quantity is None:
+            quantity = "pressure" if found.pressure is not None else "energy"
+        elif quantity == "pressure" and found.pressure is None:
+            raise InputError(f"scene {name!r} has no contact pressure estimate: give quantity 'energy'")
+        what = "pressure" if quantity == "pressure" else "energy-norm"
+        value = measured(found, quantity)
+        if value <= target:
+            run.reason = (f"target {what} error {100 * target:.3g} % met: estimate {100 * value:.3g} % "
                           f"at {problem.n} dofs after {step + 1} solves")
             steps.append(_row(step, problem, solution, found, 0, seconds, "target met"))
             break
-        marked = dorfler(found.elements, theta)
+        marked = mark(model.mesh, found, quantity, theta)
         mesh = refine(model.mesh, marked, snap)
         dofs = mesh.p.size
         if dofs > max_dofs:
-            run.reason = (f"max dofs {max_dofs} reached: estimate {100 * found.relative:.3g} % > target "
+            run.reason = (f"max dofs {max_dofs} reached: {what} estimate {100 * value:.3g} % > target "
                           f"{100 * target:.3g} % at {problem.n} dofs (the next mesh has {dofs})")
             steps.append(_row(step, problem, solution, found, 0, seconds, "max dofs"))
             break
@@ -198,4 +253,6 @@ def _row(step: int, problem: ContactProblem, solution: ContactSolution,
     return {"step": step, "dofs": problem.n, "elements": int(problem.mesh.t.shape[1]),
             "candidates": problem.m, "status": solution.status,
             "estimate": found.relative if found is not None else float("nan"),
+            "pressure_estimate": found.pressure.relative
+            if found is not None and found.pressure is not None else float("nan"),
             "marked": marked, "seconds": seconds, "action": action}
