@@ -250,15 +250,30 @@ TRUNCATED = {"qp-osqp": "max_iter", "qp-clarabel": "max_iter", "qp-piqp": "max_i
 @pytest.mark.parametrize("method", sorted(TRUNCATED))
 def test_truncated_run_is_not_converged(method):
     require(method)
-    sol = solve(case(12, 5, 1), method, max_iter=1)
+    sol = solve(case(12, 5, 1), method, max_iter=1, polish=False)  # the backend's own answer
     assert sol.status == TRUNCATED[method], sol.message
     assert sol.extras["raw_status"]
 
 
 def test_cvxpy_truncated_first_order_run():
     require("cvxpy")
-    sol = solve(case(12, 5, 1), "cvxpy", max_iter=1, solver="OSQP")
+    sol = solve(case(12, 5, 1), "cvxpy", max_iter=1, solver="OSQP", polish=False)
     assert sol.status == "max_iter" and sol.extras["raw_status"] == "user_limit"
+
+
+@pytest.mark.parametrize("method", ["qp-osqp", "qp-clarabel", "cvxpy"])
+def test_polish_by_default_says_which_answer_it_returns(method):
+    """Polished by default: a truncated run's answer either becomes the polished one, and the
+    message says so, or stays the backend's, not converged."""
+    require(method)
+    sol = solve(case(12, 5, 1), method, max_iter=1)
+    record = sol.extras["polish"]
+    assert record["raw_status"] == TRUNCATED[method]
+    if record["kept"]:
+        assert "the polished answer" in sol.message
+        assert sol.status == "converged" and record["polished"] != record["raw"]
+    else:
+        assert sol.status == TRUNCATED[method] and "the backend's answer" in sol.message
 
 
 def test_cvxpy_refuses_unknown_solver():

@@ -33,6 +33,9 @@ METHOD = "cvxpy"
 DEFAULT_SOLVER = "CLARABEL"
 #: measured by tools/formulations.py (docs/formulations.md): no form wins clearly with Clarabel
 DEFAULT_FORM = "primal"
+#: polished by default: with Clarabel's gap at tol² every validation case then ends converged
+#: and exact at tol 1e-8 (docs/crosscheck.md); raw, 3 of 8 end inaccurate
+DEFAULT_POLISH = True
 OPTIONS = ("solver", "form", "polish", "max_dense_dofs")
 
 #: cvxpy status → ours (anything else is ``failed``)
@@ -106,7 +109,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     solver : (option) cvxpy solver name, default ``"CLARABEL"``; any installed
         solver that accepts a QP.
     form, polish, max_dense_dofs : (options) as for the ``qp-*`` methods
-        (:mod:`signorini.solvers.forms`); default ``form="primal"``.
+        (:mod:`signorini.solvers.forms`); default ``form="primal"``, ``polish=True``.
 
     Returns
     -------
@@ -121,7 +124,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                          f"{', '.join(OPTIONS)}")
     limit = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
     form, note = forms.resolve(METHOD, problem, options.get("form"), DEFAULT_FORM, limit)
-    polishing = forms.check_polish(METHOD, options.get("polish", False))
+    polishing = forms.check_polish(METHOD, options.get("polish", DEFAULT_POLISH))
     import cvxpy as cp  # as above
 
     solver = _check_solver(options.get("solver", DEFAULT_SOLVER))
