@@ -9,7 +9,8 @@ The public API (see the README's "Python" section)::
 :func:`solve` takes a scene name or a :class:`ContactProblem` (from
 :func:`build_problem`, :meth:`ContactProblem.from_qp` or
 :meth:`ContactProblem.load`) and returns a :class:`Result` in the problem's
-own units; :func:`certificate` judges any answer; :func:`methods` and
+own units; :func:`certificate` judges any answer; :func:`crosscheck` solves one
+problem with several methods and compares every pair; :func:`methods` and
 :func:`scene_families` list what there is.
 """
 
@@ -24,6 +25,7 @@ from signorini.api import (
     scene_families,
     solve,
 )
+from signorini.crosschecking import CrossCheck, crosscheck
 from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
 from signorini.kkt import Certificate
 from signorini.problem import ContactProblem, ContactSolution, Scales
@@ -33,5 +35,6 @@ __version__ = "0.1.0"
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 __all__ = ["DEFAULT_METHOD", "BackendNotInstalled", "Certificate", "ContactProblem", "ContactSolution",
-           "InputError", "Result", "Scales", "SignoriniError", "SolverError", "__version__",
-           "build_problem", "certificate", "methods", "scene_families", "solve"]
+           "CrossCheck", "InputError", "Result", "Scales", "SignoriniError", "SolverError",
+           "__version__", "build_problem", "certificate", "crosscheck", "methods", "scene_families",
+           "solve"]

@@ -7,7 +7,7 @@ Layers, low to high (a module may import its own layer and the layers below):
 2. ``problem``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
 3. ``solvers``                           the registry collects each backend's METHODS
 4. ``scenes``                            families, meshing, scene files, building problems
-5. ``api`` and the package itself        the public Python API
+5. ``api``, ``crosschecking``, the package: the public Python API
 6. ``studies``, ``output``, ``teaching`` one runner and its studies; reports, plots, export
 7. ``cli``                               parsing only
 
@@ -34,7 +34,7 @@ LAYERS = {
     "fem": 2,
     "solvers": 3,
     "scenes": 4,
-    "api": 5, "": 5,
+    "api": 5, "crosschecking": 5, "": 5,
     "studies": 6, "output": 6, "teaching": 6,
     "cli": 7,
 }

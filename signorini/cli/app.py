@@ -13,11 +13,11 @@ import logging
 import sys
 from typing import Sequence
 
-from signorini.cli import bench, listing, solve, studies
+from signorini.cli import bench, crosscheck, listing, solve, studies
 from signorini.cli.common import EXIT_FAILED, EXIT_USAGE, Parser
 from signorini.errors import InputError, SignoriniError
 
-COMMANDS = (solve, studies, bench, listing)
+COMMANDS = (solve, crosscheck, studies, bench, listing)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,350 @@
+"""Cross-checking methods against each other: the paper's Uzawa, QP backends, the exact answer.
+
+``crosscheck(problem, methods)`` solves one problem with every method at one
+relative KKT tolerance and compares every pair of answers (:func:`signorini.kkt.compare`):
+
+- ``lam_rel`` = ‖λ_a − λ_b‖∞ / max(‖λ_a‖∞, ‖λ_b‖∞), ``u_rel`` likewise for u;
+- ``apart``: candidates active (λ̃ > g̃) in one answer and inactive in the other,
+  with λ̃ = λᵢ/‖λ‖∞ and g̃ the gap over the length scale of :class:`signorini.kkt.Certificate`;
+  **weakly active** nodes are left out and counted apart (``weak``): a node is
+  weakly active in an answer when both λ̃ and g̃ are at most
+  ``max(kkt.WEAK_TOL, tol_a, tol_b)`` — it touches with (next to) no force, and a natural
+  residual within the tolerance cannot say on which side it belongs.
+
+A pair is **judged** when both methods *say* ``converged`` — their own claim
+(``claimed_status``), whether or not the certificate backed it, because a
+claim of success is what a cross-check is there to test. A judged pair
+**disagrees** when a node is classified apart, or λ or u differ by more than
+``AGREE_FACTOR × max(tol_a, tol_b)``; that is a bug in one of the two (or a
+tolerance that means less than it says). The factor: the certificate bounds
+residuals, not errors, and W = N K⁻¹ Nᵀ's conditioning turns residuals within
+tol into λ errors of up to 1.6e3 × tol (316 converged runs with the exact active
+set, docs/formulations/runs.json: OSQP's dual at 75k dofs, tol 1e-9); 10⁴ leaves
+room for finer meshes and still catches, at tol 1e-8, a λ off by 1e-4.
+
+The methods run one after another in this process (a problem from
+:meth:`ContactProblem.from_qp` cannot be rebuilt in a worker); a method that
+refuses the problem (a dense backend on a large one) or is not installed is a
+row that says so, and takes part in no pair.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from signorini.api import Result, build_problem, solve
+from signorini.errors import BackendNotInstalled, InputError
+from signorini.kkt import WEAK_TOL, compare
+from signorini.problem import ContactProblem
+from signorini.references import reference_metrics, reference_of
+from signorini.solvers.base import DEFAULT_ACCEPT, check_tol
+from signorini.solvers.registry import get_method
+
+#: the methods compared when none are named: the paper's, the two named QP backends,
+#: the modelling layer and the exact reference
+DEFAULT_METHODS = ("uzawa", "qp-osqp", "qp-clarabel", "cvxpy", "pdas")
+#: the tolerance every method is asked for when none is given (issue 17's)
+DEFAULT_TOL = 1e-8
+#: two converged answers agree when λ and u differ by at most this × the larger tolerance
+AGREE_FACTOR = 1e4
+#: a row's status when the method refused the problem or its backend is missing
+REFUSED, NOT_INSTALLED = "refused", "not installed"
+
+
+@dataclass
+class MethodRun:
+    """One method's answer: what it said, what the certificate says, and Hertz's errors.
+
+    ``form`` is the QP formulation a QP method ran; ``polished`` is True when
+    the polished answer is returned, False when polish left the backend's own,
+    None when there was no polish. ``reference`` holds the errors against the
+    problem's analytic reference (``p0_rel``, ``a_rel``, ``pressure_l2_rel`` for
+    Hertz), empty when it has none.
+    """
+
+    method: str
+    tol: float
+    status: str
+    claimed_status: str
+    message: str
+    iterations: int = 0
+    time_s: float = float("nan")
+    form: str = ""
+    polished: bool | None = None
+    kkt: dict[str, float] = field(default_factory=dict)
+    kkt_worst: float = float("nan")
+    kkt_worst_name: str = ""
+    reference: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def says_converged(self) -> bool:
+        return self.claimed_status == "converged"
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+@dataclass
+class Pair:
+    """Two methods' answers compared (see the module's docstring for every field)."""
+
+    first: str
+    second: str
+    lam_rel: float
+    u_rel: float
+    apart: int
+    weak: int
+    weak_tol: float
+    limit: float
+    judged: bool
+
+    @property
+    def agree(self) -> bool:
+        """Within ``limit`` in λ and u, and no node classified apart."""
+        return bool(self.lam_rel <= self.limit and self.u_rel <= self.limit and self.apart == 0)
+
+    @property
+    def verdict(self) -> str:
+        """``agree`` or ``DISAGREE`` for a judged pair; otherwise ``not judged``."""
+        if not self.judged:
+            return "not judged"
+        return "agree" if self.agree else "DISAGREE"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {**asdict(self), "agree": self.agree, "verdict": self.verdict}
+
+
+def agreement(problem: ContactProblem, first: Result, second: Result, tol_first: float,
+              tol_second: float) -> Pair:
+    """Compare two results of ``problem`` (solved at ``tol_first`` and ``tol_second``)."""
+    loose = max(tol_first, tol_second)
+    weak_tol = max(WEAK_TOL, loose)
+    found = compare(problem, first.solution, second.solution, weak_tol=weak_tol)
+    judged = first.claimed_status == "converged" and second.claimed_status == "converged"
+    return Pair(first.method, second.method, found.lam_rel, found.u_rel, found.misclassified,
+                found.weak, weak_tol, AGREE_FACTOR * loose, judged)
+
+
+@dataclass
+class CrossCheck:
+    """Every method's run and every pair's comparison on one problem."""
+
+    problem: ContactProblem
+    tol: float
+    runs: list[MethodRun]
+    pairs: list[Pair]
+    results: dict[str, Result] = field(default_factory=dict, repr=False)
+
+    @property
+    def disagreements(self) -> list[Pair]:
+        """Pairs of methods that both said ``converged`` and disagree."""
+        return [pair for pair in self.pairs if pair.verdict == "DISAGREE"]
+
+    @property
+    def passed(self) -> bool:
+        """No two methods that said ``converged`` disagree."""
+        return not self.disagreements
+
+    def to_dict(self) -> dict[str, Any]:
+        """The record ``signorini crosscheck --json`` writes."""
+        problem = self.problem
+        return {"scene": problem.scene, "params": problem.params, "dofs": problem.n,
+                "contact_candidates": problem.m, "tol": self.tol,
+                "reference": problem.reference, "agree_factor": AGREE_FACTOR,
+                "passed": self.passed, "methods": [run.as_dict() for run in self.runs],
+                "pairs": [pair.as_dict() for pair in self.pairs]}
+
+    def summary(self) -> str:
+        """The printed tables (what ``signorini crosscheck`` shows)."""
+        return render(self.to_dict())
+
+    def markdown(self) -> str:
+        """The same tables in Markdown (``signorini crosscheck --md``)."""
+        return render_markdown(self.to_dict())
+
+
+def _reference_errors(result: Result) -> dict[str, float]:
+    reference = reference_of(result.problem)
+    if reference is None or not result.finite:
+        return {}
+    metrics = reference_metrics(result.problem, result.solution)
+    keys = reference.convergence or tuple(k for k in ("pressure_max_rel",) if k in metrics)
+    return {key: float(metrics[key]) for key in keys if key in metrics}
+
+
+def _run_of(result: Result, tol: float) -> MethodRun:
+    solution = result.solution
+    cert = result.certificate
+    worst_name, worst = cert.worst()
+    polish = solution.extras.get("polish")
+    return MethodRun(result.method, tol, solution.status, solution.own_status, solution.message,
+                     result.iterations, float(solution.extras.get("method_s", float("nan"))),
+                     str(solution.extras.get("form", "")),
+                     None if polish is None else bool(polish.get("kept")), cert.as_dict(),
+                     float(worst), worst_name, _reference_errors(result))
+
+
+def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ...] | None = None,
+               *, tol: float | None = DEFAULT_TOL, params: dict[str, Any] | None = None,
+               options: dict[str, dict[str, Any]] | None = None) -> CrossCheck:
+    """Solve ``problem`` with every method and compare every pair of answers.
+
+    Parameters
+    ----------
+    problem : a :class:`ContactProblem`, or a scene name or ``.toml`` file built with ``params``.
+    methods : method names (default :data:`DEFAULT_METHODS`); ``module:function`` for your own.
+    tol : the relative KKT tolerance every method is asked for (default 1e-8; ``None``
+        leaves each method its own default, judged at ``DEFAULT_ACCEPT``).
+    options : per-method options, ``{"qp-osqp": {"polish": False}}``.
+
+    Returns
+    -------
+    CrossCheck
+        ``runs`` (status, claim, certificate, Hertz's errors), ``pairs`` (λ, u, nodes
+        apart, verdict), ``passed`` (no two methods that said converged disagree).
+
+    Raises
+    ------
+    InputError
+        An unknown method, a method named twice, options for a method not
+        compared, a bad tolerance: before anything is solved.
+    """
+    if isinstance(methods, str):
+        raise InputError(f"methods must be a list of names, got the string {methods!r}: "
+                         f"write methods=[{methods!r}, 'pdas']")
+    names = list(DEFAULT_METHODS if methods is None else methods)
+    for name in names:
+        get_method(name)  # an unknown name fails here, before any work
+    if len(names) < 2:
+        raise InputError(f"a cross-check compares at least two methods, got {names}: "
+                         "name two or more (--method uzawa --method pdas)")
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        raise InputError(f"method {twice[0]!r} is named twice: name each method once")
+    options = dict(options or {})
+    stray = sorted(set(options) - set(names))
+    if stray:
+        raise InputError(f"options for {stray[0]!r}, which is not among the methods "
+                         f"({', '.join(names)}): add it with --method {stray[0]}")
+    tol = check_tol(tol)
+    if isinstance(problem, str):
+        problem = build_problem(problem, **(params or {}))
+    elif params:
+        raise InputError("params= builds a scene by name: give crosscheck('hertz-cylinder', "
+                         "params=...) or build the problem with those parameters first")
+    elif not isinstance(problem, ContactProblem):
+        raise InputError(f"problem must be a ContactProblem or a scene name, got "
+                         f"{type(problem).__name__}")
+    judged_tol = tol if tol is not None else DEFAULT_ACCEPT
+    runs: list[MethodRun] = []
+    results: dict[str, Result] = {}
+    for name in names:
+        try:
+            result = solve(problem, name, tol=tol, **options.get(name, {}))
+        except BackendNotInstalled as exc:
+            runs.append(MethodRun(name, judged_tol, NOT_INSTALLED, NOT_INSTALLED, str(exc)))
+            continue
+        except InputError as exc:  # e.g. a dense backend refusing a large problem
+            if name in options:
+                raise  # the caller's own options are wrong: say so, as solve would
+            runs.append(MethodRun(name, judged_tol, REFUSED, REFUSED, str(exc)))
+            continue
+        results[name] = result
+        runs.append(_run_of(result, judged_tol))
+    tol_of = {run.method: run.tol for run in runs}
+    pairs = [agreement(problem, results[a], results[b], tol_of[a], tol_of[b])
+             for a, b in itertools.combinations(names, 2) if a in results and b in results]
+    return CrossCheck(problem, judged_tol, runs, pairs, results)
+
+
+# --- the tables ---------------------------------------------------------------------------------
+
+REFERENCE_COLUMNS = (("p0_rel", "p0 err"), ("a_rel", "a err"), ("pressure_l2_rel", "L2 err"),
+                     ("pressure_max_rel", "p max err"))
+
+
+def _num(value: Any, spec: str = ".1e") -> str:
+    if value is None or (isinstance(value, float) and not np.isfinite(value)):
+        return "–"
+    return format(value, spec)
+
+
+def _said(run: dict[str, Any]) -> str:
+    if run["claimed_status"] != run["status"]:
+        return f"{run['claimed_status']} → {run['status']}"
+    return run["status"]
+
+
+def _form(run: dict[str, Any]) -> str:
+    polish = {None: "", True: ", polished", False: ", raw (polish did not help)"}[run["polished"]]
+    return (run["form"] or "–") + polish
+
+
+def _tables(record: dict[str, Any]) -> tuple[str, list[str], list[list[str]], list[str],
+                                              list[list[str]]]:
+    """The title and the two tables (methods, pairs) as header and rows of strings."""
+    title = (f"cross-check of {record['scene'] or 'a problem'}: {record['dofs']:,} dofs, "
+             f"{record['contact_candidates']:,} contact candidates, tol {record['tol']:.0e}")
+    present = [(key, label) for key, label in REFERENCE_COLUMNS
+               if any(key in run["reference"] for run in record["methods"])]
+    head = ["method", "said → certificate", "form", "worst KKT", "iterations", "time s"]
+    head += [label for _, label in present]
+    rows = []
+    for run in record["methods"]:
+        row = [run["method"], _said(run), _form(run),
+               f"{_num(run['kkt_worst'])} {run['kkt_worst_name']}".strip(),
+               str(run["iterations"]), _num(run["time_s"], ".2f")]
+        row += [_num(run["reference"].get(key), ".2e") for key, _ in present]
+        rows.append(row)
+    pair_head = ["pair", "λ rel", "u rel", "nodes apart", "weak", "limit", "verdict"]
+    pair_rows = [[f"{p['first']} ~ {p['second']}", _num(p["lam_rel"]), _num(p["u_rel"]),
+                  str(p["apart"]), str(p["weak"]), _num(p["limit"]), p["verdict"]]
+                 for p in record["pairs"]]
+    return title, head, rows, pair_head, pair_rows
+
+
+def _plain(head: list[str], rows: list[list[str]]) -> list[str]:
+    widths = [max(len(x) for x in column) for column in zip(head, *rows)]
+    return ["  ".join(x.ljust(w) for x, w in zip(line, widths)).rstrip() for line in [head, *rows]]
+
+
+def _verdict_line(record: dict[str, Any]) -> str:
+    bad = [p for p in record["pairs"] if p["verdict"] == "DISAGREE"]
+    if bad:
+        names = ", ".join(f"{p['first']} ~ {p['second']}" for p in bad)
+        return (f"DISAGREE: {names} both said converged and differ beyond "
+                f"{record['agree_factor']:.0e} × tol or classify nodes apart")
+    judged = sum(p["judged"] for p in record["pairs"])
+    return f"every judged pair agrees ({judged} of {len(record['pairs'])} pairs said converged on both sides)"
+
+
+def render(record: dict[str, Any]) -> str:
+    """The cross-check record as plain-text tables (see :meth:`CrossCheck.to_dict`)."""
+    title, head, rows, pair_head, pair_rows = _tables(record)
+    return "\n".join([title, "", *_plain(head, rows), "", *_plain(pair_head, pair_rows), "",
+                      _verdict_line(record)])
+
+
+def _md(head: list[str], rows: list[list[str]]) -> list[str]:
+    return ["| " + " | ".join(head) + " |", "|" + "---|" * len(head),
+            *("| " + " | ".join(x.replace("|", "\\|") for x in row) + " |" for row in rows)]
+
+
+def render_markdown(record: dict[str, Any]) -> str:
+    """The cross-check record as Markdown."""
+    title, head, rows, pair_head, pair_rows = _tables(record)
+    params = ", ".join(f"{k}={v}" for k, v in record["params"].items()) or "defaults"
+    notes = (f"Parameters: {params}. A pair is judged when both methods said `converged` "
+             f"(their own claim); it disagrees when a node is active in one answer and "
+             f"inactive in the other (weakly active nodes apart: force and gap both within "
+             f"max(1e-6, tol)), or λ or u differ by more than {record['agree_factor']:.0e} × tol.")
+    return "\n".join([f"# {title}", "", notes, "", *_md(head, rows), "", *_md(pair_head, pair_rows),
+                      "", _verdict_line(record), ""])
+
+
+__all__ = ["AGREE_FACTOR", "DEFAULT_METHODS", "DEFAULT_TOL", "CrossCheck", "MethodRun", "Pair",
+           "agreement", "crosscheck", "render", "render_markdown"]

@@ -1,0 +1,158 @@
+"""signorini.crosscheck on every validation case, with the QP methods' defaults and without them.
+
+    .venv/bin/python tools/crosscheck_cases.py        # ≈ 1 min here; docs/crosscheck/cases.json
+    .venv/bin/python tools/crosscheck_cases.py --doc  # docs/crosscheck.md's tables from it
+
+Every case of the validation suite (signorini.studies.suite.DEFAULT_CASES) is cross-checked
+at tol 1e-8 with uzawa, qp-osqp, qp-clarabel, cvxpy and pdas (signorini.crosschecking), in
+three variants of the QP methods' options:
+
+- ``default``: each method's defaults (OSQP's dual form, Clarabel and cvxpy primal; polished;
+  Clarabel's gap tolerance at tol², floored at 1e-12);
+- ``raw``: the same without polish (``polish=false``): the backends' own answers;
+- ``before``: raw, with Clarabel's gap tolerance at tol (the translation before issue 17).
+
+The issue's condition is read from the pairs with pdas (the exact answer): a method passes a
+case when it said ``converged``, the certificate agrees, λ is within 1e-6 of pdas's and no node
+is classified apart. tests/test_crosscheck.py holds docs/crosscheck.md's tables to the JSON and
+the default variant to that condition.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from readme import pattern
+
+import signorini
+from signorini.files import atomic_write_text, to_json
+from signorini.studies.suite import DEFAULT_CASES
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs" / "crosscheck" / "cases.json"
+DOC = ROOT / "docs" / "crosscheck.md"
+TOL = 1e-8
+METHODS = ("uzawa", "qp-osqp", "qp-clarabel", "cvxpy", "pdas")
+QP_METHODS = ("qp-osqp", "qp-clarabel", "cvxpy")
+#: the issue's condition on λ against the exact answer
+LAM_LIMIT = 1e-6
+RAW = {name: {"polish": False} for name in QP_METHODS}
+VARIANTS = {
+    "default": {},
+    "raw": RAW,
+    "before": {**RAW, "qp-clarabel": {"polish": False, "tol_gap_abs": TOL, "tol_gap_rel": TOL,
+                                      "tol_ktratio": TOL}},
+}
+
+
+def commit() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def run() -> dict:
+    data = {"command": "python tools/crosscheck_cases.py", "tol": TOL, "commit": commit(),
+            "machine": f"{platform.node()}: {platform.processor() or platform.machine()}, "
+                       f"{os.cpu_count()} cores, Python {platform.python_version()}",
+            "load_before": list(os.getloadavg()), "variants": {}}
+    start = time.perf_counter()
+    for case in DEFAULT_CASES:
+        problem = signorini.build_problem(case.scene, **case.params)
+        for variant, options in VARIANTS.items():
+            check = signorini.crosscheck(problem, METHODS, tol=TOL, options=options)
+            record = check.to_dict()
+            record["case"] = case.name
+            data["variants"].setdefault(variant, {})[case.name] = record
+            print(f"{case.name:<22} {variant:<8} {'passed' if check.passed else 'DISAGREE'}",
+                  file=sys.stderr)
+    data["seconds"] = time.perf_counter() - start
+    data["load_after"] = list(os.getloadavg())
+    return data
+
+
+def verdict(record: dict, method: str) -> dict:
+    """A method's run on a case and its pair with pdas: status, λ vs pdas, nodes apart, ok."""
+    run_ = next(r for r in record["methods"] if r["method"] == method)
+    pair = next((p for p in record["pairs"] if {p["first"], p["second"]} == {method, "pdas"}), None)
+    ok = (pair is not None and run_["status"] == "converged" and run_["claimed_status"] == "converged"
+          and pair["lam_rel"] is not None and pair["lam_rel"] <= LAM_LIMIT and pair["apart"] == 0)
+    return {"status": run_["status"], "claimed": run_["claimed_status"], "polished": run_["polished"],
+            "lam_rel": None if pair is None else pair["lam_rel"],
+            "apart": None if pair is None else pair["apart"], "ok": ok}
+
+
+def cell(v: dict) -> str:
+    said = v["status"] if v["claimed"] == v["status"] else f"{v['claimed']} → {v['status']}"
+    lam = "–" if v["lam_rel"] is None else f"{v['lam_rel']:.1e}"
+    apart = f", {v['apart']} apart" if v["apart"] else ""
+    mark = "**ok**" if v["ok"] else said
+    polished = " (polished)" if v["polished"] else ""
+    return f"{mark}{polished}: λ {lam}{apart}"
+
+
+def table(data: dict, variant: str) -> str:
+    cases = data["variants"][variant]
+    head = "| case | dofs | " + " | ".join(m for m in METHODS if m != "pdas") + " | pairs |"
+    lines = [head, "|---|---:|" + "---|" * (len(METHODS) - 1) + "---|"]
+    for name, record in cases.items():
+        cells = [cell(verdict(record, m)) for m in METHODS if m != "pdas"]
+        pairs = "agree" if record["passed"] else "DISAGREE: " + ", ".join(
+            f"{p['first']} ~ {p['second']}" for p in record["pairs"] if p["verdict"] == "DISAGREE")
+        lines.append(f"| {name} | {record['dofs']:,} | " + " | ".join(cells) + f" | {pairs} |")
+    return "\n".join(lines)
+
+
+def summary(data: dict) -> str:
+    lines = ["| variant | " + " | ".join(QP_METHODS) + " | cases where every judged pair agrees |",
+             "|---|" + "---:|" * len(QP_METHODS) + "---:|"]
+    for variant, cases in data["variants"].items():
+        counts = [sum(verdict(r, m)["ok"] for r in cases.values()) for m in QP_METHODS]
+        passed = sum(r["passed"] for r in cases.values())
+        lines.append(f"| {variant} | " + " | ".join(f"{c}/{len(cases)}" for c in counts)
+                     + f" | {passed}/{len(cases)} |")
+    head = (f"tol {data['tol']:.0e}; {data['machine']}; commit {data['commit']}; "
+            f"{data['seconds']:.0f} s for all; load average {data['load_before'][0]:.1f} → "
+            f"{data['load_after'][0]:.1f}\n\n")
+    return head + "\n".join(lines)
+
+
+def blocks(data: dict) -> dict[str, str]:
+    return {"summary": summary(data), **{v: table(data, v) for v in data["variants"]}}
+
+
+def write_doc(data: dict) -> None:
+    text = DOC.read_text(encoding="utf-8")
+    for name, body in blocks(data).items():
+        if not pattern(name).search(text):
+            raise SystemExit(f"{DOC.name} has no block '{name}'")
+        text = pattern(name).sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
+    atomic_write_text(DOC, text)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--doc", action="store_true", help="write docs/crosscheck.md's tables")
+    args = parser.parse_args()
+    if args.doc:
+        import json
+
+        write_doc(json.loads(OUT.read_text()))
+        return 0
+    OUT.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(OUT, to_json(run()))
+    print(f"written: {OUT}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
