@@ -39,7 +39,7 @@ import numpy as np
 from signorini.api import Result, build_problem, solve
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.kkt import WEAK_TOL, compare
-from signorini.problem import ContactProblem
+from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics, reference_of
 from signorini.solvers.base import DEFAULT_ACCEPT, check_tol
 from signorini.solvers.registry import get_method
@@ -118,13 +118,16 @@ class Pair:
         return {**asdict(self), "agree": self.agree, "verdict": self.verdict}
 
 
-def agreement(problem: ContactProblem, first: Result, second: Result, tol_first: float,
-              tol_second: float) -> Pair:
-    """Compare two results of ``problem`` (solved at ``tol_first`` and ``tol_second``)."""
+def agreement(problem: ContactProblem, first: ContactSolution, second: ContactSolution,
+              tol_first: float, tol_second: float) -> Pair:
+    """Compare two answers of ``problem`` (solved at ``tol_first`` and ``tol_second``).
+
+    The one definition of agreement: the cross-check and the validation suite both use it.
+    """
     loose = max(tol_first, tol_second)
     weak_tol = max(WEAK_TOL, loose)
-    found = compare(problem, first.solution, second.solution, weak_tol=weak_tol)
-    judged = first.claimed_status == "converged" and second.claimed_status == "converged"
+    found = compare(problem, first, second, weak_tol=weak_tol)
+    judged = first.own_status == "converged" and second.own_status == "converged"
     return Pair(first.method, second.method, found.lam_rel, found.u_rel, found.misclassified,
                 found.weak, weak_tol, AGREE_FACTOR * loose, judged)
 
@@ -256,7 +259,7 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
         results[name] = result
         runs.append(_run_of(result, judged_tol))
     tol_of = {run.method: run.tol for run in runs}
-    pairs = [agreement(problem, results[a], results[b], tol_of[a], tol_of[b])
+    pairs = [agreement(problem, results[a].solution, results[b].solution, tol_of[a], tol_of[b])
              for a, b in itertools.combinations(names, 2) if a in results and b in results]
     return CrossCheck(problem, judged_tol, runs, pairs, results)
 

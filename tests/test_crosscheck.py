@@ -107,26 +107,26 @@ def test_agreement_judges_claims_and_leaves_weak_nodes_apart():
     exact = signorini.solve(problem, "pdas", tol=1e-12)
     near = signorini.solve(problem, "pdas", tol=1e-12)
     near.solution.lam = exact.solution.lam * (1 + 0.5 * AGREE_FACTOR * 1e-8)
-    assert agreement(problem, exact, near, 1e-8, 1e-8).verdict == "agree"
+    assert agreement(problem, exact.solution, near.solution, 1e-8, 1e-8).verdict == "agree"
     far = signorini.solve(problem, "pdas", tol=1e-12)
     far.solution.lam = exact.solution.lam * (1 + 2 * AGREE_FACTOR * 1e-8)
-    pair = agreement(problem, exact, far, 1e-8, 1e-8)
+    pair = agreement(problem, exact.solution, far.solution, 1e-8, 1e-8)
     assert pair.verdict == "DISAGREE" and pair.apart == 0
     # a node on the other side of the zone's edge is apart
     flipped = signorini.solve(problem, "pdas", tol=1e-12)
     flipped.solution.lam = np.array([0.5, 0.4])  # λ̃ 0.8 against its gap 1 over 2: "active"
-    assert agreement(problem, exact, flipped, 1e-2, 1e-2).apart == 1
+    assert agreement(problem, exact.solution, flipped.solution, 1e-2, 1e-2).apart == 1
     # ...unless both its force and its gap are within the looser tolerance: weakly active
     touching = signorini.ContactProblem.from_qp(K=np.diag([2.0, 1.0]), f=np.array([1.0, 0.0]),
                                                 N=np.eye(2), d=np.array([0.25, 0.0]))
     a = signorini.solve(touching, "pdas", tol=1e-12)
     b = signorini.solve(touching, "pdas", tol=1e-12)
     b.solution.lam = np.array([0.5, 1e-7])
-    pair = agreement(touching, a, b, 1e-6, 1e-6)
+    pair = agreement(touching, a.solution, b.solution, 1e-6, 1e-6)
     assert (pair.apart, pair.weak) == (0, 1)
     # a method that did not say converged is shown, not judged
     far.solution.claimed_status, far.solution.status = "", "inaccurate"
-    assert agreement(problem, exact, far, 1e-8, 1e-8).verdict == "not judged"
+    assert agreement(problem, exact.solution, far.solution, 1e-8, 1e-8).verdict == "not judged"
 
 
 def test_a_missing_backend_is_a_row_not_an_error():
@@ -202,3 +202,25 @@ def test_the_crosscheck_doc_is_its_runs_and_meets_the_issue():
     assert qp.BACKEND_BY_NAME["osqp"].polish and qp.BACKEND_BY_NAME["clarabel"].polish
     assert cvxpy_.DEFAULT_POLISH
     assert qp.BACKEND_BY_NAME["clarabel"].tolerance(1e-8)["tol_gap_abs"] == 1e-12
+
+
+def test_the_validation_suite_cross_checks_uzawa_with_osqp_and_clarabel():
+    """Every case: uzawa against qp-osqp and qp-clarabel (default form) at the suite's tight
+    tolerance; a check that fails when they disagree, or when either did not converge."""
+    require("qp-osqp", "qp-clarabel")
+    from signorini.studies import suite
+
+    cases = suite.select_cases(["block"])
+    result = suite.run_suite(cases, ["uzawa", "qp-osqp", "qp-clarabel"], isolate=False)
+    crossed = [c for c in result.checks if "cross-checked" in c.name]
+    assert [c.name.split(" (")[0] for c in crossed] == ["uzawa cross-checked with qp-osqp",
+                                                       "uzawa cross-checked with qp-clarabel"]
+    assert all(c.passed for c in crossed) and result.passed
+    case = result.results[0]
+    lying = case.solutions[suite.label("qp-clarabel", suite.TIGHT_TOL)]
+    lying.lam = 1.01 * lying.lam  # still says converged: the cross-check must catch it
+    checks = suite.cross_checks(case)
+    assert [c.passed for c in checks] == [True, False]
+    assert "λ 9.9e-03" in checks[1].detail  # 0.01 over the larger ‖λ‖∞
+    case.solutions[suite.label("qp-osqp", suite.TIGHT_TOL)].status = "inaccurate"
+    assert not suite.cross_checks(case)[0].passed

@@ -22,6 +22,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from signorini.crosschecking import agreement
 from signorini.errors import InputError
 from signorini.pressure import contact_profile, radial_distance
 from signorini.problem import ContactProblem, ContactSolution
@@ -50,6 +51,9 @@ REFERENCE = {"kind": REFERENCE_METHOD, "tol": TIGHT_TOL}
 REFERENCE_LABEL = f"{REFERENCE_METHOD}@{TIGHT_TOL:.0e}"
 #: methods also run at their backend's own default tolerance, to show what it gives
 DEFAULT_TOLERANCE_RUNS = ("qp-osqp", "qp-clarabel")
+#: the paper's method, cross-checked on every case against the two named QP backends in their
+#: default formulation (signorini.crosschecking.agreement): both must converge and agree
+CROSS_CHECKED = ("uzawa", ("qp-osqp", "qp-clarabel"))
 #: seconds one run may take (its worker is then stopped and the run is a "timeout")
 TIME_LIMIT = 600.0
 #: what the suite measures of each run besides the runner's row
@@ -265,6 +269,7 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
             checks.append(Check(case.name, f"{row['label']} converged: same active set as pdas",
                                 vs["misclassified"] == 0, None, vs["misclassified"] == 0,
                                 f"{vs['misclassified']} nodes misclassified"))
+    checks += cross_checks(result)
     must_converge = {"uzawa": "uzawa (the paper's method) converged"}
     must_converge.update({name: f"{name} (asked for by name) converged" for name in required})
     for row in result.runs:
@@ -276,6 +281,35 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
         other = by_name[case.same_as].reference
         diff = float(np.max(np.abs(other.lam - ref.lam)) / np.max(np.abs(other.lam)))
         limit(f"dimensionless λ equals that of {case.same_as}", diff, "units_invariance")
+    return checks
+
+
+def cross_checks(result: CaseResult) -> list[Check]:
+    """Uzawa against each of :data:`CROSS_CHECKED`'s QP backends at the tight tolerance.
+
+    A check for each backend run on the case: it passes when both runs ended
+    ``converged`` and :func:`~signorini.crosschecking.agreement` finds them
+    agreeing (no node classified apart, λ and u within its limit); its value is λ's
+    relative difference.
+    """
+    first, partners = CROSS_CHECKED
+    runs = {row["method"]: row for row in result.runs if row.get("tol") == TIGHT_TOL}
+    if first not in runs:
+        return []
+    checks = []
+    for partner in partners:
+        if partner not in runs:
+            continue
+        name = f"{first} cross-checked with {partner} (default form): both converged and agree"
+        a, b = (result.solutions.get(label(m, TIGHT_TOL)) for m in (first, partner))
+        if a is None or b is None:
+            checks.append(Check(result.case.name, name, False, None, False, "no answer to compare"))
+            continue
+        pair = agreement(result.problem, a, b, TIGHT_TOL, TIGHT_TOL)
+        ok = a.status == "converged" and b.status == "converged" and pair.agree
+        checks.append(Check(result.case.name, name, pair.lam_rel, pair.limit, ok,
+                            f"{first} {a.status}, {partner} {b.status}; λ {pair.lam_rel:.1e}, "
+                            f"u {pair.u_rel:.1e}, {pair.apart} nodes apart ({pair.weak} weak)"))
     return checks
 
 
