@@ -156,3 +156,31 @@ def test_the_pressure_estimate_shrinks_with_the_mesh_and_tracks_the_error():
     assert fine.estimate.pressure.relative < 0.7 * coarse.estimate.pressure.relative
     error = tool.pressure_error(coarse, fine)  # the finer mesh's pressure as the reference
     assert 0.5 < coarse.estimate.pressure.relative / error < 3.0
+
+
+def test_the_adaptive_findings_are_the_runs():
+    """docs/estimate.md's reading of the adaptive runs, held to docs/estimate/runs.json."""
+    rows = tool.load("adaptive")
+
+    def run(scene, nu, mesh="adaptive"):
+        return [r for r in rows if r["scene"] == scene and r["nu"] == nu and r["mesh"].startswith(mesh)]
+
+    def first(scene, nu, target):
+        return next(r for r in run(scene, nu) if r["pressure_estimate"] <= target)
+
+    text = (ROOT / "docs" / "estimate.md").read_text()
+    sphere = run("hertz-sphere", 0.3)
+    assert (first("hertz-sphere", 0.3, 0.003)["dofs"], first("hertz-sphere", 0.3, 0.001)["dofs"]) == (19521, 50528)
+    span = f"{min(r['effectivity'] for r in sphere):.2f}–{max(r['effectivity'] for r in sphere):.2f}"
+    assert span == "1.10–1.26" and span in text
+    cylinder = run("hertz-cylinder", 0.3)
+    uniform = {r["mesh"]: r for r in run("hertz-cylinder", 0.3, "uniform")}
+    graded = {r["mesh"]: r for r in run("hertz-cylinder", 0.3, "graded")}
+    assert cylinder[-1]["pressure_error"] > uniform["uniform, refine 1"]["pressure_error"]
+    assert cylinder[-1]["dofs"] > uniform["uniform, refine 1"]["dofs"]
+    assert graded["graded (40, 0.1)"]["pressure_error"] < min(
+        r["pressure_error"] for r in cylinder if r["dofs"] <= 2 * graded["graded (40, 0.1)"]["dofs"])
+    assert min(r["effectivity"] for r in cylinder) == pytest.approx(0.47, abs=0.005)
+    every = [r for nu in (0.0, 0.3, 0.45) for r in run("hertz-cylinder", nu)]
+    assert max(max(abs(r["p0_err"]), abs(r["a_err"])) for r in every) < 7e-4
+    assert all(r["dofs"] <= tool.MAX_DOFS for r in rows if r["mesh"] == "adaptive")

@@ -1,8 +1,9 @@
 """Effectivity of the a posteriori estimate (signorini.fem.estimate) on the Hertz scenes, and
 what adaptive refinement (signorini.scenes.adapt) reaches against uniform and hand-graded meshes.
 
-    .venv/bin/python tools/estimate.py [effectivity] [adaptive]   # both: ~6 min here;
+    .venv/bin/python tools/estimate.py [effectivity] [adaptive]   # both: ~12 min here;
                                                                   # writes docs/estimate/runs.json
+    .venv/bin/python tools/estimate.py figure                     # adaptive.png from the JSON
 
 For each scene and base mesh, the scene is solved at ``refine`` = 0, 1, ...
 (uniform refinements of the graded mesh) and at two more levels. The true
@@ -39,17 +40,23 @@ SCENES = ("hertz-cylinder", "hertz-sphere")
 #: (n_contact, grading, levels): a coarse base with three levels, each scene's default mesh with two
 BASES = ((16, 0.2, 3), (None, None, 2))
 REFERENCE_STEPS = 2
-#: the adaptive runs: targets (relative, energy norm), the dof limit, and what they are held against
+#: the adaptive runs: targets (the contact pressure's relative L² error), the dof limit, the
+#: reference (the same loop driven further), the ν values, and the meshes held against them
 TARGETS = (0.003, 0.001)
-MAX_DOFS = 250_000
-UNIFORM_LEVELS = 3
+MAX_DOFS = 80_000
+REFERENCE_TARGET, REFERENCE_DOFS = 0.0002, 250_000
+NUS = (0.0, 0.3, 0.45)
+CHART_NU = 0.3
+UNIFORM_LEVELS = 2
 HAND_GRADED = ((40, 0.1), (60, 0.05), (120, 0.05))
+FIGURE = ROOT / "docs" / "estimate" / "adaptive.png"
 
 
-def solve(scene: str, n_contact: int | None, grading: float | None, refine: int):
+def solve(scene: str, n_contact: int | None, grading: float | None, refine: int,
+          nu: float | None = None):
     """The scene at ``refine`` (mesh parameters None: the scene's defaults), exactly; and the time."""
     method = "nested" if refine >= 2 else "pdas"
-    mesh = {"n_contact": n_contact, "grading": grading}
+    mesh = {"n_contact": n_contact, "grading": grading, "nu": nu}
     start = time.perf_counter()
     result = signorini.solve(scene, method=method, tol=1e-10,
                              params={**{k: v for k, v in mesh.items() if v is not None},
@@ -146,47 +153,155 @@ def tables(rows: list[dict], adaptive: list[dict] | None = None) -> dict[str, st
     out["estimate-hertz"] = "\n".join(lines)
     if adaptive:
         out["adaptive"] = adaptive_table(adaptive)
+        out["adaptive-summary"] = adaptive_summary(adaptive)
     return out
 
 
-def _hertz_row(problem, solution, found, **fields) -> dict:
+def pressure_profile(result) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Arc coordinate, nodal pressure and contact weight of every candidate (problem units)."""
+    problem, solution = result.problem, result.solution
+    return problem.contact_points[:, 0], solution.lam / problem.weights, problem.weights
+
+
+def pressure_error(coarse, reference) -> float:
+    """‖p_h − p_ref‖ / ‖p_h‖ over the coarse candidates (weighted by their contact weights), the
+    reference's nodal pressure interpolated linearly along the arc."""
+    x, p, w = pressure_profile(coarse)
+    xr, pr, _ = pressure_profile(reference)
+    order = np.argsort(xr)
+    difference = p - np.interp(x, xr[order], pr[order])
+    return float(np.sqrt(np.sum(w * difference ** 2) / np.sum(w * p ** 2)))
+
+
+class _Step:
+    """What :func:`solve_adaptive` hands ``on_step``, shaped like an API result."""
+
+    def __init__(self, problem, solution, found):
+        self.problem, self.solution, self.estimate = problem, solution, found
+
+
+def _row(result, reference, **fields) -> dict:
+    problem, solution, found = result.problem, result.solution, result.estimate
     hertz = reference_of(problem).compare(problem, solution)
+    error = pressure_error(result, reference)
     return {**fields, "dofs": problem.n, "relative": found.relative,
+            "pressure_estimate": found.pressure.relative, "pressure_error": error,
+            "effectivity": found.pressure.relative / error if error > 0 else float("nan"),
+            "pressure_hertz": hertz.pressure_l2_rel,
             "p0_err": hertz.p0 / hertz.p0_ref - 1, "a_err": hertz.a / hertz.a_ref - 1}
 
 
+def adaptive_steps(scene: str, params: dict, target: float, max_dofs: int):
+    """Every step of one adaptive run (as :class:`_Step`, with the loop's time so far) and its end."""
+    steps, start = [], time.perf_counter()
+
+    def step(problem, solution, found):
+        if found is None:  # the loop stops on it and says why (run.reason)
+            print(f"{scene} {params}: {problem.n} dofs ended {solution.status}", file=sys.stderr)
+            return
+        steps.append((_Step(problem, solution, found), time.perf_counter() - start))
+        print(f"{scene} {params} adaptive: {problem.n} dofs, pressure η "
+              f"{100 * found.pressure.relative:.3f} %", file=sys.stderr)
+
+    # pdas's default tolerance 1e-9: at 1e-10 the sphere at ν = 0.45 ends `inaccurate` at 66k dofs
+    run = solve_adaptive(scene, params, target, tol=1e-9, max_dofs=max_dofs, on_step=step)
+    return steps, run
+
+
 def run_adaptive() -> list[dict]:
-    """Every step of one adaptive run per scene (to the smaller target), uniform and hand-graded."""
+    """Adaptive runs to the smaller target for every scene and ν, each step against a reference
+    (the same loop driven to REFERENCE_TARGET); at ν = 0.3 also uniform and hand-graded meshes."""
     rows = []
     for scene in SCENES:
-        start = time.perf_counter()
-
-        def step(problem, solution, found, scene=scene, start=start):
-            rows.append(_hertz_row(problem, solution, found, scene=scene, mesh="adaptive",
-                                   seconds=time.perf_counter() - start))
-            print(f"{scene} adaptive: {problem.n} dofs, η {100 * found.relative:.2f} %",
-                  file=sys.stderr)
-
-        run = solve_adaptive(scene, {}, min(TARGETS), tol=1e-10, max_dofs=MAX_DOFS, on_step=step)
-        rows[-1]["reason"] = run.reason
-        for refine in range(UNIFORM_LEVELS + 1):
-            result, seconds = solve(scene, None, None, refine)
-            rows.append(_hertz_row(result.problem, result.solution, result.estimate, scene=scene,
-                                   mesh=f"uniform, refine {refine}", seconds=seconds))
-        for n_contact, grading in HAND_GRADED:
-            result, seconds = solve(scene, n_contact, grading, 0)
-            rows.append(_hertz_row(result.problem, result.solution, result.estimate, scene=scene,
-                                   mesh=f"graded ({n_contact}, {grading:g})", seconds=seconds))
+        for nu in NUS:
+            steps, _ = adaptive_steps(scene, {"nu": nu}, REFERENCE_TARGET, REFERENCE_DOFS)
+            reference = steps[-1][0]
+            steps, run = adaptive_steps(scene, {"nu": nu}, min(TARGETS), MAX_DOFS)
+            for k, (result, seconds) in enumerate(steps):
+                rows.append(_row(result, reference, scene=scene, nu=nu, mesh="adaptive", step=k,
+                                 seconds=seconds, reference_dofs=reference.problem.n))
+            rows[-1]["reason"] = run.reason
+            if nu != CHART_NU:
+                continue
+            for refine in range(UNIFORM_LEVELS + 1):
+                result, seconds = solve(scene, None, None, refine, nu)
+                rows.append(_row(result, reference, scene=scene, nu=nu, seconds=seconds,
+                                 mesh=f"uniform, refine {refine}"))
+            for n_contact, grading in HAND_GRADED:
+                result, seconds = solve(scene, n_contact, grading, 0, nu)
+                rows.append(_row(result, reference, scene=scene, nu=nu, seconds=seconds,
+                                 mesh=f"graded ({n_contact}, {grading:g})"))
     return rows
 
 
 def adaptive_table(rows: list[dict]) -> str:
-    lines = ["| scene | mesh | dofs | η / ‖u_h‖ | a | p₀ | time |", "|---|---|---:|---:|---:|---:|---:|"]
+    lines = ["| scene | ν | mesh | dofs | pressure estimate | pressure error | effectivity "
+             "| vs Hertz: pressure | a | p₀ | time |",
+             "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        label = r["mesh"] if r["mesh"] != "adaptive" else "adaptive, step"
-        lines.append(f"| {r['scene']} | {label} | {r['dofs']:,} | {100 * r['relative']:.2f} % "
+        label = f"adaptive, step {r['step']}" if r["mesh"] == "adaptive" else r["mesh"]
+        lines.append(f"| {r['scene']} | {r['nu']:g} | {label} | {r['dofs']:,} "
+                     f"| {100 * r['pressure_estimate']:.3f} % | {100 * r['pressure_error']:.3f} % "
+                     f"| {r['effectivity']:.2f} | {100 * r['pressure_hertz']:.3f} % "
                      f"| {_pct(r['a_err'])} | {_pct(r['p0_err'])} | {r['seconds']:.1f} s |")
     return "\n".join(lines)
+
+
+def adaptive_summary(rows: list[dict]) -> str:
+    """Per scene, ν and target: the first adaptive step whose estimate meets it."""
+    lines = ["| scene | ν | target | dofs | pressure error | a | p₀ | effectivity over the run |",
+             "|---|---:|---:|---:|---:|---:|---:|---|"]
+    for scene in SCENES:
+        for nu in NUS:
+            run = [r for r in rows if r["scene"] == scene and r["nu"] == nu and r["mesh"] == "adaptive"]
+            known = [r["effectivity"] for r in run if np.isfinite(r["effectivity"])]
+            span = f"{min(known):.2f}–{max(known):.2f}" if known else "—"
+            for target in TARGETS:
+                met = next((r for r in run if r["pressure_estimate"] <= target), None)
+                if met is None:
+                    lines.append(f"| {scene} | {nu:g} | {100 * target:g} % | not met within "
+                                 f"{MAX_DOFS:,} | | | | {span} |")
+                    continue
+                lines.append(f"| {scene} | {nu:g} | {100 * target:g} % | {met['dofs']:,} "
+                             f"| {100 * met['pressure_error']:.3f} % | {_pct(met['a_err'])} "
+                             f"| {_pct(met['p0_err'])} | {span} |")
+    return "\n".join(lines)
+
+
+def adaptive_figure(rows: list[dict], path: Path) -> None:
+    """The true pressure error against dofs and against time: adaptive, uniform, hand-graded."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from signorini.files import save_figure
+
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5))
+    from matplotlib.ticker import NullFormatter
+
+    kinds = (("adaptive", "o-", "adaptive (pressure estimate)"), ("uniform", "s--", "uniform refinement"),
+             ("graded", "^", "hand-graded (n_contact, grading)"))
+    for row_axes, scene in zip(axes, SCENES):
+        chosen = [r for r in rows if r["scene"] == scene and r["nu"] == CHART_NU]
+        for kind, style, label in kinds:
+            series = sorted((r for r in chosen if r["mesh"].startswith(kind)), key=lambda r: r["dofs"])
+            for ax, key in zip(row_axes, ("dofs", "seconds")):
+                ax.loglog([r[key] for r in series], [100 * r["pressure_error"] for r in series], style,
+                          label=label)
+                if kind == "adaptive":
+                    ax.loglog([r[key] for r in series], [100 * r["pressure_estimate"] for r in series],
+                              "o", mfc="none", color="C0", alpha=0.6, label="its estimate")
+        for ax, key in zip(row_axes, ("dofs", "wall time [s] (adaptive: the loop so far)")):
+            ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.yaxis.set_minor_formatter(NullFormatter())
+            ax.set_xlabel(key)
+            ax.set_ylabel("contact pressure error [%]")
+            ax.set_title(f"{scene}, ν = {CHART_NU:g}", fontsize=9)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=7)
+    fig.tight_layout()
+    save_figure(fig, path)
 
 
 def load(part: str = "rows") -> list[dict]:
@@ -196,10 +311,14 @@ def load(part: str = "rows") -> list[dict]:
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["effectivity", "adaptive"]
     record = json.loads(OUT.read_text()) if OUT.exists() else {}
-    record["command"] = "python tools/estimate.py " + " ".join(parts)
+    if parts != ["figure"]:
+        record["command"] = "python tools/estimate.py " + " ".join(parts)
     if "effectivity" in parts:
         record["rows"] = run()
     if "adaptive" in parts:
         record["adaptive"] = run_adaptive()
-    atomic_write_text(OUT, to_json(record))
-    print(f"written: {OUT}", file=sys.stderr)
+    if parts != ["figure"]:
+        atomic_write_text(OUT, to_json(record))
+        print(f"written: {OUT}", file=sys.stderr)
+    if "adaptive" in parts or "figure" in parts:
+        adaptive_figure(record["adaptive"], FIGURE)

@@ -56,6 +56,7 @@ def blocks(document: Path = README) -> dict[str, str]:
         return {"validation": readme_validation(report),
                 "peer": "\n".join(peer[peer.index("") + 1:]),  # the summary of docs/peer/peer.md
                 "one-million": one_million(ROOT / "docs" / "speed" / "one-million"),
+                "adaptive-summary": estimate_study.adaptive_summary(estimate_study.load("adaptive")),
                 **stability.tables(stability.load())}
     if document == ACCURACY:
         return accuracy.tables(accuracy.load())
@@ -65,7 +66,8 @@ def blocks(document: Path = README) -> dict[str, str]:
 
 
 def pattern(name: str) -> re.Pattern:
-    return re.compile(rf"(<!-- generated: {name} -->\n)(.*?)(\n<!-- end generated -->)", re.S)
+    # the body may be empty (a block not yet written): the newline before the end marker is optional
+    return re.compile(rf"(<!-- generated: {name} -->\n)(.*?)(\n?<!-- end generated -->)", re.S)
 
 
 def current(text: str, name: str) -> str | None:
@@ -80,7 +82,7 @@ def main() -> int:
             if current(text, name) is None:
                 print(f"{document.name} has no block '{name}'", file=sys.stderr)
                 return 1
-            text = pattern(name).sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
+            text = pattern(name).sub(lambda m, body=body: m.group(1) + body + "\n<!-- end generated -->", text)
         atomic_write_text(document, text)
     return 0
 
