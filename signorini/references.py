@@ -25,6 +25,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_sphere_radius
 from signorini.errors import InputError
 from signorini.pressure import (
     compare_hertz,
@@ -55,6 +56,8 @@ class Reference:
     convergence: tuple[str, ...] = ()
     resultant: bool = False
     figure: bool = False
+    extent: Callable[[dict[str, Any]], float | None] | None = None
+    extent_margin: float = 0.0
 
     def metrics(self, problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:
         """The comparison as a flat dictionary; empty when the answer has no finite forces."""
@@ -65,11 +68,23 @@ class Reference:
 
 _PRESSURE_ERRORS = ("p0_rel", "a_rel", "pressure_l2_rel")
 
+
+def _hertz_extent(half_width: Callable[[float, float, float], float]):
+    def extent(params: dict[str, Any]) -> float | None:
+        if not all(isinstance(params.get(k), (int, float)) for k in ("P", "R", "E", "nu")):
+            return None  # no target load (a prescribed push), or not a Hertz scene's parameters
+        if not params["P"] > 0:
+            return None
+        return half_width(params["P"], params["R"], contact_modulus(params["E"], params["nu"]))
+    return extent
+
 REFERENCES: dict[str, Reference] = {r.name: r for r in (
     Reference("hertz-2d", "Hertz's cylinder on a flat, plane strain", compare_hertz, "hertz",
-              _PRESSURE_ERRORS, figure=True),
+              _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_cylinder_half_width),
+              extent_margin=0.002),
     Reference("hertz-3d", "Hertz's sphere on a flat", compare_hertz_sphere, "hertz",
-              _PRESSURE_ERRORS, figure=True),
+              _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_sphere_radius),
+              extent_margin=0.006),
     Reference("reverse-hertz", "a block pressed by a rigid cylinder (Hertz 2D)",
               compare_reverse_hertz, "hertz", _PRESSURE_ERRORS, resultant=True),
     Reference("punch", "a rigid flat punch on a half-plane", compare_punch, "punch",

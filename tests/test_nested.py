@@ -11,6 +11,7 @@ from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.scenes import build as scenes
 from signorini.scenes import build_problem, coarse_values, get_scene
 from signorini.solvers.registry import solve
+from signorini.solvers.nested import analytic_zone
 from signorini.teaching.synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
@@ -47,10 +48,34 @@ def cylinder():
 def test_nested_equals_pdas_on_the_cylinder(cylinder):
     reference = solve(cylinder, "pdas")
     fresh = cylinder.with_data()  # no solver kept from load targeting: predicts from scratch
-    nested = solve(fresh, "nested")
+    nested = solve(fresh, "nested", analytic=False)
     assert nested.status == "converged" and "coarse model" in nested.message
     assert_same_answer(cylinder, reference, nested)
     assert certificate(cylinder, nested).worst()[1] < 1e-10
+
+
+@pytest.mark.parametrize("scene, nu", [("hertz-cylinder", 0.3), ("hertz-sphere", 0.0),
+                                       ("hertz-sphere", 0.45)])
+def test_the_analytic_zone_predicts_on_one_factorisation(scene, nu):
+    """Hertz's a for the target load predicts the zone (the sphere at ν = 0 is 0.5 % off it)."""
+    problem = build_problem(scene, refine=1, nu=nu).with_data()
+    reference = solve(problem, "pdas")
+    nested = solve(problem, "nested")
+    assert nested.status == "converged" and "analytic zone" in nested.message
+    assert_same_answer(problem, reference, nested)
+    assert "1 factorisation(s)" in nested.message and nested.extras["band"] <= 8
+
+
+def test_a_wrong_analytic_zone_is_amended_not_trusted():
+    """A zone predicted for a load 10 % lower (a 5 % too small): the answer stays exact."""
+    problem = build_problem("hertz-cylinder", refine=1).with_data()
+    zone, a = analytic_zone(problem)
+    shifted = analytic_zone(problem.with_data(params={**problem.params, "P": problem.params["P"] * 0.9}))
+    assert shifted is not None and shifted[0].core.sum() < zone.core.sum()
+    reference = solve(problem, "pdas")
+    nested = solve(problem, "nested", zone=shifted[0])
+    assert nested.status == "converged"
+    assert_same_answer(problem, reference, nested)
 
 
 def test_nested_reuses_the_load_targeting_factorisation(cylinder):
@@ -159,5 +184,5 @@ def test_a_coarse_model_out_of_range_means_no_prediction(monkeypatch):
     """Coarser parameters a scene refuses give no coarse model (pdas), never an input error."""
     problem = build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4).with_data()
     monkeypatch.setattr(scenes, "coarse_values", lambda name, params: {"n_contact": 1})
-    nested = solve(problem, "nested")
+    nested = solve(problem, "nested", analytic=False)
     assert nested.status == "converged" and nested.extras["fallback"] == "pdas"

@@ -87,6 +87,25 @@ def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: n
     return Zone(core=core, band=band)
 
 
+def zone_around(x: np.ndarray, a: float, margin: float) -> Zone | None:
+    """The zone of candidates at abscissae ``x`` (2D, axisymmetric) for a contact half-width ``a``.
+
+    Core: inside ``a − max(2h, margin·a)``; band: up to ``a + max(h, margin·a)``
+    (``h`` the candidates' spacing at a) — the asymmetry of :func:`predict_zone`.
+    None when the candidates do not reach past the band on both sides.
+    """
+    x = np.asarray(x, dtype=float)
+    if not (a > 0) or len(x) < 3 or not np.all(np.isfinite(x)):
+        return None
+    ordered = np.sort(x)
+    at = int(np.clip(np.searchsorted(ordered, a), 1, len(x) - 1))
+    h = ordered[at] - ordered[at - 1]
+    inner, outer = a - max(2 * h, margin * a), a + max(h, margin * a)
+    if outer >= ordered[-1] or inner <= ordered[0]:
+        return None
+    return Zone(core=x < inner, band=(x >= inner) & (x <= outer))
+
+
 class ZoneSolver:
     """``min ½uᵀKu − fᵀu, Nu ≤ d`` solved exactly around a predicted zone (see module doc).
 

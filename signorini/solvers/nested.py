@@ -1,6 +1,10 @@
-"""Nested: a coarse model predicts the contact zone, one factorisation makes it exact.
+"""Nested: a predicted contact zone, made exact on one factorisation.
 
-The coarse model of the same scene (about 16× fewer dofs; see
+The prediction is, in this order: a zone given as an option; the analytic
+contact half-width of the scene's reference for its target load (Hertz's a,
+:attr:`signorini.references.Reference.extent`), trusted to its
+``extent_margin`` of a — it costs nothing; or the coarse model of the same
+scene (about 16× fewer dofs; see
 :func:`signorini.scenes.coarse_values`) is solved first, by this method
 again, down to a model with no coarser one (solved by ``pdas``). Its contact
 zone predicts the fine one; :class:`signorini.numerics.zone.ZoneSolver` then pins
@@ -25,8 +29,9 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.numerics.factor import selection_dofs
-from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
+from signorini.numerics.zone import Zone, ZoneSolver, predict_zone, zone_around
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.references import reference_of
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
 from signorini.solvers.options import take_options
@@ -34,7 +39,19 @@ from signorini.solvers.options import take_options
 log = logging.getLogger(__name__)
 
 DEFAULT_TOL = 1e-9
-DEFAULTS = {"backend": None, "coarse": None, "zone": None, "neighbours": None}
+DEFAULTS = {"backend": None, "coarse": None, "zone": None, "neighbours": None, "analytic": True}
+def analytic_zone(problem: ContactProblem) -> tuple[Zone, float] | None:
+    """The zone from the reference's contact half-width a (2D and axisymmetric models) and a,
+    in the problem's length units (:func:`signorini.numerics.zone.zone_around`); None without."""
+    reference = reference_of(problem)
+    if reference is None or reference.extent is None or problem.contact_points.shape[1] != 2:
+        return None
+    a = reference.extent(problem.params)
+    if a is None:
+        return None
+    a /= problem.scales.length
+    zone = zone_around(problem.contact_points[:, 0], a, reference.extent_margin)
+    return None if zone is None else (zone, a)
 
 
 def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | None, str]:
@@ -45,6 +62,10 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | N
             raise InputError(f"method 'nested': option zone must be a signorini.numerics.zone.Zone "
                              f"over the {problem.m} candidates")
         return zone, "given zone"
+    if opts["analytic"] and opts["coarse"] is None:
+        found = analytic_zone(problem)
+        if found is not None:
+            return found[0], f"the reference's analytic zone (a = {found[1]:.4g})"
     coarse = opts["coarse"]
     if coarse is None and problem.coarse_model is not None:
         coarse = problem.coarse_model(problem)
@@ -113,6 +134,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 METHODS = (
     Method(name="nested", function=solve, family="active set", exact=True,
-           summary="coarse model predicts the contact zone; one factorisation + exact band LCP",
+           summary="analytic or coarse-model contact zone; one factorisation + exact band LCP",
            default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)),
 )
