@@ -109,5 +109,5 @@ def test_a_stored_problem_keeps_nested_s_coarse_model(tmp_path):
 
     result = solve(problem, "nested", analytic=False)
     assert result.status == "converged" and "zone from coarse model" in result.message, result.message
-    result = solve(problem, "nested")  # the scene's reference gives a zone for nothing
+    result = solve(problem.with_data(), "nested")  # the scene's reference: a zone for nothing
     assert result.status == "converged" and "analytic zone" in result.message, result.message
