@@ -312,7 +312,7 @@ def test_sparse_backend_accepts_max_dense_dofs_and_ignores_it():
     require("qp-clarabel")
     problem = big_sparse_problem(3001)
     sol = solve(problem, "qp-clarabel", tol=1e-9, max_dense_dofs=5)
-    assert sol.extras["raw_status"] == "Solved"
+    assert sol.status == "converged"  # Clarabel says AlmostSolved at its gap of 1e-14; polished
     np.testing.assert_allclose(sol.u[:2], [-0.5, -0.5], atol=1e-5)  # both candidates touch
     np.testing.assert_allclose(sol.lam, [0.5, 0.5], atol=1e-5)
 

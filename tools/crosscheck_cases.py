@@ -8,7 +8,7 @@ at tol 1e-8 with uzawa, qp-osqp, qp-clarabel, cvxpy and pdas (signorini.crossche
 three variants of the QP methods' options:
 
 - ``default``: each method's defaults (OSQP's dual form, Clarabel and cvxpy primal; polished;
-  Clarabel's gap tolerance at tol², floored at 1e-12);
+  Clarabel's gap tolerance at tol², floored at 1e-14);
 - ``raw``: the same without polish (``polish=false``): the backends' own answers;
 - ``before``: raw, with Clarabel's gap tolerance at tol (the translation before issue 17).
 
