@@ -14,7 +14,7 @@ from signorini.numerics.factor import PARDISO_OVER_CHOLMOD_FROM, available_backe
 from signorini.solvers.registry import methods
 
 #: optional backends a plain solve or ``signorini methods`` must not import
-HEAVY = ("cvxpy", "petsc4py", "mpi4py", "qpsolvers", "osqp", "clarabel", "matplotlib")
+HEAVY = ("cvxpy", "petsc4py", "mpi4py", "qpsolvers", "osqp", "clarabel", "matplotlib", "pyamg")
 
 
 def fresh(code: str) -> dict:

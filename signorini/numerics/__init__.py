@@ -7,4 +7,6 @@
 - :mod:`~signorini.numerics.zone`: exact contact around a predicted contact zone on one
   factorisation (the kernel of the ``nested`` method and of large load targeting);
 - :mod:`~signorini.numerics.loading`: the push that gives a target contact force.
+- :mod:`~signorini.numerics.multigrid`: algebraic multigrid (pyamg) and CG with pinned dofs,
+  the linear algebra of ``pdas-amg``.
 """

@@ -19,13 +19,13 @@ from typing import Any
 
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers import condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
+from signorini.solvers import amg, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.base import ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol, judge
 
 log = logging.getLogger(__name__)
 
 #: the backend modules; each lists its methods in ``METHODS`` and never imports this module
-BACKENDS = (nested, pdas, condensed, uzawa, qp, cvxpy_, petsc_)
+BACKENDS = (nested, pdas, amg, condensed, uzawa, qp, cvxpy_, petsc_)
 
 REGISTRY: dict[str, Method] = {method.name: method for backend in BACKENDS
                                for method in backend.METHODS}

@@ -1,0 +1,121 @@
+"""Algebraic multigrid for elasticity, and conjugate gradients with some dofs pinned.
+
+A hierarchy is built once for an SPD matrix ``A`` (K with some dofs pinned:
+their rows and columns replaced by ``s·I``, ``s`` the mean free diagonal, so
+that they neither couple nor stand out) and then preconditions CG on systems
+whose pinned set differs from ``A``'s in a few rows: each such row is a
+low-rank change, which costs CG a few iterations, not a new hierarchy.
+
+Two hierarchies, one interface (``apply(r) -> z``, ``backend``, ``setup_s``):
+
+- ``pyamg``: smoothed aggregation (Vaněk, Mandel & Brezina 1996) from pyamg,
+  on K's node blocks with the rigid-body modes as near-null space;
+- ``petsc``: PETSc's GAMG (plain aggregation, the same near-null space) through
+  petsc4py, serial (built in :mod:`signorini.solvers.amg`, which knows PETSc's set-up).
+
+:func:`pinned_cg` is preconditioned CG on the free dofs only: the pinned dofs
+keep their values, the preconditioner's output is zeroed on them (so the
+operator CG sees, ``P M P`` on the free subspace, stays SPD whatever pinned
+set the hierarchy was built for). :data:`COUNTS` counts hierarchies built and
+CG iterations done in this process, so that tests count work instead of timing it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+
+#: hierarchies built and CG iterations done in this process (read before and after a step)
+COUNTS = {"hierarchies": 0, "cg_iterations": 0, "cg_solves": 0}
+#: CG restarts from the true residual when the recursive one says done but the true one does not
+MAX_RESTARTS = 4
+
+
+def pinned_matrix(K: sp.csr_matrix, pinned: np.ndarray) -> sp.csr_matrix:
+    """K with the ``pinned`` dofs' rows and columns made ``s·I`` (s: mean diagonal of the rest)."""
+    K = sp.csr_matrix(K)
+    diagonal = K.diagonal()
+    free = ~pinned
+    scale = float(np.mean(np.abs(diagonal[free]))) if free.any() else 1.0
+    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+    touched = pinned[rows] | pinned[K.indices]
+    data = np.where(touched, 0.0, K.data)
+    out = sp.csr_matrix((data, K.indices.copy(), K.indptr.copy()), shape=K.shape)
+    out = out + sp.diags(np.where(pinned, scale, 0.0))
+    out.sort_indices()
+    return out.tocsr()
+
+
+class PyamgHierarchy:
+    """pyamg's smoothed aggregation of ``A`` (node blocks of ``block`` dofs, near-null ``modes``)."""
+
+    backend = "pyamg"
+
+    def __init__(self, A: sp.csr_matrix, modes: np.ndarray | None, block: int):
+        import pyamg  # a default dependency, but 0.3-0.7 s to import: only when a solve needs it
+
+        start = time.perf_counter()
+        blocked = A.tobsr(blocksize=(block, block)) if block > 1 and A.shape[0] % block == 0 else A
+        self._hierarchy = pyamg.smoothed_aggregation_solver(blocked, B=modes)
+        self._cycle = self._hierarchy.aspreconditioner(cycle="V")
+        self.levels = [level.A.shape[0] for level in self._hierarchy.levels]
+        self.setup_s = time.perf_counter() - start
+        COUNTS["hierarchies"] += 1
+
+    def apply(self, r: np.ndarray) -> np.ndarray:
+        return self._cycle.matvec(r)
+
+
+@dataclass
+class CGResult:
+    """What one pinned CG solve did: iterations, and its residual's norms at start and end."""
+
+    iterations: int
+    initial: float  # ‖r₀‖₂ on the free dofs
+    final: float  # ‖r‖₂ on the free dofs (the true residual)
+    final_inf: float  # ‖r‖∞ on the free dofs
+
+
+def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
+              precondition: Callable[[np.ndarray], np.ndarray],
+              done: Callable[[float, float, float], bool], max_iter: int = 2000) -> CGResult:
+    """Solve ``(K x)[free] = f[free]`` for ``x[free]`` in place, ``x[~free]`` held fixed.
+
+    ``done(‖r‖₂, ‖r‖∞, ‖r₀‖₂)`` decides when to stop (an absolute target, an
+    Eisenstat–Walker forcing term against the first residual, or both); it is
+    checked on the recursive residual and confirmed on the true one (CG
+    restarts from it at most :data:`MAX_RESTARTS` times). Preconditioned by
+    ``precondition`` restricted to the free dofs.
+    """
+    mask = free.astype(float)
+    r = mask * (f - K @ x)
+    initial = float(np.linalg.norm(r))
+    iterations = 0
+    COUNTS["cg_solves"] += 1
+    for _ in range(MAX_RESTARTS + 1):
+        if done(float(np.linalg.norm(r)), float(np.max(np.abs(r), initial=0.0)), initial):
+            break
+        z = mask * precondition(r)
+        p = z.copy()
+        rz = float(r @ z)
+        while iterations < max_iter:
+            q = mask * (K @ p)
+            alpha = rz / float(p @ q)
+            x += alpha * p
+            r -= alpha * q
+            iterations += 1
+            if done(float(np.linalg.norm(r)), float(np.max(np.abs(r), initial=0.0)), initial):
+                break
+            z = mask * precondition(r)
+            rz, rz_old = float(r @ z), rz
+            p = z + (rz / rz_old) * p
+        r = mask * (f - K @ x)  # the true residual: confirm, or restart from it
+        if iterations >= max_iter:
+            break
+    COUNTS["cg_iterations"] += iterations
+    return CGResult(iterations, initial, float(np.linalg.norm(r)),
+                    float(np.max(np.abs(r), initial=0.0)))

@@ -1,0 +1,136 @@
+"""pdas-amg: PDAS with CG + algebraic multigrid agrees with pdas, and counts its work.
+
+Work is counted, never timed: hierarchies built (one per solve), CG
+iterations, factorisations (none without a coarse model to solve).
+"""
+
+import importlib.util
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from signorini.errors import InputError
+from signorini.kkt import certificate, compare
+from signorini.numerics import factor, multigrid
+from signorini.scenes import build_problem
+from signorini.solvers import amg
+from signorini.solvers.registry import solve
+from signorini.teaching.synthetic import random_problem
+
+pytest.importorskip("pyamg", reason="pdas-amg needs pyamg (a default dependency)")
+
+BACKENDS = ["pyamg", pytest.param("petsc", marks=pytest.mark.skipif(
+    importlib.util.find_spec("petsc4py") is None, reason="PETSc's GAMG needs petsc4py (extra 'petsc')"))]
+
+SCENES = [
+    ("hertz-sphere-3d", {"delta": 0.0025}),  # 3D, no coarse model at refine=0: PDAS from nothing
+    ("hertz-cylinder", {"n_contact": 16, "grading": 0.4, "delta": 0.004}),
+    ("block", {"nx": 12, "ny": 12}),
+    ("reverse-hertz", {}),  # a curved obstacle: rows rotated into bounds
+]
+
+
+@pytest.fixture(scope="module")
+def problems():
+    return {name: build_problem(name, **values) for name, values in SCENES}
+
+
+def assert_agrees(problem, first, second, lam_tol=1e-8):
+    agreement = compare(problem, first, second)
+    assert agreement.lam_rel <= lam_tol, agreement.as_dict()
+    assert agreement.misclassified == 0, agreement.as_dict()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("name", [name for name, _ in SCENES])
+def test_agrees_with_pdas(problems, name, backend):
+    problem = problems[name]
+    reference = solve(problem, "pdas")
+    before = dict(multigrid.COUNTS)
+    solution = solve(problem, "pdas-amg", amg=backend)
+    assert solution.status == "converged", solution.message
+    assert certificate(problem, solution).worst()[1] <= 1e-9
+    assert_agrees(problem, solution, reference)
+    assert multigrid.COUNTS["hierarchies"] - before["hierarchies"] == 1
+    assert solution.extras["hierarchies"] == 1 and solution.extras["amg"] == backend
+
+
+def test_no_factorisation_and_the_certificate_uses_the_multigrid(problems):
+    """Without a coarse model nothing is factorised: not the method, not its certificate."""
+    problem = build_problem("hertz-sphere-3d", delta=0.0025)
+    before = dict(factor.COUNTS)
+    solution = solve(problem, "pdas-amg", amg="pyamg")
+    assert solution.status == "converged"
+    assert np.isfinite(certificate(problem, solution).duality_gap)
+    assert factor.COUNTS["factorisations"] == before["factorisations"]
+    assert problem.cached_factor is None
+
+
+def test_cg_iterations_are_counted_and_bounded(problems):
+    """The 6,879-dof sphere from an empty active set: 6-7 steps, about 70-90 CG iterations
+    (measured with both hierarchies); a loose first solve that lost the prediction took 4x more."""
+    problem = problems["hertz-sphere-3d"]
+    before = multigrid.COUNTS["cg_iterations"]
+    solution = solve(problem, "pdas-amg", amg="pyamg")
+    spent = multigrid.COUNTS["cg_iterations"] - before
+    assert solution.extras["cg_iterations"] == sum(solution.history["cg_iterations"])
+    assert spent >= solution.extras["cg_iterations"]  # and the certificate's own
+    assert solution.extras["cg_iterations"] <= 150, solution.history
+    assert solution.iterations <= 10
+
+
+def test_a_predicted_active_set_saves_steps(problems):
+    """Started from the exact active set, one solve and one confirmation remain."""
+    problem = problems["hertz-sphere-3d"]
+    exact = solve(problem, "pdas")
+    solution = solve(problem, "pdas-amg", amg="pyamg", active0=exact.lam > 0)
+    assert solution.status == "converged"
+    assert solution.history["changes"][0] == 0
+    assert solution.iterations <= 2
+    assert_agrees(problem, solution, exact)
+
+
+def test_a_coarse_model_predicts_the_first_active_set():
+    problem = build_problem("hertz-sphere-3d", refine=1, n_contact=8, delta=0.0025)
+    solution = solve(problem, "pdas-amg", amg="pyamg")
+    assert solution.status == "converged", solution.message
+    assert solution.extras["first_active"].startswith("coarse model")
+    assert solution.history["changes"][0] < 0.1 * problem.m
+    assert solution.iterations <= 6
+
+
+def test_bad_options_are_refused(problems):
+    problem = problems["block"]
+    with pytest.raises(InputError, match="amg"):
+        solve(problem, "pdas-amg", amg="hypre")
+    with pytest.raises(InputError, match="active0"):
+        solve(problem, "pdas-amg", active0=[True, False])
+    with pytest.raises(InputError, match="no option"):
+        solve(problem, "pdas-amg", rho=1.0)
+
+
+def test_eisenstat_walker_forcing_stays_in_its_range():
+    assert amg._forcing(1e-4, 1.0, None) == 1e-4  # the first step keeps the given term
+    assert amg._forcing(1e-2, 1.0, 1.0) == amg.ETA_MAX  # no progress: the loosest
+    assert amg._forcing(1e-2, 1e-6, 1.0) == amg.ETA_MIN  # fast progress: floored
+    assert amg.ETA_MIN < amg._forcing(1e-2, 0.1, 1.0) < amg.ETA_MAX
+
+
+def test_a_problem_without_a_mesh():
+    """No node blocks, no rigid modes: scalar aggregation, still exact."""
+    problem = random_problem(60, 20, seed=3, condition=50.0)
+    N = problem.N.tocsr()
+    keep = N.data == -1.0  # one dof per row: a bound each
+    rows = np.repeat(np.arange(N.shape[0]), np.diff(N.indptr))[keep]
+    problem = problem.with_data(N=sp.csr_matrix((N.data[keep], (rows, N.indices[keep])),
+                                                shape=N.shape))
+    solution = solve(problem, "pdas-amg", amg="pyamg")
+    assert solution.status == "converged", solution.message
+    assert_agrees(problem, solution, solve(problem, "pdas"))
+
+
+def test_rows_sharing_a_dof_fail_with_the_alternative():
+    problem = random_problem(60, 20, seed=3, condition=50.0)
+    solution = solve(problem, "pdas-amg")
+    assert solution.status == "failed" and "use pdas" in solution.message
