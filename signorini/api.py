@@ -32,7 +32,7 @@ from signorini.solvers.registry import Method
 from signorini.solvers.registry import methods as _all_methods
 from signorini.solvers.registry import solve as _solve
 
-DEFAULT_METHOD = "pdas"
+DEFAULT_METHOD = "auto"
 
 
 def _scalar_rows(value: Any) -> bool:
@@ -251,7 +251,8 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     ``problem`` is a :class:`ContactProblem` (from :func:`build_problem`,
     :meth:`ContactProblem.from_qp` or :meth:`ContactProblem.load`) or the name
     of a scene (see :func:`scenes`), built with ``params`` in the scene's units.
-    ``method`` is one of :func:`methods` (default ``pdas``); ``tol`` the
+    ``method`` is one of :func:`methods` (default ``auto``: ``pdas`` in 2D and axisymmetric
+    models, ``pdas-amg`` for large 3D ones; the result says which and why); ``tol`` the
     relative KKT tolerance the answer must meet to be ``converged``; other
     keyword arguments are the method's options. Bad input raises
     :class:`signorini.InputError`; a method that fails returns a result whose

@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import signorini
 from signorini.errors import InputError
 from signorini.kkt import certificate, compare
 from signorini.numerics import factor, multigrid
 from signorini.scenes import build_problem
-from signorini.solvers import amg
+from signorini.solvers import amg, auto
 from signorini.solvers.registry import solve
 from signorini.teaching.synthetic import random_problem
 
@@ -134,3 +135,41 @@ def test_rows_sharing_a_dof_fail_with_the_alternative():
     problem = random_problem(60, 20, seed=3, condition=50.0)
     solution = solve(problem, "pdas-amg")
     assert solution.status == "failed" and "use pdas" in solution.message
+
+
+# --- auto: the default method -------------------------------------------------------------------
+
+def test_auto_is_the_default_and_picks_pdas_in_2d():
+    result = signorini.solve("hertz-cylinder", params={"n_contact": 16, "grading": 0.4})
+    assert signorini.DEFAULT_METHOD == "auto"
+    assert result.solution.method == "pdas" and result.status == "converged"
+    record = result.to_dict()
+    assert record["method"] == "pdas" and record["extras"]["auto"].startswith("2D model")
+    assert "auto picked 2D model" in record["message"]
+
+
+def test_auto_picks_pdas_for_axisymmetric_and_small_3d(problems):
+    axisymmetric = build_problem("hertz-sphere", n_contact=16, grading=0.4)
+    assert auto.choose(axisymmetric)[0] == "pdas"
+    assert "axisymmetric" in auto.choose(axisymmetric)[1]
+    small = problems["hertz-sphere-3d"]
+    name, why = auto.choose(small)
+    assert name == "pdas" and f"< {auto.AMG_FROM_DOFS:,}" in why
+
+
+def test_auto_picks_pdas_amg_for_large_3d(problems, monkeypatch):
+    monkeypatch.setattr(auto, "AMG_FROM_DOFS", 1_000)
+    problem = problems["hertz-sphere-3d"]
+    solution = solve(problem, "auto", amg="pyamg")
+    assert solution.method == "pdas-amg" and solution.status == "converged"
+    assert solution.extras["auto"].startswith("3D model of 6,879 dofs ≥ 1,000: pdas-amg")
+    assert solution.extras["hierarchies"] == 1
+
+
+def test_auto_in_the_command_line(capsys):
+    from signorini.cli import main  # the CLI, as a user runs it
+
+    code = main(["solve", "block", "--set", "nx=8", "--set", "ny=8"])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert out.startswith("block with pdas: converged") and "auto picked 2D model" in out

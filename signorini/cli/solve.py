@@ -56,7 +56,8 @@ def add_parsers(sub) -> None:
     """Register ``solve``."""
     solve = sub.add_parser("solve", help="solve one scene with one method")
     solve.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
-    solve.add_argument("--method", default="pdas", help="method name (see 'signorini methods')")
+    solve.add_argument("--method", default="auto",
+                       help="method name (see 'signorini methods'; auto: pdas in 2D, pdas-amg for large 3D)")
     solve.add_argument("--tol", help="the method's tolerance (default: the method's own)")
     solve.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="scene parameter, e.g. --set a_over_R=0.05")

@@ -19,13 +19,13 @@ from typing import Any
 
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers import amg, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
+from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.base import ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol, judge
 
 log = logging.getLogger(__name__)
 
 #: the backend modules; each lists its methods in ``METHODS`` and never imports this module
-BACKENDS = (nested, pdas, amg, condensed, uzawa, qp, cvxpy_, petsc_)
+BACKENDS = (auto, nested, pdas, amg, condensed, uzawa, qp, cvxpy_, petsc_)
 
 REGISTRY: dict[str, Method] = {method.name: method for backend in BACKENDS
                                for method in backend.METHODS}
@@ -113,7 +113,8 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
             solve_time=time.perf_counter() - start)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
-    solution.method = method
+    if "auto" not in solution.extras:  # auto names the method it picked
+        solution.method = method
     return judge(problem, solution, tol if tol is not None else spec.default_tol)
 
 

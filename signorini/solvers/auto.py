@@ -1,0 +1,78 @@
+"""``auto``: the method picked from the problem's dimension, size and the installed backends.
+
+- 2D and axisymmetric models: ``pdas`` (exact; its sparse factorisations of a
+  2D stiffness barely fill in: 1M dofs end to end in about 30 s here);
+- 3D models from :data:`AMG_FROM_DOFS` dofs: ``pdas-amg`` (CG + algebraic
+  multigrid, no factorisation: ``pdas`` ran out of memory on the 350k-dof
+  sphere, its 3D factors fill in like n^(4/3)), when pyamg is installed and
+  every contact row bounds its own dofs (rows sharing a dof have no bound
+  form); otherwise ``pdas``;
+- smaller 3D models: ``pdas`` (as fast there, measured, and it needs no CG).
+
+The chosen method's name is the solution's ``method``; ``extras["auto"]``
+and the message say what was picked and why. Options are passed on to the
+chosen method.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from typing import Any
+
+import numpy as np
+
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers import amg, pdas
+from signorini.solvers.base import Method
+
+#: 3D models of at least this many free dofs go to pdas-amg. On hertz-sphere-3d (load ≈ 5,
+#: docs/amg/): at 12k dofs pdas took 2.5 s, pdas-amg 2.7 s; at 47k both 12-16 s; at 350k pdas was
+#: killed for memory (its factorisations fill in like n^(4/3) in 3D) and pdas-amg converged
+AMG_FROM_DOFS = 50_000
+CHOICES = {"pdas": pdas.solve, "pdas-amg": amg.solve}
+
+
+def dimension(problem: ContactProblem) -> int:
+    """2 or 3: the mesh's (or, without one, the contact points') dimension."""
+    if problem.mesh is not None:
+        return int(problem.mesh.p.shape[0])
+    return int(np.atleast_2d(problem.contact_points).shape[1])
+
+
+def _rows_share_a_dof(problem: ContactProblem) -> bool:
+    N = problem.N.tocsr()
+    return bool(N.nnz and np.bincount(N.indices[N.data != 0], minlength=problem.n).max() > 1)
+
+
+def choose(problem: ContactProblem) -> tuple[str, str]:
+    """``(method, why)`` for ``problem``."""
+    dim, n = dimension(problem), problem.n
+    if problem.axisymmetric or dim < 3:
+        kind = "axisymmetric" if problem.axisymmetric else "2D"
+        return "pdas", f"{kind} model: pdas (exact; 2D factorisations are fast)"
+    if n < AMG_FROM_DOFS:
+        return "pdas", f"3D model of {n:,} dofs < {AMG_FROM_DOFS:,}: pdas (a factorisation is cheap)"
+    if importlib.util.find_spec("pyamg") is None:
+        return "pdas", f"3D model of {n:,} dofs, but pyamg is not installed (pip install pyamg): pdas"
+    if _rows_share_a_dof(problem):
+        return "pdas", f"3D model of {n:,} dofs whose contact rows share dofs (no bound form): pdas"
+    return "pdas-amg", (f"3D model of {n:,} dofs ≥ {AMG_FROM_DOFS:,}: pdas-amg "
+                        "(CG + multigrid, no factorisation to fill in)")
+
+
+def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+          **options: Any) -> ContactSolution:
+    """Solve with the method :func:`choose` picks; say which and why."""
+    name, why = choose(problem)
+    solution = CHOICES[name](problem, tol=tol, max_iter=max_iter, **options)
+    solution.method = name
+    solution.extras["auto"] = why
+    solution.message = f"auto picked {why}; {solution.message}"
+    return solution
+
+
+METHODS = (
+    Method(name="auto", function=solve, family="auto", exact=True,
+           summary="picks pdas (2D, axisymmetric, small 3D) or pdas-amg (large 3D) and says why",
+           default_tol=1e-9, options=tuple(sorted(set(pdas.DEFAULTS) | set(amg.DEFAULTS)))),
+)
