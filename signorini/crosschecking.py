@@ -194,7 +194,8 @@ def _run_of(result: Result, tol: float) -> MethodRun:
 def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ...] | None = None,
                *, tol: float | None = DEFAULT_TOL, params: dict[str, Any] | None = None,
                options: dict[str, dict[str, Any]] | None = None) -> CrossCheck:
-    """Solve ``problem`` with every method and compare every pair of answers.
+    """Solve ``problem`` with every method; for every pair ``‖λ_a − λ_b‖∞ / max(‖λ_a‖∞, ‖λ_b‖∞)``,
+    the same for u, and the nodes classified apart (see the module's docstring).
 
     Parameters
     ----------

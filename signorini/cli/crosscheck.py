@@ -39,7 +39,7 @@ def method_options(items: list[str]) -> dict[str, dict]:
 
 
 def cmd_crosscheck(args: argparse.Namespace) -> int:
-    from signorini.crosschecking import DEFAULT_METHODS, crosscheck  # per command (start-up)
+    from signorini.crosschecking import DEFAULT_METHODS, DEFAULT_TOL, crosscheck  # per command (start-up)
     from signorini.files import atomic_write_text, to_json  # per command (start-up)
 
     check_output(args.json, "--json")
@@ -49,7 +49,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     params = pairs(args.set, "--set")
     tol = parse_tol(args.tol) if args.tol is not None else None
     methods = args.method or list(DEFAULT_METHODS)
-    check = crosscheck(args.scene, methods, tol=tol if tol is not None else 1e-8, params=params,
+    check = crosscheck(args.scene, methods, tol=DEFAULT_TOL if tol is None else tol, params=params,
                        options=method_options(args.opt))
     record = check.to_dict()
     if args.json == "-":
