@@ -28,7 +28,7 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import Reference, reference_of
 from signorini.scenes import SCENES, SceneFamily, build_problem
 from signorini.scenes.adapt import parse_target, solve_adaptive
-from signorini.solvers.registry import Method
+from signorini.solvers.registry import Method, check_request
 from signorini.solvers.registry import methods as _all_methods
 from signorini.solvers.registry import solve as _solve
 
@@ -283,6 +283,7 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
         raise InputError(f"{given} steers adaptive refinement: give target_error "
                          "(--target-error) with it")
     if isinstance(problem, str):
+        check_request(method, tol, max_iter, options)  # bad options fail before the scene is built
         problem = build_problem(problem, **(params or {}))
     elif params:
         raise InputError("params= builds a scene by name: give solve('hertz-cylinder', params=...) "

@@ -126,7 +126,7 @@ def test_work_of_each_form(method):
     ({"form": "primel"}, "form='primel' is not one of primal, shifted, dual"),
     ({"polish": "yes"}, "polish='yes' must be true or false"),
     ({"form": "dual", "max_dense_dofs": 5}, "form='dual' builds the dense m × m"),
-    ({"form": "dual", "max_dense_dofs": 0}, "max_dense_dofs must be a positive integer"),
+    ({"form": "dual", "max_dense_dofs": 0}, "max_dense_dofs=0 must be an integer ≥ 1"),
 ])
 def test_bad_options_fail_before_any_work(method, options, match):
     problem = signorini.build_problem("block")

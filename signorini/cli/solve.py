@@ -14,10 +14,15 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.api import build_problem, solve  # per command (start-up)
     from signorini.files import to_json  # per command (start-up)
 
+    from signorini.solvers.registry import check_request, get_method  # per command (start-up)
+
     params = pairs(args.set, "--set")
-    options = {k: option_value(v) for k, v in pairs(args.opt, "--opt").items()}
-    max_iter = options.pop("max_iter", None)
+    texts = pairs(args.opt, "--opt")
+    max_iter = option_value(texts.pop("max_iter")) if "max_iter" in texts else None
     tol = parse_tol(args.tol) if args.tol is not None else None
+    # every option read as its declared kind and checked before the scene is built
+    options = get_method(args.method).parse_options(texts)
+    check_request(args.method, tol, max_iter, options)
     if args.json not in (None, "-") and Path(args.json).is_dir():
         raise InputError(f"--json {args.json!r} is a directory: give a file name, "
                          f"e.g. --json {Path(args.json) / 'result.json'}")

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import importlib.util
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from signorini.adequacy import adequacy, warnings
 from signorini.errors import InputError
 from signorini.kkt import certificate
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.options import Option, check_names, guess_value
 
 SolverFunction = Callable[..., ContactSolution]
 
@@ -37,7 +38,10 @@ class Method:
     ``requires`` lists the Python modules it imports; ``extra`` is the
     pip extra that installs them. ``dense`` methods build dense matrices and
     refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
-    answer up to round-off when they converge.
+    answer up to round-off when they converge. ``options`` names the options
+    it takes; ``typed_options`` declares their kinds and ranges
+    (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
+    refuses a bad value before any work.
     """
 
     name: str
@@ -50,10 +54,31 @@ class Method:
     family: str = ""
     default_tol: float | None = None
     options: tuple[str, ...] = field(default=())
+    typed_options: Mapping[str, Option] = field(default_factory=dict)
 
     @property
     def installed(self) -> bool:
         return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
+
+    def check_options(self, given: Mapping[str, Any]) -> dict[str, Any]:
+        """``given`` with every declared option checked and converted; InputError otherwise.
+
+        Unknown names are refused for every method that lists its options (a
+        user's method lists none and takes what its function takes).
+        """
+        if self.family == "user":
+            return dict(given)
+        check_names(self.name, given, self.options)
+        return {name: self.typed_options[name].check(self.name, value)
+                if name in self.typed_options else value for name, value in given.items()}
+
+    def parse_options(self, texts: Mapping[str, str]) -> dict[str, Any]:
+        """``--opt name=text`` pairs read as each option's declared kind, and checked."""
+        if self.family != "user":
+            check_names(self.name, texts, self.options)
+        return {name: self.typed_options[name].parse(self.name, text)
+                if name in self.typed_options else guess_value(text)
+                for name, text in texts.items()}
 
 
 #: relative KKT residuals cannot be certified below a few hundred times double precision's ε

@@ -14,13 +14,16 @@ import time
 from typing import Any
 
 from signorini.errors import InputError
+from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
-from signorini.solvers.options import take_options
+from signorini.solvers.options import Option, declare, take_options
 
-DEFAULTS = {"backend": None, "block": 128, "max_candidates": 20_000}
+DEFAULTS = declare(
+    Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)),
+    Option("block", "positive_count", 128), Option("max_candidates", "positive_count", 20_000))
 
 
 def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
@@ -49,5 +52,5 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="condensed", function=solve, family="active set", exact=True,
            summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
-           default_tol=1e-9, options=tuple(DEFAULTS)),
+           default_tol=1e-9, options=tuple(DEFAULTS), typed_options=DEFAULTS),
 )

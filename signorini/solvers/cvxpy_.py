@@ -25,7 +25,8 @@ from signorini.errors import InputError, SolverError
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
-from signorini.solvers.qp import BACKEND_BY_NAME, DEFAULT_MAX_DENSE_DOFS
+from signorini.solvers.options import Option, take_options
+from signorini.solvers.qp import BACKEND_BY_NAME, COMMON_TYPES
 
 log = logging.getLogger(__name__)
 
@@ -36,7 +37,9 @@ DEFAULT_FORM = "primal"
 #: polished by default: with Clarabel's gap at tol² every validation case then ends converged
 #: and exact at tol 1e-8 (docs/crosscheck.md); raw, 3 of 8 end inaccurate
 DEFAULT_POLISH = True
-OPTIONS = ("solver", "form", "polish", "max_dense_dofs")
+#: the options, by kind (the solver is checked against cvxpy's installed ones when it runs)
+TYPED_OPTIONS = {"solver": Option("solver", "text", DEFAULT_SOLVER), **COMMON_TYPES}
+OPTIONS = tuple(TYPED_OPTIONS)
 
 #: cvxpy status → ours (anything else is ``failed``)
 STATUS_MAP = {"optimal": "converged", "optimal_inaccurate": "inaccurate",
@@ -117,21 +120,18 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         ``u = x.value``, ``λ = constraint.dual_value``; ``extras["raw_status"]``
         is cvxpy's status.
     """
-    unknown = sorted(set(options) - set(OPTIONS))
-    if unknown:
-        raise InputError(f"method 'cvxpy' does not accept option(s) "
-                         f"{', '.join(repr(u) for u in unknown)}; accepted options: "
-                         f"{', '.join(OPTIONS)}")
-    limit = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
-    form, note = forms.resolve(METHOD, problem, options.get("form"), DEFAULT_FORM, limit)
-    polishing = forms.check_polish(METHOD, options.get("polish", DEFAULT_POLISH))
+    options = take_options(METHOD, options, TYPED_OPTIONS)
+    limit = forms.dense_limit(options["max_dense_dofs"])
+    form, note = forms.resolve(METHOD, problem, options["form"], DEFAULT_FORM, limit)
+    polishing = forms.check_polish(METHOD, DEFAULT_POLISH if options["polish"] is None
+                                   else options["polish"])
     import cvxpy as cp  # as above
 
-    solver = _check_solver(options.get("solver", DEFAULT_SOLVER))
+    solver = _check_solver(options["solver"])
     opts = solver_options(solver, tol, max_iter)
 
     start = time.perf_counter()
-    qp = forms.formulate(problem, form, fallback=options.get("form") is None)
+    qp = forms.formulate(problem, form, fallback=options["form"] is None)
     x = cp.Variable(qp.q.size)
     contact = x >= 0 if qp.bounds else qp.G @ x <= qp.h
     model = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, qp.P, assume_PSD=True) + qp.q @ x),
@@ -183,5 +183,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name=METHOD, function=solve,
            summary="the QP as a cvxpy model (Clarabel by default; option solver)",
-           requires=("cvxpy",), extra="", family="cvxpy", exact=False, options=OPTIONS),
+           requires=("cvxpy",), extra="", family="cvxpy", exact=False, options=OPTIONS,
+           typed_options=TYPED_OPTIONS),
 )

@@ -28,18 +28,22 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import selection_dofs
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone, zone_around
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_of
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
-from signorini.solvers.options import take_options
+from signorini.solvers.options import Option, declare, take_options
 
 log = logging.getLogger(__name__)
 
 DEFAULT_TOL = 1e-9
-DEFAULTS = {"backend": None, "coarse": None, "zone": None, "neighbours": None, "analytic": True}
+DEFAULTS = declare(
+    Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)),
+    Option("coarse", "object", types=(ContactProblem,)), Option("zone", "object", types=(Zone,)),
+    Option("neighbours", "count"), Option("analytic", "bool", True))
 def analytic_zone(problem: ContactProblem) -> tuple[Zone, float] | None:
     """The zone from the reference's contact half-width a (2D and axisymmetric models) and a,
     in the problem's length units (:func:`signorini.numerics.zone.zone_around`); None without."""
@@ -135,5 +139,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="nested", function=solve, family="active set", exact=True,
            summary="analytic or coarse-model contact zone; one factorisation + exact band LCP",
-           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)),
+           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
+           typed_options=DEFAULTS),
 )

@@ -31,14 +31,18 @@ from typing import Any
 
 import numpy as np
 
+from signorini.errors import InputError
 from signorini.kkt import gap_scale
+from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import ActiveSetSolver, factorize
 from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
-from signorini.solvers.options import positive_number, take_options
+from signorini.solvers.options import Option, declare, take_options
 
-DEFAULTS = {"c": 1.0, "lam0": None, "callback": None, "backend": None}
+DEFAULTS = declare(
+    Option("c", "positive", 1.0), Option("lam0", "vector"), Option("callback", "callable"),
+    Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)))
 MAX_ITER = 100
 
 
@@ -55,7 +59,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
           **options: Any) -> ContactSolution:
     """Semismooth Newton / PDAS on the full saddle-point system (one sparse LU per step)."""
     opts = take_options("pdas", options, DEFAULTS)
-    c = positive_number("pdas", "c", opts["c"])
+    c = opts["c"]
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
     start = time.perf_counter()
     system = ActiveSetSolver(problem.K, problem.N, opts["backend"])
@@ -65,7 +69,10 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     elif opts["lam0"] is None:
         u, lam = system.solve(np.zeros(problem.m, dtype=bool), problem.f, problem.d)
     else:
-        lam = np.maximum(np.asarray(opts["lam0"], dtype=float), 0.0)
+        if opts["lam0"].shape != (problem.m,):
+            raise InputError(f"method 'pdas': option lam0 has {opts['lam0'].size} entries, the "
+                             f"problem {problem.m} contact candidates")
+        lam = np.maximum(opts["lam0"], 0.0)
         u = problem.displacement_for(lam)
     history: dict[str, list[float]] = {"changes": [], "primal": [], "active": []}
     active = None
@@ -103,5 +110,5 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="pdas", function=solve, family="active set", exact=True,
            summary="primal-dual active set / semismooth Newton, exact when it converges",
-           default_tol=1e-9, options=tuple(DEFAULTS)),
+           default_tol=1e-9, options=tuple(DEFAULTS), typed_options=DEFAULTS),
 )

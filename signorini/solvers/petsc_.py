@@ -36,15 +36,15 @@ from typing import Any
 
 import numpy as np
 
-from signorini.errors import InputError
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import cluster
 from signorini.solvers.base import Method
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
-from signorini.solvers.options import take_options
+from signorini.solvers.options import Option, declare, take_options
 
-DEFAULTS = {"ksp": "auto", "petsc_options": ""}
 KSP_CHOICES = ("auto", "mumps", "gamg")
+DEFAULTS = declare(Option("ksp", "choice", "auto", choices=KSP_CHOICES),
+                   Option("petsc_options", "text", ""))
 #: ``ksp=auto`` uses GAMG for 3D problems of at least this many dofs (MUMPS below, and in 2D)
 GAMG_FROM_DOFS = 20_000
 #: PETSc type of each method
@@ -332,12 +332,6 @@ def _reason_text(kind: str, reason: int) -> str:
 def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: int | None,
            options: dict[str, Any]) -> ContactSolution:
     opts = take_options(method, options, DEFAULTS)
-    if opts["ksp"] not in KSP_CHOICES:
-        raise InputError(f"method {method!r}: option ksp={opts['ksp']!r} is not one of "
-                         f"{', '.join(KSP_CHOICES)}")
-    if not isinstance(opts["petsc_options"], str):
-        raise InputError(f"method {method!r}: option petsc_options must be a string of PETSc "
-                         "options, e.g. petsc_options='-snes_monitor'")
     kind, petsc_type = KINDS[method]
     tol = DEFAULT_TOL if tol is None else tol
     ksp = opts["ksp"]
@@ -405,5 +399,6 @@ SUMMARIES = {
 METHODS = tuple(
     Method(name=name, function=_make(name), summary=SUMMARIES[name],
            requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
-           exact=name == "petsc-vi", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS))
+           exact=name == "petsc-vi", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
+           typed_options=DEFAULTS)
     for name in KINDS)

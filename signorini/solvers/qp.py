@@ -29,6 +29,8 @@ from signorini.errors import BackendNotInstalled, InputError, SolverError
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
+from signorini.solvers.options import Option, declare
+from signorini.solvers.qp_options import typed
 from signorini.solvers.qp_reports import (Reader, read_clarabel, read_cvxopt, read_ecos, read_found,
                                           read_gurobi, read_info, read_quadprog, read_scs)
 
@@ -39,6 +41,10 @@ DEFAULT_MAX_DENSE_DOFS = 3000
 
 #: options every ``qp-*`` method accepts besides its backend's own
 COMMON_OPTIONS = ("max_dense_dofs", "form", "polish")
+#: their kinds (None: the backend's default form and polish)
+COMMON_TYPES = declare(Option("max_dense_dofs", "positive_count", DEFAULT_MAX_DENSE_DOFS),
+                       Option("form", "choice", None, choices=(None, *forms.FORMS)),
+                       Option("polish", "bool", None))
 
 CONVERGED, INACCURATE, MAX_ITER, INFEASIBLE, FAILED = (
     "converged", "inaccurate", "max_iter", "infeasible", "failed")
@@ -326,15 +332,16 @@ BACKEND_BY_NAME: dict[str, Backend] = {backend.name: backend for backend in BACK
 # --- solving --------------------------------------------------------------------------------
 
 
-def _check_options(backend: Backend, options: Mapping[str, Any]) -> int:
-    """Refuse options the backend does not accept; return ``max_dense_dofs``."""
+def _check_options(backend: Backend, options: Mapping[str, Any]) -> dict[str, Any]:
+    """Refuse options the backend does not accept or values of the wrong kind; the checked ones."""
     unknown = sorted(set(options) - set(backend.accepted_options))
     if unknown:
         raise InputError(
             f"method {backend.method_name!r} does not accept option(s) "
             f"{', '.join(repr(name) for name in unknown)}; accepted options: "
             f"{', '.join(backend.accepted_options)}")
-    return forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
+    kinds = typed(backend.options, COMMON_TYPES)
+    return {name: kinds[name].check(backend.method_name, value) for name, value in options.items()}
 
 
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
@@ -371,7 +378,8 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         The backend raised (re-raised ``from`` its exception).
     """
     spec = BACKEND_BY_NAME[backend]
-    max_dense_dofs = _check_options(spec, options)
+    options = _check_options(spec, options)
+    max_dense_dofs = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
     form, note = forms.resolve(spec.method_name, problem, options.get("form"), spec.form,
                                max_dense_dofs)
     polishing = forms.check_polish(spec.method_name, options.get("polish", spec.polish))
@@ -453,5 +461,6 @@ METHODS = tuple(
     Method(name=backend.method_name, function=_method_function(backend),
            summary=backend.summary, requires=("qpsolvers", *backend.modules),
            extra=backend.extra, dense=backend.dense, exact=False, family="qp",
-           options=backend.accepted_options)
+           options=backend.accepted_options,
+           typed_options=typed(backend.options, COMMON_TYPES))
     for backend in BACKENDS)

@@ -82,6 +82,26 @@ def _load_user_method(spec: str) -> Method:
 
 
 
+def check_request(method: str, tol: Any = None, max_iter: Any = None,
+                  options: dict[str, Any] | None = None) -> tuple[Method, float | None,
+                                                                  int | None, dict[str, Any]]:
+    """The method, tolerance, iteration limit and options of a solve, checked before any work.
+
+    InputError for an unknown method, a bad tolerance or limit, an unknown
+    option or a value of the wrong kind; BackendNotInstalled when the method's
+    backend is missing.
+    """
+    spec = get_method(method)
+    checked = spec.check_options(options or {})  # also for a backend that is not installed
+    tol, max_iter = check_tol(tol), check_max_iter(max_iter)
+    if not spec.installed:
+        missing = [m for m in spec.requires if importlib.util.find_spec(m) is None]
+        raise BackendNotInstalled(
+            f"method {method!r} needs {', '.join(missing)}: "
+            f"pip install 'signorini[{spec.extra or 'all'}]'")
+    return spec, tol, max_iter, checked
+
+
 def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
           max_iter: int | None = None, **options: Any) -> ContactSolution:
     """Solve ``problem`` with ``method`` and judge the answer with the KKT certificate.
@@ -93,14 +113,7 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     ``failed`` solution; bad input (unknown options, non-positive tolerances)
     raises :class:`InputError`.
     """
-    spec = get_method(method)
-    if not spec.installed:
-        missing = [m for m in spec.requires if importlib.util.find_spec(m) is None]
-        raise BackendNotInstalled(
-            f"method {method!r} needs {', '.join(missing)}: "
-            f"pip install 'signorini[{spec.extra or 'all'}]'")
-    tol = check_tol(tol)
-    max_iter = check_max_iter(max_iter)
+    spec, tol, max_iter, options = check_request(method, tol, max_iter, options)
     start = time.perf_counter()
     try:
         solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
@@ -120,5 +133,5 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
 
 
 
-__all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_ACCEPT", "Method", "REGISTRY", "get_method",
-           "judge", "methods", "register", "solve"]
+__all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_ACCEPT", "Method", "REGISTRY", "check_request",
+           "get_method", "judge", "methods", "register", "solve"]

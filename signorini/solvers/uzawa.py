@@ -42,12 +42,18 @@ from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
-from signorini.solvers.options import positive_number, take_options
+from signorini.solvers.options import Option, declare, take_options
 
-DEFAULTS = {"rho": None, "step_fraction": 0.9, "lam0": None, "divergence_factor": 1e8,
-            "operator": "auto", "callback": None, "acceleration": "none"}
+DEFAULTS = declare(
+    Option("rho", "positive"), Option("step_fraction", "positive", 0.9), Option("lam0", "vector"),
+    Option("divergence_factor", "positive", 1e8),
+    Option("operator", "choice", "auto", choices=("auto", "delassus", "backsolve")),
+    Option("callback", "callable"),
+    Option("acceleration", "choice", "none", choices=("none", "nesterov")))
 #: the accelerated variant: FISTA's momentum needs ρ ≤ 1/λ_max(W), half the plain bound
-NESTEROV_DEFAULTS = {**DEFAULTS, "step_fraction": 0.5, "acceleration": "nesterov"}
+NESTEROV_DEFAULTS = {**DEFAULTS, "step_fraction": Option("step_fraction", "positive", 0.5),
+                     "acceleration": Option("acceleration", "choice", "nesterov",
+                                            choices=("none", "nesterov"))}
 DELASSUS_MAX_CANDIDATES = 2000
 RATE_WINDOW = 20
 DEFAULT_TOL = 1e-8
@@ -117,9 +123,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
           **options: Any) -> ContactSolution:
     """The paper's Uzawa iteration with one factorisation of K (optionally accelerated)."""
     opts = take_options(_name, options, _defaults)
-    if opts["acceleration"] not in ("none", "nesterov"):
-        raise InputError(f"method {_name!r}: option acceleration={opts['acceleration']!r} "
-                         "must be none or nesterov")
     accelerated = opts["acceleration"] == "nesterov"
     tol = DEFAULT_TOL if tol is None else tol
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
@@ -132,12 +135,15 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
     lam_max, power_steps = delassus_max_eigenvalue(problem.N, factor, apply_W=apply_W)
     if opts["rho"] is not None:
-        rho = positive_number("uzawa", "rho", opts["rho"])
+        rho = opts["rho"]
     else:
-        rho = positive_number("uzawa", "step_fraction", opts["step_fraction"]) * 2.0 / lam_max
-    divergence_factor = positive_number("uzawa", "divergence_factor", opts["divergence_factor"])
+        rho = opts["step_fraction"] * 2.0 / lam_max
+    divergence_factor = opts["divergence_factor"]
     build_time = time.perf_counter() - start
-    lam = np.zeros(problem.m) if opts["lam0"] is None else np.maximum(np.asarray(opts["lam0"], float), 0)
+    if opts["lam0"] is not None and opts["lam0"].shape != (problem.m,):
+        raise InputError(f"method {_name!r}: option lam0 has {opts['lam0'].size} entries, the "
+                         f"problem {problem.m} contact candidates")
+    lam = np.zeros(problem.m) if opts["lam0"] is None else np.maximum(opts["lam0"], 0)
     history: dict[str, list[float]] = {"primal": [], "natural": [], "step": []}
     status, message = "max_iter", f"not converged after {max_iter} iterations"
     limit = None
@@ -210,8 +216,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="uzawa", function=solve, family="dual", exact=False,
            summary="the paper's Uzawa iteration: projected gradient ascent on the dual",
-           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS)),
+           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS), typed_options=DEFAULTS),
     Method(name="uzawa-nesterov", function=solve_nesterov, family="dual", exact=False,
            summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
-           default_tol=DEFAULT_TOL, options=tuple(NESTEROV_DEFAULTS)),
+           default_tol=DEFAULT_TOL, options=tuple(NESTEROV_DEFAULTS),
+           typed_options=NESTEROV_DEFAULTS),
 )
