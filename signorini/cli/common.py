@@ -52,6 +52,19 @@ def parse_tol(text: str) -> float:
     return check_tol(value, "--tol")  # the API's rule, said about the option
 
 
+def parse_time_limit(text: str | None, flag: str = "--time-limit") -> float | None:
+    """Seconds as a finite positive float (None stays None), or InputError naming ``flag``."""
+    if text is None:
+        return None
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = float("nan")
+    if not (seconds > 0 and seconds != float("inf")):
+        raise InputError(f"{flag} {text!r} must be a positive number of seconds, e.g. {flag} 30")
+    return seconds
+
+
 def write_json(path: str, text: str) -> None:
     from signorini.files import atomic_write_text  # per command (start-up)
 

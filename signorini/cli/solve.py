@@ -6,14 +6,15 @@ import argparse
 import sys
 from pathlib import Path
 
+from signorini.cli.common import (EXIT_FAILED, option_value, pairs, parse_time_limit, parse_tol,
+                                  write_json)
 from signorini.errors import InputError
-from signorini.cli.common import EXIT_FAILED, pairs, option_value, parse_tol, write_json
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.api import build_problem, solve  # per command (start-up)
+    from signorini.api import Result, build_problem, solve  # per command (start-up)
     from signorini.files import to_json  # per command (start-up)
-
+    from signorini.kkt import certificate  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
 
     params = pairs(args.set, "--set")
@@ -23,6 +24,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
     # every option read as its declared kind and checked before the scene is built
     options = get_method(args.method).parse_options(texts)
     check_request(args.method, tol, max_iter, options)
+    time_limit = parse_time_limit(args.time_limit)
+    if time_limit is not None and args.target_error is not None:
+        raise InputError("--time-limit runs one solve in a worker process and --target-error "
+                         "refines in this one: give one of them")
     if args.json not in (None, "-") and Path(args.json).is_dir():
         raise InputError(f"--json {args.json!r} is a directory: give a file name, "
                          f"e.g. --json {Path(args.json) / 'result.json'}")
@@ -39,8 +44,17 @@ def cmd_solve(args: argparse.Namespace) -> int:
         problem = result.problem
     else:
         problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
-        result = solve(problem, args.method, tol=tol, max_iter=max_iter, max_dofs=args.max_dofs,
-                       target_on=args.target_on, **options)
+        if time_limit is None:
+            result = solve(problem, args.method, tol=tol, max_iter=max_iter, max_dofs=args.max_dofs,
+                           target_on=args.target_on, **options)
+        else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
+            from signorini.studies.runner import solve_within  # per command (start-up)
+
+            spec = {"kind": "scene", "scene": args.scene, "params": params,
+                    "nondimensionalise": not args.raw_units}
+            solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
+                                    max_iter=max_iter, options=options)
+            result = Result(problem, solution, certificate(problem, solution))
     record = result.to_dict()
     if args.json:
         write_json(args.json, to_json(record))
@@ -79,6 +93,9 @@ def add_parsers(sub) -> None:
                        "see --target-on")
     solve.add_argument("--target-on", choices=["pressure", "energy"], help="with --target-error: "
                        "the contact pressure's L2 error (default, 2D scenes) or the energy norm's")
+    solve.add_argument("--time-limit", metavar="SECONDS", help="solve in a worker process that is "
+                       "stopped after SECONDS (assembly included): a method that hangs or exits "
+                       "costs its limit and ends 'failed'")
     solve.add_argument("--max-dofs", type=int, metavar="N", help="with --target-error: no mesh "
                        "beyond N dofs (default 100000)")
     solve.set_defaults(run=cmd_solve)

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from signorini.errors import InputError
-from signorini.cli.common import EXIT_FAILED, pairs
+from signorini.cli.common import EXIT_FAILED, pairs, parse_time_limit
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
@@ -46,12 +46,16 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from signorini.output.report import checks_summary, write_suite_report  # as above
     from signorini.studies.suite import run_suite, select_cases  # as above
 
+    time_limit = parse_time_limit(args.time_limit)
     writable_directory(args.out)
     methods = args.method or None
+    limit = {} if time_limit is None else {"time_limit": time_limit}
     suite = run_suite(select_cases(args.case), method_names=methods,
-                      progress=lambda line: print(line, file=sys.stderr))
+                      progress=lambda line: print(line, file=sys.stderr), **limit)
     command = "signorini validate" + "".join(f" --method {m}" for m in args.method)
     command += "".join(f" --case {c}" for c in args.case)
+    if time_limit is not None:
+        command += f" --time-limit {args.time_limit}"
     if args.out != "validation-report":
         command += f" --out {shlex.quote(args.out)}"
     paths = write_suite_report(suite, args.out, command)
@@ -88,20 +92,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def cmd_stability(args: argparse.Namespace) -> int:
-    import math
-
     # each command loads what it needs (the atlas starts matplotlib and every backend)
     from signorini.files import writable_directory
     from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report  # as above
 
     axes = select_axes(args.axis)
-    try:
-        time_limit = float(args.time_limit)
-    except ValueError:
-        time_limit = float("nan")
-    if not (math.isfinite(time_limit) and time_limit > 0):
-        raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
-                         "e.g. --time-limit 30")
+    time_limit = parse_time_limit(args.time_limit)
     writable_directory(Path(args.out) / "stability")
 
     def progress(axis, i, n, task, row):
@@ -144,6 +140,8 @@ def add_parsers(sub) -> None:
                                "a method named here must converge on every case")
     validate.add_argument("--case", action="append", default=[],
                           help="only this case (repeatable; default: all)")
+    validate.add_argument("--time-limit", metavar="SECONDS", help="seconds per run in the worker "
+                          "process (default 600): a method that hangs costs its limit")
     validate.set_defaults(run=cmd_validate)
 
     sweep = sub.add_parser("sweep", help="solve many load levels with one factorisation")

@@ -19,7 +19,7 @@ import numpy as np
 from signorini.adequacy import adequacy, warnings
 from signorini.errors import InputError
 from signorini.kkt import certificate
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.options import Option, check_names, guess_value
 
 SolverFunction = Callable[..., ContactSolution]
@@ -107,6 +107,37 @@ def check_max_iter(max_iter: Any) -> int | None:
     if not ok or max_iter < 1:
         raise InputError(f"max_iter must be a positive integer, got {max_iter!r}")
     return int(max_iter)
+
+
+def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> ContactSolution:
+    """``solution`` when it is what a method must return, else a ``failed`` one saying why.
+
+    A method returns a :class:`ContactSolution` whose ``u`` holds n floats and
+    ``lam`` m floats (finite when it claims ``converged``; a method without an
+    answer returns NaN, :meth:`ContactSolution.failure`), and whose status is
+    one of :data:`signorini.problem.STATUSES`. A user's method that returns anything
+    else cannot be judged, so it cannot be ``converged``.
+    """
+    def failed(reason: str) -> ContactSolution:
+        return ContactSolution.failure(method, problem, "failed",
+                                       f"the method broke its contract: {reason}")
+
+    if not isinstance(solution, ContactSolution):
+        return failed(f"it returned {type(solution).__name__}, not a ContactSolution")
+    if solution.status not in STATUSES:
+        return failed(f"status {solution.status!r} is not one of {', '.join(STATUSES)}")
+    for name, size in (("u", problem.n), ("lam", problem.m)):
+        value = getattr(solution, name)
+        if not isinstance(value, np.ndarray) or value.shape != (size,) \
+                or value.dtype.kind not in "fiu":
+            got = (f"{value.dtype} array of shape {value.shape}" if isinstance(value, np.ndarray)
+                   else type(value).__name__)
+            return failed(f"{name} must be an array of {size} floats, got a {got}")
+        if value.dtype.kind != "f":
+            setattr(solution, name, value.astype(float))
+    if solution.status == "converged" and not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
+        return failed(f"status {solution.status!r} with non-finite entries in u or lam")
+    return solution
 
 
 def judge(problem: ContactProblem, solution: ContactSolution,

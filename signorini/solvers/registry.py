@@ -20,7 +20,8 @@ from typing import Any
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
-from signorini.solvers.base import ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol, judge
+from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol,
+                                    hold_to_contract, judge)
 
 log = logging.getLogger(__name__)
 
@@ -74,6 +75,14 @@ def _load_user_method(spec: str) -> Method:
     except ImportError as exc:
         raise InputError(f"method {spec!r}: cannot import module {module_name!r} ({exc}); "
                          "give --method module:function or path/to/file.py:function") from exc
+    except SyntaxError as exc:
+        raise InputError(f"method {spec!r}: {exc.filename or module_name}, line {exc.lineno}: "
+                         f"syntax error ({exc.msg}): fix the file") from None
+    except (Exception, SystemExit) as exc:  # the user's module failed while it was imported
+        what = f"sys.exit({exc.code!r})" if isinstance(exc, SystemExit) else \
+            f"{type(exc).__name__}: {exc}"
+        raise InputError(f"method {spec!r}: importing {module_name!r} failed ({what}): "
+                         "fix the module so that it imports") from None
     func = getattr(module, attr, None)
     if not callable(func):
         raise InputError(f"method {spec!r}: module {module_name!r} has no function {attr!r}")
@@ -124,6 +133,11 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
         solution = ContactSolution.failure(
             method, problem, "failed", f"{type(exc).__name__}: {exc}",
             solve_time=time.perf_counter() - start)
+    except SystemExit as exc:  # a method that exits ends neither the run nor fakes its success
+        solution = ContactSolution.failure(
+            method, problem, "failed", f"the method called sys.exit({exc.code!r})",
+            solve_time=time.perf_counter() - start)
+    solution = hold_to_contract(problem, method, solution)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
     if "auto" not in solution.extras:  # auto names the method it picked

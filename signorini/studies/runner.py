@@ -51,6 +51,7 @@ from signorini.scenes.block import force_controlled_exact
 from signorini.solvers import cluster
 from signorini.solvers.registry import ACCEPT_FACTOR, DEFAULT_ACCEPT, get_method, solve
 from signorini.studies.measures import (
+    answer_from,
     answer_record,
     bound_at_solution,
     certificate_of,
@@ -291,6 +292,29 @@ def _run_here(task: Task, cache: _Cache) -> Row:
         return run_task(task, _Cache() if task.fresh else cache)
     except Exception as exc:  # a bug of the runner itself: one row says so
         return failed_row(task, exc)
+
+
+def solve_within(problem: ContactProblem, spec: dict[str, Any], method: str, time_limit: float, *,
+                 tol: float | None = None, max_iter: int | None = None,
+                 options: dict[str, Any] | None = None) -> ContactSolution:
+    """One solve in a worker process of its own, stopped after ``time_limit`` seconds.
+
+    ``spec`` describes ``problem`` (:func:`~signorini.studies.problems.build_spec`)
+    so that the worker can build it again. Returns the package's answer, judged
+    in the worker, or a ``failed`` solution saying that the run was stopped or
+    that the worker died (a method that hangs or ends the process costs its
+    limit, not the run); InputError when the worker refused the input.
+    """
+    task = Task(axis="solve", case=str(spec.get("scene", spec["kind"])), value="", problem=spec,
+                method=method, tol=tol, max_iter=max_iter, options=dict(options or {}),
+                reference={"kind": "none"}, measure=("answer",), fresh=True)
+    row = Worker(time_limit).run(task)
+    if row.get("wrapper") == "input-error":
+        raise InputError(row.get("message", "the worker refused the input"))
+    if "answer" in row:
+        return answer_from(row["answer"])
+    return ContactSolution.failure(method, problem, "failed",
+                                   row.get("message") or f"the run ended {row.get('status')}")
 
 
 def run_tasks(tasks: Sequence[Task], *, isolate: bool = True, time_limit: float = DEFAULT_TIME_LIMIT,
