@@ -23,7 +23,7 @@ from signorini.solvers.options import Option, declare, take_options
 
 DEFAULTS = declare(
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)),
-    Option("block", "positive_count", 128), Option("max_candidates", "positive_count", 20_000))
+    Option("block", "positive_count", None), Option("max_candidates", "positive_count", 20_000))
 
 
 def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
@@ -35,7 +35,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                          f"exceeds max_candidates = {opts['max_candidates']}: use pdas")
     start = time.perf_counter()
     factor = factorize(problem.K, opts["backend"])
-    W = delassus(problem.N, factor, block=int(opts["block"]))
+    W = delassus(problem.N, factor, block=None if opts["block"] is None else int(opts["block"]))
     b = problem.N @ factor.solve(problem.f) - problem.d
     build_time = time.perf_counter() - start
     lam, steps = solve_lcp(W, b, max_iter=200 if max_iter is None else int(max_iter))
