@@ -48,10 +48,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
     # each command loads what it needs (the benchmark's report starts matplotlib)
     from signorini.files import writable_directory
     from signorini.scenes import get_scene  # as above
+    from signorini.scenes.size import check_size  # as above
     from signorini.solvers.registry import get_method, methods  # as above
     from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
 
-    out = writable_directory(args.out or "bench-report")
     family = get_scene(args.scene or "hertz-cylinder")
     levels = parse_sizes(args.sizes or "0,1")
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
@@ -78,7 +78,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     runs = []
     for level in levels:
         params = {**base, "refine": level}
-        family.parse(params)  # bad scene parameters fail here, before any run
+        check_size(family.name, family.parse(params))  # bad or too big: refused before any run
         for method in chosen:
             few = args.default_only_from is not None and level >= args.default_only_from
             for tolerance in (["high"] if method.exact else ["default"] if few else tolerances):
@@ -90,6 +90,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         print(f"[{i}/{n}] {run.size} {run.label}@{run.tolerance}: {row['status']} "
               f"{row.get('time_s', float('nan')):.3g} s", file=sys.stderr)
 
+    out = writable_directory(args.out or "bench-report")  # only once the input is accepted
     if not args.report_only:
         run_benchmark(runs, Path(out), time_limit=args.time_limit, progress=progress)
     given = [a for a in sys.argv[2:] if a != "--report-only"]  # the command that made the CSV

@@ -14,14 +14,15 @@ from signorini.cli.common import EXIT_FAILED, pairs, parse_time_limit
 def cmd_converge(args: argparse.Namespace) -> int:
     # each command loads what it needs (the studies start matplotlib)
     from signorini.files import writable_directory
-    from signorini.studies.convergence import grading_comparison, run_study, study_table, write_study  # as above
+    from signorini.studies.convergence import check_study, grading_comparison, run_study, study_table, write_study  # as above
 
-    writable_directory(args.out)
     if args.levels < 0 or args.levels > 6:
         raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
     if args.uniform_levels is not None and not 0 <= args.uniform_levels <= 4:
         raise InputError(f"--uniform-levels {args.uniform_levels} must be in 0..4")
     params = pairs(args.set, "--set")
+    check_study(args.scene, args.levels, params, args.method or None, args.fit_from)
+    writable_directory(args.out)  # only once the input is accepted
     say = (lambda line: print(line, file=sys.stderr))
     study = run_study(args.scene, args.levels, params, methods=args.method or None,
                       fit_from=args.fit_from, progress=say)
@@ -37,6 +38,11 @@ def cmd_converge(args: argparse.Namespace) -> int:
               f"({comparison.graded_how}), uniform {comparison.uniform_dofs:,.0f} dofs "
               f"({comparison.uniform_how}): grading saves {comparison.saving:,.0f}×")
     print(f"report: {paths['markdown']}")
+    never = [m for m in args.method if not any(r.method == m and r.status == "converged"
+                                               for r in study.rows)]
+    if never:
+        print(f"signorini: {', '.join(never)} converged at no level", file=sys.stderr)
+        return EXIT_FAILED
     return 0
 
 
@@ -70,8 +76,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from signorini.studies.sweep import parse_loads, plot_sweep, sweep_loads  # per command (start-up)
 
     loads = parse_loads(args.load)
-    directory = writable_directory(args.out)
     problem = build_problem(args.scene, **pairs(args.set, "--set"))
+    directory = writable_directory(args.out)  # only once the input is accepted
     levels = sweep_loads(problem, loads, progress=lambda i, n: print(
         f"\r  load level {i}/{n}", end="" if i < n else "\n", file=sys.stderr))
     rows = [vars(level) for level in levels]

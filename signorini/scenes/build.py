@@ -19,6 +19,7 @@ from signorini.problem import ContactProblem, Scales
 from signorini.references import REFERENCES
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
+from signorini.scenes.size import check_size
 from signorini.solvers.nested import zone_from_coarse
 
 #: load targeting on a model of at least this many dofs first solves a coarser model of the
@@ -104,7 +105,16 @@ def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> C
     else:
         family = get_scene(name)
         params = family.parse(values)
-        model = family.build(params, set(values))
+        check_size(name, params)  # too big for this machine: refused before any mesh is made
+        try:
+            model = family.build(params, set(values))
+        except (RuntimeError, ValueError, ArithmeticError, IndexError, MemoryError) as exc:
+            # the mesher gave up (too many elements, a relaxation that folded the mesh) or ran
+            # out of memory: the parameters asked for a mesh it cannot make
+            given = ", ".join(f"{k}={v}" for k, v in values.items()) or "its defaults"
+            raise InputError(f"scene {name!r} with {given} could not be meshed "
+                             f"({type(exc).__name__}: {exc}): make the mesh coarser (a larger "
+                             "grading or a smaller n_contact)") from None
         zone = predicted_zone(name, model, nondimensionalise)
     problem = assemble(model, nondimensionalise=nondimensionalise, zone=zone)
     problem.scene = name

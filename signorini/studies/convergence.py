@@ -37,6 +37,8 @@ from signorini.pressure import compare_punch, contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import REFERENCES
 from signorini.scenes import SCENES, get_scene, scene_reference
+from signorini.scenes.size import check_size
+from signorini.solvers.registry import get_method
 from signorini.solvers.registry import methods as registered_methods
 from signorini.studies.runner import Row, Task, run_tasks
 
@@ -170,6 +172,34 @@ def level_results(rows: list[Row], metrics: tuple[str, ...]) -> list[LevelResult
     return out
 
 
+def check_study(scene: str, levels: int, params: dict[str, Any] | None = None,
+                methods: list[str] | None = None, fit_from: int = 0) -> tuple[dict[str, Any], Any]:
+    """A convergence study's input checked before any run: ``(level-0 parameters, reference)``.
+
+    InputError for levels outside 0..6, a scene without ``refine`` or a
+    reference, an unknown method, ``fit_from`` beyond the levels, or a finest
+    level too big for this machine (:func:`signorini.scenes.size.check_size`).
+    """
+    if not isinstance(levels, int) or isinstance(levels, bool) or not 0 <= levels <= 6:
+        raise InputError(f"--levels {levels!r} must be an integer in 0..6 (each level quadruples the dofs)")
+    base = _study_params(scene, dict(params or {}))
+    reference = REFERENCES.get(scene_reference(scene))
+    if reference is None or not reference.convergence:
+        raise InputError(f"scene {scene!r} has no analytic reference to converge to")
+    for name in methods or ():
+        get_method(name)  # an unknown method is refused before any level is solved
+    if isinstance(fit_from, bool) or not isinstance(fit_from, int) or not 0 <= fit_from <= max(levels - 1, 0):
+        raise InputError(f"--fit-from {fit_from!r} must be a level in 0..{max(levels - 1, 0)}: a rate "
+                         f"is fitted over at least two of the levels 0..{levels}")
+    family = get_scene(scene)
+    try:
+        finest = family.parse({**base, "refine": levels})
+    except InputError as exc:
+        raise InputError(f"--levels {levels} asks for refine={levels} at the finest level: {exc}") from None
+    check_size(scene, finest)
+    return base, reference
+
+
 def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
               methods: list[str] | None = None, tol: float = 1e-10, fit_from: int = 0,
               progress: Callable[[str], None] | None = None, *, isolate: bool = True,
@@ -183,12 +213,7 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     runner: one worker process (``isolate``), each run within ``time_limit`` seconds.
     """
     say = progress or (lambda message: None)
-    if not isinstance(levels, int) or isinstance(levels, bool) or not 0 <= levels <= 6:
-        raise InputError(f"--levels {levels!r} must be an integer in 0..6 (each level quadruples the dofs)")
-    base = _study_params(scene, dict(params or {}))
-    reference = REFERENCES.get(scene_reference(scene))
-    if reference is None or not reference.convergence:
-        raise InputError(f"scene {scene!r} has no analytic reference to converge to")
+    base, reference = check_study(scene, levels, params, methods, fit_from)
     chosen = methods or exact_methods()
     tasks = [level_task(scene, level, base, name, tol) for level in range(levels + 1)
              for name in chosen]

@@ -39,6 +39,10 @@ class SweepLevel:
     p0_ref: float | None
 
 
+#: most loads one sweep solves
+MAX_LOADS = 1000
+
+
 def parse_loads(text: str) -> np.ndarray:
     """``P1:P2:n`` → n loads from P1 to P2 (linearly spaced)."""
     parts = text.split(":")
@@ -50,6 +54,9 @@ def parse_loads(text: str) -> np.ndarray:
         raise InputError(f"--load {text!r} is not P1:P2:n, e.g. --load 0.001:0.004:8") from None
     if not (np.isfinite(first) and np.isfinite(last) and 0 < first <= last and count >= 1):
         raise InputError(f"--load {text!r} needs 0 < P1 ≤ P2 and n ≥ 1")
+    if count > MAX_LOADS:
+        raise InputError(f"--load {text!r} asks for {count} loads: at most {MAX_LOADS} "
+                         f"(each is one solve), e.g. --load {parts[0]}:{parts[1]}:{MAX_LOADS}")
     return np.linspace(first, last, count)
 
 

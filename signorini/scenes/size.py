@@ -1,0 +1,138 @@
+"""A scene's size before it is meshed: estimated dofs and memory, refused above what the machine holds.
+
+Each family's dofs are estimated from its parameters by a model calibrated on
+its own default mesh (tests/test_scene_size.py holds every estimate within a
+factor 1.5 of the mesh actually built, over the mesh parameters' ranges):
+
+    dofs ≈ [b + (dofs₀ − b) · (n_contact / n₀)^α · (grading₀ / grading)^β
+            · (1 + ¼ ln(a₀ / a))] · 2^(d · refine)
+
+(α = 0.75, β = 1.35, b = 300 for the graded 2D meshes, α = 1.35, β = 1.5,
+b = 1000 for the 3D octant: b is the coarse far field that every mesh has;
+the last factor counts the uniform refinements, the one before it the longer
+grading from a smaller contact), but never more than the uniform mesh at the
+contact's element size, ``c · (n_contact / (a/R))^d · 2^(d · refine)`` (c
+measured at grading 1e-6: 5.2 for the discs, 2.66 reverse-hertz, 6,082 for
+the punch, whose size is not scaled by a). The block's dofs are exact. Memory is
+the peak resident size per dof of building the scene and solving it with
+``pdas``, measured here (Python's own ~0.3 GB included): 4.2 kB per dof for
+hertz-cylinder refine=3 (298k dofs), 22 kB for hertz-sphere-3d refine=1 (47k
+dofs); taken as 4 kB (2D) and 20 kB (3D). A 3D factorisation grows faster
+than the dofs (``pdas`` at 350k 3D dofs was killed at 21 GB), which a
+factorising method has to weigh on its own.
+
+A scene whose estimate exceeds :func:`memory_limit` — by default three
+quarters of this machine's physical memory, or ``SIGNORINI_MAX_MEMORY_GB`` —
+is refused with one line before any mesh is made.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from typing import Any
+
+from signorini.errors import InputError
+
+#: the environment variable that raises (or lowers) the memory a scene may take, in GB
+MEMORY_VARIABLE = "SIGNORINI_MAX_MEMORY_GB"
+#: bytes per dof of building a scene and solving it with pdas (see the module's docstring)
+BYTES_PER_DOF = {2: 4_000, 3: 20_000}
+
+
+@dataclass(frozen=True)
+class SizeModel:
+    """A family's default mesh and how its dofs grow with the mesh parameters."""
+
+    dim: int
+    dofs: float
+    n_contact: float
+    grading: float
+    a_over_R: float | None = None
+    uniform: float | None = None
+
+    @property
+    def alpha(self) -> float:
+        return 0.75 if self.dim == 2 else 1.35
+
+    @property
+    def beta(self) -> float:
+        return 1.35 if self.dim == 2 else 1.5
+
+    @property
+    def far_field(self) -> float:
+        return 300.0 if self.dim == 2 else 1000.0
+
+    def estimate(self, p: dict[str, Any]) -> float:
+        dofs = (self.dofs - self.far_field) * (p["n_contact"] / self.n_contact) ** self.alpha
+        dofs *= (self.grading / p["grading"]) ** self.beta
+        if self.a_over_R is not None and p.get("a_over_R") is not None \
+                and p["a_over_R"] < self.a_over_R:
+            dofs *= 1.0 + 0.25 * math.log(self.a_over_R / p["a_over_R"])
+        dofs += self.far_field
+        if self.uniform is not None:  # no finer than uniform at the contact's element size
+            dofs = min(dofs, self.uniform * (p["n_contact"] / p.get("a_over_R", 1.0)) ** self.dim)
+        return dofs * 2.0 ** (self.dim * p.get("refine", 0))
+
+
+#: measured at each family's defaults (signorini commit 66f74ea: hertz-cylinder 4,866 dofs,
+#: hertz-sphere 6,824, hertz-sphere-3d 7,284, punch 7,948, reverse-hertz 6,118)
+SIZE_MODELS = {
+    "hertz-cylinder": SizeModel(2, 4866, 40, 0.15, 0.05, uniform=5.2),
+    "hertz-sphere": SizeModel(2, 6824, 60, 0.15, 0.05, uniform=5.2),
+    "hertz-sphere-3d": SizeModel(3, 7284, 10, 0.5, 0.05),
+    "punch": SizeModel(2, 7948, 128, 0.2, uniform=6082.0),
+    "reverse-hertz": SizeModel(2, 6118, 128, 0.3, uniform=2.66),
+}
+
+
+def estimate_dofs(family: str, params: dict[str, Any]) -> tuple[float, int] | None:
+    """``(dofs, dimension)`` of scene ``family`` with checked ``params``; None when unknown."""
+    if family == "block":
+        return 2.0 * (params["nx"] + 1) * (params["ny"] + 1), 2
+    model = SIZE_MODELS.get(family)
+    return None if model is None else (model.estimate(params), model.dim)
+
+
+def physical_memory() -> float:
+    """This machine's physical memory in bytes (NaN when the system does not say)."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return float("nan")
+
+
+def memory_limit() -> float:
+    """Bytes a scene may take: ``SIGNORINI_MAX_MEMORY_GB``, else ¾ of the physical memory."""
+    text = os.environ.get(MEMORY_VARIABLE)
+    if text is not None:
+        try:
+            limit = float(text) * 1e9
+        except ValueError:
+            limit = float("nan")
+        if not (limit > 0 and math.isfinite(limit)):
+            raise InputError(f"{MEMORY_VARIABLE}={text!r} must be a positive number of GB, "
+                             f"e.g. {MEMORY_VARIABLE}=20")
+        return limit
+    total = physical_memory()
+    return 0.75 * total if math.isfinite(total) else math.inf
+
+
+def check_size(family: str, params: dict[str, Any]) -> None:
+    """InputError, with the estimate, the limit and how to raise it, when the scene is too big."""
+    found = estimate_dofs(family, params)
+    if found is None:
+        return
+    dofs, dim = found
+    need, limit = dofs * BYTES_PER_DOF[dim], memory_limit()
+    if need <= limit:
+        return
+    names = [k for k in ("n_contact", "grading", "refine", "nx", "ny") if k in params]
+    mesh = ", ".join(f"{k}={params[k]:g}" for k in names)
+    raise InputError(
+        f"scene {family!r} with {mesh} would have about {dofs:,.0f} dofs and take about "
+        f"{need / 1e9:,.1f} GB to build and solve, over the limit of {limit / 1e9:,.1f} GB "
+        f"(¾ of this machine's memory unless {MEMORY_VARIABLE} says otherwise): make the mesh "
+        f"coarser ({', '.join(names)}), or raise the limit, e.g. "
+        f"{MEMORY_VARIABLE}={math.ceil(need / 1e9) + 1}")

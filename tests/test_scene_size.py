@@ -1,0 +1,101 @@
+"""Size before allocation (issue 13 §2): a scene too big for the machine is refused before meshing.
+
+The estimate of :mod:`signorini.scenes.size` is held to the meshes the
+families really build, and the refusal names the estimate, the limit and the
+variable that raises it.
+"""
+
+import pytest
+
+from signorini.cli import main
+from signorini.errors import InputError
+from signorini.scenes.families import SCENES
+from signorini.scenes.size import MEMORY_VARIABLE, SIZE_MODELS, check_size, estimate_dofs
+
+VARIANTS = [
+    ("hertz-cylinder", {}), ("hertz-cylinder", {"n_contact": 20}),
+    ("hertz-cylinder", {"n_contact": 120}), ("hertz-cylinder", {"grading": 0.3}),
+    ("hertz-cylinder", {"a_over_R": 0.01}), ("hertz-cylinder", {"refine": 1}),
+    ("hertz-sphere", {}), ("hertz-sphere", {"n_contact": 30}), ("hertz-sphere", {"grading": 0.1}),
+    ("hertz-sphere-3d", {}), ("hertz-sphere-3d", {"n_contact": 5}),
+    ("hertz-sphere-3d", {"n_contact": 20}), ("hertz-sphere-3d", {"grading": 1.0}),
+    ("hertz-sphere-3d", {"refine": 1}),
+    ("punch", {}), ("punch", {"n_contact": 512}), ("punch", {"grading": 0.1}),
+    ("reverse-hertz", {}), ("reverse-hertz", {"n_contact": 64}),
+    ("reverse-hertz", {"grading": 0.15}), ("block", {"nx": 40, "ny": 7}),
+    # the convergence studies' coarse starts
+    ("hertz-cylinder", {"n_contact": 15, "grading": 0.6}),
+    ("hertz-sphere", {"n_contact": 12, "grading": 0.6}), ("punch", {"n_contact": 16, "grading": 0.6}),
+    ("reverse-hertz", {"n_contact": 16, "grading": 0.6}),
+]
+
+
+def test_every_built_in_family_has_an_estimate():
+    assert set(SCENES) == set(SIZE_MODELS) | {"block"}
+
+
+@pytest.mark.parametrize("family, values", VARIANTS, ids=[f"{f}-{v}" for f, v in VARIANTS])
+def test_the_estimate_is_within_a_factor_1_5_of_the_mesh_built(family, values):
+    scene = SCENES[family]
+    params = scene.parse(values)
+    estimate, dim = estimate_dofs(family, params)
+    mesh = scene.build(params, set(values)).mesh
+    dofs = mesh.p.shape[0] * mesh.p.shape[1]
+    assert dim == mesh.p.shape[0]
+    assert dofs / 1.5 <= estimate <= 1.5 * dofs, (estimate, dofs)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["hertz-cylinder", "--set", "refine=5"], ["refine=5", "4,98", "dofs", "GB"]),
+    (["hertz-sphere-3d", "--set", "refine=3"], ["refine=3", "dofs", "GB"]),
+    (["hertz-cylinder", "--set", "grading=0.0001", "--set", "n_contact=100"], ["grading=0.0001", "coarser"]),
+    (["block", "--set", "nx=100000", "--set", "ny=100000"], ["nx=100000", "(nx, ny)"]),
+    (["punch", "--set", "n_contact=10000000"], ["n_contact=1e+07"]),
+])
+def test_a_scene_too_big_is_refused_in_one_line_with_the_way_to_raise_the_limit(
+        capsys, monkeypatch, argv, words):
+    monkeypatch.setenv(MEMORY_VARIABLE, "19")
+    assert main(["solve", *argv]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    for word in [*words, "limit of 19.0 GB", f"{MEMORY_VARIABLE}="]:
+        assert word in err, (word, err)
+
+
+def test_the_variable_raises_and_lowers_the_limit(monkeypatch):
+    params = SCENES["hertz-cylinder"].parse({"refine": 4})  # about 1.2M dofs, 5 GB
+    monkeypatch.setenv(MEMORY_VARIABLE, "6")
+    check_size("hertz-cylinder", params)
+    monkeypatch.setenv(MEMORY_VARIABLE, "2")
+    with pytest.raises(InputError, match="over the limit of 2.0 GB"):
+        check_size("hertz-cylinder", params)
+    for bad in ("-1", "lots", "nan", "0"):
+        monkeypatch.setenv(MEMORY_VARIABLE, bad)
+        with pytest.raises(InputError, match=f"{MEMORY_VARIABLE}='{bad}' must be a positive"):
+            check_size("hertz-cylinder", params)
+
+
+@pytest.mark.parametrize("family, values, dofs", [
+    ("hertz-cylinder", {"n_contact": 4, "grading": 1e-6}, 33282),
+    ("hertz-cylinder", {"n_contact": 8, "grading": 1e-6, "mesher": "bisection"}, 132098),
+    ("punch", {"n_contact": 8, "grading": 1e-6}, 389240),
+    ("reverse-hertz", {"n_contact": 8, "grading": 1e-6}, 425328),
+])
+def test_a_nearly_uniform_mesh_is_estimated_by_the_uniform_bound(family, values, dofs):
+    # dofs: the meshes built here (commit of signorini.scenes.size); not rebuilt, they take seconds
+    estimate, _ = estimate_dofs(family, SCENES[family].parse(values))
+    assert dofs / 1.5 <= estimate <= 1.5 * dofs
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["hertz-cylinder", "--set", "n_contact=8", "--set", "grading=1e-6"],
+     ["could not be meshed", "grading=1e-6"]),
+    (["punch", "--set", "n_contact=16", "--set", "grading=1e-6"],
+     ["could not be meshed", "400000 elements"]),
+])
+def test_a_mesh_the_mesher_cannot_make_is_one_line(capsys, argv, words):
+    assert main(["solve", *argv]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    for word in words:
+        assert word in err, (word, err)
