@@ -282,6 +282,9 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
         given = "max_dofs (--max-dofs)" if max_dofs is not None else "target_on (--target-on)"
         raise InputError(f"{given} steers adaptive refinement: give target_error "
                          "(--target-error) with it")
+    if params is not None and not isinstance(params, dict):
+        raise InputError(f"params must be a dict of scene parameters, got {type(params).__name__}: "
+                         "e.g. params={'E': 2.1e11}")
     if isinstance(problem, str):
         check_request(method, tol, max_iter, options)  # bad options fail before the scene is built
         problem = build_problem(problem, **(params or {}))

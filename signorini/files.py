@@ -27,6 +27,32 @@ def writable_directory(path: str | os.PathLike) -> Path:
     return directory
 
 
+def check_output_file(path: str | os.PathLike, flag: str) -> Path:
+    """InputError unless a file can be written at ``path`` (checked before any work).
+
+    The folder must exist and be writable, the path must not be a folder, and
+    the name must fit the file system's limit.
+    """
+    target = Path(path)
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.is_dir():
+        raise InputError(f"{flag} {str(target)!r}: the folder {str(parent)!r} does not exist: "
+                         "create it or choose another path")
+    try:
+        longest = os.pathconf(parent, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        longest = 255
+    if len(os.fsencode(target.name)) > longest:
+        raise InputError(f"{flag}: the file name is {len(os.fsencode(target.name))} bytes long, "
+                         f"over this file system's {longest}: choose a shorter name")
+    if target.is_dir():
+        raise InputError(f"{flag} {str(target)!r} is a directory: give a file name, "
+                         f"e.g. {flag} {target / 'result.json'}")
+    if not os.access(parent, os.W_OK) or (target.exists() and not os.access(target, os.W_OK)):
+        raise InputError(f"{flag} {str(target)!r} is not writable: choose a writable path")
+    return target
+
+
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
     """Write ``data`` to ``path`` so that readers see the old file or the new one, never half."""
     target = Path(path)

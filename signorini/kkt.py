@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from signorini.errors import InputError
 from signorini.numerics.factor import selection_dofs
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -102,6 +103,14 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     The result is kept on the solution (for these same arrays, problem and
     options): judging a solution and then reporting it costs one evaluation.
     """
+    if not isinstance(problem, ContactProblem):
+        raise InputError(f"certificate: problem must be a ContactProblem, got {type(problem).__name__}")
+    if not isinstance(solution, ContactSolution):
+        raise InputError(f"certificate: solution must be a ContactSolution, got "
+                         f"{type(solution).__name__} (result.solution for a signorini.solve result)")
+    if np.shape(solution.u) != (problem.n,) or np.shape(solution.lam) != (problem.m,):
+        raise InputError(f"certificate: solution.u must have {problem.n} entries and solution.lam "
+                         f"{problem.m}, got {np.shape(solution.u)} and {np.shape(solution.lam)}")
     key = (id(problem), id(solution.u), id(solution.lam), duality_gap)
     kept = getattr(solution, "_certificate", None)
     if kept is not None and kept[0] == key:

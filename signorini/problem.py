@@ -27,6 +27,7 @@ from skfem import MeshTet, MeshTri
 
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
+from signorini.numerics.arrays import sparse_argument, vector_argument
 from signorini.numerics.factor import factorize
 
 #: the statuses a :class:`ContactSolution` can carry
@@ -198,12 +199,10 @@ class ContactProblem:
     watch: Watch | None = None
 
     def __post_init__(self) -> None:
-        self.K = sp.csr_matrix(self.K)
-        self.N = sp.csr_matrix(self.N)
-        self.f = np.asarray(self.f, dtype=float)
-        self.d = np.asarray(self.d, dtype=float)
+        self.K, self.N = sparse_argument(self.K, "K"), sparse_argument(self.N, "N")
+        self.f, self.d = vector_argument(self.f, "f"), vector_argument(self.d, "d")
         if self.weights is not None:
-            self.weights = np.asarray(self.weights, dtype=float)
+            self.weights = vector_argument(self.weights, "weights")
         n, m = self.K.shape[0], self.N.shape[0]
         if self.K.shape != (n, n):
             raise InputError(f"K must be square, got shape {self.K.shape}")

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from typing import Sequence
 
@@ -84,5 +85,11 @@ def _main(argv: Sequence[str] | None, ranks: int = 1) -> int:
     except KeyboardInterrupt:
         print("signorini: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:  # e.g. piped into `head`
-        return 0
+    except BrokenPipeError:  # e.g. piped into `head`: say so once, on stderr, and fail
+        try:  # what is still buffered for the closed stdout must not raise again at exit
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        print("signorini: error: standard output was closed before the output was written",
+              file=sys.stderr)
+        return EXIT_FAILED

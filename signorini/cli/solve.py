@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from signorini.cli.common import (EXIT_FAILED, option_value, pairs, parse_time_limit, parse_tol,
                                   write_json)
@@ -13,7 +12,7 @@ from signorini.errors import InputError
 
 def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.api import Result, build_problem, solve  # per command (start-up)
-    from signorini.files import to_json  # per command (start-up)
+    from signorini.files import check_output_file, to_json  # per command (start-up)
     from signorini.kkt import certificate  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
 
@@ -28,9 +27,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if time_limit is not None and args.target_error is not None:
         raise InputError("--time-limit runs one solve in a worker process and --target-error "
                          "refines in this one: give one of them")
-    if args.json not in (None, "-") and Path(args.json).is_dir():
-        raise InputError(f"--json {args.json!r} is a directory: give a file name, "
-                         f"e.g. --json {Path(args.json) / 'result.json'}")
+    if args.json not in (None, "-"):
+        check_output_file(args.json, "--json")  # every output checked before the solve
     if args.vtk:
         from signorini.output.export import check_vtk_path  # per command (start-up)
 

@@ -99,6 +99,9 @@ def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> C
     ``name`` may be the path of a TOML scene file (``*.toml``, see
     :mod:`signorini.scenes.scenefile`); ``values`` then override its parameters.
     """
+    if not isinstance(name, str):
+        raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
+                         f"{type(name).__name__}: e.g. build_problem('hertz-cylinder')")
     zone = None
     if name.lower().endswith(".toml"):  # a scene file: signorini.scenes.scenefile
         name, model = build_scene_model(name, values)

@@ -45,6 +45,8 @@ Errors name the file, the table and key, and the line when it can be found
 
 from __future__ import annotations
 
+import contextlib
+import io
 import logging
 import re
 import sys
@@ -272,11 +274,14 @@ def read_mesh(path: str | Path) -> MeshWithBoundaries:
         raise InputError(f"mesh file {path} does not exist")
     # .msh is Gmsh's (meshio would also try ANSYS and print its complaint on stdout)
     file_format = "gmsh" if path.suffix.lower() == ".msh" else None
-    try:
-        raw = meshio.read(path, file_format=file_format)
-    except Exception as exc:  # meshio raises many kinds (ReadError, ValueError, KeyError...)
-        raise InputError(f"mesh file {path} cannot be read by meshio "
-                         f"({type(exc).__name__}: {exc})") from exc
+    said = io.StringIO()
+    try:  # meshio prints its complaints, and its Gmsh reader may call sys.exit
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            raw = meshio.read(path, file_format=file_format)
+    except (Exception, SystemExit) as exc:  # meshio raises many kinds (ReadError, ValueError...)
+        detail = said.getvalue().strip().splitlines()[-1:] or [f"{type(exc).__name__}: {exc}"]
+        raise InputError(f"mesh file {path} cannot be read by meshio ({detail[0].strip()}): "
+                         "give a mesh file meshio reads, e.g. Gmsh .msh (format 2.2 or 4)") from None
     points = np.asarray(raw.points, dtype=float)
     if points.shape[1] == 3:
         if np.any(np.abs(points[:, 2]) > 1e-12 * max(1.0, float(np.max(np.abs(points))))):

@@ -40,6 +40,9 @@ def register(method: Method) -> Method:
 
 def get_method(name: str) -> Method:
     """Look a method up by name; unknown names list the known ones."""
+    if not isinstance(name, str):
+        raise InputError(f"method must be a name (a string), got {type(name).__name__}: "
+                         f"e.g. method='pdas'")
     if name in REGISTRY:
         return REGISTRY[name]
     if ":" in name:
