@@ -242,13 +242,13 @@ class ContactProblem:
         positions; there is no analytic reference to compare with. Shapes
         and values are checked (InputError names the array and the fix).
         """
-        K = sp.csr_matrix(K)
+        K = sparse_argument(K, "K")
         n = K.shape[0]
         if K.shape[0] != K.shape[1]:
             raise InputError(f"K must be square, got shape {K.shape}")
         if n and abs(K - K.T).max() > 1e-10 * abs(K).max():
             raise InputError("K must be symmetric: pass the stiffness matrix itself, or ½(K + Kᵀ)")
-        N = sp.csr_matrix(np.atleast_2d(N) if not sp.issparse(N) else N)
+        N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")
         m = N.shape[0]
         if contact_points is None:
             contact_points = np.full((m, 2), np.nan)

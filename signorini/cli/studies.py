@@ -52,11 +52,16 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from signorini.output.report import checks_summary, write_suite_report  # as above
     from signorini.studies.suite import run_suite, select_cases  # as above
 
+    from signorini.solvers.registry import get_method  # as above
+
     time_limit = parse_time_limit(args.time_limit)
-    writable_directory(args.out)
     methods = args.method or None
+    for name in args.method:
+        get_method(name)  # an unknown method is refused before the report folder is made
+    cases = select_cases(args.case)
+    writable_directory(args.out)
     limit = {} if time_limit is None else {"time_limit": time_limit}
-    suite = run_suite(select_cases(args.case), method_names=methods,
+    suite = run_suite(cases, method_names=methods,
                       progress=lambda line: print(line, file=sys.stderr), **limit)
     command = "signorini validate" + "".join(f" --method {m}" for m in args.method)
     command += "".join(f" --case {c}" for c in args.case)
