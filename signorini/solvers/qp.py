@@ -16,8 +16,11 @@ The methods are registered by one loop at the bottom of the module.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import logging
+import os
+import sys
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -344,6 +347,27 @@ def _check_options(backend: Backend, options: Mapping[str, Any]) -> dict[str, An
     return {name: kinds[name].check(backend.method_name, value) for name, value in options.items()}
 
 
+@functools.cache
+def _silence_highs_banner() -> None:
+    """HiGHS prints its banner from C on the first ``Highs()`` of a process, whatever the
+    options (highspy 1.16): make that first one with the process's output sent nowhere."""
+    import highspy
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    sink = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(sink, 1)
+        os.dup2(sink, 2)
+        highspy.Highs()
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved + [sink]:
+            os.close(fd)
+
+
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
              max_iter: int | None = None, **options: Any) -> ContactSolution:
     """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with one qpsolvers backend.
@@ -408,6 +432,8 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
     qp = (qpsolvers.Problem(data.P, data.q, lb=np.zeros(problem.m)) if data.bounds
           else qpsolvers.Problem(data.P, data.q, data.G, data.h))
     build_time = time.perf_counter() - start
+    if spec.name == "highs":
+        _silence_highs_banner()
     try:
         with warnings.catch_warnings(record=True) as record:
             warnings.simplefilter("always")
