@@ -81,7 +81,7 @@ def _hertz_extent(half_width: Callable[[float, float, float], float]):
 REFERENCES: dict[str, Reference] = {r.name: r for r in (
     Reference("hertz-2d", "Hertz's cylinder on a flat, plane strain", compare_hertz, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_cylinder_half_width),
-              extent_margin=0.002),
+              extent_margin=0.001),
     Reference("hertz-3d", "Hertz's sphere on a flat", compare_hertz_sphere, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_sphere_radius),
               extent_margin=0.006),
