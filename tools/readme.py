@@ -48,6 +48,17 @@ def one_million(run: Path) -> str:
             f"the solve {record['time']['solve_s']:.2f} s)")
 
 
+def nested_ratios(csv_path: Path) -> str:
+    """The README's line on nested against one factorisation, from the committed bench CSV."""
+    import csv
+
+    rows = list(csv.DictReader(csv_path.open()))
+    parts = [f"{int(r['dofs']):,} dofs: {float(r['time_s']):.2f} s against {float(r['factor_s']):.2f} s, "
+             f"**{float(r['ratio_to_factor']):.2f}×**" for r in rows if r["method"] == "nested"]
+    return ("`nested` against one PARDISO factorisation + solve of the same K, in one run "
+            "([`docs/bench-nested/bench.md`](docs/bench-nested/bench.md)): " + "; ".join(parts) + ".")
+
+
 def blocks(document: Path = README) -> dict[str, str]:
     """The generated blocks of ``document`` by name, from their artefacts."""
     if document == README:
@@ -57,6 +68,7 @@ def blocks(document: Path = README) -> dict[str, str]:
                 "peer": "\n".join(peer[peer.index("") + 1:]),  # the summary of docs/peer/peer.md
                 "one-million": one_million(ROOT / "docs" / "speed" / "one-million"),
                 "adaptive-summary": estimate_study.adaptive_summary(estimate_study.load("adaptive")),
+                "nested-ratios": nested_ratios(ROOT / "docs" / "bench-nested" / "bench.csv"),
                 **stability.tables(stability.load())}
     if document == ACCURACY:
         return accuracy.tables(accuracy.load())
