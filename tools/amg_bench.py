@@ -1,0 +1,273 @@
+"""pdas-amg at scale on hertz-sphere-3d: the measurements behind docs/amg/ (issue 14).
+
+    .venv/bin/python tools/amg_bench.py run [--part NAME ...]   # measure, merge into docs/amg/bench.json
+    .venv/bin/python tools/amg_bench.py md                      # docs/amg/bench.md from the JSON
+
+Parts (each one a key of the JSON, re-run alone with --part):
+
+- ``backends``: one multigrid set-up and one CG solve of K (the bound form with the
+  prescribed dofs pinned, no contact) to a relative residual of 1e-10, on the 350k-dof
+  sphere: pyamg's smoothed aggregation, PETSc GAMG plain and smoothed;
+- ``crossover``: pdas against pdas-amg (method time) at 7k, 12k and 47k dofs;
+- ``whole-350k`` and ``whole-1m``: the default command, ``/usr/bin/time -v signorini solve
+  hertz-sphere-3d ... --json``, whole process (wall time, peak memory, the record);
+- ``petsc-350k``: the same problem solved in one process by pdas-amg and petsc-vi (1 rank):
+  λ's relative difference and the nodes classified apart.
+
+Every part records the load average before and after it: the machine has 2 cores, shared.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs" / "amg"
+JSON = OUT / "bench.json"
+SIGNORINI = str(ROOT / ".venv" / "bin" / "signorini")
+SPHERE_350K = {"refine": 2, "delta": 0.0025}
+SPHERE_1M = {"refine": 2, "n_contact": 24, "delta": 0.0025}
+PARTS = ("backends", "crossover", "whole-350k", "petsc-350k", "whole-1m")
+
+
+def machine() -> dict:
+    cpu = ""
+    for line in Path("/proc/cpuinfo").read_text().splitlines():
+        if line.startswith("model name"):
+            cpu = line.split(":", 1)[1].strip()
+            break
+    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
+            "memory_gb": round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 1e9, 1)}
+
+
+def load() -> float:
+    return round(os.getloadavg()[0], 2)
+
+
+def command_line(params: dict) -> list[str]:
+    words = [SIGNORINI, "solve", "hertz-sphere-3d"]
+    for key, value in params.items():
+        words += ["--set", f"{key}={value}"]
+    return words
+
+
+def whole(params: dict) -> dict:
+    """The default command under /usr/bin/time -v: wall time, peak memory and its record."""
+    with tempfile.TemporaryDirectory() as tmp:
+        record_path = Path(tmp) / "result.json"
+        words = command_line(params) + ["--json", str(record_path)]
+        before = load()
+        proc = subprocess.run(["/usr/bin/time", "-v", *words], capture_output=True, text=True,
+                              cwd=ROOT)
+        timing = dict(line.strip().rsplit(": ", 1) for line in proc.stderr.splitlines()
+                      if ": " in line and line.startswith("\t"))
+        record = json.loads(record_path.read_text()) if record_path.exists() else None
+    clock = timing.get("Elapsed (wall clock) time (h:mm:ss or m:ss)", "0:0").split(":")
+    wall = sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock)))
+    keep = ("scene", "params", "method", "status", "message", "iterations", "dofs",
+            "contact_candidates", "time", "kkt", "total_force", "hertz", "extras")
+    return {"command": " ".join(["/usr/bin/time", "-v", *words[:1]]).replace(str(ROOT) + "/", "")
+            + " " + " ".join(words[1:-2]),
+            "returncode": proc.returncode, "wall_s": wall,
+            "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2,
+            "load_before": before, "load_after": load(),
+            "record": None if record is None else {k: record.get(k) for k in keep if k in record}}
+
+
+def backends() -> dict:
+    """One set-up + one CG solve of K per multigrid, on the 350k-dof sphere's bound form."""
+    from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg, pinned_matrix
+    from signorini.scenes import build_problem
+    from signorini.solvers import amg
+    from signorini.solvers.bounds import bound_form
+
+    problem = build_problem("hertz-sphere-3d", **SPHERE_350K)
+    form = bound_form(problem)
+    pinned = form.lower == form.upper
+    A = pinned_matrix(form.K, pinned)
+    modes = form.rigid_modes()
+    rows = {}
+    variants = {"pyamg (smoothed aggregation)": lambda: PyamgHierarchy(A, modes, form.block),
+                "petsc GAMG (plain aggregation)": lambda: amg.GamgHierarchy(A, modes, form.block)}
+    for name, make in variants.items():
+        before = load()
+        start = time.perf_counter()
+        hierarchy = make()
+        setup = time.perf_counter() - start
+        x = np.zeros(form.n)
+        f = np.where(pinned, 0.0, form.f)
+        target = 1e-10 * np.linalg.norm(f)
+        start = time.perf_counter()
+        result = pinned_cg(A, f, x, ~pinned, hierarchy.apply, lambda r2, ri, r0: r2 <= target,
+                           5000)
+        rows[name] = {"setup_s": setup, "solve_s": time.perf_counter() - start,
+                      "iterations": result.iterations, "relative_residual": result.final / np.linalg.norm(f),
+                      "load_before": before, "load_after": load()}
+        del hierarchy
+    return {"dofs": problem.n, "bound_form_unknowns": form.n, "nonzeros": int(A.nnz),
+            "rtol": 1e-10, "rows": rows}
+
+
+def crossover() -> dict:
+    from signorini.scenes import build_problem
+    from signorini.solvers.registry import solve
+
+    rows = []
+    for params in ({"delta": 0.0025}, {"n_contact": 16, "delta": 0.0025},
+                   {"refine": 1, "delta": 0.0025}):
+        problem = build_problem("hertz-sphere-3d", **params)
+        row = {"params": params, "dofs": problem.n, "load_before": load()}
+        for method in ("pdas", "pdas-amg"):
+            solve(problem, method)  # warm: imports, the coarse model's first build
+            solution = solve(problem, method)
+            row[method] = {"status": solution.status, "method_s": solution.extras["method_s"]}
+        row["load_after"] = load()
+        rows.append(row)
+    return {"rows": rows}
+
+
+def petsc_350k() -> dict:
+    from signorini.kkt import compare
+    from signorini.scenes import build_problem
+    from signorini.solvers.registry import solve
+
+    problem = build_problem("hertz-sphere-3d", **SPHERE_350K)
+    before = load()
+    ours = solve(problem, "pdas-amg")
+    theirs = solve(problem, "petsc-vi")
+    agreement = compare(problem, ours, theirs)
+    return {"dofs": problem.n, "load_before": before, "load_after": load(),
+            "pdas-amg": {"status": ours.status, "method_s": ours.extras["method_s"]},
+            "petsc-vi": {"status": theirs.status, "method_s": theirs.extras["method_s"],
+                         "iterations": theirs.iterations},
+            "lam_rel": agreement.lam_rel, "u_rel": agreement.u_rel,
+            "misclassified": agreement.misclassified}
+
+
+MEASURE = {"backends": backends, "crossover": crossover, "petsc-350k": petsc_350k,
+           "whole-350k": lambda: whole(SPHERE_350K), "whole-1m": lambda: whole(SPHERE_1M)}
+
+
+def read() -> dict:
+    return json.loads(JSON.read_text()) if JSON.exists() else {}
+
+
+def write(data: dict) -> None:
+    from signorini.files import atomic_write_text
+
+    OUT.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(JSON, json.dumps(data, indent=1, sort_keys=True) + "\n")
+
+
+def run(parts: list[str]) -> None:
+    data = read()
+    for part in parts:
+        start = time.strftime("%Y-%m-%d %H:%M")
+        data[part] = {"date": start, "commit": subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+            cwd=ROOT).stdout.strip(), **MEASURE[part]()}
+        data["machine"] = machine()
+        write(data)
+        print(f"{part} done", flush=True)
+
+
+# --- the report ---------------------------------------------------------------------------------
+
+def whole_sentence(run: dict) -> str:
+    record = run["record"]
+    extras = record["extras"]
+    hertz = record.get("hertz") or {}
+    worst = max(v for v in record["kkt"].values() if v is not None)
+    return (f"`{run['command']}`: {record['dofs']:,} dofs, {record['status']} with "
+            f"{record['method']} ({extras.get('auto', '')}) in {run['wall_s']:.0f} s whole command "
+            f"and {run['peak_gb']:.1f} GB peak (load average {run['load_before']:.1f} → "
+            f"{run['load_after']:.1f}); every KKT residual ≤ {worst:.1e}; "
+            f"{record['iterations']} active-set steps, {extras['cg_iterations']} CG iterations, "
+            f"{extras['hierarchies']} hierarchy; assembly {record['time']['assemble_s']:.1f} s, "
+            f"method {extras['method_s']:.1f} s"
+            + (f"; Hertz's p₀ within {100 * hertz['p0_rel']:.2f} %, a within "
+               f"{100 * hertz['a_rel']:.2f} %" if hertz else ""))
+
+
+def readme_paragraph(data: dict) -> str:
+    """The README's block ``amg`` (tools/readme.py)."""
+    lines = []
+    if "whole-350k" in data:
+        lines.append("- " + whole_sentence(data["whole-350k"]) + ".")
+    if "whole-1m" in data and data["whole-1m"]["record"] is not None:
+        lines.append("- " + whole_sentence(data["whole-1m"]) + ".")
+    if "petsc-350k" in data:
+        p = data["petsc-350k"]
+        lines.append(f"- Against `petsc-vi` (1 rank) on the same {p['dofs']:,}-dof problem in one "
+                     f"process: λ within {p['lam_rel']:.1e} (relative), {p['misclassified']} nodes "
+                     f"classified apart; method time {p['pdas-amg']['method_s']:.0f} s against "
+                     f"{p['petsc-vi']['method_s']:.0f} s (load {p['load_before']:.1f}).")
+    return "\n".join(lines)
+
+
+def markdown(data: dict) -> str:
+    m = data.get("machine", {})
+    out = ["# pdas-amg on hertz-sphere-3d", "",
+           f"Generated by `tools/amg_bench.py md` from [bench.json](bench.json). Machine: "
+           f"{m.get('cpu', '?')}, {m.get('cores', '?')} cores shared with other work, "
+           f"{m.get('memory_gb', '?')} GB. One run each; timings are noisy (the load average is "
+           "given with each): compare ratios within a row.", ""]
+    if "backends" in data:
+        b = data["backends"]
+        out += ["## One multigrid set-up and one CG solve of K", "",
+                f"The bound form of the {b['dofs']:,}-dof sphere ({b['bound_form_unknowns']:,} "
+                f"unknowns, {b['nonzeros']:,} nonzeros, prescribed dofs pinned), CG from zero to a "
+                f"relative residual of {b['rtol']:g} (commit {b['commit']}, {b['date']}).", "",
+                "| multigrid | set-up (s) | CG (s) | iterations | s per iteration | load |",
+                "|---|---:|---:|---:|---:|---:|"]
+        for name, row in b["rows"].items():
+            out.append(f"| {name} | {row['setup_s']:.1f} | {row['solve_s']:.1f} | "
+                       f"{row['iterations']} | {row['solve_s'] / max(row['iterations'], 1):.3f} | "
+                       f"{row['load_before']:.1f} |")
+        out.append("")
+    if "crossover" in data:
+        out += ["## pdas against pdas-amg on small 3D models (method time, second run)", "",
+                "| dofs | pdas (s) | pdas-amg (s) | load |", "|---:|---:|---:|---:|"]
+        for row in data["crossover"]["rows"]:
+            out.append(f"| {row['dofs']:,} | {row['pdas']['method_s']:.2f} | "
+                       f"{row['pdas-amg']['method_s']:.2f} | {row['load_before']:.1f} |")
+        out.append("")
+    out += ["## The default command at scale", "", readme_paragraph(data), ""]
+    if "backends" in data and "whole-350k" in data:
+        gamg = data["backends"]["rows"].get("petsc GAMG (plain aggregation)")
+        method = data["whole-350k"]["record"]["extras"]["method_s"]
+        if gamg:
+            one = gamg["setup_s"] + gamg["solve_s"]
+            out += [f"The method alone at 350k dofs took {method / one:.1f}× one GAMG set-up and "
+                    f"CG solve of K to 1e-10 ({method:.1f} s against {one:.1f} s, different runs "
+                    "and loads).", ""]
+    return "\n".join(out)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = parser.add_subparsers(dest="what", required=True)
+    runner = sub.add_parser("run")
+    runner.add_argument("--part", action="append", choices=PARTS)
+    sub.add_parser("md")
+    args = parser.parse_args()
+    if args.what == "run":
+        run(args.part or list(PARTS))
+    from signorini.files import atomic_write_text
+
+    atomic_write_text(OUT / "bench.md", markdown(read()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
