@@ -190,8 +190,8 @@ def mesh_finding(rows: Rows) -> str:
     at_all = ", ".join(name(m) for m in every)
     return (f"**Mesh** (axis 2, {dofs[0]:,} → {dofs[-1]:,} dofs, h halving): PDAS takes "
             + " → ".join(str(i) for i in pdas) + " steps from a cold start and `nested` "
-            + " → ".join(str(i) for i in nested) + " (its coarse model's zone; the coarsest level "
-            "has none and runs PDAS); Uzawa "
+            + " → ".join(str(i) for i in nested) + " (the zone from Hertz's width for the load, "
+            "one factorisation at every level); Uzawa "
             f"{uzawa[0]:,} → {uzawa[-1]:,} iterations (×{growth:.2f} per halving of h), "
             f"`uzawa-nesterov` {nesterov[0]:,} → {nesterov[-1]:,}. Of the sparse QP backends "
             f"{at_all} {'is' if len(every) == 1 else 'are'} right at all {len(levels)} levels at "
@@ -291,16 +291,18 @@ def force_finding(rows: Rows) -> str:
           | {m for m in methods_of(singular) if m.startswith("petsc-")},
           "the QP backends but a few, cvxpy and the PETSc methods are right on the singular K")
     claim({r["method"] for r in singular if r["outcome"] != "right"} - set(lost)
-          == {"pdas", "nested", "condensed", "uzawa", "uzawa-nesterov"},
-          "PDAS, nested, the condensed dual and both Uzawas fail on the singular K")
+          == {"pdas", "pdas-amg", "auto", "nested", "condensed", "uzawa", "uzawa-nesterov"},
+          "PDAS (and pdas-amg, auto's picks), nested, the condensed dual and both Uzawas fail on "
+          "the singular K")
     moved = one(eps, method="pdas")["patch_lam_rel"]
     not_helped = [r for r in eps if r["outcome"] != "right"]
     claim(all(r["status"] == "max_iter" for r in not_helped if r["method"].startswith("uzawa")),
           "both Uzawas stop at max_iter on the regularised problem")
     return (f"**Force control** (axis 6): K is singular; {len(fine)} of {len(singular)} methods are "
             "right on it (every QP backend but " + names(lost) + ", cvxpy and the PETSc methods; "
-            f"λ within {power(worst)} of the exact patch solution), while PDAS, `nested`, the condensed dual "
-            "and both Uzawas need K⁻¹ and fail. The handling: "
+            f"λ within {power(worst)} of the exact patch solution), while PDAS (also `pdas-amg`, and "
+            "`auto`, which picks one of them), `nested`, the condensed dual and both Uzawas need K⁻¹ "
+            "and fail. The handling: "
             f"`signorini.diagnose.regularise(problem, {power(eps[0]['value'])})` adds "
             f"{power(eps[0]['value'])} · mean(diag K) to the diagonal; then {len(right(eps))} of "
             f"{len(eps)} methods are right and λ moves by {power(moved, 1)} "
