@@ -115,7 +115,7 @@ class ZoneSolver:
     """
 
     def __init__(self, K: sp.spmatrix, N: sp.spmatrix, backend: str | None = None):
-        self.K = sp.csc_matrix(K)
+        self.K = K if sp.issparse(K) else sp.csr_matrix(K)
         self.N = sp.csr_matrix(N)
         dofs = selection_dofs(self.N)
         if dofs is None:
@@ -127,7 +127,7 @@ class ZoneSolver:
         self.dofs, self.coef = dofs, rows.data.copy()
         self.n, self.m = self.K.shape[0], self.N.shape[0]
         self.backend = resolve_backend(backend, self.n, self.K.nnz)
-        self._pinning = Pinning(self.K, analyse=self.backend == "cholmod")
+        self._pinning = Pinning(self.K, self.backend)
         self._core: np.ndarray | None = None
         self._factor: PinnedFactor | None = None
         self._columns: dict[int, np.ndarray] = {}
@@ -149,45 +149,50 @@ class ZoneSolver:
         self._columns.clear()
         self.factorisations += 1
 
-    def _band_columns(self, band: np.ndarray) -> np.ndarray:
-        """``Z = K̃⁻¹ N_Bᵀ`` (n × |B|): displacements under a unit force at each band node."""
+    def _solutions(self, F: np.ndarray, D: np.ndarray, zone: Zone,
+                   band: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``U0``: u (n, or n × k) with the core's gaps closed, loads F and no band forces; and
+        ``Z = K̃⁻¹ N_Bᵀ`` (n × |B|), the displacements under a unit force at each band node.
+
+        The band columns not kept from an earlier call are solved in the same call as U0
+        (one pass over the factor for both; at 1M dofs a pass costs a tenth of the factorisation).
+        """
+        core = zone.core
+        rhs = np.array(F, dtype=float).reshape(self.n, -1)
+        rhs[self.dofs[core]] = D[core].reshape(-1, rhs.shape[1]) / self.coef[core][:, None]
         missing = [j for j in band if j not in self._columns]
-        for first in range(0, len(missing), BLOCK):
-            chunk = missing[first:first + BLOCK]
-            rhs = np.zeros((self.n, len(chunk)))
-            rhs[self.dofs[chunk], np.arange(len(chunk))] = self.coef[chunk]
-            block = self._factor.solve(rhs)
-            self.back_solves += len(chunk)
+        chunks = [missing[first:first + BLOCK] for first in range(0, len(missing), BLOCK)]
+        U0 = None
+        for chunk in chunks or [[]]:
+            units = np.zeros((self.n, len(chunk)))
+            units[self.dofs[chunk], np.arange(len(chunk))] = self.coef[chunk]
+            block = self._factor.solve(units if U0 is not None else np.hstack([rhs, units]))
+            self.back_solves += block.shape[1]
+            if U0 is None:
+                U0, block = block[:, :rhs.shape[1]], block[:, rhs.shape[1]:]
             for k, j in enumerate(chunk):
                 self._columns[j] = block[:, k]
-        if len(band) == 0:
-            return np.zeros((self.n, 0))
-        return np.column_stack([self._columns[j] for j in band])
+        Z = np.column_stack([self._columns[j] for j in band]) if len(band) else np.zeros((self.n, 0))
+        return (U0[:, 0] if np.ndim(F) == 1 else U0), Z
 
-    def _particular(self, F: np.ndarray, D: np.ndarray, core: np.ndarray) -> np.ndarray:
-        """u (n × k) with the core's gaps closed, loads F and no band forces."""
-        rhs = np.array(F, dtype=float)
-        coef = self.coef[core][:, None] if rhs.ndim == 2 else self.coef[core]
-        rhs[self.dofs[core]] = D[core] / coef
-        self.back_solves += 1 if rhs.ndim == 1 else rhs.shape[1]
-        return self._factor.solve(rhs)
-
-    def _core_reactions(self, residual: np.ndarray, core: np.ndarray) -> np.ndarray:
-        """Contact forces of the core nodes from ``f − K u`` on their dofs."""
-        coef = self.coef[core][:, None] if residual.ndim == 2 else self.coef[core]
-        return residual[self.dofs[core]] / coef
+    def _core_reactions(self, F: np.ndarray, U: np.ndarray, core: np.ndarray) -> np.ndarray:
+        """Contact forces of the core nodes, ``(F − K U)`` on their dofs (``F`` None: ``−K U``)."""
+        coef = self.coef[core][:, None] if U.ndim == 2 else self.coef[core]
+        residual = -self._factor.fixed_rows(U)
+        if F is not None:
+            residual += F[self.dofs[core]]
+        return residual / coef
 
     def _pieces(self, F: np.ndarray, D: np.ndarray, zone: Zone):
         """Everything affine: ``u = U0 − Zλ_B``, band gaps ``Wλ_B − b``, core ``R + Gλ_B``."""
         self._use_core(zone.core)
         band = np.nonzero(zone.band)[0]
-        Z = self._band_columns(band)
-        U0 = self._particular(F, D, zone.core)
+        U0, Z = self._solutions(F, D, zone, band)
         W = self.N[band] @ Z
         W = 0.5 * (W + W.T)
         b = self.N[band] @ U0 - D[band]
-        R = self._core_reactions(F - self.K @ U0, zone.core)
-        G = self._core_reactions(self.K @ Z, zone.core) if len(band) else np.zeros((0, 0))
+        R = self._core_reactions(F, U0, zone.core)
+        G = -self._core_reactions(None, Z, zone.core) if len(band) else np.zeros((0, 0))
         return band, Z, U0, W, b, R, G
 
     # --- the check that makes it exact ---------------------------------------------------------
