@@ -182,7 +182,7 @@ class PardisoFactor(Factor):
 
         self.matrix, self.shape = K, K.shape
         COUNTS["factorisations"] += 1
-        self._upper = sp.triu(K, format="csr") if upper is None else upper
+        self._upper = _upper_csr(K) if upper is None else upper
         self._solver = pypardiso.PyPardisoSolver(mtype=2)
         for index, value in PARDISO_IPARM.items():
             self._solver.set_iparm(index, value)
