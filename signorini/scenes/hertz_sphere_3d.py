@@ -22,9 +22,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from skfem import MeshTet
 
 from signorini.fem.model import CutLoad, FlatObstacle3D, SceneModel
+from signorini.fem.topology import moved
 from signorini.scenes.base import CANDIDATE_REMEDY, LOADING, Param, SceneFamily, at_least, between
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, load_choice, recorded_params
 from signorini.scenes.meshing import (
@@ -71,7 +71,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
         mesh = snap(mesh.refined())
     surface = on_ball_octant_surface(mesh, centre)
     curved = curved_boundary_facets(mesh, centre)
-    mesh = MeshTet(mesh.p * R, mesh.t)
+    mesh = moved(mesh, mesh.p * R)
     x, y, z = mesh.p
     rho = np.hypot(x, y)
     candidates = surface[(rho[surface] <= p["candidates"] * a_est * R * (1 + 1e-9))

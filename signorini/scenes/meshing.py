@@ -20,6 +20,7 @@ from scipy.spatial import Delaunay
 from skfem import Mesh, MeshTet, MeshTri
 
 from signorini.fem.model import CutLoad
+from signorini.fem.topology import moved, with_topology
 from signorini.scenes.relax import relax
 
 log = logging.getLogger(__name__)
@@ -181,13 +182,14 @@ def on_ball_octant_surface(mesh: MeshTet, centre: tuple[float, float, float],
     planes ``x = cₓ``, ``y = c_y``, ``z = c_z``; the nodes of curved facets
     (including those on the rims where a plane meets the sphere) are returned.
     """
-    return np.unique(mesh.facets[:, curved_boundary_facets(mesh, centre, tol)])
+    curved = curved_boundary_facets(mesh, centre, tol)  # finds the facets first (fast)
+    return np.unique(mesh.facets[:, curved])
 
 
 def curved_boundary_facets(mesh: MeshTet, centre: tuple[float, float, float],
                            tol: float = 1e-9) -> np.ndarray:
     """Boundary facets of a ball octant that are not in one of its three cut planes."""
-    facets = mesh.boundary_facets()
+    facets = with_topology(mesh).boundary_facets()
     coords = mesh.p[:, mesh.facets[:, facets]]  # (3, 3 nodes, facets)
     planar = np.zeros(facets.size, dtype=bool)
     for axis in range(3):
@@ -210,7 +212,7 @@ def snap_to_sphere(centre: tuple[float, float, float],
         p = mesh.p.copy()
         offset = p[:, nodes] - c
         p[:, nodes] = c + radius * offset / np.linalg.norm(offset, axis=0)
-        snapped = MeshTet(p, np.ascontiguousarray(mesh.t))
+        snapped = moved(mesh, p)
         before, after = signed_volumes(mesh), signed_volumes(snapped)
         if np.any(before * after <= 0):
             raise RuntimeError("snapping to the sphere inverted a tetrahedron: "
