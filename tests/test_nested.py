@@ -66,6 +66,37 @@ def test_the_analytic_zone_predicts_on_one_factorisation(scene, nu):
     assert "1 factorisation(s)" in nested.message and nested.extras["band"] <= 8
 
 
+def test_the_analytic_zone_predicts_the_3d_sphere_by_the_distance_from_the_axis():
+    """In 3D the zone is a ring around Hertz's radius a (x² + y² against a²), as wide as the
+    candidates' spacing there: nested is exact on one factorisation from it."""
+    problem = build_problem("hertz-sphere-3d").with_data()
+    zone, a = analytic_zone(problem)
+    rho = np.hypot(problem.contact_points[:, 0], problem.contact_points[:, 1])
+    assert rho[zone.core].max() < a < rho[zone.band].max()
+    assert rho[zone.rest].min() > a and zone.band.sum() < problem.m / 2
+    reference = solve(problem, "pdas")
+    nested = solve(problem, "nested")
+    assert nested.status == "converged" and "analytic zone" in nested.message
+    assert "1 factorisation(s)" in nested.message
+    assert_same_answer(problem, reference, nested)
+
+
+@pytest.mark.slow
+def test_auto_reuses_the_load_targeting_factorisation_of_a_large_3d_model():
+    """At 47k dofs the 3D sphere's load is targeted on the analytic zone (one factorisation of
+    K); auto then picks nested, which solves on that factorisation by back-solves only."""
+    from signorini.numerics.factor import COUNTS
+
+    problem = build_problem("hertz-sphere-3d", refine=1)
+    assert problem.warm_start.zone_solver is not None
+    before = dict(COUNTS)
+    answer = solve(problem, "auto")
+    assert answer.method == "nested" and answer.status == "converged"
+    assert COUNTS["factorisations"] == before["factorisations"]
+    assert answer.extras["auto"].startswith("K (")
+    assert solve(problem, "auto", c=2.0).method == "pdas"  # an option nested does not take
+
+
 def test_a_wrong_analytic_zone_is_amended_not_trusted():
     """A zone predicted for a load 10 % lower (a 5 % too small): the answer stays exact."""
     problem = build_problem("hertz-cylinder", refine=1).with_data()

@@ -87,11 +87,12 @@ def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: n
     return Zone(core=core, band=band)
 
 
-def zone_around(x: np.ndarray, a: float, margin: float) -> Zone | None:
+def zone_around(x: np.ndarray, a: float, margin: float, spacing: float | None = None) -> Zone | None:
     """The zone of candidates at abscissae ``x`` (2D, axisymmetric) for a contact half-width ``a``.
 
     Core: inside ``a − max(2h, margin·a)``; band: up to ``a + max(h, margin·a)``
-    (``h`` the candidates' spacing at a) — the asymmetry of :func:`predict_zone`.
+    (``h`` the candidates' ``spacing`` at a, by default the gap between the sorted
+    abscissae there) — the asymmetry of :func:`predict_zone`.
     None when the candidates do not reach past the band on both sides.
     """
     x = np.asarray(x, dtype=float)
@@ -99,11 +100,34 @@ def zone_around(x: np.ndarray, a: float, margin: float) -> Zone | None:
         return None
     ordered = np.sort(x)
     at = int(np.clip(np.searchsorted(ordered, a), 1, len(x) - 1))
-    h = ordered[at] - ordered[at - 1]
+    h = ordered[at] - ordered[at - 1] if spacing is None else spacing
     inner, outer = a - max(2 * h, margin * a), a + max(h, margin * a)
     if outer >= ordered[-1] or inner <= ordered[0]:
         return None
     return Zone(core=x < inner, band=(x >= inner) & (x <= outer))
+
+
+def radial_distance(points: np.ndarray) -> np.ndarray:
+    """Each candidate's distance from the first point of contact along the flat: ``|x|`` of a 2D
+    or axisymmetric point (x, y), ``√(x² + y²)`` of a 3D one (x, y, z) over a flat z = const."""
+    points = np.atleast_2d(points)
+    return np.abs(points[:, 0]) if points.shape[1] == 2 else np.hypot(points[:, 0], points[:, 1])
+
+
+def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | None:
+    """:func:`zone_around` for candidates at ``points`` (m, 2 or 3) around a contact of radius
+    ``a`` centred at the origin: by :func:`radial_distance`; in 3D ``h`` is the candidates'
+    median distance to their nearest neighbour within a quarter of a from the edge (their
+    radial distances crowd together, so the gap between sorted ones says nothing)."""
+    points = np.atleast_2d(np.asarray(points, dtype=float))
+    rho = radial_distance(points)
+    if points.shape[1] == 2:
+        return zone_around(rho, a, margin)
+    near = points[np.abs(rho - a) < 0.25 * a]
+    if len(near) < 3:
+        return None
+    distance, _ = cKDTree(near).query(near, k=2)
+    return zone_around(rho, a, margin, spacing=float(np.median(distance[:, 1])))
 
 
 class ZoneSolver:

@@ -14,7 +14,7 @@ from typing import Any
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.model import SceneModel
-from signorini.numerics.zone import zone_around
+from signorini.numerics.zone import zone_around_points
 from signorini.problem import ContactProblem, Scales
 from signorini.references import REFERENCES
 from signorini.scenes.families import SCENES, get_scene
@@ -76,15 +76,15 @@ def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
 
 def predicted_zone(name: str, model: SceneModel, nondimensionalise: bool):
     """The contact zone of a large load-targeted model (or None): from the reference's analytic
-    contact half-width where it has one (2D and axisymmetric), else from a coarser model."""
+    contact half-width (radius) where it has one, else from a coarser model."""
     dofs = model.mesh.p.shape[0] * model.mesh.p.shape[1]
     if model.target_load is None or dofs < NESTED_FROM_DOFS:
         return None
     reference = REFERENCES.get(SCENES[name].reference) if name in SCENES else None
-    if reference is not None and reference.extent is not None and model.mesh.p.shape[0] == 2:
+    if reference is not None and reference.extent is not None:
         a = reference.extent(model.params)
-        zone = None if a is None else zone_around(model.mesh.p[0, model.contact_nodes], a,
-                                                  reference.extent_margin)
+        zone = None if a is None else zone_around_points(model.mesh.p[:, model.contact_nodes].T, a,
+                                                         reference.extent_margin)
         if zone is not None:
             return zone
     coarse = _coarse_model(name, model.params, nondimensionalise)

@@ -30,7 +30,7 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import selection_dofs
-from signorini.numerics.zone import Zone, ZoneSolver, predict_zone, zone_around
+from signorini.numerics.zone import Zone, ZoneSolver, predict_zone, zone_around_points
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_of
 from signorini.solvers import pdas
@@ -44,17 +44,20 @@ DEFAULTS = declare(
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)),
     Option("coarse", "object", types=(ContactProblem,)), Option("zone", "object", types=(Zone,)),
     Option("neighbours", "count"), Option("analytic", "bool", True))
+
+
 def analytic_zone(problem: ContactProblem) -> tuple[Zone, float] | None:
-    """The zone from the reference's contact half-width a (2D and axisymmetric models) and a,
-    in the problem's length units (:func:`signorini.numerics.zone.zone_around`); None without."""
+    """The zone from the reference's contact half-width (radius) a and a, in the problem's length
+    units (:func:`signorini.numerics.zone.zone_around_points`: 2D, axisymmetric and 3D models);
+    None without."""
     reference = reference_of(problem)
-    if reference is None or reference.extent is None or problem.contact_points.shape[1] != 2:
+    if reference is None or reference.extent is None:
         return None
     a = reference.extent(problem.params)
     if a is None:
         return None
     a /= problem.scales.length
-    zone = zone_around(problem.contact_points[:, 0], a, reference.extent_margin)
+    zone = zone_around_points(problem.contact_points, a, reference.extent_margin)
     return None if zone is None else (zone, a)
 
 
