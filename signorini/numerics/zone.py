@@ -87,10 +87,11 @@ def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: n
     return Zone(core=core, band=band)
 
 
-def zone_around(x: np.ndarray, a: float, margin: float, spacing: float | None = None) -> Zone | None:
+def zone_around(x: np.ndarray, a: float, margin: float, spacing: float | None = None,
+                outside: float = 1.0) -> Zone | None:
     """The zone of candidates at abscissae ``x`` (2D, axisymmetric) for a contact half-width ``a``.
 
-    Core: inside ``a − max(2h, margin·a)``; band: up to ``a + max(h, margin·a)``
+    Core: inside ``a − max(2h, margin·a)``; band: up to ``a + max(outside·h, margin·a)``
     (``h`` the candidates' ``spacing`` at a, by default the gap between the sorted
     abscissae there) — the asymmetry of :func:`predict_zone`.
     None when the candidates do not reach past the band on both sides.
@@ -101,7 +102,7 @@ def zone_around(x: np.ndarray, a: float, margin: float, spacing: float | None = 
     ordered = np.sort(x)
     at = int(np.clip(np.searchsorted(ordered, a), 1, len(x) - 1))
     h = ordered[at] - ordered[at - 1] if spacing is None else spacing
-    inner, outer = a - max(2 * h, margin * a), a + max(h, margin * a)
+    inner, outer = a - max(2 * h, margin * a), a + max(outside * h, margin * a)
     if outer >= ordered[-1] or inner <= ordered[0]:
         return None
     return Zone(core=x < inner, band=(x >= inner) & (x <= outer))
@@ -118,7 +119,10 @@ def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | No
     """:func:`zone_around` for candidates at ``points`` (m, 2 or 3) around a contact of radius
     ``a`` centred at the origin: by :func:`radial_distance`; in 3D ``h`` is the candidates'
     median distance to their nearest neighbour within a quarter of a from the edge (their
-    radial distances crowd together, so the gap between sorted ones says nothing)."""
+    radial distances crowd together, so the gap between sorted ones says nothing), and the band
+    stops at ``a + margin·a``: a ring of candidates costs a back-solve each (30 ms at 351k dofs)
+    and a node beyond it that touches joins it for one back-solve more (measured on the 3D sphere:
+    the band fell from 300 to 200 nodes at 351k dofs)."""
     points = np.atleast_2d(np.asarray(points, dtype=float))
     rho = radial_distance(points)
     if points.shape[1] == 2:
@@ -127,7 +131,7 @@ def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | No
     if len(near) < 3:
         return None
     distance, _ = cKDTree(near).query(near, k=2)
-    return zone_around(rho, a, margin, spacing=float(np.median(distance[:, 1])))
+    return zone_around(rho, a, margin, spacing=float(np.median(distance[:, 1])), outside=0.0)
 
 
 class ZoneSolver:
