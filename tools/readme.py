@@ -17,6 +17,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
+import amg_bench  # noqa: E402  (tools/amg_bench.py: 3D at scale, docs/amg)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 
@@ -69,6 +70,7 @@ def blocks(document: Path = README) -> dict[str, str]:
                 "one-million": one_million(ROOT / "docs" / "speed" / "one-million"),
                 "adaptive-summary": estimate_study.adaptive_summary(estimate_study.load("adaptive")),
                 "nested-ratios": nested_ratios(ROOT / "docs" / "bench-nested" / "bench.csv"),
+                "amg": amg_bench.readme_paragraph(amg_bench.read()),
                 **stability.tables(stability.load())}
     if document == ACCURACY:
         return accuracy.tables(accuracy.load())
