@@ -99,3 +99,17 @@ def test_a_mesh_the_mesher_cannot_make_is_one_line(capsys, argv, words):
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
     for word in words:
         assert word in err, (word, err)
+
+
+def test_a_pushed_3d_scene_is_sized_for_pdas_amg_and_a_loaded_one_for_its_factorisation(
+        monkeypatch):
+    """docs/amg: the pushed 1,093,024-dof sphere peaked at 3.85 GB with pdas-amg; a target load
+    factorises K (13.4 kB per dof at 351k, growing): at 19 GB the first fits, the second is refused
+    with the push as the way out."""
+    monkeypatch.setenv(MEMORY_VARIABLE, "19")
+    family = SCENES["hertz-sphere-3d"]
+    pushed = family.parse({"refine": 2, "n_contact": 24, "delta": 0.0025})
+    check_size("hertz-sphere-3d", pushed)  # no error
+    loaded = family.parse({"refine": 2, "n_contact": 24})
+    with pytest.raises(InputError, match=r"prescribe a push instead of the load \(--set delta"):
+        check_size("hertz-sphere-3d", loaded)

@@ -19,7 +19,12 @@ the peak resident size per dof of building the scene and solving it with
 hertz-cylinder refine=3 (298k dofs), 22 kB for hertz-sphere-3d refine=1 (47k
 dofs); taken as 4 kB (2D) and 20 kB (3D). A 3D factorisation grows faster
 than the dofs (``pdas`` at 350k 3D dofs was killed at 21 GB), which a
-factorising method has to weigh on its own.
+factorising method has to weigh on its own. Two 3D paths are measured apart
+(docs/amg/): a prescribed push (``delta``) goes to ``pdas-amg`` by default,
+no factorisation — 1.3 GB at 350,532 dofs, 3.85 GB at 1,093,024, taken as
+5 kB per dof; a target load is met by load targeting on one factorisation of
+K (4.7 GB at 351,076 dofs, 13.4 kB per dof), whose fill grows like n^⅓ per
+dof: 20 kB × (dofs / 350k)^⅓ from 350k dofs on.
 
 A scene whose estimate exceeds :func:`memory_limit` — by default three
 quarters of this machine's physical memory, or ``SIGNORINI_MAX_MEMORY_GB`` —
@@ -39,6 +44,19 @@ from signorini.errors import InputError
 MEMORY_VARIABLE = "SIGNORINI_MAX_MEMORY_GB"
 #: bytes per dof of building a scene and solving it with pdas (see the module's docstring)
 BYTES_PER_DOF = {2: 4_000, 3: 20_000}
+#: bytes per dof of a 3D scene given a push (no load targeting): pdas-amg, no factorisation
+BYTES_PER_DOF_3D_PUSHED = 5_000
+#: from this many 3D dofs a factorisation's bytes per dof grow like (dofs / this)^⅓
+FILL_GROWS_FROM = 350_000
+
+
+def bytes_per_dof(dim: int, dofs: float, params: dict[str, Any]) -> float:
+    """Memory per dof of building and solving a scene (see the module's docstring)."""
+    if dim == 2:
+        return BYTES_PER_DOF[2]
+    if params.get("delta") is not None and params.get("P") is None:
+        return BYTES_PER_DOF_3D_PUSHED
+    return BYTES_PER_DOF[3] * max(1.0, dofs / FILL_GROWS_FROM) ** (1 / 3)
 
 
 @dataclass(frozen=True)
@@ -125,7 +143,7 @@ def check_size(family: str, params: dict[str, Any]) -> None:
     if found is None:
         return
     dofs, dim = found
-    need, limit = dofs * BYTES_PER_DOF[dim], memory_limit()
+    need, limit = dofs * bytes_per_dof(dim, dofs, params), memory_limit()
     if need <= limit:
         return
     names = [k for k in ("n_contact", "grading", "refine", "nx", "ny") if k in params]
@@ -135,4 +153,13 @@ def check_size(family: str, params: dict[str, Any]) -> None:
         f"{need / 1e9:,.1f} GB to build and solve, over the limit of {limit / 1e9:,.1f} GB "
         f"(¾ of this machine's memory unless {MEMORY_VARIABLE} says otherwise): make the mesh "
         f"coarser ({', '.join(names)}), or raise the limit, e.g. "
-        f"{MEMORY_VARIABLE}={math.ceil(need / 1e9) + 1}")
+        f"{MEMORY_VARIABLE}={math.ceil(need / 1e9) + 1}" + _push_hint(dim, dofs, params, limit))
+
+
+def _push_hint(dim: int, dofs: float, params: dict[str, Any], limit: float) -> str:
+    """For a 3D scene with a target load that a push would fit: say so."""
+    pushed = dofs * BYTES_PER_DOF_3D_PUSHED
+    if dim != 3 or bytes_per_dof(dim, dofs, params) == BYTES_PER_DOF_3D_PUSHED or pushed > limit:
+        return ""
+    return (f"; or prescribe a push instead of the load (--set delta=...): no load targeting, no "
+            f"factorisation (pdas-amg), about {pushed / 1e9:,.1f} GB")
