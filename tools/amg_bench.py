@@ -81,7 +81,8 @@ def whole(params: dict) -> dict:
     wall = sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock)))
     keep = ("scene", "params", "method", "status", "message", "iterations", "dofs",
             "contact_candidates", "time", "kkt", "total_force", "hertz", "extras")
-    return {"command": " ".join(["/usr/bin/time", "-v", *words[:1]]).replace(str(ROOT) + "/", "")
+    env = [f"{k}={os.environ[k]}" for k in ("SIGNORINI_MAX_MEMORY_GB",) if k in os.environ]
+    return {"command": " ".join(env + ["/usr/bin/time", "-v", *words[:1]]).replace(str(ROOT) + "/", "")
             + " " + " ".join(words[1:-2]),
             "returncode": proc.returncode, "wall_s": wall,
             "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2,
