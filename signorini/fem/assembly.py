@@ -41,6 +41,7 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.topology import moved
+from signorini.numerics.factor import FactorTooLarge
 from signorini.numerics.loading import calibrate_push
 from signorini.numerics.zone import ZoneSolver
 from signorini.problem import ContactProblem, Push, Scales, WarmStart, Watch
@@ -463,6 +464,8 @@ def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
             log.info("load targeted on a predicted zone (%s): %d factorisation(s), %d back-solves",
                      final.counts(), system.factorisations, system.back_solves)
             return scale, (lam, None), (system, final)
+        except FactorTooLarge:
+            raise  # a refusal, not a failed prediction: the full active set would factorise too
         except (ValueError, ArithmeticError) as exc:
             log.info("load targeting on the predicted zone failed (%s): full active set", exc)
     scale, lam, u = calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity, f0=f0,

@@ -165,6 +165,42 @@ class CholmodFactor(Factor):
 #: 261k) while the residual of K u = f moved from 1.2e-12 to 1.7e-12 of ‖f‖ (5.6e-13 → 7.5e-13):
 #: a Cholesky factor needs no refinement, and every certificate still checks the answer.
 PARDISO_IPARM = {1: 1, 2: 2, 8: 0}
+#: the environment variable that caps a factorisation's memory, in GB (default: MemAvailable)
+FACTOR_MEMORY_VARIABLE = "SIGNORINI_MAX_FACTOR_GB"
+
+
+class FactorTooLarge(InputError):
+    """A factorisation whose symbolic analysis says it would not fit in memory (refused before
+    its numeric phase)."""
+
+
+def factor_memory_limit() -> float:
+    """Bytes a factorisation may take: ``SIGNORINI_MAX_FACTOR_GB``, else MemAvailable (inf when
+    the system does not say)."""
+    text = os.environ.get(FACTOR_MEMORY_VARIABLE)
+    if text is not None:
+        try:
+            limit = float(text) * 1e9
+        except ValueError:
+            limit = float("nan")
+        if not limit > 0:
+            raise InputError(f"{FACTOR_MEMORY_VARIABLE}={text!r} must be a positive number of GB, "
+                             f"e.g. {FACTOR_MEMORY_VARIABLE}=16")
+        return limit
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    return float("inf")
+
+
+def pardiso_factor_bytes(iparm: np.ndarray) -> float:
+    """The memory PARDISO's analysis says its numeric phase needs: the larger of the analysis's
+    peak (iparm 15) and the permanent memory plus the factor's (iparm 16 + 17), in bytes."""
+    return 1024.0 * max(float(iparm[14]), float(iparm[15]) + float(iparm[16]))
 
 
 class PardisoFactor(Factor):
@@ -181,15 +217,35 @@ class PardisoFactor(Factor):
         import pypardiso  # MKL: 0.2 s to import, only for a matrix PARDISO factorises
 
         self.matrix, self.shape = K, K.shape
-        COUNTS["factorisations"] += 1
         self._upper = _upper_csr(K) if upper is None else upper
-        self._solver = pypardiso.PyPardisoSolver(mtype=2)
+        self._solver = solver = pypardiso.PyPardisoSolver(mtype=2)
         for index, value in PARDISO_IPARM.items():
-            self._solver.set_iparm(index, value)
+            solver.set_iparm(index, value)
         # pypardiso searches sys.prefix for MKL on every new solver (0.2-0.4 s) unless told where
         # it is (its documented PYPARDISO_MKL_RT): tell it once
-        os.environ.setdefault("PYPARDISO_MKL_RT", self._solver.libmkl._name)
-        self._solver.factorize(self._upper)
+        os.environ.setdefault("PYPARDISO_MKL_RT", solver.libmkl._name)
+        # pypardiso's factorize() runs PARDISO's phases 11 (analysis) and 22 (numeric) as one;
+        # they are run apart here (its own _check_A, _call_pardiso and the matrix it remembers,
+        # as its factorize does) so that the numeric phase only starts when it fits
+        A, rhs = self._upper, np.zeros((K.shape[0], 1))
+        solver._check_A(A)
+        solver.set_phase(11)
+        solver._call_pardiso(A, rhs)
+        self.memory = pardiso_factor_bytes(solver.iparm)
+        limit = factor_memory_limit()
+        if self.memory > limit:
+            solver.free_memory(everything=True)
+            raise FactorTooLarge(
+                f"factorising K ({K.shape[0]:,} dofs) needs about {self.memory / 1e9:,.1f} GB "
+                f"(PARDISO's analysis), more than the {limit / 1e9:,.2f} GB available "
+                f"({FACTOR_MEMORY_VARIABLE} or MemAvailable): use a method without a "
+                "factorisation (--method pdas-amg, or petsc-vi --opt ksp=gamg), a coarser mesh, or "
+                "for a 3D scene a push (--set delta=...) instead of a target load")
+        solver.factorized_A = (solver._hash_csr_matrix(A) if A.nnz > solver.size_limit_storage
+                               else A.copy())
+        solver.set_phase(22)
+        solver._call_pardiso(A, rhs)
+        COUNTS["factorisations"] += 1
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         return self._solver.solve(self._upper, _count_solve(np.asarray(b, dtype=float)))
