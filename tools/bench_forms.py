@@ -22,17 +22,14 @@ holds docs/bench-forms.md's tables to the JSON.
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import platform
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from readme import pattern
+from readme import fill_blocks, head_commit, study_main
 
 from signorini.files import atomic_write_text, to_json
 from signorini.solvers import cvxpy_, qp
@@ -87,20 +84,9 @@ def tasks(size: str, path: Path) -> list[Task]:
     return out
 
 
-def commit() -> str:
-    """HEAD's short hash (or $SIGNORINI_COMMIT when run from an export of a commit)."""
-    if os.environ.get("SIGNORINI_COMMIT"):
-        return os.environ["SIGNORINI_COMMIT"]
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                              text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def run() -> dict:
     data = {"command": "python tools/bench_forms.py", "tol": TOL, "time_limit": TIME_LIMIT,
-            "scene": SCENE, "params": BASE, "commit": commit(),
+            "scene": SCENE, "params": BASE, "commit": head_commit(),
             "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
                        f"Python {platform.python_version()}",
             "load_before": list(os.getloadavg()), "sizes": {}}
@@ -210,28 +196,12 @@ def blocks(data: dict) -> dict[str, str]:
 
 def write_doc(data: dict) -> None:
     """Every block of docs/bench-forms.md, and the README's summary where it has the block."""
-    for document in (DOC, ROOT / "README.md"):
-        text = document.read_text(encoding="utf-8")
-        for name, body in blocks(data).items():
-            if not pattern(name).search(text):
-                if document == DOC:
-                    raise SystemExit(f"{DOC.name} has no block '{name}'")
-                continue
-            text = pattern(name).sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
-        atomic_write_text(document, text)
+    fill_blocks(DOC, blocks(data))
+    fill_blocks(ROOT / "README.md", blocks(data), required=False)
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--doc", action="store_true", help="write docs/bench-forms.md's tables")
-    args = parser.parse_args()
-    if args.doc:
-        write_doc(json.loads(OUT.read_text()))
-        return 0
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(OUT, to_json(run()))
-    print(f"written: {OUT}", file=sys.stderr)
-    return 0
+    return study_main("docs/bench-forms.md", OUT, run, write_doc)
 
 
 if __name__ == "__main__":

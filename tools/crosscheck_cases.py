@@ -20,19 +20,16 @@ the default variant to that condition.
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from readme import pattern
+from readme import fill_blocks, head_commit, study_main
 
 import signorini
-from signorini.files import atomic_write_text, to_json
 from signorini.studies.suite import DEFAULT_CASES
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -52,16 +49,8 @@ VARIANTS = {
 }
 
 
-def commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                              text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def run() -> dict:
-    data = {"command": "python tools/crosscheck_cases.py", "tol": TOL, "commit": commit(),
+    data = {"command": "python tools/crosscheck_cases.py", "tol": TOL, "commit": head_commit(),
             "machine": f"{platform.node()}: {platform.processor() or platform.machine()}, "
                        f"{os.cpu_count()} cores, Python {platform.python_version()}",
             "load_before": list(os.getloadavg()), "variants": {}}
@@ -131,27 +120,11 @@ def blocks(data: dict) -> dict[str, str]:
 
 
 def write_doc(data: dict) -> None:
-    text = DOC.read_text(encoding="utf-8")
-    for name, body in blocks(data).items():
-        if not pattern(name).search(text):
-            raise SystemExit(f"{DOC.name} has no block '{name}'")
-        text = pattern(name).sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
-    atomic_write_text(DOC, text)
+    fill_blocks(DOC, blocks(data))
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--doc", action="store_true", help="write docs/crosscheck.md's tables")
-    args = parser.parse_args()
-    if args.doc:
-        import json
-
-        write_doc(json.loads(OUT.read_text()))
-        return 0
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(OUT, to_json(run()))
-    print(f"written: {OUT}", file=sys.stderr)
-    return 0
+    return study_main("docs/crosscheck.md", OUT, run, write_doc)
 
 
 if __name__ == "__main__":

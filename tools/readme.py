@@ -84,6 +84,51 @@ def pattern(name: str) -> re.Pattern:
     return re.compile(rf"(<!-- generated: {name} -->\n)(.*?)(\n?<!-- end generated -->)", re.S)
 
 
+def fill_blocks(document: Path, bodies: dict[str, str], required: bool = True) -> None:
+    """Write each generated block of ``document`` from ``bodies``; a block the document lacks
+    stops the tool when ``required`` (the study's own page), else is left out (the README)."""
+    text = document.read_text(encoding="utf-8")
+    for name, body in bodies.items():
+        if not pattern(name).search(text):
+            if required:
+                raise SystemExit(f"{document.name} has no block '{name}'")
+            continue
+        text = pattern(name).sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
+    atomic_write_text(document, text)
+
+
+def head_commit() -> str:
+    """HEAD's short hash (or $SIGNORINI_COMMIT when run from an export of a commit)."""
+    import os
+    import subprocess
+
+    if os.environ.get("SIGNORINI_COMMIT"):
+        return os.environ["SIGNORINI_COMMIT"]
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def study_main(doc: str, out: Path, run, write_doc) -> int:
+    """The command line of a study tool: ``--doc`` renders ``doc``'s tables from the committed
+    ``out``; without it the study runs and ``out`` is written (atomically)."""
+    import argparse
+
+    from signorini.files import to_json
+
+    parser = argparse.ArgumentParser(description=sys.modules["__main__"].__doc__.split("\n")[0])
+    parser.add_argument("--doc", action="store_true", help=f"write {doc}'s tables")
+    if parser.parse_args().doc:
+        write_doc(json.loads(out.read_text()))
+        return 0
+    out.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out, to_json(run()))
+    print(f"written: {out}", file=sys.stderr)
+    return 0
+
+
 def current(text: str, name: str) -> str | None:
     match = pattern(name).search(text)
     return match.group(2) if match else None

@@ -174,18 +174,26 @@ class FactorTooLarge(InputError):
     its numeric phase)."""
 
 
+def gigabytes_from(variable: str) -> float | None:
+    """Bytes from the environment variable ``variable`` given in GB (None when it is not set);
+    anything but a positive number is an input error naming it."""
+    text = os.environ.get(variable)
+    if text is None:
+        return None
+    try:
+        limit = float(text) * 1e9
+    except ValueError:
+        limit = float("nan")
+    if not (limit > 0 and np.isfinite(limit)):
+        raise InputError(f"{variable}={text!r} must be a positive number of GB, e.g. {variable}=16")
+    return limit
+
+
 def factor_memory_limit() -> float:
     """Bytes a factorisation may take: ``SIGNORINI_MAX_FACTOR_GB``, else MemAvailable (inf when
     the system does not say)."""
-    text = os.environ.get(FACTOR_MEMORY_VARIABLE)
-    if text is not None:
-        try:
-            limit = float(text) * 1e9
-        except ValueError:
-            limit = float("nan")
-        if not limit > 0:
-            raise InputError(f"{FACTOR_MEMORY_VARIABLE}={text!r} must be a positive number of GB, "
-                             f"e.g. {FACTOR_MEMORY_VARIABLE}=16")
+    limit = gigabytes_from(FACTOR_MEMORY_VARIABLE)
+    if limit is not None:
         return limit
     try:
         with open("/proc/meminfo", encoding="ascii") as meminfo:

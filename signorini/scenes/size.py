@@ -39,6 +39,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from signorini.errors import InputError
+from signorini.numerics.factor import gigabytes_from
 
 #: the environment variable that raises (or lowers) the memory a scene may take, in GB
 MEMORY_VARIABLE = "SIGNORINI_MAX_MEMORY_GB"
@@ -123,15 +124,8 @@ def physical_memory() -> float:
 
 def memory_limit() -> float:
     """Bytes a scene may take: ``SIGNORINI_MAX_MEMORY_GB``, else ¾ of the physical memory."""
-    text = os.environ.get(MEMORY_VARIABLE)
-    if text is not None:
-        try:
-            limit = float(text) * 1e9
-        except ValueError:
-            limit = float("nan")
-        if not (limit > 0 and math.isfinite(limit)):
-            raise InputError(f"{MEMORY_VARIABLE}={text!r} must be a positive number of GB, "
-                             f"e.g. {MEMORY_VARIABLE}=20")
+    limit = gigabytes_from(MEMORY_VARIABLE)
+    if limit is not None:
         return limit
     total = physical_memory()
     return 0.75 * total if math.isfinite(total) else math.inf
