@@ -112,3 +112,32 @@ def test_cli_converge(tmp_path, capsys):
     assert "Fitted rates" in capsys.readouterr().out
     assert main(["converge", "block", "--levels", "1", "--out", str(out)]) == 2
     assert "refine" in capsys.readouterr().err
+
+
+def test_the_rates_docs_convergence_states_are_the_committed_studies():
+    """docs/convergence.md's fitted rates, as written, from the committed study JSONs
+    (docs/convergence/convergence-*.json), for both exact methods, which must agree."""
+    import json
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "docs" / "convergence.md").read_text(encoding="utf-8")
+
+    def rates(scene):
+        study = json.loads((root / "docs" / "convergence" / f"convergence-{scene}.json").read_text())
+        found = study["study"]["rates"]
+        assert set(found) >= {"pdas", "condensed"}
+        for metric, value in found["pdas"].items():
+            assert found["condensed"][metric] == pytest.approx(value, abs=1e-6)
+        return found["pdas"]
+
+    cylinder = rates("hertz-cylinder")
+    assert (f"**p₀ {cylinder['p0_rel']:.2f}, a {cylinder['a_rel']:.2f}, pressure L2 "
+            f"{cylinder['pressure_l2_rel']:.2f}**") in text
+    punch = rates("punch")
+    assert (f"interior max error **{punch['pressure_max_rel']:.2f}**, interior L2 "
+            f"**{punch['pressure_l2_rel']:.2f}**, edge node pressure "
+            f"**{punch['edge_over_centre']:.2f}**").replace("-", "−") in text
+    reverse = rates("reverse-hertz")
+    assert f"p₀ {reverse['p0_rel']:.2f}, pressure L2 {reverse['pressure_l2_rel']:.2f}" in text
+    assert f"({reverse['a_rel']:.2f})".replace("-", "−") in text
