@@ -58,7 +58,7 @@ def test_bad_load_ranges_are_refused(text):
         parse_loads(text)
 
 
-def test_sweep_command_writes_its_files(tmp_path, capsys):
+def test_sweep_command_writes_its_files(tmp_path, capsys, saved_figures):
     out = tmp_path / "sweep"
     code = main(["sweep", "hertz-cylinder", "--load", "0.001:0.003:3", "--set", "n_contact=16",
                  "--set", "grading=0.4", "--out", str(out)])
@@ -66,4 +66,13 @@ def test_sweep_command_writes_its_files(tmp_path, capsys):
     record = json.loads((out / "sweep.json").read_text())
     assert len(record["levels"]) == 3
     assert (out / "sweep.png").stat().st_size > 10_000
+    (figure,) = saved_figures  # a against the load, p₀ on a twin axis, both with Hertz's √P
+    width, peak = figure.axes
+    assert width.get_xlabel() == "load P per unit thickness"
+    assert width.get_ylabel() == "contact half-width a" and peak.get_ylabel() == "peak pressure p₀"
+    lines = {line.get_label(): line for ax in figure.axes for line in ax.get_lines()}
+    assert {"a (numeric)", "Hertz a ∝ √P", "p₀ (numeric)", "Hertz p₀ ∝ √P"} <= set(lines)
+    levels = record["levels"]
+    assert list(lines["a (numeric)"].get_ydata()) == pytest.approx([r["a"] for r in levels])
+    assert list(lines["p₀ (numeric)"].get_ydata()) == pytest.approx([r["p0"] for r in levels])
     assert (out / "sweep.csv").read_text().count("\n") == 4

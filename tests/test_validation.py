@@ -38,9 +38,19 @@ def test_the_papers_uzawa_reaches_the_exact_answer(hertz):
     assert hertz.paper.extras["rho_over_bound"] == pytest.approx(0.9)
 
 
-def test_hertz_figure_is_written(hertz, tmp_path):
+def test_hertz_figure_shows_both_methods_against_hertz(hertz, tmp_path, saved_figures):
     path = hertz.visualize(tmp_path / "p.png")
     assert path.stat().st_size > 10_000
+    (figure,) = saved_figures
+    (ax,) = figure.axes
+    assert ax.get_xlabel() == "x / a (Hertz)" and ax.get_ylabel() == "p / p₀ (Hertz)"
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    assert {"Hertz", "pdas (exact)", "uzawa (the paper)"} <= set(lines)
+    assert {t.get_text() for t in ax.get_legend().get_texts()} >= {"Hertz", "pdas (exact)"}
+    exact, paper = lines["pdas (exact)"].get_ydata(), lines["uzawa (the paper)"].get_ydata()
+    assert len(exact) == hertz.problem.m and np.allclose(exact, paper, atol=1e-4)
+    assert np.max(exact) == pytest.approx(1.0, abs=0.01)  # the peak at Hertz's p₀, within 1 %
+    assert np.max(lines["Hertz"].get_ydata()) == pytest.approx(1.0)
 
 
 def test_block_patch_test_is_exact():
