@@ -7,7 +7,6 @@ the ``mpirun`` tests also when no ``mpirun`` is on the PATH. Never more
 ranks than cores: an oversubscribed run is 20–40× slower.
 """
 
-import importlib.util
 import json
 import subprocess
 import sys
@@ -78,9 +77,15 @@ def test_rows_sharing_a_dof_have_no_bound_form():
     shared = problem.with_data(N=sp.csr_matrix(N))
     with pytest.raises(NoBoundForm, match="share a dof"):
         bound_form(shared)
-    if importlib.util.find_spec("petsc4py") is not None:  # the method says so, and fails
-        answer = solve(shared, "petsc-vi")
-        assert answer.status == "failed" and "share a dof" in answer.message
+
+
+def test_petsc_vi_says_that_rows_share_a_dof_and_fails():
+    pytest.importorskip("petsc4py", reason="petsc-vi needs petsc4py (make installs it)")
+    problem = random_problem(12, 4, seed=3)
+    N = problem.N.tolil()
+    N[1, :] = N[0, :]  # two rows on the same dofs
+    answer = solve(problem.with_data(N=sp.csr_matrix(N)), "petsc-vi")
+    assert answer.status == "failed" and "share a dof" in answer.message
 
 
 def test_a_row_without_free_dofs_bounds_nothing_or_is_infeasible():
