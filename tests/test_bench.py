@@ -54,7 +54,7 @@ def test_rows_resume_and_time_limit(tmp_path):
 
 
 @pytest.mark.slow
-def test_summary_metrics(tmp_path):
+def test_summary_metrics(tmp_path, saved_figures):
     csv_path = run_benchmark(runs(("pdas", "high"), ("qp-scs", "default")), tmp_path)
     table = {s["method"]: s for s in summary(read_rows(csv_path))}
     assert table["pdas"]["success_rate"] == 1.0 and table["pdas"]["correct_rate"] == 1.0
@@ -68,6 +68,19 @@ def test_summary_metrics(tmp_path):
     text = report.read_text()
     assert "| pdas | high | 1 | 100% | 100% |" in text
     assert (tmp_path / "speed-vs-kkt.png").stat().st_size > 5_000
+    # the speed–accuracy figure: each run at its time and worst KKT residual, filled only where
+    # the package says converged (SCS's refused claim is a hollow marker)
+    (ax,) = saved_figures[0].axes
+    assert ax.get_xlabel() == "time [s]" and ax.get_ylabel() == "worst relative KKT residual"
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    assert set(lines) == {"pdas @ high", "qp-scs @ default"}
+    assert {t.get_text() for t in ax.get_legend().get_texts()} == set(lines)
+    for row in read_rows(csv_path):
+        line = lines[f"{row['method']} @ {row['tolerance']}"]
+        assert line.get_xdata()[0] == pytest.approx(row["time_s"])
+        assert line.get_ydata()[0] == pytest.approx(max(row["kkt_worst"], 1e-16))
+        assert (line.get_markerfacecolor() == "none") == (row["status"] != "converged")
+    assert lines["pdas @ high"].get_color() != lines["qp-scs @ default"].get_color()
 
 
 def test_bench_command_checks_its_arguments(tmp_path, capsys):

@@ -4,6 +4,7 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from signorini.cli import main
@@ -115,7 +116,7 @@ def test_unwritable_outputs_are_input_errors(capsys, tmp_path):
 
 
 @pytest.mark.slow
-def test_validate_writes_a_passing_report(capsys, tmp_path):
+def test_validate_writes_a_passing_report(capsys, tmp_path, saved_figures):
     out_dir = tmp_path / "report"
     code, out, err = run(capsys, "validate", "--method", "pdas", "--method", "uzawa",
                          "--out", str(out_dir))
@@ -126,6 +127,15 @@ def test_validate_writes_a_passing_report(capsys, tmp_path):
     assert {r["method"] for r in report["runs"]} == {"pdas", "uzawa"}
     assert (out_dir / "report.md").read_text().startswith("# signorini validation report")
     assert (out_dir / "hertz-cylinder-pressure.png").stat().st_size > 10_000
+    # the pressure figure plots both methods asked for against Hertz's curve, in Hertz's units
+    (ax,) = [ax for f in saved_figures for ax in f.axes
+             if ax.get_title().startswith("hertz-cylinder: contact pressure")]
+    assert ax.get_xlabel() == "x / a (Hertz)" and ax.get_ylabel() == "p / p₀ (Hertz)"
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    (uzawa,) = [label for label in lines if label.startswith("uzawa")]
+    exact = np.asarray(lines["pdas"].get_ydata())
+    assert exact.max() == pytest.approx(1.0, abs=0.02)  # the peak is Hertz's p0
+    np.testing.assert_allclose(lines[uzawa].get_ydata(), exact, atol=1e-5)
     assert "hertz-cylinder" in err  # progress goes to stderr
 
 

@@ -10,6 +10,7 @@ from signorini.errors import InputError
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 from signorini.studies.convergence import (
+    LABELS,
     dofs_for_error,
     fitted_rate,
     grading_comparison,
@@ -53,8 +54,13 @@ def test_exact_methods_coincide_and_errors_fall(hertz_study):
     for method in study.methods:
         _, dofs, p0 = study.series(method, "p0_rel")
         assert len(p0) == 3 and np.all(np.diff(dofs) > 0)
-        assert p0[-1] < p0[0]
-        assert study.rates[method]["p0_rel"] > 0.5
+        h, _, l2 = study.series(method, "pressure_l2_rel")
+        # first order (docs/convergence.md pins 1.00 on the committed study): every halving of h at
+        # least halves p0's error here, where the tiny meshes are still pre-asymptotic (faster)
+        assert np.all(p0[:-1] / p0[1:] >= 2.0)
+        assert study.rates[method]["p0_rel"] == pytest.approx(fitted_rate(h, p0))
+        assert study.rates[method]["pressure_l2_rel"] == pytest.approx(fitted_rate(h, l2))
+        assert study.rates[method]["pressure_l2_rel"] >= 0.95
     rates = [study.rates[m]["p0_rel"] for m in study.methods]
     assert max(rates) - min(rates) < 1e-6
 
@@ -62,7 +68,8 @@ def test_exact_methods_coincide_and_errors_fall(hertz_study):
 def test_punch_study_shows_the_edge_singularity():
     study = run_study("punch", 2, {"n_contact": 4, "grading": 0.8, "size": 6}, methods=["pdas"])
     assert study.rates["pdas"]["edge_over_centre"] == pytest.approx(-0.5, abs=0.1)
-    assert study.rates["pdas"]["pressure_max_rel"] > 0.5
+    # the peak pressure's error falls at first order (1.15 on the committed 4-level study)
+    assert study.rates["pdas"]["pressure_max_rel"] == pytest.approx(1.1, abs=0.2)
 
 
 @pytest.mark.slow
@@ -75,11 +82,23 @@ def test_grading_comparison_at_equal_dofs():
         assert ax.get_xscale() == "log"
 
 
-def test_write_study_writes_markdown_json_and_figures(hertz_study, tmp_path):
+def test_write_study_writes_markdown_json_and_figures(hertz_study, tmp_path, saved_figures):
     paths = write_study(hertz_study, tmp_path, "signorini converge hertz-cylinder --levels 2")
     payload = json.loads(paths["json"].read_text())
     assert payload["study"]["scene"] == "hertz-cylinder"
     assert "rates" in payload["study"] and paths["figure"].stat().st_size > 10_000
+    # the figure shows each method's errors against h, its fitted rate in the legend
+    (ax,) = saved_figures[0].axes
+    assert ax.get_xscale() == ax.get_yscale() == "log" and ax.get_xlabel().startswith("h ")
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    legend = {t.get_text() for t in ax.get_legend().get_texts()}
+    for method in hertz_study.methods:
+        h, _, p0 = hertz_study.series(method, "p0_rel")
+        rate = hertz_study.rates[method]["p0_rel"]
+        label = f"{LABELS['p0_rel']} ({method}): rate {rate:.2f}"
+        assert label in legend
+        np.testing.assert_allclose(lines[label].get_xdata(), h)
+        np.testing.assert_allclose(lines[label].get_ydata(), np.abs(p0))
     assert "Fitted rates" in paths["markdown"].read_text()
 
 

@@ -85,7 +85,7 @@ def test_getfem_solves_hertz_on_a_coarse_mesh(scene, tolerance):
 
 @pytest.mark.slow
 @pytest.mark.usefixtures("getfem")
-def test_the_command_writes_the_table_on_a_tiny_ladder(tmp_path, capsys):
+def test_the_command_writes_the_table_on_a_tiny_ladder(tmp_path, capsys, saved_figures):
     out = tmp_path / "peer"
     code = main(["bench", "--peer", "getfem", "--scene", "hertz-cylinder", "--sizes", "0",
                  "--repeat", "1", "--out", str(out)])
@@ -98,6 +98,16 @@ def test_the_command_writes_the_table_on_a_tiny_ladder(tmp_path, capsys):
     table = (out / "peer.md").read_text()
     assert "| hertz-cylinder | GetFEM | h = a/16 |" in table and "| signorini |" in table
     assert "0.3 %" in table
+    # the figure: each code's |p0| and |a| errors against dofs (left) and wall time (right)
+    left, right = saved_figures[0].axes
+    assert left.get_xlabel() == "dofs" and right.get_xlabel() == "whole-process wall time [s]"
+    for ax, x in ((left, "dofs"), (right, "wall_s")):
+        lines = {line.get_label(): line for line in ax.get_lines()}
+        for row in rows:
+            for key, name in (("p0_rel", "p₀"), ("a_rel", "a")):
+                line = lines[f"{row['code']}: {name}"]
+                assert line.get_xdata()[0] == pytest.approx(float(row[x]))
+                assert line.get_ydata()[0] == pytest.approx(max(abs(float(row[key])), 1e-6))
     record = json.loads((out / "peer.json").read_text())
     assert record["repeat"] == 1 and len(record["rows"][0]["walls_s"]) == 1
 

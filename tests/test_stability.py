@@ -226,7 +226,7 @@ def test_each_axis_is_one_module_with_everything_about_it():
     assert select_axes(["uzawa-step", "8", "1"]) == (AXES[0], AXES[7])
 
 
-def test_a_quick_axis_writes_its_files(tmp_path):
+def test_a_quick_axis_writes_its_files(tmp_path, saved_figures):
     result = run_atlas(select_axes(["1"]), quick=True, isolate=False)
     assert {r["axis"] for r in result.rows} == {"uzawa-step"}
     paths = write_report(result, tmp_path, "signorini stability --axis 1 --quick")
@@ -238,6 +238,17 @@ def test_a_quick_axis_writes_its_files(tmp_path):
     data = json.loads((tmp_path / "stability" / "runs.json").read_text())
     assert data["wrapper"]["runs"] == len(result.rows)
     assert (tmp_path / "stability" / "axis1-uzawa-step.png").stat().st_size > 10_000
+    # the figure: iterations against the step, one line per scene and method, the bound at 1
+    (ax,) = saved_figures[0].axes
+    assert ax.get_xlabel() == "step ρ / (2/λ_max(W))" and ax.get_xscale() == "log"
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    assert "ρ = 2/λ_max(W)" in lines and list(lines["ρ = 2/λ_max(W)"].get_xdata()) == [1.0, 1.0]
+    for (case, method) in {(r["case"], r["method"]) for r in result.rows}:
+        mine = sorted((r for r in result.rows if (r["case"], r["method"]) == (case, method)),
+                      key=lambda r: r["value"])
+        line = lines[f"{case}, {method}"]
+        np.testing.assert_allclose(line.get_xdata(), [r["value"] for r in mine])
+        np.testing.assert_allclose(line.get_ydata(), [max(r["iterations"], 1) for r in mine])
     assert paths["report"] == tmp_path / "stability.md"
     right, runs, faults = wrapper_record(result.rows)
     assert right == runs and not faults
