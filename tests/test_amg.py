@@ -92,6 +92,7 @@ def test_a_predicted_active_set_saves_steps(problems):
     assert_agrees(problem, solution, exact)
 
 
+@pytest.mark.slow
 def test_a_coarse_model_predicts_the_first_active_set():
     problem = build_problem("hertz-sphere-3d", refine=1, n_contact=8, delta=0.0025)
     solution = solve(problem, "pdas-amg", amg="pyamg")

@@ -54,6 +54,7 @@ def test_nested_equals_pdas_on_the_cylinder(cylinder):
     assert certificate(cylinder, nested).worst()[1] < 1e-10
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene, nu", [("hertz-cylinder", 0.3), ("hertz-sphere", 0.0),
                                        ("hertz-sphere", 0.45)])
 def test_the_analytic_zone_predicts_on_one_factorisation(scene, nu):

@@ -153,6 +153,7 @@ def test_a_file_that_does_not_import_is_an_input_error_naming_it(capsys, tmp_pat
     assert not (tmp_path / "r.json").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("function, words", [
     ("hangs", ["failed", "no answer within 3 s: the run was stopped"]),
     ("kills_its_process", ["failed", "the worker process died"]),
