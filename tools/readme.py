@@ -73,7 +73,9 @@ def blocks(document: Path = README) -> dict[str, str]:
                 "amg": amg_bench.readme_paragraph(amg_bench.read()),
                 **stability.tables(stability.load())}
     if document == ACCURACY:
-        return accuracy.tables(accuracy.load())
+        peer = peer_table(json.loads((ROOT / "docs" / "peer-nu0" / "peer.json").read_text())["rows"])
+        return {**accuracy.tables(accuracy.load()),
+                "peer-nu0": "\n".join(peer[:peer.index("")])}  # every run of docs/peer-nu0
     if document == ESTIMATE:
         return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"))
     raise ValueError(f"no generated blocks for {document}")
