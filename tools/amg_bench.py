@@ -42,7 +42,17 @@ SPHERE_350K = {"refine": 2, "delta": 0.0025}
 SPHERE_1M = {"refine": 2, "n_contact": 24, "delta": 0.0025}
 SPHERE_350K_LOAD = {"refine": 2}
 PARTS = ("backends", "crossover", "whole-350k", "petsc-350k", "whole-1m", "whole-350k-load",
-         "petsc-350k-load")
+         "petsc-350k-load", "scale")
+#: the scale table (part ``scale``): a push, so that every method solves the same problem
+SCALE_SIZES = {"50k": {"refine": 1, "delta": 0.0025}, "350k": SPHERE_350K, "1m": SPHERE_1M}
+#: (label, method, options, MPI ranks)
+SCALE_METHODS = (("pdas-amg", "pdas-amg", (), 1),
+                 ("petsc-vi, 1 rank", "petsc-vi", ("ksp=gamg",), 1),
+                 ("petsc-vi, 2 ranks", "petsc-vi", ("ksp=gamg",), 2),
+                 ("nested", "nested", (), 1), ("pdas", "pdas", (), 1))
+SCALE_TIMEOUT = 900.0
+#: one AMG solve's relative residual: pdas-amg drives stationarity to 0.1 · tol (tol 1e-9)
+AMG_RTOL = 1e-10
 
 
 def machine() -> dict:
@@ -66,27 +76,50 @@ def command_line(params: dict) -> list[str]:
     return words
 
 
-def whole(params: dict) -> dict:
-    """The default command under /usr/bin/time -v: wall time, peak memory and its record."""
+def timed(words: list[str], timeout: float | None = None,
+          env: dict | None = None) -> tuple[subprocess.CompletedProcess | None, dict]:
+    """``words`` under /usr/bin/time -v: the finished process (None on timeout) and its wall time
+    (``wall_s``) and peak resident memory of its largest process (``peak_gb``)."""
+    try:
+        proc = subprocess.run(["/usr/bin/time", "-v", *words], capture_output=True, text=True,
+                              cwd=ROOT, timeout=timeout, env=env)
+    except subprocess.TimeoutExpired:
+        return None, {"wall_s": float(timeout), "peak_gb": float("nan")}
+    timing = dict(line.strip().rsplit(": ", 1) for line in proc.stderr.splitlines()
+                  if ": " in line and line.startswith("\t"))
+    clock = timing.get("Elapsed (wall clock) time (h:mm:ss or m:ss)", "0:0").split(":")
+    return proc, {"wall_s": sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock))),
+                  "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2}
+
+
+def whole(params: dict, method: str | None = None, options: tuple[str, ...] = (), ranks: int = 1,
+          timeout: float | None = None) -> dict:
+    """The command (by default the default one) under /usr/bin/time -v: wall time, peak memory
+    and its record; ``ranks`` > 1 runs it under mpirun."""
     with tempfile.TemporaryDirectory() as tmp:
         record_path = Path(tmp) / "result.json"
-        words = command_line(params) + ["--json", str(record_path)]
+        words = command_line(params) + (["--method", method] if method else [])
+        for option in options:
+            words += ["--opt", option]
+        words += ["--json", str(record_path)]
+        env = None
+        if ranks > 1:
+            from signorini.solvers.cluster import mpirun_command
+
+            words, env = mpirun_command(ranks, words)
         before = load()
-        proc = subprocess.run(["/usr/bin/time", "-v", *words], capture_output=True, text=True,
-                              cwd=ROOT)
-        timing = dict(line.strip().rsplit(": ", 1) for line in proc.stderr.splitlines()
-                      if ": " in line and line.startswith("\t"))
+        proc, timing = timed(words, timeout, env)
         record = json.loads(record_path.read_text()) if record_path.exists() else None
-    clock = timing.get("Elapsed (wall clock) time (h:mm:ss or m:ss)", "0:0").split(":")
-    wall = sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock)))
     keep = ("scene", "params", "method", "status", "message", "iterations", "dofs",
             "contact_candidates", "time", "kkt", "total_force", "hertz", "extras")
     env = [f"{k}={os.environ[k]}" for k in ("SIGNORINI_MAX_MEMORY_GB",) if k in os.environ]
-    return {"command": " ".join(env + ["/usr/bin/time", "-v", *words[:1]]).replace(str(ROOT) + "/", "")
-            + " " + " ".join(words[1:-2]),
-            "returncode": proc.returncode, "wall_s": wall,
-            "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2,
+    shown = " ".join(words[:-2]).replace(str(ROOT) + "/", "")
+    lines = proc.stderr.strip().splitlines() if proc is not None else []
+    said = [line for line in lines if line.startswith("signorini")]
+    return {"command": " ".join(env + ["/usr/bin/time", "-v", shown]),
+            "returncode": None if proc is None else proc.returncode, **timing,
             "load_before": before, "load_after": load(),
+            "said": said[-1] if said else ("timed out" if proc is None else ""),
             "record": None if record is None else {k: record.get(k) for k in keep if k in record}}
 
 
@@ -160,7 +193,48 @@ def petsc_350k(params: dict = SPHERE_350K, method: str = "pdas-amg") -> dict:
             "misclassified": agreement.misclassified}
 
 
-MEASURE = {"backends": backends, "crossover": crossover, "petsc-350k": petsc_350k,
+def one_amg_solve(params: dict, rtol: float = AMG_RTOL) -> dict:
+    """One GAMG set-up and CG solve of K (prescribed dofs pinned, no contact) from zero to ``rtol``:
+    the least an exact method without a factorisation can spend (run in a process of its own)."""
+    from signorini.numerics.multigrid import pinned_cg, pinned_matrix
+    from signorini.scenes import build_problem
+    from signorini.solvers import amg
+    from signorini.solvers.bounds import bound_form
+
+    problem = build_problem("hertz-sphere-3d", **params)
+    form = bound_form(problem)
+    pinned = form.lower == form.upper
+    A = pinned_matrix(form.K, pinned)
+    hierarchy = amg.GamgHierarchy(A, form.rigid_modes(), form.block)
+    setup = hierarchy.setup_s  # PETSc's import is not the hierarchy's
+    f = np.where(pinned, 0.0, form.f)
+    target = rtol * np.linalg.norm(f)
+    start = time.perf_counter()
+    result = pinned_cg(A, f, np.zeros(form.n), ~pinned, hierarchy.apply,
+                       lambda r2, ri, r0: r2 <= target, 5000)
+    return {"dofs": problem.n, "setup_s": setup, "solve_s": time.perf_counter() - start,
+            "iterations": result.iterations, "rtol": rtol}
+
+
+def scale() -> dict:
+    """Issue 14's table: at ~50k, ~350k and ~1M dofs, one AMG solve of K and each method's whole
+    command (its own process, /usr/bin/time -v), pdas and nested where they fit."""
+    sizes = {}
+    for name, params in SCALE_SIZES.items():
+        before = load()
+        proc, timing = timed([sys.executable, str(Path(__file__).resolve()), "amg-solve",
+                              json.dumps(params)], timeout=SCALE_TIMEOUT)
+        one = json.loads(proc.stdout.strip().splitlines()[-1]) if proc and proc.returncode == 0 else None
+        runs = {}
+        for label, method, options, ranks in SCALE_METHODS:
+            runs[label] = whole(params, method, options, ranks, timeout=SCALE_TIMEOUT)
+            print(f"{name} {label}: {runs[label]['wall_s']:.0f} s", file=sys.stderr, flush=True)
+        sizes[name] = {"params": params, "one_amg_solve": one, "one_amg_process": timing,
+                       "load_before": before, "load_after": load(), "runs": runs}
+    return {"sizes": sizes}
+
+
+MEASURE = {"backends": backends, "scale": scale, "crossover": crossover, "petsc-350k": petsc_350k,
            "whole-350k": lambda: whole(SPHERE_350K), "whole-1m": lambda: whole(SPHERE_1M),
            "whole-350k-load": lambda: whole(SPHERE_350K_LOAD),
            "petsc-350k-load": lambda: petsc_350k(SPHERE_350K_LOAD, "auto")}
@@ -280,7 +354,12 @@ def main() -> int:
     runner = sub.add_parser("run")
     runner.add_argument("--part", action="append", choices=PARTS)
     sub.add_parser("md")
+    solver = sub.add_parser("amg-solve")
+    solver.add_argument("params")
     args = parser.parse_args()
+    if args.what == "amg-solve":
+        print(json.dumps(one_amg_solve(json.loads(args.params))))
+        return 0
     if args.what == "run":
         run(args.part or list(PARTS))
     from signorini.files import atomic_write_text
