@@ -14,8 +14,8 @@ at assembly):
   may go on beyond the candidates.
 
 Either makes the result ``model_inadequate`` with a message naming what to
-change. Warnings that keep the status: ν > 0.45 with P1 triangles (volumetric
-locking: docs/accuracy.md and the atlas's ν axis) and an obstacle that starts
+change. Warnings that keep the status: ν > 0.45 with plain P1 triangles (volumetric
+locking: docs/accuracy.md and the atlas's ν axis; not with volumetric=nodal) and an obstacle that starts
 inside the body by more than the push.
 """
 
@@ -80,9 +80,10 @@ def warnings(problem: ContactProblem) -> list[str]:
     """What may make an exact answer a poor model (the status stays)."""
     said = []
     nu = problem.params.get("nu")
-    if isinstance(nu, (int, float)) and nu > LOCKING_NU:
+    if isinstance(nu, (int, float)) and nu > LOCKING_NU and problem.params.get("volumetric") == "element":
         said.append(f"ν = {nu:g} > {LOCKING_NU:g}: P1 triangles lock, the pressure can be several "
-                    "percent off (docs/accuracy.md); refine near the contact or lower ν")
+                    "percent off (docs/accuracy.md); set the scene parameter volumetric=nodal "
+                    "(the volumetric strain averaged at the nodes: no locking)")
     watch = problem.watch
     if watch is not None and watch.candidate_gaps.size:
         push = float(np.max(np.abs(problem.prescribed), initial=0.0))

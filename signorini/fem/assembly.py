@@ -41,6 +41,7 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.topology import moved
+from signorini.fem.volumetric import volumetric_stiffness
 from signorini.numerics.factor import FactorTooLarge
 from signorini.numerics.loading import calibrate_push
 from signorini.numerics.zone import ZoneSolver
@@ -113,9 +114,8 @@ def contact_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray,
     return asm(weight, basis)[nodes]
 
 
-def stiffness_form(model: SceneModel, E: float) -> BilinearForm:
+def stiffness_form(model: SceneModel, Lambda: float, Mu: float) -> BilinearForm:
     """The elastic bilinear form of ``model``: plane strain or 3D, or axisymmetric."""
-    Lambda, Mu = lame_parameters(E, model.nu)
     if model.axisymmetric:
         if model.mesh.p.shape[0] != 2:
             raise InputError("an axisymmetric scene needs a 2D mesh in (r, z)")
@@ -238,13 +238,25 @@ def solid_stiffness(mesh: Any, Lambda: float, Mu: float) -> sp.csr_matrix:
 
 
 def stiffness(model: SceneModel, mesh: Any, E: float) -> sp.csr_matrix:
-    """K of the whole mesh (no boundary conditions), dofs interleaved by node."""
+    """K of the whole mesh (no boundary conditions), dofs interleaved by node.
+
+    With ``model.volumetric == "nodal"`` the λ-part averages the volumetric
+    strain at the nodes (:mod:`signorini.fem.volumetric`: P1 without locking).
+    """
+    Lambda, Mu = lame_parameters(E, model.nu)
+    if model.volumetric == "nodal":
+        return (_elastic_stiffness(model, mesh, 0.0, Mu)
+                + volumetric_stiffness(mesh, Lambda, model.axisymmetric)).tocsr()
+    return _elastic_stiffness(model, mesh, Lambda, Mu)
+
+
+def _elastic_stiffness(model: SceneModel, mesh: Any, Lambda: float, Mu: float) -> sp.csr_matrix:
     if mesh.p.shape[0] == 2 and not model.axisymmetric:
-        return plane_strain_stiffness(mesh, *lame_parameters(E, model.nu))
+        return plane_strain_stiffness(mesh, Lambda, Mu)
     if mesh.p.shape[0] == 3 and mesh.t.shape[0] == 4:
-        return solid_stiffness(mesh, *lame_parameters(E, model.nu))
+        return solid_stiffness(mesh, Lambda, Mu)
     basis = Basis(mesh, ElementVector(mesh.elem()))
-    return asm(stiffness_form(model, E), basis).tocsr()
+    return asm(stiffness_form(model, Lambda, Mu), basis).tocsr()
 
 
 def nodal_dofs(mesh: Any) -> np.ndarray:
@@ -335,7 +347,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None) -> Co
         scale, calibration, zone_solver = _calibrate(
             K_II, N_free, lifted, target, model.force_multiplicity, zone, model.predicted_contact)
     f, d, load_offset, full = lifted(scale)
-    params = dict(model.params)
+    params = dict(model.params, volumetric=model.volumetric)  # auto resolved: what K integrates
     if model.target_load is not None:
         delta_nominal = -min(v for c, _, v in model.dirichlet if c == model.load_dofs[0])
         params["delta"] = delta_nominal * scale

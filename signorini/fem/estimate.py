@@ -45,6 +45,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem.quadrature import get_quadrature
 
+from signorini.fem.volumetric import nodal_volumetric_strain
 from signorini.problem import ContactProblem, ContactSolution
 
 #: quadrature order of the element integrals: 2 integrates the plane-strain and 3D ones
@@ -147,15 +148,19 @@ def strains(mesh: Any, u: np.ndarray, rule: Quadrature, axisymmetric: bool = Fal
     return np.array(parts)
 
 
-def energy_density(eps: np.ndarray, Lambda: float, Mu: float, dim: int) -> np.ndarray:
+def energy_density(eps: np.ndarray, Lambda: float, Mu: float, dim: int,
+                   trace: np.ndarray | None = None) -> np.ndarray:
     """``ε : C : ε = 2μ ε : ε + λ (tr ε)²`` of strains laid out as :func:`strains` gives them.
 
     The first ``dim`` components are the diagonal, the next ``dim (dim − 1) / 2``
     the shears (counted twice in ``ε : ε``) and one more, if any, the hoop strain.
+    ``trace`` replaces ``tr ε`` in the λ term: the volumetric strain averaged at
+    the nodes when K was assembled so (:mod:`signorini.fem.volumetric`).
     """
     shears = dim * (dim - 1) // 2
     diagonal = np.concatenate([eps[:dim], eps[dim + shears:]])
-    trace = diagonal.sum(axis=0)
+    if trace is None:
+        trace = diagonal.sum(axis=0)
     squares = np.sum(diagonal ** 2, axis=0) + 2.0 * np.sum(eps[dim:dim + shears] ** 2, axis=0)
     return 2.0 * Mu * squares + Lambda * trace ** 2
 
@@ -283,13 +288,15 @@ def boundary_normals(mesh: Any, nodes: np.ndarray) -> np.ndarray:
 
 
 def pressure_estimate(problem: ContactProblem, solution: ContactSolution, nodal: np.ndarray,
-                      Lambda: float, Mu: float) -> PressureEstimate | None:
+                      Lambda: float, Mu: float,
+                      nodal_trace: np.ndarray | None = None) -> PressureEstimate | None:
     """:class:`PressureEstimate` from the recovered nodal strain ``nodal`` (2D models, None else).
 
     ``p*`` is the traction ``σ* ν`` on the body's curved boundary (outward
     normal ν) along the obstacle's normal — the direction of N's row: on
     Hertz's cylinder at x = 0.7 a, taking ν as the obstacle's normal instead
-    biases p* by about 0.2 % of p₀ for any mesh (measured).
+    biases p* by about 0.2 % of p₀ for any mesh (measured). ``nodal_trace`` is the
+    volumetric strain at the nodes when K averages it there (else the recovered strain's trace).
     """
     mesh, dim = problem.mesh, problem.mesh.p.shape[0]
     if dim != 2 or problem.weights is None or not np.all(np.isfinite(solution.lam)):
@@ -299,7 +306,7 @@ def pressure_estimate(problem: ContactProblem, solution: ContactSolution, nodal:
     except ValueError:
         return None
     e = nodal[:, nodes]
-    trace = e[0] + e[1] + (e[3] if len(e) > 3 else 0.0)
+    trace = e[0] + e[1] + (e[3] if len(e) > 3 else 0.0) if nodal_trace is None else nodal_trace[nodes]
     sxx, syy, sxy = Lambda * trace + 2.0 * Mu * e[0], Lambda * trace + 2.0 * Mu * e[1], 2.0 * Mu * e[2]
     nu = boundary_normals(mesh, nodes)
     towards = unit_normals(problem, dim).T  # the obstacle's normal, from the body to the obstacle
@@ -348,10 +355,17 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
     u = problem.expand(solution.u).reshape(-1, dim)
     rule = quadrature(mesh, axisymmetric)
     eps = strains(mesh, u, rule, axisymmetric)
-    energy = np.sum(energy_density(eps, Lambda, Mu, dim) * rule.dx, axis=1)
+    theta = theta_points = jump = None
+    if problem.params.get("volumetric") == "nodal":
+        # K's λ-part sees the volumetric strain averaged at the nodes: a continuous P1 field,
+        # which ZZ's recovery leaves as it is; only the strain's other part jumps
+        theta = nodal_volumetric_strain(mesh, u, axisymmetric)
+        theta_points = np.einsum("ke,kq->eq", theta[mesh.t], rule.bary)
+        jump = np.zeros_like(theta_points)
+    energy = np.sum(energy_density(eps, Lambda, Mu, dim, theta_points) * rule.dx, axis=1)
     nodal = nodal_recovery(mesh, eps, rule)
     recovered = np.einsum("cke,kq->ceq", nodal[:, mesh.t], rule.bary)
-    squares = np.sum(energy_density(recovered - eps, Lambda, Mu, dim) * rule.dx, axis=1)
+    squares = np.sum(energy_density(recovered - eps, Lambda, Mu, dim, jump) * rule.dx, axis=1)
     recovery = float(np.sqrt(squares.sum()))
     contact_squares = np.zeros_like(squares)
     if contact and problem.weights is not None and np.all(np.isfinite(solution.lam)):
@@ -368,5 +382,5 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
                          contact=float(np.sqrt(contact_squares.sum())),
                          energy_norm=float(np.sqrt(energy.sum())),
                          scale=float(np.sqrt(s.force * s.displacement)),
-                         pressure=pressure_estimate(problem, solution, nodal, Lambda, Mu)
+                         pressure=pressure_estimate(problem, solution, nodal, Lambda, Mu, theta)
                          if contact else None)

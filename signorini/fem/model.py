@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from signorini.fem.volumetric import resolve
+
 
 @dataclass
 class FlatObstacle:
@@ -83,3 +85,10 @@ class SceneModel:
     predicted_contact: np.ndarray | None = None
     #: what to change when the contact outgrows the candidates (signorini.adequacy)
     candidate_remedy: str = "extend the scene's contact candidates or lower the load"
+
+    @property
+    def volumetric(self) -> str:
+        """How K integrates λ (tr ε)²: ``element`` (plain P1) or ``nodal`` (signorini.fem.volumetric).
+
+        The scene parameter ``volumetric`` (``auto`` by default: nodal from ν = 0.4 on)."""
+        return resolve(self.params.get("volumetric", "auto"), self.nu)

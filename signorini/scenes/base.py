@@ -15,6 +15,7 @@ from typing import Any, Callable
 
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
+from signorini.fem.volumetric import CHOICES
 
 
 @dataclass(frozen=True)
@@ -88,6 +89,13 @@ MESHER = Param("mesher", "relaxed",
                "relaxed: the graded mesh's nodes moved into near-equilateral triangles (more "
                "accurate per dof: docs/accuracy.md); bisection: the graded mesh as refined",
                kind=str, check=one_of("relaxed", "bisection"))
+
+#: how every scene's K integrates λ (tr ε)² (signorini.fem.volumetric)
+VOLUMETRIC = Param("volumetric", "auto",
+                   "element: plain P1, the volumetric strain element by element (locks as nu -> "
+                   "0.5); nodal: the volumetric strain averaged at the nodes (no locking, K with "
+                   "2.7x the nonzeros: docs/accuracy.md); auto: nodal from nu = 0.4 on",
+                   kind=str, check=one_of(*CHOICES))
 
 #: what a scene with a ``candidates`` parameter says when the contact outgrows its candidates
 CANDIDATE_REMEDY = ("raise the scene parameter candidates (now {candidates:g}, in contact half-widths) "

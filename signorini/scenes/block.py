@@ -31,7 +31,7 @@ from signorini.fem.assembly import assemble, boundary_weights
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.fem.obstacles import ScaledQuery
 from signorini.problem import ContactProblem, ContactSolution, Scales
-from signorini.scenes.base import Param, SceneFamily, at_least, poisson_ratio, positive
+from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, poisson_ratio, positive
 from signorini.solvers.pdas import solve as pdas
 
 PARAMS = (
@@ -39,6 +39,7 @@ PARAMS = (
     Param("H", 1.0, "height of the block", check=positive),
     Param("E", 1.0, "Young's modulus", check=positive),
     Param("nu", 0.3, "Poisson's ratio", check=poisson_ratio),
+    VOLUMETRIC,
     Param("delta", 0.01, "prescribed downward displacement of the top", check=positive),
     Param("nx", 16, "elements along the width", kind=int, check=at_least(1)),
     Param("ny", 16, "elements along the height", kind=int, check=at_least(1)),

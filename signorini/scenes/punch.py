@@ -33,7 +33,7 @@ from signorini.analytic import contact_modulus
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
-from signorini.scenes.base import Param, SceneFamily, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.meshing import distance_to_segment, refine_to_size
 
 
@@ -56,6 +56,7 @@ PARAMS = (
     Param("size", 20.0, "block half-width and height in units of a", check=at_least(2.0)),
     Param("E", 1.0, "Young's modulus of the block", check=positive),
     Param("nu", 0.3, "Poisson's ratio of the block", check=poisson_ratio),
+    VOLUMETRIC,
     Param("P", None, "load per unit thickness of the whole block (exclusive with load_ratio, delta)",
           check=positive),
     Param("load_ratio", 0.005, "P / (E* a): sets the load when neither P nor delta is given",

@@ -24,7 +24,7 @@ from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle
-from signorini.scenes.base import Param, SceneFamily, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.punch import bottom_contact_model, graded_half_block, mirrored_about_x0
 
 #: the mesh is uniformly fine on the bottom up to this multiple of the half-width
@@ -34,6 +34,7 @@ PARAMS = (
     Param("R", 1.0, "radius of the rigid cylinder", check=positive),
     Param("E", 1.0, "Young's modulus of the block", check=positive),
     Param("nu", 0.3, "Poisson's ratio of the block", check=poisson_ratio),
+    VOLUMETRIC,
     Param("P", None, "vertical load per unit thickness of the whole block "
           "(exclusive with a_over_R, delta)", check=positive),
     Param("a_over_R", 0.02, "contact half-width over radius: sets P by Hertz's formula "

@@ -59,6 +59,7 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery
+from signorini.fem.volumetric import CHOICES
 from signorini.scenes.base import poisson_ratio
 from signorini.scenes.families import SCENES
 
@@ -74,7 +75,7 @@ FAMILY_TABLES = ("params", "geometry", "material", "load", "mesh")
 #: the tables of a mesh scene and the keys each takes
 MESH_SCENE_KEYS = {
     "mesh": {"file", "length_scale"},
-    "material": {"E", "nu"},
+    "material": {"E", "nu", "volumetric"},
     "dirichlet": {"boundary", "component", "value"},
     "contact": {"boundary"},
     "obstacle": {"type", "height", "point", "normal", "centre", "radius", "half_width",
@@ -82,7 +83,8 @@ MESH_SCENE_KEYS = {
     "load": {"boundary", "component", "multiplicity", "target"},
 }
 #: parameters of a mesh scene that ``--set`` may override, and where they live
-MESH_SCENE_OVERRIDES = {"E": ("material", "E"), "nu": ("material", "nu"), "P": ("load", "target")}
+MESH_SCENE_OVERRIDES = {"E": ("material", "E"), "nu": ("material", "nu"), "P": ("load", "target"),
+                        "volumetric": ("material", "volumetric")}
 COMPONENTS = {"x": 0, "y": 1}
 
 
@@ -408,6 +410,9 @@ def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) 
     load = dict(_table(data, ctx, "load"))
     for key, value in overrides.items():
         table, name = MESH_SCENE_OVERRIDES[key]
+        if key == "volumetric":  # a word, checked with the file's own value below
+            material[name] = value
+            continue
         try:
             converted = float(value)
         except (TypeError, ValueError):
@@ -431,6 +436,10 @@ def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) 
     problem = poisson_ratio(nu)
     if problem:
         raise ctx.error(f"nu = {nu:g} must be {problem}", "material", "nu")
+    volumetric = material.get("volumetric", "auto")
+    if volumetric not in CHOICES:
+        raise ctx.error(f"volumetric = {volumetric!r} must be one of {', '.join(CHOICES)}",
+                        "material", "volumetric")
 
     entries = data.get("dirichlet")
     if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
@@ -458,7 +467,7 @@ def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) 
         raise ctx.error("a target load needs a non-zero prescribed displacement in the load's "
                         "component to scale", "load", "target")
     params = {"file": str(ctx.path), "mesh": str(mesh_path), "E": E, "nu": nu, "P": target,
-              "length_scale": length_scale, "multiplicity": multiplicity}
+              "length_scale": length_scale, "multiplicity": multiplicity, "volumetric": volumetric}
     return SceneModel(
         mesh=mesh, E=E, nu=nu, dirichlet=dirichlet, contact_nodes=candidates,
         contact_facets=facets,
