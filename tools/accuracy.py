@@ -1,6 +1,6 @@
 """Where the Hertz scenes' difference to Hertz comes from: loading, mesh grading, ν, finite body.
 
-    .venv/bin/python tools/accuracy.py        # ~3 min here; writes docs/accuracy/runs.json
+    .venv/bin/python tools/accuracy.py        # ~4 min here; writes docs/accuracy/runs.json
 
 Every run solves with pdas at tol 1e-10 through the public API; p₀ and a are
 Hertz's profile fitted to the nodal pressures (signorini.pressure.hertz_fit).
@@ -31,6 +31,9 @@ SPHERE_MESHES = (("displacement", "bisection", 100, 0.15), ("traction", "bisecti
                  ("traction", "relaxed", 100, 0.15))
 DEFAULTS = {"hertz-cylinder": (40, 0.15), "hertz-sphere": (60, 0.15)}
 RATIOS = (0.05, 0.025, 0.0125)
+#: plain P1 against the volumetric strain averaged at the nodes, on the default mesh and a finer one
+VOLUMETRIC_NUS = (0.3, 0.4, 0.45, 0.49, 0.499)
+VOLUMETRIC_MESHES = {"hertz-cylinder": (40, 80), "hertz-sphere": (60, 120)}
 
 
 def cases() -> list[dict]:
@@ -40,24 +43,34 @@ def cases() -> list[dict]:
         for loading, mesher, n_contact, grading in meshes:
             for nu in NUS:
                 out.append({"table": table, "scene": scene, "loading": loading, "mesher": mesher,
-                            "n_contact": n_contact, "grading": grading, "nu": nu, "a_over_R": 0.05})
+                            "n_contact": n_contact, "grading": grading, "nu": nu, "a_over_R": 0.05,
+                            "volumetric": "element"})
     for scene, (n_contact, grading) in DEFAULTS.items():
         for nu in NUS:
             for ratio in RATIOS:
                 out.append({"table": "finite-body", "scene": scene, "loading": "traction",
                             "mesher": "relaxed", "n_contact": n_contact, "grading": grading,
-                            "nu": nu, "a_over_R": ratio})
+                            "nu": nu, "a_over_R": ratio, "volumetric": "auto"})
+    for scene, meshes in VOLUMETRIC_MESHES.items():
+        for n_contact in meshes:
+            for volumetric in ("element", "nodal"):
+                for nu in VOLUMETRIC_NUS:
+                    out.append({"table": "volumetric", "scene": scene, "loading": "traction",
+                                "mesher": "relaxed", "n_contact": n_contact, "grading": 0.15,
+                                "nu": nu, "a_over_R": 0.05, "volumetric": volumetric})
     return out
 
 
 def run() -> list[dict]:
     rows = []
     for i, case in enumerate(cases(), 1):
-        params = {k: case[k] for k in ("loading", "mesher", "n_contact", "grading", "nu", "a_over_R")}
+        params = {k: case[k] for k in ("loading", "mesher", "n_contact", "grading", "nu", "a_over_R",
+                                       "volumetric")}
         start = time.perf_counter()
         result = signorini.solve(case["scene"], params=params, tol=1e-10)
         hertz = result.hertz
         rows.append({**case, "status": result.status, "dofs": result.problem.n,
+                     "nonzeros": int(result.problem.K.nnz),
                      "a_err": hertz.a / hertz.a_ref - 1, "p0_err": hertz.p0 / hertz.p0_ref - 1,
                      "p0_nodal_err": hertz.p0_nodal / hertz.p0_ref - 1,
                      "l2": hertz.pressure_l2_rel, "seconds": time.perf_counter() - start})
@@ -98,6 +111,17 @@ def tables(rows: list[dict]) -> dict[str, str]:
             lines.append(f"| {scene} | {nu:g} | " + " | ".join(
                 f"{_pct(r['a_err'])}, {_pct(r['p0_err'])}" for r in group) + " |")
     out["finite-body"] = "\n".join(lines)
+    volumetric = [r for r in rows if r["table"] == "volumetric"]
+    lines = ["| scene | n_contact | dofs | volumetric | nonzeros of K | " + " | ".join(
+                 f"a, p₀ at ν = {nu:g}" for nu in VOLUMETRIC_NUS) + " |",
+             "|---|---:|---:|---|---:|" + "---|" * len(VOLUMETRIC_NUS)]
+    for key in dict.fromkeys((r["scene"], r["n_contact"], r["volumetric"]) for r in volumetric):
+        group = [r for r in volumetric if (r["scene"], r["n_contact"], r["volumetric"]) == key]
+        cells = [f"{_pct(r['a_err'])}, {_pct(r['p0_err'])}"
+                 + ("" if r["status"] == "converged" else f" ({r['status']})") for r in group]
+        lines.append(f"| {key[0]} | {key[1]} | {group[0]['dofs']:,} | {key[2]} | "
+                     f"{group[0]['nonzeros']:,} | " + " | ".join(cells) + " |")
+    out["volumetric"] = "\n".join(lines)
     return out
 
 
