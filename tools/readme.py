@@ -73,9 +73,12 @@ def blocks(document: Path = README) -> dict[str, str]:
                 "amg": amg_bench.readme_paragraph(amg_bench.read()),
                 **stability.tables(stability.load())}
     if document == ACCURACY:
-        peer = peer_table(json.loads((ROOT / "docs" / "peer-nu0" / "peer.json").read_text())["rows"])
-        return {**accuracy.tables(accuracy.load()),
-                "peer-nu0": "\n".join(peer[:peer.index("")])}  # every run of docs/peer-nu0
+        runs = {}
+        for name in ("peer-nu0", "peer-nu045"):  # every run of docs/peer-nu0, docs/peer-nu045
+            peer = peer_table(json.loads((ROOT / "docs" / name / "peer.json").read_text())["rows"])
+            runs[name] = "\n".join(peer[:peer.index("")])
+        runs["peer-nu045-summary"] = "\n".join(peer[peer.index("") + 1:])
+        return {**accuracy.tables(accuracy.load()), **runs}
     if document == ESTIMATE:
         return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"))
     raise ValueError(f"no generated blocks for {document}")
