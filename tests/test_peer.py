@@ -145,3 +145,30 @@ def test_the_readme_s_time_reading_is_the_committed_run():
                             key=lambda r: r["dofs"]) for code in ("signorini", "getfem"))
         assert ours["wall_s"] < theirs["wall_s"]
         assert f"{ours['wall_s']:.2f} s against {theirs['wall_s']:.2f} s" in readme
+
+
+def test_docs_peer_reading_is_the_committed_run():
+    """docs/peer.md's reading of docs/peer/peer.json and docs/speed/startup.json."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    rows = json.loads((root / "docs" / "peer" / "peer.json").read_text())["rows"]
+
+    def worst(r):
+        return max(abs(r["p0_rel"]), abs(r["a_rel"]))
+
+    cylinder = [r for r in rows if r["scene"] == "hertz-cylinder"]
+    (default,) = [r for r in cylinder if r["code"] == "signorini" and r["mesh"] == "n_contact=40"]
+    getfem = [r for r in cylinder if r["code"] == "getfem"]
+    assert worst(default) < min(worst(r) for r in getfem)  # the default beats every GetFEM rung
+    coarser = [r for r in cylinder if r["code"] == "signorini" and r["dofs"] < default["dofs"]]
+    assert coarser and all(worst(r) > worst(min(getfem, key=lambda g: g["dofs"])) for r in coarser)
+    # the start-up: the contact work is the smallest part of the default run
+    startup = {r["step"]: r["fastest_s"] for r in
+               json.loads((root / "docs" / "speed" / "startup.json").read_text())["rows"]}
+    package = startup["import the package's command line"]
+    mesh = startup["… and mesh the default cylinder (relaxed, 4,803 dofs)"] - package
+    rest = startup["`signorini solve hertz-cylinder` (4,803 dofs)"] - package - mesh
+    assert rest < mesh and rest < package
+    floor = startup["… and scipy.spatial (Delaunay, k-d trees)"]
+    assert floor > startup["GetFEM: the cylinder at h = a/16 (2,298 dofs), our script"]

@@ -1,4 +1,4 @@
-"""Write the generated blocks of README.md, docs/accuracy.md and docs/estimate.md from the committed
+"""Write the generated blocks of README.md, docs/accuracy.md, docs/estimate.md and docs/peer.md from the committed
 artefacts they quote.
 
     .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`,
@@ -20,6 +20,7 @@ import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
 import amg_bench  # noqa: E402  (tools/amg_bench.py: 3D at scale, docs/amg)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
+import startup  # noqa: E402  (tools/startup.py: whole-process time before the contact)
 
 from signorini.files import atomic_write_text  # noqa: E402
 from signorini.output.report import readme_validation  # noqa: E402
@@ -29,7 +30,8 @@ ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 ACCURACY = ROOT / "docs" / "accuracy.md"
 ESTIMATE = ROOT / "docs" / "estimate.md"
-DOCUMENTS = (README, ACCURACY, ESTIMATE)
+PEER = ROOT / "docs" / "peer.md"
+DOCUMENTS = (README, ACCURACY, ESTIMATE, PEER)
 
 
 def one_million(run: Path) -> str:
@@ -79,6 +81,11 @@ def blocks(document: Path = README) -> dict[str, str]:
             runs[name] = "\n".join(peer[:peer.index("")])
         runs["peer-nu045-summary"] = "\n".join(peer[peer.index("") + 1:])
         return {**accuracy.tables(accuracy.load()), **runs}
+    if document == PEER:
+        peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
+        return {"peer-runs": "\n".join(peer[:peer.index("")]),
+                "peer-summary": "\n".join(peer[peer.index("") + 1:]),
+                "startup": startup.table(startup.load()), "startup-reading": startup.reading(startup.load())}
     if document == ESTIMATE:
         return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"))
     raise ValueError(f"no generated blocks for {document}")
