@@ -207,3 +207,21 @@ def test_the_nu_0_45_findings_are_the_runs():
     assert 0.5 < min(sphere) and max(sphere) < 3 and f"{min(sphere):.2f}–{max(sphere):.2f}" in docs
     cylinder = [r["effectivity"] for r in run("hertz-cylinder")]
     assert f"effectivity down to {min(cylinder):.2f}" in docs
+
+
+def test_where_the_true_error_is_is_the_runs():
+    """docs/estimate.md: the true pressure error peaks at the zone's edge, the estimate looks elsewhere."""
+    rows = [r for r in tool.load("adaptive") if r["mesh"] == "adaptive"]
+    text = (ROOT / "docs" / "estimate.md").read_text()
+    tops = [r["true_top_x"] for r in rows]
+    assert 0.97 <= min(tops) and max(tops) <= 1.003 + 5e-4
+    shares = [r["true_top_share"] for r in rows]
+    there = [r["estimate_share_at_true_top"] for r in rows]
+    assert f"it carries {100 * min(shares):.0f}–{100 * max(shares):.0f} % of the true error²" in text
+    assert f"only {100 * min(there):.0f}–{100 * max(there):.0f} % of the estimate's" in text
+    coarse = [r for r in rows if r["scene"] == "hertz-cylinder" and r["step"] == 0]
+    assert all(abs(r["estimate_top_x"] - 1.004) < 5e-4 for r in coarse)
+    low, high = (f"{100 * f(r['estimate_top_share'] for r in coarse):.0f}" for f in (min, max))
+    assert f"(x/a = 1.004: {low}–{high} %" in text
+    cylinder = [r["effectivity"] for r in rows if r["scene"] == "hertz-cylinder"]
+    assert f"from {min(cylinder):.2f} to {max(cylinder):.2f} on the cylinder" in text

@@ -60,6 +60,7 @@ def test_auto_averages_from_nu_0_4():
     assert resolve("auto", NODAL_FROM_NU - 1e-9) == "element"
     assert resolve("auto", NODAL_FROM_NU) == "nodal"
     assert resolve("element", 0.49) == "element" and resolve("nodal", 0.0) == "nodal"
+    assert resolve("auto", 0.49, dim=3) == "element" and resolve("nodal", 0.3, dim=3) == "nodal"
     small = {"n_contact": 12, "grading": 0.4}
     for nu, used in ((0.3, "element"), (0.45, "nodal")):
         problem = signorini.build_problem("hertz-cylinder", nu=nu, **small)

@@ -180,6 +180,23 @@ class _Step:
         self.problem, self.solution, self.estimate = problem, solution, found
 
 
+def where_the_error_is(result, reference, a: float) -> dict:
+    """Which candidate carries the largest share of the true pressure error², and of the estimate's,
+    each at x / a (a: Hertz's, problem units) with the other measure's share at that node."""
+    x, p, w = pressure_profile(result)
+    xr, pr, _ = pressure_profile(reference)
+    order = np.argsort(xr)
+    true = w * (p - np.interp(x, xr[order], pr[order])) ** 2
+    true, estimate = true / true.sum(), result.estimate.pressure.indicators
+    estimate = estimate / estimate.sum()
+    worst_true, worst_estimate = int(np.argmax(true)), int(np.argmax(estimate))
+    return {"true_top_x": float(x[worst_true] / a), "true_top_share": float(true[worst_true]),
+            "estimate_share_at_true_top": float(estimate[worst_true]),
+            "estimate_top_x": float(x[worst_estimate] / a),
+            "estimate_top_share": float(estimate[worst_estimate]),
+            "true_share_at_estimate_top": float(true[worst_estimate])}
+
+
 def _row(result, reference, **fields) -> dict:
     problem, solution, found = result.problem, result.solution, result.estimate
     hertz = reference_of(problem).compare(problem, solution)
@@ -188,7 +205,8 @@ def _row(result, reference, **fields) -> dict:
             "pressure_estimate": found.pressure.relative, "pressure_error": error,
             "effectivity": found.pressure.relative / error if error > 0 else float("nan"),
             "pressure_hertz": hertz.pressure_l2_rel,
-            "p0_err": hertz.p0 / hertz.p0_ref - 1, "a_err": hertz.a / hertz.a_ref - 1}
+            "p0_err": hertz.p0 / hertz.p0_ref - 1, "a_err": hertz.a / hertz.a_ref - 1,
+            **where_the_error_is(result, reference, hertz.a_ref / problem.scales.length)}
 
 
 def adaptive_steps(scene: str, params: dict, target: float, max_dofs: int):

@@ -90,5 +90,5 @@ class SceneModel:
     def volumetric(self) -> str:
         """How K integrates λ (tr ε)²: ``element`` (plain P1) or ``nodal`` (signorini.fem.volumetric).
 
-        The scene parameter ``volumetric`` (``auto`` by default: nodal from ν = 0.4 on)."""
-        return resolve(self.params.get("volumetric", "auto"), self.nu)
+        The scene parameter ``volumetric`` (``auto`` by default: nodal from ν = 0.4 on in 2D)."""
+        return resolve(self.params.get("volumetric", "auto"), self.nu, self.mesh.p.shape[0])

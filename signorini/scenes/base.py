@@ -94,7 +94,8 @@ MESHER = Param("mesher", "relaxed",
 VOLUMETRIC = Param("volumetric", "auto",
                    "element: plain P1, the volumetric strain element by element (locks as nu -> "
                    "0.5); nodal: the volumetric strain averaged at the nodes (no locking, K with "
-                   "2.7x the nonzeros: docs/accuracy.md); auto: nodal from nu = 0.4 on",
+                   "2.7x the nonzeros in 2D, 5.2x in 3D: docs/accuracy.md); auto: nodal from nu = 0.4 "
+                   "on in 2D and axisymmetric models, element in 3D",
                    kind=str, check=one_of(*CHOICES))
 
 #: what a scene with a ``candidates`` parameter says when the contact outgrows its candidates
