@@ -113,3 +113,22 @@ def test_a_pushed_3d_scene_is_sized_for_pdas_amg_and_a_loaded_one_for_its_factor
     loaded = family.parse({"refine": 2, "n_contact": 24})
     with pytest.raises(InputError, match=r"prescribe a push instead of the load \(--set delta"):
         check_size("hertz-sphere-3d", loaded)
+
+
+def test_the_nodal_average_is_sized_for_its_denser_stiffness(monkeypatch):
+    """The volumetric strain averaged at the nodes took 2.2x (2D) and 2.6x (3D) plain P1's peak
+    memory (signorini.scenes.size.NODAL_MEMORY): a scene that fits in plain P1 can be refused
+    with it, and auto picks it only in 2D from ν = 0.4."""
+    from signorini.scenes.size import bytes_per_dof
+    family = SCENES["hertz-cylinder"]
+    plain = family.parse({"refine": 3, "nu": 0.3})
+    nodal = family.parse({"refine": 3, "nu": 0.3, "volumetric": "nodal"})
+    auto_high = family.parse({"refine": 3, "nu": 0.45})
+    assert bytes_per_dof(2, 3e5, nodal) == pytest.approx(2.2 * bytes_per_dof(2, 3e5, plain))
+    assert bytes_per_dof(2, 3e5, auto_high) == bytes_per_dof(2, 3e5, nodal)
+    sphere = SCENES["hertz-sphere-3d"].parse({"nu": 0.45})
+    assert bytes_per_dof(3, 5e4, sphere) == bytes_per_dof(3, 5e4, SCENES["hertz-sphere-3d"].parse({}))
+    monkeypatch.setenv(MEMORY_VARIABLE, "2")  # about 300k dofs: 1.2 GB plain, 2.6 GB averaged
+    check_size("hertz-cylinder", plain)  # no error
+    with pytest.raises(InputError, match="would have about"):
+        check_size("hertz-cylinder", nodal)
