@@ -42,7 +42,7 @@ SPHERE_350K = {"refine": 2, "delta": 0.0025}
 SPHERE_1M = {"refine": 2, "n_contact": 24, "delta": 0.0025}
 SPHERE_350K_LOAD = {"refine": 2}
 PARTS = ("backends", "crossover", "whole-350k", "petsc-350k", "whole-1m", "whole-350k-load",
-         "petsc-350k-load", "scale")
+         "petsc-350k-load", "scale", "nested-1m")
 #: the scale table (part ``scale``): a push, so that every method solves the same problem
 SCALE_SIZES = {"50k": {"refine": 1, "delta": 0.0025}, "350k": SPHERE_350K, "1m": SPHERE_1M}
 #: (label, method, options, MPI ranks)
@@ -237,7 +237,9 @@ def scale() -> dict:
 MEASURE = {"backends": backends, "scale": scale, "crossover": crossover, "petsc-350k": petsc_350k,
            "whole-350k": lambda: whole(SPHERE_350K), "whole-1m": lambda: whole(SPHERE_1M),
            "whole-350k-load": lambda: whole(SPHERE_350K_LOAD),
-           "petsc-350k-load": lambda: petsc_350k(SPHERE_350K_LOAD, "auto")}
+           "petsc-350k-load": lambda: petsc_350k(SPHERE_350K_LOAD, "auto"),
+           # the scale table's 1M nested run again, after its band columns stopped being kept whole
+           "nested-1m": lambda: whole(SPHERE_1M, "nested", timeout=SCALE_TIMEOUT)}
 
 
 def read() -> dict:
@@ -309,6 +311,65 @@ def readme_paragraph(data: dict) -> str:
     return "\n".join(lines)
 
 
+def _scale_cells(run: dict, one_s: float | None) -> list[str]:
+    """status, whole command, method, method / one AMG solve, peak memory of one scale run."""
+    record = run["record"]
+    if record is None:  # refused before solving (exit 2), timed out, or killed
+        said = run["said"].removeprefix("signorini: error: ")
+        if run["returncode"] is None:
+            status = f"timed out (limit {SCALE_TIMEOUT:.0f} s)"
+        elif run["returncode"] in (137, -9):
+            status = "killed by the kernel (out of memory)"
+        else:
+            status = f"refused: {said}" if said else f"exit {run['returncode']}, no answer"
+        peak = "–" if run["peak_gb"] != run["peak_gb"] else f"{run['peak_gb']:.1f}"
+        return [status, f"{run['wall_s']:.0f}", "–", "–", peak]
+    method_s = record["extras"]["method_s"]
+    ratio = f"{method_s / one_s:.1f}×" if one_s else "–"
+    return [record["status"], f"{run['wall_s']:.0f}", f"{method_s:.1f}", ratio, f"{run['peak_gb']:.1f}"]
+
+
+def scale_table(data: dict) -> str:
+    """The README's block ``amg-scale``: every size and method of part ``scale``."""
+    part = data["scale"]
+    lines = [f"`.venv/bin/python tools/amg_bench.py run --part scale` (commit {part['commit']}, "
+             f"{part['date']}): `signorini solve hertz-sphere-3d` pushed by `delta=0.0025`, each run "
+             "a process of its own under `/usr/bin/time -v`; *one AMG solve* is one GAMG set-up and "
+             f"CG of K from zero to a relative residual of {AMG_RTOL:g} (the least an exact method "
+             "without a factorisation spends); *method* is the method's own time (its set-up "
+             "included, not the assembly or the certificate); memory is the largest process's peak.",
+             "", "| dofs | method | status | whole command [s] | method [s] | method / one AMG solve "
+             "| peak memory [GB] |", "|---:|---|---|---:|---:|---:|---:|"]
+    for size in sorted(part["sizes"].values(), key=lambda size: size["params"].get("refine", 0)
+                       * 100 + size["params"].get("n_contact", 0)):
+        one = size["one_amg_solve"]
+        one_s = one["setup_s"] + one["solve_s"] if one else None
+        dofs = next((r["record"]["dofs"] for r in size["runs"].values() if r["record"]),
+                    one["dofs"] if one else 0)
+        lines.append(f"| {dofs:,} | one AMG solve ({one['iterations']} CG iterations) | – | "
+                     f"{size['one_amg_process']['wall_s']:.0f} | {one_s:.1f} | 1× | "
+                     f"{size['one_amg_process']['peak_gb']:.1f} |" if one else
+                     f"| {dofs:,} | one AMG solve | failed | – | – | – | – |")
+        for label, run in size["runs"].items():
+            lines.append(f"| {dofs:,} | {label} | " + " | ".join(_scale_cells(run, one_s)) + " |")
+    return "\n".join(lines)
+
+
+def nested_again(data: dict) -> str:
+    """The sentence on the 1M nested run measured again (part ``nested-1m``)."""
+    run = data.get("nested-1m")
+    if not run:
+        return ""
+    record = run["record"]
+    status = record["status"] if record else _scale_cells(run, None)[0]
+    extras = record.get("extras", {}) if record else {}
+    return (f"`nested` at 1,093,024 dofs measured again at commit {run['commit']} ({run['date']}), "
+            f"after its band columns stopped being kept whole beyond 512 MB "
+            f"(`signorini.numerics.zone.COLUMN_BYTES`): {status} in {run['wall_s']:.0f} s whole "
+            f"command and {run['peak_gb']:.1f} GB peak"
+            + (f", a band of {extras['band']:,} nodes" if "band" in extras else "") + ".")
+
+
 def markdown(data: dict) -> str:
     m = data.get("machine", {})
     out = ["# pdas-amg on hertz-sphere-3d", "",
@@ -336,6 +397,9 @@ def markdown(data: dict) -> str:
             out.append(f"| {row['dofs']:,} | {row['pdas']['method_s']:.2f} | "
                        f"{row['pdas-amg']['method_s']:.2f} | {row['load_before']:.1f} |")
         out.append("")
+    if "scale" in data:
+        out += ["## Every method at ~50k, ~350k and ~1M dofs", "", scale_table(data), "",
+                nested_again(data), ""]
     out += ["## The default command at scale", "", readme_paragraph(data), ""]
     if "backends" in data and "whole-350k" in data:
         gamg = data["backends"]["rows"].get("petsc GAMG (plain aggregation)")

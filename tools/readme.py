@@ -73,6 +73,8 @@ def blocks(document: Path = README) -> dict[str, str]:
                 "adaptive-summary": estimate_study.adaptive_summary(estimate_study.load("adaptive")),
                 "nested-ratios": nested_ratios(ROOT / "docs" / "bench-nested" / "bench.csv"),
                 "amg": amg_bench.readme_paragraph(amg_bench.read()),
+                "amg-scale": amg_bench.scale_table(amg_bench.read()),
+                "amg-nested-again": amg_bench.nested_again(amg_bench.read()),
                 **stability.tables(stability.load())}
     if document == ACCURACY:
         runs = {}

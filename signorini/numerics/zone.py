@@ -43,6 +43,11 @@ log = logging.getLogger(__name__)
 ROUND_OFF = 1e-10
 #: back-solves are done on blocks of this many band nodes
 BLOCK = 32
+#: band columns ``K̃⁻¹N_jᵀ`` are kept whole while they fit in this many bytes; beyond, only what
+#: the band's LCP reads of them (``N z_j`` and the core's reactions) is kept, and the displacement
+#: costs one back-solve more. At 1,093,024 3D dofs a band of a thousand nodes kept whole took
+#: 8.7 GB, twice with the matrix stacked from them: ``nested`` was killed by the kernel at 23 GB.
+COLUMN_BYTES = 512 * 2 ** 20
 
 
 @dataclass
@@ -158,7 +163,9 @@ class ZoneSolver:
         self._pinning = Pinning(self.K, self.backend)
         self._core: np.ndarray | None = None
         self._factor: PinnedFactor | None = None
-        self._columns: dict[int, np.ndarray] = {}
+        #: per band node: ``N z_j`` and the core's reactions to ``z_j``, and ``z_j`` while it fits
+        self._columns: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
+        self._whole = 0
         self.factorisations = 0
         self.back_solves = 0
 
@@ -175,15 +182,21 @@ class ZoneSolver:
         self._factor = PinnedFactor(self.K, self.dofs[core], self.backend, self._pinning)
         self._core = core.copy()
         self._columns.clear()
+        self._whole = 0
         self.factorisations += 1
+
+    def _units(self, band) -> np.ndarray:
+        """``N_Bᵀ`` as dense columns (n × |B|): a unit force along each band node's normal."""
+        units = np.zeros((self.n, len(band)))
+        units[self.dofs[band], np.arange(len(band))] = self.coef[band]
+        return units
 
     def _solutions(self, F: np.ndarray, D: np.ndarray, zone: Zone,
                    band: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``U0``: u (n, or n × k) with the core's gaps closed, loads F and no band forces; and
-        ``Z = K̃⁻¹ N_Bᵀ`` (n × |B|), the displacements under a unit force at each band node.
-
-        The band columns not kept from an earlier call are solved in the same call as U0
-        (one pass over the factor for both; at 1M dofs a pass costs a tenth of the factorisation).
+        """``U0``: u (n × k) with the core's gaps closed, loads F and no band forces, and the
+        right-hand sides it solves; the band columns ``z_j = K̃⁻¹ N_jᵀ`` not kept from an earlier
+        call are solved in the same call as U0 (one pass over the factor for both; at 1M dofs a
+        pass costs a tenth of the factorisation) and kept (see :data:`COLUMN_BYTES`).
         """
         core = zone.core
         rhs = np.array(F, dtype=float).reshape(self.n, -1)
@@ -192,16 +205,29 @@ class ZoneSolver:
         chunks = [missing[first:first + BLOCK] for first in range(0, len(missing), BLOCK)]
         U0 = None
         for chunk in chunks or [[]]:
-            units = np.zeros((self.n, len(chunk)))
-            units[self.dofs[chunk], np.arange(len(chunk))] = self.coef[chunk]
+            units = self._units(chunk)
             block = self._factor.solve(units if U0 is not None else np.hstack([rhs, units]))
             self.back_solves += block.shape[1]
             if U0 is None:
                 U0, block = block[:, :rhs.shape[1]], block[:, rhs.shape[1]:]
+            gaps, reactions = self.N @ block, self._factor.fixed_rows(block)
             for k, j in enumerate(chunk):
-                self._columns[j] = block[:, k]
-        Z = np.column_stack([self._columns[j] for j in band]) if len(band) else np.zeros((self.n, 0))
-        return (U0[:, 0] if np.ndim(F) == 1 else U0), Z
+                whole = (self._whole + 1) * self.n * 8 <= COLUMN_BYTES
+                self._whole += whole
+                self._columns[j] = (gaps[:, k], reactions[:, k],
+                                    block[:, k].copy() if whole else None)
+        return U0, rhs
+
+    def _displacement(self, U0: np.ndarray, rhs: np.ndarray, band: np.ndarray,
+                      lam_band: np.ndarray) -> np.ndarray:
+        """``u = U0 − Σ_B z_j λ_j``: from the kept columns, or one back-solve when some were not."""
+        if not len(band):
+            return U0
+        kept = [self._columns[j][2] for j in band]
+        if all(z is not None for z in kept):
+            return U0 - np.column_stack(kept) @ lam_band
+        self.back_solves += 1
+        return self._factor.solve(rhs - self._units(band) @ lam_band)
 
     def _core_reactions(self, F: np.ndarray, U: np.ndarray, core: np.ndarray) -> np.ndarray:
         """Contact forces of the core nodes, ``(F − K U)`` on their dofs (``F`` None: ``−K U``)."""
@@ -212,16 +238,20 @@ class ZoneSolver:
         return residual / coef
 
     def _pieces(self, F: np.ndarray, D: np.ndarray, zone: Zone):
-        """Everything affine: ``u = U0 − Zλ_B``, band gaps ``Wλ_B − b``, core ``R + Gλ_B``."""
+        """Everything affine: ``u = U0 − Zλ_B`` (U0 and its right-hand sides), band gaps
+        ``Wλ_B − b``, core ``R + Gλ_B``."""
         self._use_core(zone.core)
         band = np.nonzero(zone.band)[0]
-        U0, Z = self._solutions(F, D, zone, band)
-        W = self.N[band] @ Z
-        W = 0.5 * (W + W.T)
-        b = self.N[band] @ U0 - D[band]
-        R = self._core_reactions(F, U0, zone.core)
-        G = -self._core_reactions(None, Z, zone.core) if len(band) else np.zeros((0, 0))
-        return band, Z, U0, W, b, R, G
+        U0, rhs = self._solutions(F, D, zone, band)
+        if len(band):
+            W = np.column_stack([self._columns[j][0][band] for j in band])
+            W = 0.5 * (W + W.T)
+            G = np.column_stack([self._columns[j][1] for j in band]) / self.coef[zone.core][:, None]
+        else:
+            W, G = np.zeros((0, 0)), np.zeros((0, 0))
+        b = self.N[band] @ U0 - np.asarray(D, dtype=float)[band].reshape(len(band), U0.shape[1])
+        R = self._core_reactions(F, U0 if np.ndim(F) > 1 else U0[:, 0], zone.core)
+        return band, U0, rhs, W, (b if np.ndim(F) > 1 else b[:, 0]), R, G
 
     # --- the check that makes it exact ---------------------------------------------------------
 
@@ -248,9 +278,9 @@ class ZoneSolver:
         """``(u, λ, final zone)`` for load f and gaps d, starting from ``zone``."""
         zone = zone.copy()
         for _ in range(max_rounds):
-            band, Z, U0, W, b, R, G = self._pieces(f, d, zone)
+            band, U0, rhs, W, b, R, G = self._pieces(f, d, zone)
             lam_band = solve_lcp(W, b)[0] if len(band) else np.zeros(0)
-            u = U0 - Z @ lam_band
+            u = self._displacement(U0[:, 0], rhs[:, 0], band, lam_band)
             lam = np.zeros(self.m)
             lam[band] = lam_band
             lam[zone.core] = R + (G @ lam_band if len(band) else 0.0)
@@ -269,9 +299,9 @@ class ZoneSolver:
         D = np.column_stack([d1, d0])
         zone = zone.copy()
         for _ in range(max_rounds):
-            band, Z, U0, W, b, R, G = self._pieces(F, D, zone)
+            band, U0, rhs, W, b, R, G = self._pieces(F, D, zone)
             s, lam_band = _band_push(W, b, R, G, target, multiplicity)
-            u = U0 @ [s, 1.0] - Z @ lam_band
+            u = self._displacement(U0 @ [s, 1.0], rhs @ [s, 1.0], band, lam_band)
             lam = np.zeros(self.m)
             lam[band] = lam_band
             lam[zone.core] = R @ [s, 1.0] + (G @ lam_band if len(band) else 0.0)
