@@ -45,8 +45,9 @@ ROUND_OFF = 1e-10
 BLOCK = 32
 #: band columns ``K̃⁻¹N_jᵀ`` are kept whole while they fit in this many bytes; beyond, only what
 #: the band's LCP reads of them (``N z_j`` and the core's reactions) is kept, and the displacement
-#: costs one back-solve more. At 1,093,024 3D dofs a band of a thousand nodes kept whole took
-#: 8.7 GB, twice with the matrix stacked from them: ``nested`` was killed by the kernel at 23 GB.
+#: costs one back-solve more. At 1,093,024 3D dofs (a pushed sphere) the band had 1,894 nodes:
+#: 8.7 MB a column, 16.6 GB kept whole, more with the matrix stacked from them, and ``nested``
+#: was killed by the kernel at 23 GB; with the budget it peaked at 15.4 GB (docs/amg/bench.json).
 COLUMN_BYTES = 512 * 2 ** 20
 
 
