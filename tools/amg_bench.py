@@ -363,8 +363,11 @@ def nested_again(data: dict) -> str:
     record = run["record"]
     status = record["status"] if record else _scale_cells(run, None)[0]
     extras = record.get("extras", {}) if record else {}
-    return (f"`nested` at 1,093,024 dofs measured again at commit {run['commit']} ({run['date']}), "
-            f"after its band columns stopped being kept whole beyond 512 MB "
+    from signorini.numerics.zone import COLUMN_BYTES
+
+    dofs = f"{record['dofs']:,} dofs" if record else "1M dofs"
+    return (f"`nested` at {dofs} measured again at commit {run['commit']} ({run['date']}), "
+            f"after its band columns stopped being kept whole beyond {COLUMN_BYTES / 2 ** 20:.0f} MB "
             f"(`signorini.numerics.zone.COLUMN_BYTES`): {status} in {run['wall_s']:.0f} s whole "
             f"command and {run['peak_gb']:.1f} GB peak"
             + (f", a band of {extras['band']:,} nodes" if "band" in extras else "") + ".")

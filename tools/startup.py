@@ -1,6 +1,6 @@
 """What a whole process costs before any contact is computed: interpreters, imports, the default solve.
 
-    .venv/bin/python tools/startup.py         # ~1 min here; writes docs/speed/startup.json
+    .venv/bin/python tools/startup.py         # ~20 s here; writes docs/speed/startup.json
 
 Each step is its own fresh process, timed from start to exit, the fastest of ``REPEAT`` runs
 (interleaved); the byte-code cache is warm, as on a user's machine. The package's steps run

@@ -45,7 +45,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem.quadrature import get_quadrature
 
-from signorini.fem.volumetric import nodal_volumetric_strain
+from signorini.fem.volumetric import nodal_volumetric_strain, simplex_gradients
 from signorini.problem import ContactProblem, ContactSolution
 
 #: quadrature order of the element integrals: 2 integrates the plane-strain and 3D ones
@@ -116,12 +116,9 @@ def quadrature(mesh: Any, axisymmetric: bool = False, order: int | None = None) 
         order = AXISYMMETRIC_ORDER if axisymmetric else QUADRATURE_ORDER
     X, W = get_quadrature(mesh.refdom, order)
     bary = np.vstack([1.0 - X.sum(axis=0), X])
-    corners = mesh.p[:, mesh.t]  # (dim, d + 1, elements)
-    J = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)  # (elements, dim, d): columns edges
-    inverse = np.linalg.inv(J)  # rows: gradients of the barycentric coordinates 1..d
-    gradients = np.concatenate([-inverse.sum(axis=1, keepdims=True), inverse], axis=1)
-    points = np.einsum("dke,kq->deq", corners, bary)
-    dx = np.abs(np.linalg.det(J))[:, None] * W[None, :]
+    gradients, jacobian = simplex_gradients(mesh)
+    points = np.einsum("dke,kq->deq", mesh.p[:, mesh.t], bary)
+    dx = jacobian[:, None] * W[None, :]
     if axisymmetric:
         dx = dx * points[0]
     return Quadrature(bary=bary, points=points, dx=dx, gradients=gradients)

@@ -55,14 +55,14 @@ def resolve(choice: str, nu: float, dim: int = 2) -> str:
     return choice
 
 
-def _gradients(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Gradients (elements, d + 1, dim) of every simplex's barycentric coordinates, and its measure."""
+def simplex_gradients(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Gradients (elements, d + 1, dim) of every simplex's barycentric coordinates, and ``|det J|``
+    of its map from the reference simplex (d! times its measure)."""
     corners = mesh.p[:, mesh.t]  # (dim, d + 1, elements)
-    J = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)  # (elements, dim, d)
-    inverse = np.linalg.inv(J)
+    J = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)  # (elements, dim, d): columns edges
+    inverse = np.linalg.inv(J)  # rows: gradients of the barycentric coordinates 1..d
     gradients = np.concatenate([-inverse.sum(axis=1, keepdims=True), inverse], axis=1)
-    factorial = 2.0 if mesh.p.shape[0] == 2 else 6.0
-    return gradients, np.abs(np.linalg.det(J)) / factorial
+    return gradients, np.abs(np.linalg.det(J))
 
 
 def averaging(mesh: Any, axisymmetric: bool = False) -> tuple[sp.csr_matrix, np.ndarray]:
@@ -76,7 +76,8 @@ def averaging(mesh: Any, axisymmetric: bool = False) -> tuple[sp.csr_matrix, np.
     p, t = mesh.p, mesh.t
     dim, nodes = p.shape
     corners, elements = t.shape
-    gradients, measure = _gradients(mesh)
+    gradients, jacobian = simplex_gradients(mesh)
+    measure = jacobian / (2.0 if dim == 2 else 6.0)
     if axisymmetric:
         r = p[0, t]  # (3, elements)
         weight = measure * (r + r.sum(axis=0)) / 12.0  # ∫_K φₙ r dA, (3, elements)
