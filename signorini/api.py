@@ -287,7 +287,7 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
                          "e.g. params={'E': 2.1e11}")
     if isinstance(problem, str):
         check_request(method, tol, max_iter, options)  # bad options fail before the scene is built
-        problem = build_problem(problem, **(params or {}))
+        problem = build_problem(problem, solved_by=method, **(params or {}))
     elif params:
         raise InputError("params= builds a scene by name: give solve('hertz-cylinder', params=...) "
                          "or build the problem with those parameters first")
@@ -296,6 +296,8 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
                          f"{type(problem).__name__}: build one with signorini.build_problem(...) "
                          "or ContactProblem.from_qp(K, f, N, d)")
     solution = _solve(problem, method, tol=tol, max_iter=max_iter, **options)
+    if solution.problem is not None:  # the target load was pending: matched with the answer
+        problem = solution.problem
     return Result(problem, solution, certificate(problem, solution))
 
 

@@ -29,11 +29,10 @@ from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
 from signorini.numerics.arrays import sparse_argument, vector_argument
 from signorini.numerics.factor import factorize
+from signorini.numerics.loading import calibrate_push
+from signorini.solution import STATUSES, ContactSolution
 
-#: the statuses a :class:`ContactSolution` can carry
-STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed",
-            "model_inadequate")
-
+__all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Push", "Scales", "WarmStart", "Watch"]
 
 #: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
 ITERATIVE_ENERGY_FROM = 300_000
@@ -80,6 +79,11 @@ class Push:
     full body) when the load is a traction on a cut (``f_load`` its nodal
     forces per unit P; None when the push alone loads the body). Load
     sweeps and load targeting use it without assembling again.
+
+    ``target`` is the load (dimensionless, full body) that load targeting
+    matched, or None; ``pending`` says that it has not matched it yet: the
+    problem is at a nominal push and the method (``pdas-amg``) finds the push
+    with the answer, or :meth:`ContactProblem.matched` does first.
     """
 
     f1: np.ndarray
@@ -90,6 +94,8 @@ class Push:
     f_load: np.ndarray | None = None
     offset_load: float = 0.0
     load: float = 0.0
+    target: float | None = None
+    pending: bool = False
 
     def f(self, scale: float, load: float | None = None) -> np.ndarray:
         """The load vector at push ``scale`` (and target ``load``, default the assembled one)."""
@@ -367,11 +373,34 @@ class ContactProblem:
             params["P"] = load * self.scales.force
         new = self.with_data(f=pu.f(scale, load), d=pu.d0 + scale * pu.d1,
                              load_offset=pu.offset(scale, load), prescribed=self.prescribed * ratio,
-                             params=params, push=dataclasses.replace(pu, scale=scale, load=load),
+                             params=params,
+                             push=dataclasses.replace(pu, scale=scale, load=load, pending=False),
                              warm_start=WarmStart(zone_solver=self.warm_start.zone_solver,
                                                   zone=self.warm_start.zone))
         # K is unchanged: keep its factorisation, its basis and the zone solver (not the forces)
         new._factor, new._basis = self._factor, self._basis
+        return new
+
+    @property
+    def pending(self) -> bool:
+        """The target load is not matched yet (see :class:`Push`): f and d are at a nominal push."""
+        return self.push is not None and self.push.pending
+
+    def matched(self) -> "ContactProblem":
+        """This problem at the push whose load is the target (itself when nothing is pending).
+
+        One sparse factorisation per active-set step
+        (:func:`signorini.numerics.loading.calibrate_push`); the answer it
+        found is the warm start of the problem returned.
+        """
+        if not self.pending:
+            return self
+        pu = self.push
+        f0 = pu.load * pu.f_load if pu.f_load is not None else None
+        scale, lam, u = calibrate_push(self.K, self.N, pu.f1, pu.d0, pu.d1, pu.target,
+                                       self.force_multiplicity, f0=f0)
+        new = self.pushed(scale)
+        new.warm_start = WarmStart(lam=lam, u=u)
         return new
 
     def with_data(self, **changes: Any) -> "ContactProblem":
@@ -409,7 +438,8 @@ class ContactProblem:
                 "assemble_time": self.assemble_time, "axisymmetric": self.axisymmetric,
                 "reference": self.reference,
                 "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
-                                                 "offset_load": pu.offset_load, "load": pu.load}}
+                                                 "offset_load": pu.offset_load, "load": pu.load,
+                                                 "target": pu.target, "pending": pu.pending}}
         arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
         buffer = io.BytesIO()
         np.savez(buffer, **arrays)
@@ -425,7 +455,8 @@ class ContactProblem:
         if meta["push"] is not None:
             push = Push(z["push_f1"], z["push_d0"], z["push_d1"], meta["push"]["offset1"],
                         meta["push"]["scale"], z["push_f_load"] if "push_f_load" in z else None,
-                        meta["push"].get("offset_load", 0.0), meta["push"].get("load", 0.0))
+                        meta["push"].get("offset_load", 0.0), meta["push"].get("load", 0.0),
+                        meta["push"].get("target"), meta["push"].get("pending", False))
         mesh = None
         if "mesh_p" in z:
             kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
@@ -441,59 +472,3 @@ class ContactProblem:
             scales=Scales(**meta["scales"]), scene=meta["scene"], params=meta["params"],
             push=push, mesh=mesh, assemble_time=meta["assemble_time"],
             axisymmetric=meta.get("axisymmetric", False), reference=meta.get("reference", ""))
-
-
-@dataclass
-class ContactSolution:
-    """What a solver returns: ``u`` (free dofs), ``lam`` (contact forces), status.
-
-    ``status`` is one of :data:`STATUSES`. ``converged`` means the solver
-    claims success *and* the package's KKT certificate agrees (the wrapper in
-    :func:`signorini.solvers.registry.solve` enforces this). ``history`` maps a name to
-    one value per iteration (``kkt``, ``primal``, ``dual``...).
-
-    ``u`` and ``lam`` are in the problem's units, which are dimensionless for
-    a scene built with ``nondimensionalise=True`` (the default): multiply by
-    ``problem.scales`` or read :class:`signorini.api.Result`, which gives
-    displacements, gaps, forces and pressures in the scene's own units.
-    """
-
-    method: str
-    u: np.ndarray
-    lam: np.ndarray
-    status: str
-    message: str = ""
-    iterations: int = 0
-    build_time: float = 0.0
-    solve_time: float = 0.0
-    history: dict[str, list[float]] = field(default_factory=dict)
-    extras: dict[str, Any] = field(default_factory=dict)
-    #: the method's own status when the package's certificate disagreed with it ("" otherwise)
-    claimed_status: str = ""
-    #: a factorisation of the problem's K the method holds (a PinnedFactor, possibly with
-    #: contact dofs pinned), which the certificate reuses for its duality gap and then lets go
-    factor: Any = field(default=None, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        if self.status not in STATUSES:
-            raise ValueError(f"status {self.status!r} is not one of {STATUSES}")
-
-    @property
-    def contact_force(self) -> np.ndarray:
-        return self.lam
-
-    @property
-    def own_status(self) -> str:
-        """What the method itself said: its claim when the certificate overruled it."""
-        return self.claimed_status or self.status
-
-    @property
-    def success(self) -> bool:
-        return self.status == "converged"
-
-    @classmethod
-    def failure(cls, method: str, problem: ContactProblem, status: str, message: str,
-                **kwargs: Any) -> "ContactSolution":
-        """A solution carrying no answer (NaN vectors) and a reason."""
-        return cls(method=method, u=np.full(problem.n, np.nan), lam=np.full(problem.m, np.nan),
-                   status=status, message=message, **kwargs)

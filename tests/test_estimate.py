@@ -12,7 +12,8 @@ from skfem.models.elasticity import lame_parameters
 
 import signorini
 from signorini.fem.assembly import axisymmetric_elasticity, plane_strain_stiffness
-from signorini.fem.estimate import contact_term, element_energies, estimate, quadrature, recover, strains
+from signorini.fem.estimate import (_by_quadrature, _constant_strains, contact_term, element_energies,
+                                    estimate, lame, material_units, quadrature, recover, strains)
 from signorini.fem.transfer import uniform_prolongation
 from signorini.files import to_json
 from signorini.scenes.meshing import refine_uniformly
@@ -225,3 +226,19 @@ def test_where_the_true_error_is_is_the_runs():
     assert f"(x/a = 1.004: {low}–{high} %" in text
     cylinder = [r["effectivity"] for r in rows if r["scene"] == "hertz-cylinder"]
     assert f"from {min(cylinder):.2f} to {max(cylinder):.2f} on the cylinder" in text
+
+
+@pytest.mark.parametrize("scene, params", [("hertz-sphere-3d", {}), ("hertz-cylinder", {"nu": 0.3}),
+                                           ("punch", {})])
+def test_the_closed_form_for_constant_strains_is_the_quadrature(scene, params):
+    """Plane strain and 3D P1 strains are constant per simplex: the estimate's closed form (no
+    quadrature points) gives what the order-2 quadrature gives, element by element."""
+    result = signorini.solve(scene, params=params)
+    problem = result.problem
+    mesh, dim = problem.mesh, problem.mesh.p.shape[0]
+    u = problem.expand(result.solution.u).reshape(-1, dim)
+    material = lame(*material_units(problem))
+    closed = _constant_strains(mesh, u, *material)
+    by_points = _by_quadrature(problem, mesh, u, *material)
+    for fast, reference in zip(closed, by_points[:3]):
+        assert np.allclose(fast, reference, rtol=1e-12, atol=1e-14 * np.abs(reference).max())

@@ -29,7 +29,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
 LAYERS = {
     "errors": 0, "files": 0,
     "numerics": 1,
-    "problem": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
+    "problem": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
     "adequacy": 2,
     "fem": 2,
     "solvers": 3,

@@ -47,7 +47,7 @@ def test_the_estimate_is_within_a_factor_1_5_of_the_mesh_built(family, values):
 
 @pytest.mark.parametrize("argv, words", [
     (["hertz-cylinder", "--set", "refine=5"], ["refine=5", "4,98", "dofs", "GB"]),
-    (["hertz-sphere-3d", "--set", "refine=3"], ["refine=3", "dofs", "GB"]),
+    (["hertz-sphere-3d", "--set", "refine=3", "--set", "n_contact=20"], ["refine=3", "dofs", "GB"]),
     (["hertz-cylinder", "--set", "grading=0.0001", "--set", "n_contact=100"], ["grading=0.0001", "coarser"]),
     (["block", "--set", "nx=100000", "--set", "ny=100000"], ["nx=100000", "(nx, ny)"]),
     (["punch", "--set", "n_contact=10000000"], ["n_contact=1e+07"]),
@@ -104,15 +104,19 @@ def test_a_mesh_the_mesher_cannot_make_is_one_line(capsys, argv, words):
 def test_a_pushed_3d_scene_is_sized_for_pdas_amg_and_a_loaded_one_for_its_factorisation(
         monkeypatch):
     """docs/amg: the pushed 1,093,024-dof sphere peaked at 3.85 GB with pdas-amg; a target load
-    factorises K (13.4 kB per dof at 351k, growing): at 19 GB the first fits, the second is refused
-    with the push as the way out."""
+    factorises K in the assembly (13.4 kB per dof at 351k, growing) unless pdas-amg matches it
+    itself (auto's pick at this size): at 19 GB the first and the last fit, a target load for
+    another method is refused with pdas-amg as the way out."""
     monkeypatch.setenv(MEMORY_VARIABLE, "19")
     family = SCENES["hertz-sphere-3d"]
     pushed = family.parse({"refine": 2, "n_contact": 24, "delta": 0.0025})
     check_size("hertz-sphere-3d", pushed)  # no error
     loaded = family.parse({"refine": 2, "n_contact": 24})
-    with pytest.raises(InputError, match=r"prescribe a push instead of the load \(--set delta"):
-        check_size("hertz-sphere-3d", loaded)
+    for method in ("auto", "pdas-amg"):
+        check_size("hertz-sphere-3d", loaded, method)  # no error: no factorisation
+    for method in (None, "nested", "pdas"):
+        with pytest.raises(InputError, match=r"--method auto \(the default\) or pdas-amg"):
+            check_size("hertz-sphere-3d", loaded, method)
 
 
 def test_the_nodal_average_is_sized_for_its_denser_stiffness(monkeypatch):

@@ -41,10 +41,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
                        target_on=args.target_on, **options)
         problem = result.problem
     else:
-        problem = build_problem(args.scene, nondimensionalise=not args.raw_units, **params)
+        # the worker of --time-limit builds the problem again, matching its target load itself
+        problem = build_problem(args.scene, nondimensionalise=not args.raw_units,
+                                solved_by=args.method if time_limit is None else None, **params)
         if time_limit is None:
             result = solve(problem, args.method, tol=tol, max_iter=max_iter, max_dofs=args.max_dofs,
                            target_on=args.target_on, **options)
+            problem = result.problem
         else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
             from signorini.studies.runner import solve_within  # per command (start-up)
 

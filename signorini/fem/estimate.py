@@ -38,6 +38,7 @@ thickness in plane strain and per radian in axisymmetric models.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -335,21 +336,11 @@ def material_units(problem: ContactProblem) -> tuple[float, float] | None:
     return float(params["E"]) / stress, float(params["nu"])
 
 
-def estimate(problem: ContactProblem, solution: ContactSolution,
-             contact: bool = True) -> ErrorEstimate | None:
-    """The ZZ estimate of ``solution``'s energy-norm error (None without a mesh or a material).
-
-    ``contact`` adds the complementarity term at the edge of the contact zone
-    (2D models with pressures; see the module's docstring).
-    """
-    material = material_units(problem)
-    if material is None or not np.all(np.isfinite(solution.u)):
-        return None
-    mesh, axisymmetric = problem.mesh, bool(problem.axisymmetric)
-    E, nu = material
-    Lambda, Mu = lame(E, nu)
-    dim = mesh.p.shape[0]
-    u = problem.expand(solution.u).reshape(-1, dim)
+def _by_quadrature(problem: ContactProblem, mesh: Any, u: np.ndarray, Lambda: float,
+                   Mu: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """Per element ``a(u_h, u_h)`` and ``a(e*, e*)``, the recovered nodal strain and volumetric
+    strain (or None), by quadrature: axisymmetric models and the nodal volumetric average."""
+    axisymmetric, dim = bool(problem.axisymmetric), mesh.p.shape[0]
     rule = quadrature(mesh, axisymmetric)
     eps = strains(mesh, u, rule, axisymmetric)
     theta = theta_points = jump = None
@@ -366,6 +357,65 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
     nodal = nodal_recovery(mesh, eps, rule)
     recovered = np.einsum("cke,kq->ceq", nodal[:, mesh.t], rule.bary)
     squares = np.sum(energy_density(recovered - eps, Lambda, Mu, dim, jump) * rule.dx, axis=1)
+    return energy, squares, nodal, theta
+
+
+def _constant_strains(mesh: Any, u: np.ndarray, Lambda: float,
+                      Mu: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_by_quadrature` in closed form where ε_h is constant per simplex (plane strain, 3D).
+
+    The recovery error ``e* − ε_h = Σₖ δₖ φₖ`` (``δₖ``: the recovered strain at corner k
+    minus ε_h) is linear, and ``∫ φₖ φₗ = V (1 + [k = l]) / ((d + 1)(d + 2))``, so that
+    ``a(e* − ε_h, e* − ε_h) = V (a(Σδ, Σδ) + Σₖ a(δₖ, δₖ)) / ((d + 1)(d + 2))``: what the
+    quadrature of order 2 gives (it is exact here), without its points.
+    """
+    dim = mesh.p.shape[0]
+    gradients, jacobian = simplex_gradients(mesh)
+    volume = jacobian / math.factorial(dim)
+    grad = np.einsum("kei,ekj->eij", u[mesh.t], gradients)  # ∂u_i/∂x_j per element
+    pairs = [(0, 0), (1, 1), (0, 1)] if dim == 2 else \
+        [(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)]
+    eps = np.array([0.5 * (grad[:, i, j] + grad[:, j, i]) for i, j in pairs])  # (c, e)
+    energy = energy_density(eps, Lambda, Mu, dim) * volume
+    n, corners = mesh.p.shape[1], mesh.t.shape[0]
+    share = volume / corners  # ∫ φₖ over the element
+    mass = np.zeros(n)
+    moments = np.zeros((len(eps), n))
+    for nodes in mesh.t:
+        mass += np.bincount(nodes, share, minlength=n)
+        for c in range(len(eps)):
+            moments[c] += np.bincount(nodes, eps[c] * share, minlength=n)
+    nodal = moments / mass
+    total = np.zeros_like(eps)
+    own = np.zeros_like(volume)
+    for nodes in mesh.t:
+        delta = nodal[:, nodes] - eps
+        total += delta
+        own += energy_density(delta, Lambda, Mu, dim)
+    squares = volume * (energy_density(total, Lambda, Mu, dim) + own) / (corners * (corners + 1))
+    return energy, squares, nodal
+
+
+def estimate(problem: ContactProblem, solution: ContactSolution,
+             contact: bool = True) -> ErrorEstimate | None:
+    """The ZZ estimate of ``solution``'s energy-norm error (None without a mesh or a material).
+
+    ``contact`` adds the complementarity term at the edge of the contact zone
+    (2D models with pressures; see the module's docstring).
+    """
+    material = material_units(problem)
+    if material is None or not np.all(np.isfinite(solution.u)):
+        return None
+    mesh, axisymmetric = problem.mesh, bool(problem.axisymmetric)
+    E, nu = material
+    Lambda, Mu = lame(E, nu)
+    dim = mesh.p.shape[0]
+    u = problem.expand(solution.u).reshape(-1, dim)
+    if axisymmetric or problem.params.get("volumetric") == "nodal":
+        energy, squares, nodal, theta = _by_quadrature(problem, mesh, u, Lambda, Mu)
+    else:
+        energy, squares, nodal = _constant_strains(mesh, u, Lambda, Mu)
+        theta = None
     recovery = float(np.sqrt(squares.sum()))
     contact_squares = np.zeros_like(squares)
     if contact and problem.weights is not None and np.all(np.isfinite(solution.lam)):

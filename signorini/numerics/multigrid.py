@@ -41,13 +41,20 @@ def pinned_matrix(K: sp.csr_matrix, pinned: np.ndarray) -> sp.csr_matrix:
     diagonal = K.diagonal()
     free = ~pinned
     scale = float(np.mean(np.abs(diagonal[free]))) if free.any() else 1.0
-    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-    touched = pinned[rows] | pinned[K.indices]
+    touched = pinned[K.indices]  # entries in a pinned column, then those in a pinned row
+    rows = np.flatnonzero(pinned)
+    lengths = K.indptr[rows + 1] - K.indptr[rows]
+    at = np.repeat(K.indptr[rows] - np.cumsum(lengths) + lengths, lengths) + np.arange(lengths.sum())
+    touched[at] = True
     data = np.where(touched, 0.0, K.data)
+    on_diagonal = at[K.indices[at] == np.repeat(rows, lengths)]
+    data[on_diagonal] = scale
     out = sp.csr_matrix((data, K.indices.copy(), K.indptr.copy()), shape=K.shape)
-    out = out + sp.diags(np.where(pinned, scale, 0.0))
+    if on_diagonal.size < rows.size:  # a pinned row without a diagonal entry
+        out = out + sp.diags(np.where(pinned, scale, 0.0) - out.diagonal() * pinned)
+    out.eliminate_zeros()
     out.sort_indices()
-    return out.tocsr()
+    return out
 
 
 class PyamgHierarchy:
@@ -80,24 +87,51 @@ class CGResult:
     final_inf: float  # ‖r‖∞ on the free dofs
 
 
+class Bordered:
+    """The SPD matrix ``[[K, −g], [−gᵀ, k]]`` (one more unknown, coupled through sparse ``g``)."""
+
+    def __init__(self, K: sp.csr_matrix, g: np.ndarray, k: float):
+        self.K, self.k = K, float(k)
+        self.rows = np.flatnonzero(g)
+        self.values = g[self.rows]
+        self.shape = (K.shape[0] + 1, K.shape[0] + 1)
+
+    def __matmul__(self, y: np.ndarray) -> np.ndarray:
+        n = self.K.shape[0]
+        out = np.empty(n + 1)
+        out[:n] = self.K @ y[:n]
+        out[self.rows] -= self.values * y[n]
+        out[n] = self.k * y[n] - float(self.values @ y[self.rows])
+        return out
+
+
 def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
               precondition: Callable[[np.ndarray], np.ndarray],
-              done: Callable[[float, float, float], bool], max_iter: int = 2000) -> CGResult:
+              done: Callable[[float, float, float], bool], max_iter: int = 2000,
+              weights: np.ndarray | None = None) -> CGResult:
     """Solve ``(K x)[free] = f[free]`` for ``x[free]`` in place, ``x[~free]`` held fixed.
 
     ``done(‖r‖₂, ‖r‖∞, ‖r₀‖₂)`` decides when to stop (an absolute target, an
     Eisenstat–Walker forcing term against the first residual, or both); it is
     checked on the recursive residual and confirmed on the true one (CG
     restarts from it at most :data:`MAX_RESTARTS` times). Preconditioned by
-    ``precondition`` restricted to the free dofs.
+    ``precondition`` restricted to the free dofs. ``weights`` (default one)
+    scale the residual's entries in those norms (rows of other units).
+    ``K`` may be anything with ``K @ x`` (e.g. :class:`Bordered`).
     """
     mask = free.astype(float)
+    scaled = mask if weights is None else mask * weights
+
+    def norms(r: np.ndarray) -> tuple[float, float]:
+        w = r if weights is None else scaled * r
+        return float(np.linalg.norm(w)), float(np.max(np.abs(w), initial=0.0))
+
     r = mask * (f - K @ x)
-    initial = float(np.linalg.norm(r))
+    initial = norms(r)[0]
     iterations = 0
     COUNTS["cg_solves"] += 1
     for _ in range(MAX_RESTARTS + 1):
-        if done(float(np.linalg.norm(r)), float(np.max(np.abs(r), initial=0.0)), initial):
+        if done(*norms(r), initial):
             break
         z = mask * precondition(r)
         p = z.copy()
@@ -108,7 +142,7 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
             x += alpha * p
             r -= alpha * q
             iterations += 1
-            if done(float(np.linalg.norm(r)), float(np.max(np.abs(r), initial=0.0)), initial):
+            if done(*norms(r), initial):
                 break
             z = mask * precondition(r)
             rz, rz_old = float(r @ z), rz
@@ -117,5 +151,4 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
         if iterations >= max_iter:
             break
     COUNTS["cg_iterations"] += iterations
-    return CGResult(iterations, initial, float(np.linalg.norm(r)),
-                    float(np.max(np.abs(r), initial=0.0)))
+    return CGResult(iterations, initial, *norms(r))

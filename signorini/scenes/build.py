@@ -20,6 +20,7 @@ from signorini.references import REFERENCES
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import check_size
+from signorini.solvers.auto import defers_load_targeting
 from signorini.solvers.nested import zone_from_coarse
 
 #: load targeting on a model of at least this many dofs first solves a coarser model of the
@@ -93,11 +94,17 @@ def predicted_zone(name: str, model: SceneModel, nondimensionalise: bool):
     return zone_from_coarse(model.mesh.p[:, model.contact_nodes].T / coarse.scales.length, coarse)
 
 
-def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> ContactProblem:
+def build_problem(name: str, nondimensionalise: bool = True, *, solved_by: str | None = None,
+                  **values: Any) -> ContactProblem:
     """Build scene ``name`` with parameter ``values`` and assemble its contact problem.
 
     ``name`` may be the path of a TOML scene file (``*.toml``, see
     :mod:`signorini.scenes.scenefile`); ``values`` then override its parameters.
+    ``solved_by`` names the method that will solve it: when that method
+    matches a target load itself (``pdas-amg``, or ``auto`` picking it for a
+    large 3D model), the load targeting is left to it
+    (:func:`signorini.solvers.auto.defers_load_targeting`: no factorisation of
+    K in the assembly) and the problem's target is ``pending``.
     """
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
@@ -108,7 +115,7 @@ def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> C
     else:
         family = get_scene(name)
         params = family.parse(values)
-        check_size(name, params)  # too big for this machine: refused before any mesh is made
+        check_size(name, params, solved_by)  # too big for this machine: refused before meshing
         try:
             model = family.build(params, set(values))
         except (RuntimeError, ValueError, ArithmeticError, IndexError, MemoryError) as exc:
@@ -119,7 +126,8 @@ def build_problem(name: str, nondimensionalise: bool = True, **values: Any) -> C
                              f"({type(exc).__name__}: {exc}): make the mesh coarser (a larger "
                              "grading or a smaller n_contact)") from None
         zone = predicted_zone(name, model, nondimensionalise)
-    problem = assemble(model, nondimensionalise=nondimensionalise, zone=zone)
+    defer = None if solved_by is None else (lambda p: defers_load_targeting(p, solved_by))
+    problem = assemble(model, nondimensionalise=nondimensionalise, zone=zone, defer=defer)
     problem.scene = name
     problem.reference = SCENES[name].reference if name in SCENES else ""
     problem.coarse_model = coarse_problem

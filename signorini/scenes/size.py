@@ -22,9 +22,12 @@ than the dofs (``pdas`` at 350k 3D dofs was killed at 21 GB), which a
 factorising method has to weigh on its own. Two 3D paths are measured apart
 (docs/amg/): a prescribed push (``delta``) goes to ``pdas-amg`` by default,
 no factorisation — 1.3 GB at 350,532 dofs, 3.85 GB at 1,093,024, taken as
-5 kB per dof; a target load is met by load targeting on one factorisation of
-K (4.7 GB at 351,076 dofs, 13.4 kB per dof), whose fill grows like n^⅓ per
-dof: 20 kB × (dofs / 350k)^⅓ from 350k dofs on.
+5 kB per dof; so does a target load that ``pdas-amg`` matches itself (the
+method ``auto`` picks from :data:`~signorini.solvers.auto.AMG_FROM_DOFS` 3D
+dofs, see :func:`~signorini.solvers.auto.defers_load_targeting`: 1.4 GB at
+351,076 dofs); a target load met by load targeting on one factorisation of
+K (any other method: 4.7 GB at 351,076 dofs, 13.4 kB per dof) has a fill
+that grows like n^⅓ per dof: 20 kB × (dofs / 350k)^⅓ from 350k dofs on.
 
 A scene whose estimate exceeds :func:`memory_limit` — by default three
 quarters of this machine's physical memory, or ``SIGNORINI_MAX_MEMORY_GB`` —
@@ -41,6 +44,7 @@ from typing import Any
 from signorini.errors import InputError
 from signorini.fem.volumetric import resolve
 from signorini.numerics.factor import gigabytes_from
+from signorini.solvers.auto import AMG_FROM_DOFS
 
 #: the environment variable that raises (or lowers) the memory a scene may take, in GB
 MEMORY_VARIABLE = "SIGNORINI_MAX_MEMORY_GB"
@@ -56,18 +60,23 @@ FILL_GROWS_FROM = 350_000
 NODAL_MEMORY = {2: 2.2, 3: 2.6}
 
 
-def bytes_per_dof(dim: int, dofs: float, params: dict[str, Any]) -> float:
-    """Memory per dof of building and solving a scene (see the module's docstring)."""
-    return _plain_bytes_per_dof(dim, dofs, params) * (
+def bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
+                  solved_by: str | None = None) -> float:
+    """Memory per dof of building and solving a scene (see the module's docstring) with the
+    method ``solved_by`` (None: load targeting factorises)."""
+    return _plain_bytes_per_dof(dim, dofs, params, solved_by) * (
         NODAL_MEMORY[dim] if resolve(params.get("volumetric", "auto"), params.get("nu", 0.0), dim)
         == "nodal" else 1.0)
 
 
-def _plain_bytes_per_dof(dim: int, dofs: float, params: dict[str, Any]) -> float:
+def _plain_bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
+                         solved_by: str | None = None) -> float:
     if dim == 2:
         return BYTES_PER_DOF[2]
     if params.get("delta") is not None and params.get("P") is None:
         return BYTES_PER_DOF_3D_PUSHED
+    if solved_by == "pdas-amg" or solved_by == "auto" and dofs >= AMG_FROM_DOFS:
+        return BYTES_PER_DOF_3D_PUSHED  # the method matches the load: no factorisation
     return BYTES_PER_DOF[3] * max(1.0, dofs / FILL_GROWS_FROM) ** (1 / 3)
 
 
@@ -142,13 +151,14 @@ def memory_limit() -> float:
     return 0.75 * total if math.isfinite(total) else math.inf
 
 
-def check_size(family: str, params: dict[str, Any]) -> None:
-    """InputError, with the estimate, the limit and how to raise it, when the scene is too big."""
+def check_size(family: str, params: dict[str, Any], solved_by: str | None = None) -> None:
+    """InputError, with the estimate, the limit and how to raise it, when the scene is too big
+    to solve with the method ``solved_by`` (see :func:`bytes_per_dof`)."""
     found = estimate_dofs(family, params)
     if found is None:
         return
     dofs, dim = found
-    need, limit = dofs * bytes_per_dof(dim, dofs, params), memory_limit()
+    need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
     if need <= limit:
         return
     names = [k for k in ("n_contact", "grading", "refine", "nx", "ny") if k in params]
@@ -166,5 +176,5 @@ def _push_hint(dim: int, dofs: float, params: dict[str, Any], limit: float) -> s
     pushed = dofs * BYTES_PER_DOF_3D_PUSHED
     if dim != 3 or _plain_bytes_per_dof(dim, dofs, params) == BYTES_PER_DOF_3D_PUSHED or pushed > limit:
         return ""
-    return (f"; or prescribe a push instead of the load (--set delta=...): no load targeting, no "
-            f"factorisation (pdas-amg), about {pushed / 1e9:,.1f} GB")
+    return (f"; or solve it with --method auto (the default) or pdas-amg, which match the load "
+            f"without a factorisation: about {pushed / 1e9:,.1f} GB")

@@ -68,11 +68,25 @@ def choose(problem: ContactProblem, options: Any = ()) -> tuple[str, str]:
                         "(CG + multigrid, no factorisation to fill in)")
 
 
+def defers_load_targeting(problem: ContactProblem, method: str) -> bool:
+    """Whether ``method`` (``auto`` or ``pdas-amg``) matches ``problem``'s pending target load
+    itself, so that its assembly need not factorise K for it."""
+    if method == "auto" and choose(problem)[0] != "pdas-amg" or method not in ("auto", "pdas-amg"):
+        return False
+    return amg.border_factor(problem) is not None
+
+
 def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Solve with the method :func:`choose` picks; say which and why."""
     name, why = choose(problem, options)
+    given = problem
+    if problem.pending and name != "pdas-amg":  # only pdas-amg matches a target load itself
+        problem = problem.matched()
+        name, why = choose(problem, options)
     solution = CHOICES[name](problem, tol=tol, max_iter=max_iter, **options)
+    if solution.problem is None and problem is not given:
+        solution.problem = problem
     solution.method = name
     solution.extras["auto"] = why
     solution.message = f"auto picked {why}; {solution.message}"
@@ -83,6 +97,6 @@ METHODS = (
     Method(name="auto", function=solve, family="auto", exact=True,
            summary="picks nested (K factorised by load targeting), pdas (2D, small 3D) or pdas-amg "
                    "(large 3D) and says why",
-           default_tol=1e-9,
+           default_tol=1e-9, targets_load=True,
            options=tuple(sorted(set(pdas.DEFAULTS) | set(amg.DEFAULTS) | set(nested.DEFAULTS)))),
 )

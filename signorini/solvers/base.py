@@ -41,7 +41,9 @@ class Method:
     answer up to round-off when they converge. ``options`` names the options
     it takes; ``typed_options`` declares their kinds and ranges
     (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
-    refuses a bad value before any work.
+    refuses a bad value before any work. ``targets_load`` methods take a
+    problem whose target load is pending (``problem.pending``) and match it
+    themselves; any other method gets the problem matched first.
     """
 
     name: str
@@ -55,6 +57,7 @@ class Method:
     default_tol: float | None = None
     options: tuple[str, ...] = field(default=())
     typed_options: Mapping[str, Option] = field(default_factory=dict)
+    targets_load: bool = False
 
     @property
     def installed(self) -> bool:

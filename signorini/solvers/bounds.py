@@ -127,6 +127,22 @@ def _householder(row: np.ndarray) -> np.ndarray:
     return np.eye(k) - 2.0 * np.outer(w, w) / (w @ w)
 
 
+def _with_identity_rows(K: sp.csr_matrix, free: np.ndarray, n_full: int) -> sp.csr_matrix:
+    """K (over the sorted ``free`` dofs) placed in the full dof vector, identity rows elsewhere."""
+    is_free = np.zeros(n_full, dtype=bool)
+    is_free[free] = True
+    others = np.flatnonzero(~is_free)
+    at = K.indptr[np.searchsorted(free, others)]  # each other row's entry goes before these
+    indices = np.insert(free.astype(K.indices.dtype)[K.indices], at, others)
+    data = np.insert(K.data, at, 1.0)
+    counts = np.ones(n_full, dtype=np.int64)
+    counts[free] = np.diff(K.indptr)
+    indptr = np.concatenate([[0], np.cumsum(counts)]).astype(K.indptr.dtype)
+    out = sp.csr_matrix((data, indices, indptr), shape=(n_full, n_full))
+    out.has_sorted_indices = bool(K.has_sorted_indices)
+    return out
+
+
 def bound_form(problem: ContactProblem) -> BoundForm:
     """Rotate each contact node's free dofs so that every contact row becomes a bound.
 
@@ -182,12 +198,14 @@ def bound_form(problem: ContactProblem) -> BoundForm:
     index[~empty], coef[~empty] = rotated.indices, rotated.data
     prescribed = np.ones(n_full, dtype=bool)
     prescribed[free] = False
-    K_full = embed @ problem.K @ embed.T + sp.diags(prescribed.astype(float))
+    K_full = _with_identity_rows(sp.csr_matrix(problem.K), free, n_full)
+    if len(rows_v) > 1:  # some node is rotated (else T is the identity)
+        K_full = (T.T @ K_full @ T).tocsr()
     lower = np.where(prescribed, 0.0, -np.inf)
     upper = np.where(prescribed, 0.0, np.inf)
     limit = problem.d / coef
     up, down = ~empty & (coef > 0), ~empty & (coef < 0)
     upper[index[up]], lower[index[down]] = limit[up], limit[down]
-    return BoundForm(K=(T.T @ K_full @ T).tocsr(), f=T.T @ (embed @ problem.f), lower=lower,
+    return BoundForm(K=K_full, f=T.T @ (embed @ problem.f), lower=lower,
                      upper=upper, T=T, free_dofs=free, bound_index=index, bound_coef=coef,
                      block=block, coordinates=coordinates)

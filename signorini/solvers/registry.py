@@ -127,6 +127,9 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     """
     spec, tol, max_iter, options = check_request(method, tol, max_iter, options)
     start = time.perf_counter()
+    given = problem
+    if problem.pending and not spec.targets_load:
+        problem = problem.matched()  # the target load first (factorised), then the method
     try:
         solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
     except InputError:
@@ -140,6 +143,9 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
         solution = ContactSolution.failure(
             method, problem, "failed", f"the method called sys.exit({exc.code!r})",
             solve_time=time.perf_counter() - start)
+    if solution.problem is None and problem is not given:
+        solution.problem = problem
+    problem = solution.problem if solution.problem is not None else problem
     solution = hold_to_contract(problem, method, solution)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start

@@ -1,0 +1,128 @@
+"""Load targeting left to the method: pdas-amg matches a target load without a factorisation.
+
+A scene with a target load P is assembled at a nominal push with the target
+``pending`` when the method that will solve it says it matches the load itself
+(``build_problem(..., solved_by=...)``); pdas-amg then carries the push as one
+more unknown of its CG systems (:class:`signorini.solvers.amg.LoadBorder`). The
+answer must be the one the factorised load targeting gives, for the same load;
+any other method gets the problem matched first. Work is counted, not timed.
+"""
+
+import importlib.util
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import signorini
+from signorini.kkt import certificate, compare
+from signorini.numerics import factor
+from signorini.numerics.multigrid import Bordered
+from signorini.problem import ContactProblem
+from signorini.scenes import build_problem
+from signorini.solvers import auto
+from signorini.solvers.registry import solve
+
+pytest.importorskip("pyamg", reason="pdas-amg needs pyamg (a default dependency)")
+
+SCENE = "hertz-sphere-3d"  # a target load by default (a traction on the cut, one pushed dof)
+PUSHED = {"loading": "displacement"}  # the whole cut pushed: many dofs moving together
+
+
+def factorisations() -> int:
+    return factor.COUNTS["factorisations"]
+
+
+@pytest.fixture(scope="module", params=[{}, PUSHED], ids=["traction", "pushed-cut"])
+def pair(request):
+    """(pending problem, the same scene load-targeted by factorisation)."""
+    before = factorisations()
+    pending = build_problem(SCENE, solved_by="pdas-amg", **request.param)
+    assert factorisations() == before, "a pending problem is assembled without a factorisation"
+    return pending, build_problem(SCENE, **request.param)
+
+
+def test_the_target_is_pending_until_matched(pair):
+    pending, eager = pair
+    assert pending.pending and not eager.pending
+    assert pending.push.target == pytest.approx(eager.push.target, rel=1e-12)
+    matched = pending.matched()
+    assert not matched.pending and matched.matched() is matched
+    assert matched.push.scale == pytest.approx(eager.push.scale, rel=1e-9)
+    assert np.allclose(matched.f, eager.f, rtol=0, atol=1e-9 * np.abs(eager.f).max())
+
+
+def test_pdas_amg_matches_the_load_without_a_factorisation(pair):
+    pending, eager = pair
+    reference = solve(eager, "pdas")
+    before = factorisations()
+    solution = solve(pending, "pdas-amg")
+    assert solution.status == "converged", solution.message
+    assert "one more unknown" in solution.message
+    settled = solution.problem
+    assert settled is not None and not settled.pending
+    # no factorisation of the fine model (its coarse model, if any, is small and counted apart)
+    assert factorisations() - before <= 1
+    assert certificate(settled, solution).worst()[1] <= 1e-9
+    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
+                                                                      rel=1e-8)
+    assert settled.push.scale == pytest.approx(eager.push.scale, rel=1e-7)
+    agreement = compare(eager, solution, reference)
+    assert agreement.lam_rel <= 1e-7 and agreement.misclassified == 0, agreement.as_dict()
+
+
+def test_any_other_method_gets_the_problem_matched_first(pair):
+    pending, eager = pair
+    solution = solve(pending, "pdas")
+    assert solution.status == "converged"
+    assert solution.problem is not None and not solution.problem.pending
+    assert solution.problem.total_contact_force(solution.lam) == pytest.approx(
+        pending.push.target, rel=1e-9)
+
+
+def test_the_api_reports_the_matched_problem(monkeypatch):
+    monkeypatch.setattr(auto, "AMG_FROM_DOFS", 1_000)
+    result = signorini.solve(SCENE)
+    assert result.status == "converged" and result.method == "pdas-amg"
+    assert not result.problem.pending
+    assert result.total_force == pytest.approx(result.problem.params["P"], rel=1e-8)
+    assert result.certificate.worst()[1] <= 1e-9
+
+
+def test_small_models_keep_the_factorised_targeting():
+    """auto picks pdas for a small 3D model: the assembly targets the load (and nested reuses it)."""
+    problem = build_problem(SCENE, solved_by="auto")
+    assert not problem.pending
+    assert not build_problem(SCENE, solved_by="pdas").pending
+
+
+def test_a_pending_problem_is_saved_pending(tmp_path, pair):
+    pending, _ = pair
+    path = tmp_path / "pending.npz"
+    pending.save(path)
+    loaded = ContactProblem.load(path)
+    assert loaded.pending and loaded.push.target == pending.push.target
+    solution = solve(loaded, "pdas")
+    assert solution.problem.total_contact_force(solution.lam) == pytest.approx(
+        pending.push.target, rel=1e-9)
+
+
+def test_the_bordered_operator_is_the_bordered_matrix():
+    rng = np.random.default_rng(3)
+    A = sp.random(30, 30, 0.2, random_state=3)
+    K = (A @ A.T + 5 * sp.eye(30)).tocsr()
+    g = np.zeros(30)
+    g[[2, 7, 11]] = rng.normal(size=3)
+    full = sp.bmat([[K, -g[:, None]], [-g[None, :], np.array([[4.0]])]]).toarray()
+    y = rng.normal(size=31)
+    assert np.allclose(Bordered(K, g, 4.0) @ y, full @ y)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("petsc4py") is None,
+                    reason="the petsc backend of pdas-amg needs petsc4py (extra 'petsc')")
+def test_both_multigrids_match_the_load(pair):
+    pending, eager = pair
+    first = solve(pending, "pdas-amg", amg="petsc")
+    second = solve(pending, "pdas-amg", amg="pyamg")
+    assert first.status == second.status == "converged"
+    assert compare(eager, first, second).lam_rel <= 1e-7
