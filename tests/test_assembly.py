@@ -326,7 +326,7 @@ def test_vectorised_plane_strain_stiffness_is_scikit_fems():
     from skfem import Basis, ElementVector, MeshTri, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    from signorini.fem.assembly import plane_strain_stiffness
+    from signorini.fem.stiffness import plane_strain_stiffness
 
     mesh = MeshTri.init_circle(3)
     mesh = MeshTri(mesh.p * [[2.0], [0.5]], mesh.t)  # stretched: elements of many shapes
@@ -341,7 +341,7 @@ def test_vectorised_solid_stiffness_is_scikit_fems(monkeypatch):
     from skfem import Basis, ElementVector, MeshTet, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    from signorini.fem import assembly
+    from signorini.fem import stiffness as assembly
 
     mesh = MeshTet.init_ball().refined(1)
     mesh = MeshTet(mesh.p * [[1.3], [0.7], [1.1]] + 0.1 * np.sin(mesh.p), mesh.t)  # distorted

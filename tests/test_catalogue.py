@@ -62,10 +62,11 @@ CLI = [
     # size before allocation
     (["solve", "hertz-cylinder", "--set", "refine=6"], 2, ["refine=6", "dofs", "GB",
                                                          "SIGNORINI_MAX_MEMORY_GB"]),
-    (["solve", "hertz-sphere-3d", "--set", "refine=3"], 2, ["refine=3", "dofs", "GB"]),
+    (["solve", "hertz-sphere-3d", "--set", "refine=3", "--set", "n_contact=20"], 2,
+     ["refine=3", "dofs", "GB"]),
     (["solve", "block", "--set", "nx=100000", "--set", "ny=100000"], 2, ["nx=100000", "dofs"]),
     (["solve", "punch", "--set", "n_contact=10000000"], 2, ["n_contact=1e+07", "dofs"]),
-    (["solve", "hertz-sphere-3d", "--set", "grading=0.01"], 2, ["grading=0.01", "dofs"]),
+    (["solve", "hertz-sphere-3d", "--set", "grading=0.01"], 2, ["grading=0.01", "tetrahedra"]),
     # methods and their options
     (["solve", "block", "--method", "simplex"], 2, ["unknown method", "'simplex'", "pdas"]),
     (["solve", "block", "--method", "pdas", "--opt", "c=abc"], 2, ["c='abc'", "positive"]),

@@ -11,7 +11,8 @@ from skfem import Basis, ElementTriP1, ElementVector, MeshTri, asm
 from skfem.models.elasticity import lame_parameters
 
 import signorini
-from signorini.fem.assembly import axisymmetric_elasticity, plane_strain_stiffness
+from signorini.fem.assembly import axisymmetric_elasticity
+from signorini.fem.stiffness import plane_strain_stiffness
 from signorini.fem.estimate import (_by_quadrature, _constant_strains, contact_term, element_energies,
                                     estimate, lame, material_units, quadrature, recover, strains)
 from signorini.fem.transfer import uniform_prolongation

@@ -8,7 +8,7 @@ from skfem.models.elasticity import lame_parameters
 
 import signorini
 from signorini.errors import InputError
-from signorini.fem.assembly import plane_strain_stiffness, solid_stiffness
+from signorini.fem.stiffness import plane_strain_stiffness, solid_stiffness
 from signorini.fem.volumetric import (NODAL_FROM_NU, averaging, nodal_volumetric_strain, resolve,
                                       volumetric_stiffness)
 

@@ -121,9 +121,13 @@ def signed_volumes(mesh: MeshTet) -> np.ndarray:
     return np.einsum("ij,ij->j", e1, np.cross(e2, e3, axis=0)) / 6.0
 
 
+#: the most simplices a graded mesh may reach (before any uniform refinement)
+MAX_ELEMENTS = 2_000_000
+
+
 def refine_simplices_to_size(mesh: Mesh, target: Callable[[np.ndarray], np.ndarray],
                              snap: Callable[[Mesh], Mesh] | None = None,
-                             max_elements: int = 2_000_000, max_passes: int = 120) -> Mesh:
+                             max_elements: int = MAX_ELEMENTS, max_passes: int = 120) -> Mesh:
     """Refine ``mesh`` until every simplex's longest edge is ≤ ``target(centroid)``.
 
     Works for triangles and tetrahedra alike (scikit-fem's ``refined(marked)``:

@@ -44,6 +44,7 @@ from typing import Any
 from signorini.errors import InputError
 from signorini.fem.volumetric import resolve
 from signorini.numerics.factor import gigabytes_from
+from signorini.scenes.meshing import MAX_ELEMENTS
 from signorini.solvers.auto import AMG_FROM_DOFS
 
 #: the environment variable that raises (or lowers) the memory a scene may take, in GB
@@ -54,6 +55,8 @@ BYTES_PER_DOF = {2: 4_000, 3: 20_000}
 BYTES_PER_DOF_3D_PUSHED = 5_000
 #: from this many 3D dofs a factorisation's bytes per dof grow like (dofs / this)^⅓
 FILL_GROWS_FROM = 350_000
+#: tetrahedra per dof of the 3D octant's meshes (664,768 at 351,076 dofs, hertz-sphere-3d refine=2)
+TETRAHEDRA_PER_DOF = 1.9
 #: peak memory with the volumetric strain averaged at the nodes over plain P1, same scene and
 #: default method, measured here at ν = 0.45: 1.75 GB against 0.79 GB for hertz-cylinder
 #: refine=3 (297,984 dofs), 1.41 GB against 0.54 GB for hertz-sphere-3d refine=1 (46,964 dofs)
@@ -158,6 +161,13 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
     if found is None:
         return
     dofs, dim = found
+    graded = dofs / 2.0 ** (dim * params.get("refine", 0)) * TETRAHEDRA_PER_DOF
+    if dim == 3 and graded > MAX_ELEMENTS:
+        raise InputError(
+            f"scene {family!r} with grading={params['grading']:g}, n_contact={params['n_contact']:g} "
+            f"would be graded to about {graded:,.0f} tetrahedra before any uniform refinement, "
+            f"over the mesher's {MAX_ELEMENTS:,}: make the grading larger or n_contact smaller, "
+            "and refine (refine=1, 2...) to go finer")
     need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
     if need <= limit:
         return

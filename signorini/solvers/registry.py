@@ -143,10 +143,10 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
         solution = ContactSolution.failure(
             method, problem, "failed", f"the method called sys.exit({exc.code!r})",
             solve_time=time.perf_counter() - start)
+    solution = hold_to_contract(problem, method, solution)
     if solution.problem is None and problem is not given:
         solution.problem = problem
     problem = solution.problem if solution.problem is not None else problem
-    solution = hold_to_contract(problem, method, solution)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
     if "auto" not in solution.extras:  # auto names the method it picked
