@@ -126,3 +126,14 @@ def test_both_multigrids_match_the_load(pair):
     second = solve(pending, "pdas-amg", amg="pyamg")
     assert first.status == second.status == "converged"
     assert compare(eager, first, second).lam_rel <= 1e-7
+
+
+def test_the_push_as_an_unknown_costs_few_cg_iterations(pair):
+    """The bordered system is preconditioned by the same hierarchy and the border's diagonal: the
+    CG iterations stay close to those of the same problem with the push given (counted, not
+    timed; measured at 6.9k dofs: 150 against 120 or so)."""
+    pending, _ = pair
+    targeted = solve(pending, "pdas-amg")
+    given = solve(targeted.problem, "pdas-amg")
+    assert targeted.status == given.status == "converged"
+    assert targeted.extras["cg_iterations"] <= 1.5 * given.extras["cg_iterations"] + 30

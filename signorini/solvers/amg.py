@@ -12,6 +12,12 @@ algebraic multigrid given the rigid-body modes as near-null space
 - the first active set comes from a coarse model of the scene, as for
   ``nested`` (its contact forces, nearest candidate's side), or from load
   targeting's answer, so that few steps remain;
+- a target load that is still pending (``problem.pending``: ``auto`` leaves it
+  to this method for large 3D models) is matched with the answer: the push is
+  one more unknown of every CG system (:class:`LoadBorder`), preconditioned by
+  block elimination (:func:`border_preconditioner`), so no factorisation of K
+  is ever made; the answer's problem is the given one pushed to that load
+  (``solution.problem``);
 - **one hierarchy** is built, for K with the first active set pinned; later
   sets differ in a few rows and CG pays for them in iterations;
 - CG starts from the last step's displacement, and its tolerance follows
@@ -24,12 +30,11 @@ algebraic multigrid given the rigid-body modes as near-null space
   AMG-preconditioned solver for K with the final set pinned (:class:`PinnedCG`),
   not a serial factorisation.
 
-Multigrid: ``amg=petsc`` (PETSc's GAMG, plain aggregation, through petsc4py),
-``amg=pyamg`` (smoothed aggregation) or ``auto``: GAMG when petsc4py is
-installed. On the 356k-dof bound form of ``hertz-sphere-3d`` (refine=2), one
-set-up and a CG solve to 1e-10 measured here (load ≈ 5 on 2 cores): GAMG 2.7 s
-+ 11.2 s (82 iterations, 0.14 s each), pyamg 11.9 s + 14.3 s (29, 0.49 s each);
-GAMG with smoothed aggregation 18.3 s + 6.7 s (see docs/amg/).
+Multigrid: ``amg=petsc`` (PETSc's GAMG, plain aggregation, through petsc4py,
+set up by :data:`GAMG_OPTIONS`), ``amg=pyamg`` (smoothed aggregation) or
+``auto``: GAMG when petsc4py is installed. One set-up and a CG solve to 1e-10
+of the 350k-dof pushed ``hertz-sphere-3d``'s K, each way, are in docs/amg/bench.md
+(``tools/amg_bench.py run --part backends``).
 """
 
 from __future__ import annotations
@@ -79,12 +84,13 @@ CERTIFICATE_RTOL = 1e-3
 
 
 #: PETSc options of the GAMG hierarchy (prefix ``signorini_amg_``; PETSC_OPTIONS overrides):
-#: plain aggregation (measured in the module doc), a coarsest level of up to 10,000 equations
-#: solved directly and one smoothing step per level. One set-up + CG to 1e-10 of the pushed
-#: hertz-sphere-3d's K (2-core machine, idle): at 350,532 dofs PETSc's defaults 1.3 s + 5.1 s
+#: plain aggregation, a coarsest level of up to 10,000 equations solved directly and one
+#: smoothing step per level. Chosen by one set-up + CG to 1e-10 of the pushed hertz-sphere-3d's
+#: K (by hand, idle 2-core machine): at 350,532 dofs PETSc's defaults took 1.3 s + 5.1 s
 #: (77 iterations, 7 levels), these 1.2 s + 3.3 s (52, 3 levels); at 1,093,024 dofs 4.7 s + 24.0 s
-#: (93, 8 levels) against 4.1 s + 12.6 s (62, 4 levels). A 40,000-equation coarsest level cost
-#: 0.36 s per iteration at 350k; smoothed aggregation 7 s of set-up.
+#: (93, 8 levels) against 4.1 s + 12.6 s (62, 4 levels); a 40,000-equation coarsest level cost
+#: 0.36 s per iteration at 350k, smoothed aggregation 7 s of set-up. The committed comparison
+#: at 350k is docs/amg/bench.md's first table.
 GAMG_OPTIONS = {"pc_gamg_agg_nsmooths": "0", "pc_gamg_coarse_eq_limit": "10000",
                 "mg_levels_ksp_max_it": "1"}
 
@@ -272,6 +278,29 @@ def load_border(problem: ContactProblem, form: BoundForm) -> LoadBorder | None:
                       beta=beta, target=pu.target)
 
 
+def border_preconditioner(apply, border: LoadBorder):
+    """The multigrid ``M ≈ A⁻¹`` extended to the bordered matrix ``[[A, −g], [−gᵀ, k]]``.
+
+    Block elimination with ``w = −M g`` (one V-cycle, once) and the Schur
+    complement ``S = k − gᵀ M g``: ``P = Z diag(M, 1/S) Zᵀ``, ``Z = [[I, w], [0, 1]]``,
+    symmetric positive definite for any w when S > 0 and the exact inverse
+    when M is. On the default 6.9k-dof sphere it took CG from 146 iterations (the
+    border preconditioned by its diagonal) to 129, with the whole cut pushed from 204
+    to 179, against 106 and 112 with the push given (tests/test_pending_load.py).
+    Should S not be clearly positive (M too far from A⁻¹), the border's diagonal alone.
+    """
+    Mg = apply(border.g)
+    schur = border.k - float(border.g @ Mg)
+    if not schur > 1e-3 * border.k:
+        return lambda r: np.append(apply(r[:-1]), r[-1] / border.k)
+
+    def precondition(r: np.ndarray) -> np.ndarray:
+        t = (r[-1] + float(Mg @ r[:-1])) / schur
+        return np.append(apply(r[:-1]) + Mg * t, t)
+
+    return precondition
+
+
 def _embedded(form: BoundForm, v: np.ndarray) -> np.ndarray:
     full = np.zeros(form.T.shape[0])
     full[form.free_dofs] = v
@@ -355,9 +384,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         operator = Bordered(system.K, border.g, border.k)
         rhs = np.append(border.f0, border.h)
         free_of = lambda free: np.append(free, True)  # noqa: E731
-
-        def precondition(r: np.ndarray) -> np.ndarray:
-            return np.append(hierarchy.apply(r[:-1]), r[-1] / border.k)
+        precondition = border_preconditioner(hierarchy.apply, border)
     d = problem.d
     floor = 1e-5 * float(np.max(np.abs(problem.f), initial=0.0))
     history: dict[str, list[float]] = {"changes": [], "active": [], "cg_iterations": [],

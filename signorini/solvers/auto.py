@@ -12,6 +12,11 @@
   contact zone (:class:`~signorini.numerics.zone.ZoneSolver`, kept on the
   problem): ``nested``, which reuses that factorisation and costs back-solves
   only (the 47k-dof 3D sphere: 0.16 s against pdas's 7.8 s and 8 factorisations).
+  A scene built for ``auto`` (``build_problem(..., solved_by="auto")``, as the
+  API and the command line do) is not load-targeted by factorisation when
+  ``pdas-amg`` will be picked: its target load stays pending and ``pdas-amg``
+  matches it with the answer (:func:`defers_load_targeting`); a pending
+  problem for any other pick is matched first (``problem.matched()``).
 
 The chosen method's name is the solution's ``method``; ``extras["auto"]``
 and the message say what was picked and why. Options are passed on to the
