@@ -155,11 +155,22 @@ def test_auto_picks_pdas_for_axisymmetric_and_small_3d(problems):
     assert "axisymmetric" in auto.choose(axisymmetric)[1]
     small = problems["hertz-sphere-3d"]
     name, why = auto.choose(small)
-    assert name == "pdas" and f"< {auto.AMG_FROM_DOFS:,}" in why
+    assert name == "pdas" and f"< {auto.PUSHED_AMG_FROM_DOFS:,}" in why
+
+
+def test_auto_leaves_a_pushed_3d_model_to_pdas_amg_sooner_than_a_load_targeted_one(monkeypatch):
+    """Between the two thresholds a push goes to pdas-amg, a target load (met by factorisation
+    in the assembly) to the method that reuses it."""
+    monkeypatch.setattr(auto, "PUSHED_AMG_FROM_DOFS", 1_000)
+    pushed = build_problem("hertz-sphere-3d", delta=0.0025)
+    loaded = build_problem("hertz-sphere-3d")
+    assert pushed.n < auto.AMG_FROM_DOFS and loaded.warm_start.lam is not None
+    assert auto.choose(pushed)[0] == "pdas-amg"
+    assert auto.choose(loaded)[0] == "pdas"
 
 
 def test_auto_picks_pdas_amg_for_large_3d(problems, monkeypatch):
-    monkeypatch.setattr(auto, "AMG_FROM_DOFS", 1_000)
+    monkeypatch.setattr(auto, "PUSHED_AMG_FROM_DOFS", 1_000)
     problem = problems["hertz-sphere-3d"]
     solution = solve(problem, "auto", amg="pyamg")
     assert solution.method == "pdas-amg" and solution.status == "converged"

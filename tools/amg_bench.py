@@ -14,7 +14,8 @@ Parts (each one a key of the JSON, re-run alone with --part):
   hertz-sphere-3d ... --json``, whole process (wall time, peak memory, the record);
 - ``petsc-350k``: the same problem solved in one process by pdas-amg and petsc-vi (1 rank):
   λ's relative difference and the nodes classified apart;
-- ``whole-350k-load``, ``whole-1m-load`` and ``petsc-350k-load``: the same for the scene's own
+- ``whole-350k-load``, ``whole-1m-load``, ``whole-largest-load`` (refine=3, the finest the size
+  guard lets through here) and ``petsc-350k-load``: the same for the scene's own
   default, a target load (Hertz's a/R = 0.05) instead of a push: ``auto`` picks ``pdas-amg``,
   which matches the load with the answer (the push one more unknown, no factorisation).
 
@@ -43,8 +44,10 @@ SPHERE_350K = {"refine": 2, "delta": 0.0025}
 SPHERE_1M = {"refine": 2, "n_contact": 24, "delta": 0.0025}
 SPHERE_350K_LOAD = {"refine": 2}
 SPHERE_1M_LOAD = {"refine": 2, "n_contact": 24}
+#: the finest default the size guard lets through at 19 GB (about 3.7M dofs estimated)
+SPHERE_LARGEST_LOAD = {"refine": 3}
 PARTS = ("backends", "crossover", "whole-350k", "petsc-350k", "whole-1m", "whole-350k-load",
-         "whole-1m-load", "petsc-350k-load", "scale", "nested-1m")
+         "whole-1m-load", "whole-largest-load", "petsc-350k-load", "scale", "nested-1m")
 #: the scale table (part ``scale``): a push, so that every method solves the same problem
 SCALE_SIZES = {"50k": {"refine": 1, "delta": 0.0025}, "350k": SPHERE_350K, "1m": SPHERE_1M}
 #: (label, method, options, MPI ranks)
@@ -263,6 +266,7 @@ MEASURE = {"backends": backends, "scale": scale, "crossover": crossover, "petsc-
            "whole-350k": lambda: whole(SPHERE_350K), "whole-1m": lambda: whole(SPHERE_1M),
            "whole-350k-load": lambda: whole(SPHERE_350K_LOAD),
            "whole-1m-load": lambda: whole(SPHERE_1M_LOAD),
+           "whole-largest-load": lambda: whole(SPHERE_LARGEST_LOAD),
            "petsc-350k-load": lambda: petsc_350k(SPHERE_350K_LOAD, "auto"),
            # the scale table's 1M nested run again, after its band columns stopped being kept whole
            "nested-1m": lambda: whole(SPHERE_1M, "nested", timeout=SCALE_TIMEOUT)}
@@ -318,6 +322,17 @@ def readme_paragraph(data: dict) -> str:
                      + ".")
     if "whole-1m-load" in data and data["whole-1m-load"]["record"] is not None:
         lines.append("- The same at about 1M dofs: " + whole_sentence(data["whole-1m-load"]) + ".")
+    if "whole-largest-load" in data and data["whole-largest-load"]["record"] is not None:
+        from signorini.scenes import SCENES
+        from signorini.scenes.size import bytes_per_dof, estimate_dofs
+
+        params = SCENES["hertz-sphere-3d"].parse(SPHERE_LARGEST_LOAD)
+        dofs, dim = estimate_dofs("hertz-sphere-3d", params)
+        need = dofs * bytes_per_dof(dim, dofs, params, "auto")
+        machine_gb = data.get("machine", {}).get("memory_gb", float("nan"))
+        lines.append(f"- The finest default the size guard lets through on this machine (refine=3: "
+                     f"estimated {dofs / 1e6:.1f}M dofs and {need / 1e9:.1f} GB, the limit ¾ of "
+                     f"{machine_gb:.1f} GB): " + whole_sentence(data["whole-largest-load"]) + ".")
     if "petsc-350k-load" in data:
         p = data["petsc-350k-load"]
         lines.append(f"- Its answer against `petsc-vi` (1 rank) on the same {p['dofs']:,}-dof "

@@ -7,7 +7,8 @@
   sphere, its 3D factors fill in like n^(4/3)), when pyamg is installed and
   every contact row bounds its own dofs (rows sharing a dof have no bound
   form); otherwise ``pdas``;
-- smaller 3D models: ``pdas`` (as fast there, measured, and it needs no CG);
+- smaller 3D models: ``pdas``, or ``pdas-amg`` from :data:`PUSHED_AMG_FROM_DOFS` when
+  no load targeting has solved the model already (a push: faster there, measured);
 - any model whose load targeting already factorised K around a predicted
   contact zone (:class:`~signorini.numerics.zone.ZoneSolver`, kept on the
   problem): ``nested``, which reuses that factorisation and costs back-solves
@@ -34,10 +35,16 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import amg, nested, pdas
 from signorini.solvers.base import Method
 
-#: 3D models of at least this many free dofs go to pdas-amg. On hertz-sphere-3d (load ≈ 5,
-#: docs/amg/): at 12k dofs pdas took 2.5 s, pdas-amg 2.7 s; at 47k both 12-16 s; at 350k pdas was
-#: killed for memory (its factorisations fill in like n^(4/3) in 3D) and pdas-amg converged
+#: 3D models of at least this many free dofs go to pdas-amg, and a pending target load is left to
+#: it (at 350k pdas was killed for memory: 3D factorisations fill in like n^(4/3)). Below, a target
+#: load is met by factorisation and nested or pdas confirm it: the default hertz-sphere-3d at
+#: 46,964 dofs took 2.2 s whole command so against 2.6 s with pdas-amg, at 11,975 1.2 s both
 AMG_FROM_DOFS = 50_000
+#: a 3D model with a mesh and no load targeting (a push) goes to pdas-amg from this many dofs:
+#: whole commands of the pushed hertz-sphere-3d (delta=0.0025) with pdas and pdas-amg took 1.0 s
+#: and 1.0 s at 6,879 dofs, 1.9 s and 1.2 s at 11,935, 4.8 s and 2.6 s at 46,820 (by hand, idle;
+#: the method times alone are docs/amg/bench.md's second table)
+PUSHED_AMG_FROM_DOFS = 10_000
 CHOICES = {"pdas": pdas.solve, "pdas-amg": amg.solve, "nested": nested.solve}
 
 
@@ -63,13 +70,15 @@ def choose(problem: ContactProblem, options: Any = ()) -> tuple[str, str]:
     if problem.axisymmetric or dim < 3:
         kind = "axisymmetric" if problem.axisymmetric else "2D"
         return "pdas", f"{kind} model: pdas (exact; 2D factorisations are fast)"
-    if n < AMG_FROM_DOFS:
-        return "pdas", f"3D model of {n:,} dofs < {AMG_FROM_DOFS:,}: pdas (a factorisation is cheap)"
+    pushed = problem.mesh is not None and problem.warm_start.lam is None and not problem.pending
+    least = PUSHED_AMG_FROM_DOFS if pushed else AMG_FROM_DOFS
+    if n < least:
+        return "pdas", f"3D model of {n:,} dofs < {least:,}: pdas (a factorisation is cheap)"
     if importlib.util.find_spec("pyamg") is None:
         return "pdas", f"3D model of {n:,} dofs, but pyamg is not installed (pip install pyamg): pdas"
     if _rows_share_a_dof(problem):
         return "pdas", f"3D model of {n:,} dofs whose contact rows share dofs (no bound form): pdas"
-    return "pdas-amg", (f"3D model of {n:,} dofs ≥ {AMG_FROM_DOFS:,}: pdas-amg "
+    return "pdas-amg", (f"3D model of {n:,} dofs ≥ {least:,}: pdas-amg "
                         "(CG + multigrid, no factorisation to fill in)")
 
 
