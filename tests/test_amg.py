@@ -185,3 +185,14 @@ def test_auto_in_the_command_line(capsys):
     out = capsys.readouterr().out
     assert code == 0
     assert out.startswith("block with pdas: converged") and "auto picked 2D model" in out
+
+
+@pytest.mark.parametrize("touching", [0.25, 0.5])
+def test_nodes_touching_with_no_force_end_converged_not_cycling(touching):
+    """The atlas's degenerate block: PDAS's active set cycles over nodes that touch with no force.
+    pdas-amg solves the cycling set tightly and lets the certificate judge it (either set is the
+    answer there), and its duality gap survives pinned dofs that must be released."""
+    problem = build_problem("block", nx=8, ny=8, touching=touching)
+    solution = solve(problem, "pdas-amg", tol=1e-8)
+    assert solution.status == "converged", solution.message
+    assert_agrees(problem, solution, solve(problem, "pdas", tol=1e-8), lam_tol=1e-7)

@@ -138,7 +138,10 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
         rz = float(r @ z)
         while iterations < max_iter:
             q = mask * (K @ p)
-            alpha = rz / float(p @ q)
+            curvature = float(p @ q)
+            if not curvature > 0:  # breakdown: nothing left that the free dofs can change
+                break
+            alpha = rz / curvature
             x += alpha * p
             r -= alpha * q
             iterations += 1

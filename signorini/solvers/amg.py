@@ -74,6 +74,9 @@ SAFETY = 0.1
 GAMMA, ALPHA, ETA_MAX, ETA_MIN = 0.9, 2.0, 0.1, 1e-4
 #: a coarse model below this many dofs is solved by pdas (a factorisation is cheap there)
 DIRECT_BELOW = 30_000
+#: a cycling active set is solved tightly and judged by the certificate this many times at most
+#: (PDAS cycles where nodes touch with no force; either set is then the answer)
+MAX_CYCLES = 2
 #: CG iterations allowed per solve
 CG_MAX_ITER = 3000
 #: relative residual of the certificate's solve ``e = K̃⁻¹r`` (r: the final stationarity residual).
@@ -389,7 +392,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     floor = 1e-5 * float(np.max(np.abs(problem.f), initial=0.0))
     history: dict[str, list[float]] = {"changes": [], "active": [], "cg_iterations": [],
                                        "eta": []}
-    eta, r0_last, final, tighten = ETA_MIN, None, False, 1.0
+    eta, r0_last, final, tighten, cycles = ETA_MIN, None, False, 1.0, 0
     lam = np.zeros(problem.m)
     seen = {active.tobytes()}
     status, message = "max_iter", f"active set still changing after {max_iter} steps"
@@ -423,7 +426,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         history["eta"].append(forcing[0] if forcing else 0.0)
         if opts["callback"] is not None:
             opts["callback"](step, form.displacement(x), lam)
-        if changes == 0:
+        repeated = new_active.tobytes() in seen  # a cycle: judged once its set is solved tightly
+        if changes == 0 or repeated and final:
             force = max(float(np.max(np.abs(lam * system.coef), initial=0.0)), floor, 1e-300)
             if result.final_inf <= SAFETY * tighten * tol * force:
                 candidate = ContactSolution(method="pdas-amg", u=form.displacement(x), lam=lam,
@@ -434,7 +438,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                 name, worst = certificate(problem, candidate, duality_gap=False).worst()
                 if worst <= tol:
                     status = "converged"
-                    message = (f"active set of {int(active.sum())} nodes repeated after {step} "
+                    how = "repeated" if changes == 0 else \
+                        "cycled (nodes touching with no force: either set is the answer)"
+                    message = (f"active set of {int(active.sum())} nodes {how} after {step} "
                                f"steps, certificate {worst:.1e} ({name})")
                     break
                 tighten *= 0.1
@@ -444,11 +450,14 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                     break
             final = True
             continue
-        if new_active.tobytes() in seen:
+        if repeated and cycles >= MAX_CYCLES:
             status = "failed"
             message = (f"the active set cycled after {step} steps (PDAS with inexact solves): "
                        "use pdas or petsc-vi")
             break
+        if repeated:  # solve this set tightly; the certificate then decides (above)
+            cycles, final = cycles + 1, True
+            continue
         seen.add(new_active.tobytes())
         eta, r0_last = (forcing[0] if forcing else eta), result.initial
         active, final = new_active, False
