@@ -245,8 +245,8 @@ class LoadBorder:
     row of the symmetric system ``[[K, −f₁], [−f₁ᵀ, −o₁/β]] [u; s] = [f₀;
     −(P − o₀)/β]``: K of the body with the pushed dofs as one more unknown,
     SPD once the contact holds it (:class:`~signorini.numerics.multigrid.Bordered`).
-    CG preconditions the extra row by its diagonal. Arrays are the bound
-    form's (rotated, full length).
+    CG preconditions it by block elimination (:func:`border_preconditioner`).
+    Arrays are the bound form's (rotated, full length).
     """
 
     g: np.ndarray  # the push's forces f₁
