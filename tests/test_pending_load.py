@@ -8,6 +8,7 @@ answer must be the one the factorised load targeting gives, for the same load;
 any other method gets the problem matched first. Work is counted, not timed.
 """
 
+import dataclasses
 import importlib.util
 
 import numpy as np
@@ -137,3 +138,17 @@ def test_the_push_as_an_unknown_costs_few_cg_iterations(pair):
     given = solve(targeted.problem, "pdas-amg")
     assert targeted.status == given.status == "converged"
     assert targeted.extras["cg_iterations"] <= 1.5 * given.extras["cg_iterations"] + 30
+
+
+def test_a_push_pdas_amg_cannot_carry_is_matched_before_its_bound_form(pair):
+    """When the push also moves contact candidates (d₁ ≠ 0) there is no border: pdas-amg matches
+    the load by factorisation first and then solves that problem, not the nominal one."""
+    pending, _ = pair
+    d1 = np.full(pending.m, 1e-3 * np.abs(pending.push.d0).max())
+    moved = pending.with_data(push=dataclasses.replace(pending.push, d1=d1),
+                              d=pending.push.d0 + pending.push.scale * d1)
+    assert moved.pending
+    ours, reference = solve(moved, "pdas-amg"), solve(moved, "pdas")
+    assert ours.status == reference.status == "converged"
+    assert ours.problem.push.scale == pytest.approx(reference.problem.push.scale, rel=1e-9)
+    assert compare(reference.problem, ours, reference).lam_rel <= 1e-7

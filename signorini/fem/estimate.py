@@ -52,6 +52,8 @@ from signorini.problem import ContactProblem, ContactSolution
 #: quadrature order of the element integrals: 2 integrates the plane-strain and 3D ones
 #: exactly (a linear field squared); the axisymmetric ones are rational (the hoop strain
 #: u_r / r, times r), integrated to order 4
+#: the strain components (i, j) of :func:`strains`, in their order, by dimension
+STRAIN_PAIRS = {2: [(0, 0), (1, 1), (0, 1)], 3: [(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)]}
 QUADRATURE_ORDER = 2
 AXISYMMETRIC_ORDER = 4
 
@@ -135,8 +137,7 @@ def strains(mesh: Any, u: np.ndarray, rule: Quadrature, axisymmetric: bool = Fal
     values = u[mesh.t]  # (d + 1, elements, dim)
     grad = np.einsum("kei,ekj->eij", values, rule.gradients)  # ∂u_i/∂x_j per element
     dim = grad.shape[1]
-    pairs = [(0, 0), (1, 1), (0, 1)] if dim == 2 else \
-        [(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)]
+    pairs = STRAIN_PAIRS[dim]
     q = rule.bary.shape[1]
     parts = [np.repeat((0.5 * (grad[:, i, j] + grad[:, j, i]))[:, None], q, axis=1)
              for i, j in pairs]
@@ -373,19 +374,12 @@ def _constant_strains(mesh: Any, u: np.ndarray, Lambda: float,
     gradients, jacobian = simplex_gradients(mesh)
     volume = jacobian / math.factorial(dim)
     grad = np.einsum("kei,ekj->eij", u[mesh.t], gradients)  # ∂u_i/∂x_j per element
-    pairs = [(0, 0), (1, 1), (0, 1)] if dim == 2 else \
-        [(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)]
-    eps = np.array([0.5 * (grad[:, i, j] + grad[:, j, i]) for i, j in pairs])  # (c, e)
+    eps = np.array([0.5 * (grad[:, i, j] + grad[:, j, i]) for i, j in STRAIN_PAIRS[dim]])  # (c, e)
     energy = energy_density(eps, Lambda, Mu, dim) * volume
-    n, corners = mesh.p.shape[1], mesh.t.shape[0]
-    share = volume / corners  # ∫ φₖ over the element
-    mass = np.zeros(n)
-    moments = np.zeros((len(eps), n))
-    for nodes in mesh.t:
-        mass += np.bincount(nodes, share, minlength=n)
-        for c in range(len(eps)):
-            moments[c] += np.bincount(nodes, eps[c] * share, minlength=n)
-    nodal = moments / mass
+    corners = mesh.t.shape[0]
+    centroid = Quadrature(bary=np.full((corners, 1), 1.0 / corners), points=None,
+                          dx=volume[:, None], gradients=gradients)  # exact for constant strains
+    nodal = nodal_recovery(mesh, eps[:, :, None], centroid)
     total = np.zeros_like(eps)
     own = np.zeros_like(volume)
     for nodes in mesh.t:

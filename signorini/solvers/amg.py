@@ -312,31 +312,32 @@ def _embedded(form: BoundForm, v: np.ndarray) -> np.ndarray:
     return full
 
 
-def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.ndarray, str]:
-    """The first active set and where it came from."""
+def _initial_active(problem: ContactProblem,
+                    opts: dict[str, Any]) -> tuple[np.ndarray, str, float | None]:
+    """The first active set, where it came from, and the coarse model's push ``delta`` (a first
+    push for a pending target load; None without a coarse model)."""
     if opts["active0"] is not None:
         active = np.asarray(opts["active0"], dtype=bool)
         if active.shape != (problem.m,):
             raise InputError(f"method 'pdas-amg': option active0 must be {problem.m} booleans")
-        return active, "given"
+        return active, "given", None
     if problem.warm_start.lam is not None:
-        return problem.warm_start.lam > 0, "load targeting"
+        return problem.warm_start.lam > 0, "load targeting", None
     coarse = opts["coarse"]
     if coarse is None and problem.coarse_model is not None:
         coarse = problem.coarse_model(problem)
     if coarse is None:
-        return np.zeros(problem.m, dtype=bool), "none (no coarse model)"
+        return np.zeros(problem.m, dtype=bool), "none (no coarse model)", None
     lam = coarse.warm_start.lam
     if lam is None:
         solver = pdas.solve if coarse.n < DIRECT_BELOW else solve
         solution = solver(coarse, tol=DEFAULT_TOL, amg=opts["amg"]) if solver is solve \
             else solver(coarse)
         if solution.status != "converged":
-            return np.zeros(problem.m, dtype=bool), "none (the coarse model did not solve)"
+            return np.zeros(problem.m, dtype=bool), "none (the coarse model did not solve)", None
         lam = solution.lam
     zone = predict_zone(problem.contact_points, coarse.contact_points, lam > 0, neighbours=1)
-    opts["coarse_delta"] = coarse.params.get("delta")  # a first push for a pending target load
-    return zone.core, f"coarse model of {coarse.n} dofs"
+    return zone.core, f"coarse model of {coarse.n} dofs", coarse.params.get("delta")
 
 
 def _forcing(eta: float, r0: float, r0_last: float | None) -> float:
@@ -360,16 +361,16 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     tol = DEFAULT_TOL if tol is None else tol
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
     start = time.perf_counter()
+    given = problem
+    if problem.pending and border_factor(problem) is None:
+        problem = problem.matched()  # a push that moves more than one rigid set: factorised
     try:
         form = bound_form(problem)
     except NoBoundForm as exc:
         return ContactSolution.failure("pdas-amg", problem, exc.status, str(exc),
                                        solve_time=time.perf_counter() - start)
-    system, given = PinnedSystem(form), problem
-    border = load_border(problem, form)
-    if problem.pending and border is None:
-        problem = problem.matched()  # a push that moves more than one rigid set: factorised
-    active, source = _initial_active(problem, opts)
+    system, border = PinnedSystem(form), load_border(problem, form)
+    active, source, coarse_delta = _initial_active(problem, opts)
     active &= system.bounded
     if border is not None and not active.any():  # the push needs a contact to hold the body
         active, source = first_contact(problem.d) & system.bounded, "the first point of contact"
@@ -384,8 +385,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     operator, rhs, free_of, precondition = system.K, form.f, (lambda free: free), hierarchy.apply
     if border is not None:
         nominal = problem.params.get("delta")
-        xs[-1] = problem.push.scale * (opts.get("coarse_delta") / nominal if nominal and
-                                       opts.get("coarse_delta") else 1.0)
+        xs[-1] = problem.push.scale * (coarse_delta / nominal if nominal and coarse_delta else 1.0)
         operator = Bordered(system.K, border.g, border.k)
         rhs = np.append(border.f0, border.h)
         free_of = lambda free: np.append(free, True)  # noqa: E731
@@ -466,7 +466,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     counts = {key: COUNTS[key] - counts[key] for key in COUNTS}
     u = form.displacement(x)
     if border is not None:
-        problem = problem.pushed(float(xs[-1]))
+        if problem.pending or problem.push.scale != float(xs[-1]):  # not already certified there
+            problem = problem.pushed(float(xs[-1]))
         message += "; the load targeted with the push as one more unknown (no factorisation)"
     solution = ContactSolution(
         method="pdas-amg", u=u, lam=lam, status=status,
