@@ -14,7 +14,8 @@ import signorini
 from signorini.fem.assembly import axisymmetric_elasticity
 from signorini.fem.stiffness import plane_strain_stiffness
 from signorini.fem.estimate import (_by_quadrature, _constant_strains, contact_term, element_energies,
-                                    estimate, lame, material_units, quadrature, recover, strains)
+                                    estimate, lame, material_units, quadrature, recover, strains,
+                                    zone_and_neighbours)
 from signorini.fem.transfer import uniform_prolongation
 from signorini.files import to_json
 from signorini.scenes.meshing import refine_uniformly
@@ -160,73 +161,98 @@ def test_the_pressure_estimate_shrinks_with_the_mesh_and_tracks_the_error():
     assert 0.5 < coarse.estimate.pressure.relative / error < 3.0
 
 
-def test_the_adaptive_findings_are_the_runs():
-    """docs/estimate.md's reading of the adaptive runs, held to docs/estimate/runs.json."""
+def _adaptive(rows, scene, nu, mesh="adaptive"):
+    return [r for r in rows if r["scene"] == scene and r["nu"] == nu and r["mesh"].startswith(mesh)]
+
+
+def _first(rows, target):
+    """The step that stops the loop for ``target``: the first whose estimate meets it."""
+    return next(r for r in rows if r["pressure_estimate"] <= target)
+
+
+def _span(values, digits=2):
+    values = list(values)
+    return f"{min(values):.{digits}f}–{max(values):.{digits}f}"
+
+
+def test_the_adaptive_runs_meet_issue_15s_budgets():
+    """docs/estimate.md and README: every target within 20k / 60k dofs, the true error at the
+    stopping step within the target, the effectivity within [0.5, 3] at every adaptive step."""
     rows = tool.load("adaptive")
-
-    def run(scene, nu, mesh="adaptive"):
-        return [r for r in rows if r["scene"] == scene and r["nu"] == nu and r["mesh"].startswith(mesh)]
-
-    def first(scene, nu, target):
-        return next(r for r in run(scene, nu) if r["pressure_estimate"] <= target)
-
     text = (ROOT / "docs" / "estimate.md").read_text()
-    sphere = run("hertz-sphere", 0.3)
-    assert (first("hertz-sphere", 0.3, 0.003)["dofs"], first("hertz-sphere", 0.3, 0.001)["dofs"]) == (19521, 50528)
-    span = f"{min(r['effectivity'] for r in sphere):.2f}–{max(r['effectivity'] for r in sphere):.2f}"
-    assert span == "1.10–1.26" and span in text
-    cylinder = run("hertz-cylinder", 0.3)
-    uniform = {r["mesh"]: r for r in run("hertz-cylinder", 0.3, "uniform")}
-    graded = {r["mesh"]: r for r in run("hertz-cylinder", 0.3, "graded")}
-    assert cylinder[-1]["pressure_error"] > uniform["uniform, refine 1"]["pressure_error"]
-    assert cylinder[-1]["dofs"] > uniform["uniform, refine 1"]["dofs"]
-    assert graded["graded (40, 0.1)"]["pressure_error"] < min(
-        r["pressure_error"] for r in cylinder if r["dofs"] <= 2 * graded["graded (40, 0.1)"]["dofs"])
-    assert min(r["effectivity"] for r in cylinder) == pytest.approx(0.47, abs=0.005)
-    every = [r for nu in (0.0, 0.3, 0.45) for r in run("hertz-cylinder", nu)]
-    assert max(max(abs(r["p0_err"]), abs(r["a_err"])) for r in every) < 7e-4
-    assert all(r["dofs"] <= tool.MAX_DOFS for r in rows if r["mesh"] == "adaptive")
+    readme = (ROOT / "README.md").read_text()
+    stops = {0.003: [], 0.001: []}
+    for scene in ("hertz-cylinder", "hertz-sphere"):
+        for nu in (0.0, 0.3, 0.45):
+            run = _adaptive(rows, scene, nu)
+            for target, budget in ((0.003, 20_000), (0.001, 60_000)):
+                stop = _first(run, target)
+                assert stop["dofs"] <= budget and stop["pressure_error"] <= target
+                stops[target].append(stop)
+    every = [r["effectivity"] for r in rows if r["mesh"] == "adaptive"]
+    assert 0.5 <= min(every) and max(every) <= 3.0
+    assert f"within {_span(every)} at every adaptive step" in text
+    assert f"stays within {_span(every)}× the true error" in readme
+    low, high = (f"{f(r['dofs'] for r in stops[0.003]):,}" for f in (min, max))
+    assert f"0.3 % takes {low}–{high} dofs" in text
+    low, high = (f"{f(r['dofs'] for r in stops[0.001]):,}" for f in (min, max))
+    assert f"0.1 % {low}–{high} over both scenes" in text
+    worst = max(r["pressure_error"] for r in stops[0.003]), max(r["pressure_error"] for r in stops[0.001])
+    assert f"at most {100 * worst[0]:.3f} % for 0.3 % and {100 * worst[1]:.3f} % for 0.1 %" in text
+    cylinder = [r for r in rows if r["scene"] == "hertz-cylinder"]
+    assert max(max(abs(r["p0_err"]), abs(r["a_err"])) for r in cylinder) < 6e-4
 
 
-def test_the_nu_0_45_findings_are_the_runs():
-    """README's and docs/estimate.md's words on ν = 0.45 (the nodal average), held to the runs."""
+def test_where_adaptivity_pays_is_the_runs():
+    """docs/estimate.md's and README's comparison with uniform and hand-graded meshes (ν = 0.3)."""
     rows = tool.load("adaptive")
-    docs = (ROOT / "docs" / "estimate.md").read_text() + (ROOT / "README.md").read_text()
+    text = (ROOT / "docs" / "estimate.md").read_text()
+    for scene in ("hertz-cylinder", "hertz-sphere"):
+        run = _adaptive(rows, scene, 0.3)
+        stop = _first(run, 0.001)
+        uniform = _adaptive(rows, scene, 0.3, "uniform, refine 2")[0]
+        hand = _adaptive(rows, scene, 0.3, "graded (40, 0.1)")[0]
+        # about 0.09 %: fewer dofs than uniform refinement, not less time
+        assert 2.5 < uniform["dofs"] / stop["dofs"] < 3.0 and stop["seconds"] > uniform["seconds"]
+        assert (f"{100 * stop['pressure_error']:.3f} % at {stop['dofs']:,} against "
+                f"{100 * uniform['pressure_error']:.3f} % at {uniform['dofs']:,}") in text
+        # the hand-graded mesh: the first adaptive step as good costs more dofs and time
+        as_good = next(r for r in run if r["pressure_error"] <= hand["pressure_error"] + 2e-5)
+        assert as_good["dofs"] > hand["dofs"] and as_good["seconds"] > hand["seconds"]
+        assert (f"{100 * hand['pressure_error']:.3f} % at {hand['dofs']:,}" in text
+                and f"{100 * as_good['pressure_error']:.3f} % at {as_good['dofs']:,}" in text)
+    hand = [_adaptive(rows, scene, 0.3, "graded (40, 0.1)")[0]["effectivity"]
+            for scene in ("hertz-cylinder", "hertz-sphere")]
+    uniform = _adaptive(rows, "hertz-sphere", 0.3, "uniform, refine 2")[0]["effectivity"]
+    assert f"(effectivity {hand[0]:.2f} and {hand[1]:.2f})" in text
+    assert f"the sphere's uniform refine 2 ({uniform:.2f})" in text
 
-    def run(scene):
-        return [r for r in rows if r["scene"] == scene and r["nu"] == 0.45 and r["mesh"] == "adaptive"]
 
-    def first(scene, target):
-        return next(r for r in run(scene) if r["pressure_estimate"] <= target)
-
-    for scene in ("hertz-cylinder", "hertz-sphere"):  # issue 15's budgets: 20k for 0.3 %, 60k for 0.1 %
-        coarse, fine = first(scene, 0.003), first(scene, 0.001)
-        assert coarse["dofs"] <= 20_000 and fine["dofs"] <= 60_000
-        assert max(abs(fine["p0_err"]), abs(fine["a_err"])) < 1e-3  # Hertz's p₀ and a within 0.1 %
-        for row in (coarse, fine):
-            assert f"{row['dofs']:,}" in docs and f"{100 * row['pressure_error']:.3f} %" in docs
-    sphere = [r["effectivity"] for r in run("hertz-sphere")]
-    assert 0.5 < min(sphere) and max(sphere) < 3 and f"{min(sphere):.2f}–{max(sphere):.2f}" in docs
-    cylinder = [r["effectivity"] for r in run("hertz-cylinder")]
-    assert f"effectivity down to {min(cylinder):.2f}" in docs
+def test_the_nu_0_and_0_45_findings_are_the_runs():
+    rows = tool.load("adaptive")
+    text = (ROOT / "docs" / "estimate.md").read_text()
+    sphere = _adaptive(rows, "hertz-sphere", 0.0)
+    assert (f"meets 0.3 % at {_first(sphere, 0.003)['dofs']:,} dofs and 0.1 % at "
+            f"{_first(sphere, 0.001)['dofs']:,}") in text
+    assert f"(effectivity {_span(r['effectivity'] for r in sphere)})" in text
+    for scene in ("hertz-sphere", "hertz-cylinder"):
+        run = _adaptive(rows, scene, 0.45)
+        assert f"{_first(run, 0.003)['dofs']:,} and {_first(run, 0.001)['dofs']:,}" in text
 
 
 def test_where_the_true_error_is_is_the_runs():
-    """docs/estimate.md: the true pressure error peaks at the zone's edge, the estimate looks elsewhere."""
+    """docs/estimate.md: the true pressure error mostly peaks at the zone's edge, where the
+    estimate puts little of its own."""
     rows = [r for r in tool.load("adaptive") if r["mesh"] == "adaptive"]
     text = (ROOT / "docs" / "estimate.md").read_text()
-    tops = [r["true_top_x"] for r in rows]
-    assert 0.97 <= min(tops) and max(tops) <= 1.003 + 5e-4
-    shares = [r["true_top_share"] for r in rows]
-    there = [r["estimate_share_at_true_top"] for r in rows]
-    assert f"it carries {100 * min(shares):.0f}–{100 * max(shares):.0f} % of the true error²" in text
+    edge = [r for r in rows if 0.97 <= r["true_top_x"] <= 1.0035]
+    assert len(edge) > 0.8 * len(rows)
+    assert f"x/a from 0.97 to 1.003 in {len(edge)} of {len(rows)} steps" in text
+    shares = [r["true_top_share"] for r in edge]
+    there = [r["estimate_share_at_true_top"] for r in edge]
+    assert f"carries {100 * min(shares):.0f}–{100 * max(shares):.0f} % of the true error²" in text
     assert f"only {100 * min(there):.0f}–{100 * max(there):.0f} % of the estimate's" in text
-    coarse = [r for r in rows if r["scene"] == "hertz-cylinder" and r["step"] == 0]
-    assert all(abs(r["estimate_top_x"] - 1.004) < 5e-4 for r in coarse)
-    low, high = (f"{100 * f(r['estimate_top_share'] for r in coarse):.0f}" for f in (min, max))
-    assert f"(x/a = 1.004: {low}–{high} %" in text
-    cylinder = [r["effectivity"] for r in rows if r["scene"] == "hertz-cylinder"]
-    assert f"from {min(cylinder):.2f} to {max(cylinder):.2f} on the cylinder" in text
+    assert max(there) < 0.5 * max(shares)
 
 
 @pytest.mark.parametrize("scene, params", [("hertz-sphere-3d", {}), ("hertz-cylinder", {"nu": 0.3}),
@@ -243,3 +269,25 @@ def test_the_closed_form_for_constant_strains_is_the_quadrature(scene, params):
     by_points = _by_quadrature(problem, mesh, u, *material)
     for fast, reference in zip(closed, by_points[:3]):
         assert np.allclose(fast, reference, rtol=1e-12, atol=1e-14 * np.abs(reference).max())
+
+
+def test_the_zone_and_its_first_free_neighbours_are_counted():
+    """Along a chain of boundary candidates, the nodes in contact and one free node on each side."""
+    mesh = MeshTri.init_tensor(np.linspace(0.0, 1.0, 7), np.linspace(0.0, 1.0, 3))
+    bottom = np.nonzero(mesh.p[1] == 0.0)[0]
+    bottom = bottom[np.argsort(mesh.p[0, bottom])]
+    active = np.array([False, False, True, True, False, False, False])
+    assert zone_and_neighbours(mesh, bottom, active).tolist() == [False, True, True, True, True, False,
+                                                                 False]
+    assert not zone_and_neighbours(mesh, bottom, np.zeros(7, dtype=bool)).any()
+
+
+def test_free_candidates_beyond_the_first_carry_no_pressure_estimate():
+    result = signorini.solve("hertz-cylinder", params=COARSE)
+    found = result.estimate.pressure
+    counted = found.indicators > 0
+    assert found.active.sum() > 3 and np.all(counted[found.active])
+    free = ~found.active
+    assert 0 < np.sum(counted & free) <= 2  # the first free node (one side: the other is the axis)
+    x = result.problem.contact_points[:, 0]
+    assert x[counted].max() < x[free & ~counted].min()
