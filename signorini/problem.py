@@ -142,6 +142,8 @@ class Watch:
     edge: np.ndarray
     candidate_gaps: np.ndarray
     remedy: str = "extend the scene's contact candidates or lower the load"
+    #: the mesh node of each row (adaptive refinement makes the ones that go through candidates)
+    nodes: np.ndarray | None = None
 
     def gap(self, problem: "ContactProblem", u: np.ndarray) -> np.ndarray:
         return self.gaps - self.rows @ problem.expand(u)

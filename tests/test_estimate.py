@@ -291,3 +291,28 @@ def test_free_candidates_beyond_the_first_carry_no_pressure_estimate():
     assert 0 < np.sum(counted & free) <= 2  # the first free node (one side: the other is the axis)
     x = result.problem.contact_points[:, 0]
     assert x[counted].max() < x[free & ~counted].min()
+
+
+def test_the_punch_findings_are_the_runs():
+    """docs/estimate.md on the punch: the pressure estimate stalls at the sharp corner and jumps once
+    the corner node becomes a candidate; the energy target is met; rounded corners converge."""
+    rows = tool.load("punch")
+    text = (ROOT / "docs" / "estimate.md").read_text()
+
+    def run(corners, on):
+        return [r for r in rows if r["corners"] == corners and r["on"] == on]
+
+    sharp = run("sharp", "pressure")
+    widened = [k for k, r in enumerate(sharp) if r["action"] == "candidates widened"]
+    assert len(widened) == 1
+    before = sharp[:widened[0]]
+    assert before[-1]["pressure"] > 0.9 * before[0]["pressure"]  # stalls
+    assert sharp[-1]["pressure"] > 0.9 and "max dofs" in sharp[-1]["reason"]
+    assert (f"from {100 * before[0]['pressure']:.1f} % to {100 * before[-1]['pressure']:.1f} % in "
+            f"{len(before) - 1}") in " ".join(text.split())
+    energy = run("sharp", "energy")
+    assert "target energy-norm error 2 % met" in energy[-1]["reason"]
+    assert f"meets 2 % at {energy[-1]['dofs']:,} dofs" in " ".join(text.split())
+    rounded = run("rounded, r = 0.2 a", "pressure")
+    assert rounded[-1]["pressure"] < 0.1 * rounded[0]["pressure"]
+    assert all(r["status"] == "converged" for r in rows if "status" in r)

@@ -1,8 +1,8 @@
 """Effectivity of the a posteriori estimate (signorini.fem.estimate) on the Hertz scenes, and
 what adaptive refinement (signorini.scenes.adapt) reaches against uniform and hand-graded meshes.
 
-    .venv/bin/python tools/estimate.py [effectivity] [adaptive]   # both: ~12 min here;
-                                                                  # writes docs/estimate/runs.json
+    .venv/bin/python tools/estimate.py [effectivity] [adaptive] [punch]   # all: ~15 min here;
+                                                                          # writes docs/estimate/runs.json
     .venv/bin/python tools/estimate.py figure                     # adaptive.png from the JSON
 
 For each scene and base mesh, the scene is solved at ``refine`` = 0, 1, ...
@@ -127,7 +127,8 @@ def _pct(x: float, digits: int = 3) -> str:
     return f"{100 * x:+.{digits}f} %"
 
 
-def tables(rows: list[dict], adaptive: list[dict] | None = None) -> dict[str, str]:
+def tables(rows: list[dict], adaptive: list[dict] | None = None,
+           punch: list[dict] | None = None) -> dict[str, str]:
     """Markdown tables by name: effectivity per level, and η against the Hertz errors."""
     lines = ["| scene | mesh (n_contact, grading) | refine | dofs | η / ‖u_h‖ | ‖e‖ / ‖u_h‖ "
              "| η / ‖e‖ | recovery part alone | η / ‖e‖ against the finest | contact share of η² |",
@@ -154,7 +155,52 @@ def tables(rows: list[dict], adaptive: list[dict] | None = None) -> dict[str, st
     if adaptive:
         out["adaptive"] = adaptive_table(adaptive)
         out["adaptive-summary"] = adaptive_summary(adaptive)
+    if punch:
+        out["adaptive-punch"] = punch_table(punch)
     return out
+
+
+#: the punch (sharp corners: the pressure is singular there, P/(π√(a² − x²)), not square
+#: integrable; rounded corners: bounded) driven by each estimate: (label, params, target, on)
+PUNCH_RUNS = (("sharp", {}, 0.001, "pressure"), ("sharp", {}, 0.02, "energy"),
+              ("rounded, r = 0.2 a", {"corner_radius": 0.2}, 0.001, "pressure"),
+              ("rounded, r = 0.2 a", {"corner_radius": 0.2}, 0.02, "energy"))
+PUNCH_DOFS = 60_000
+
+
+def run_punch() -> list[dict]:
+    """The adaptive loop on the punch (no build on a given mesh: its model is carried onto each
+    refinement), every step's estimates, against the energy and the pressure targets."""
+    rows = []
+    for label, params, target, on in PUNCH_RUNS:
+        start = time.perf_counter()
+        result = signorini.solve("punch", target_error=target, target_on=on, max_dofs=PUNCH_DOFS,
+                                 params=params)
+        seconds = time.perf_counter() - start
+        for s in result.solution.extras["adaptive"]:
+            rows.append({"corners": label, "target": target, "on": on, "step": s["step"],
+                         "dofs": s["dofs"], "candidates": s["candidates"], "energy": s["estimate"],
+                         "pressure": s["pressure_estimate"], "action": s["action"]})
+        rows[-1].update(status=result.status, seconds=seconds, reason=result.message.rsplit("; ", 1)[-1])
+        print(f"punch {label} {on} {target}: {result.status}, {result.problem.n} dofs", file=sys.stderr)
+    return rows
+
+
+def punch_table(rows: list[dict]) -> str:
+    lines = ["| corners | target | steps | dofs: first → last | energy estimate: first → last "
+             "| pressure estimate: first → last | candidates widened | how it ended |",
+             "|---|---|---:|---|---|---|---:|---|"]
+    for key in dict.fromkeys((r["corners"], r["target"], r["on"]) for r in rows):
+        run = [r for r in rows if (r["corners"], r["target"], r["on"]) == key]
+        solved = [r for r in run if r["action"] != "candidates widened"]
+        first, last = solved[0], solved[-1]
+        lines.append(
+            f"| {key[0]} | {100 * key[1]:g} % ({key[2]}) | {len(run)} | {first['dofs']:,} → {last['dofs']:,} "
+            f"| {100 * first['energy']:.2f} % → {100 * last['energy']:.2f} % "
+            f"| {100 * first['pressure']:.1f} % → {100 * last['pressure']:.1f} % "
+            f"| {sum(r['action'] == 'candidates widened' for r in run)} "
+            f"| {last['status']}: {last['reason']} ({last['seconds']:.1f} s) |")
+    return "\n".join(lines)
 
 
 def pressure_profile(result) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -327,14 +373,17 @@ def load(part: str = "rows") -> list[dict]:
 
 
 if __name__ == "__main__":
-    parts = sys.argv[1:] or ["effectivity", "adaptive"]
+    parts = sys.argv[1:] or ["effectivity", "adaptive", "punch"]
     record = json.loads(OUT.read_text()) if OUT.exists() else {}
-    if parts != ["figure"]:
-        record["command"] = "python tools/estimate.py " + " ".join(parts)
+    record.pop("command", None)  # one command per part: each part is re-run on its own
+    record.setdefault("commands", {}).update(
+        {part: f"python tools/estimate.py {part}" for part in parts if part != "figure"})
     if "effectivity" in parts:
         record["rows"] = run()
     if "adaptive" in parts:
         record["adaptive"] = run_adaptive()
+    if "punch" in parts:
+        record["punch"] = run_punch()
     if parts != ["figure"]:
         atomic_write_text(OUT, to_json(record))
         print(f"written: {OUT}", file=sys.stderr)

@@ -89,7 +89,8 @@ def blocks(document: Path = README) -> dict[str, str]:
                 "peer-summary": "\n".join(peer[peer.index("") + 1:]),
                 "startup": startup.table(startup.load()), "startup-reading": startup.reading(startup.load())}
     if document == ESTIMATE:
-        return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"))
+        return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"),
+                                    estimate_study.load("punch"))
     raise ValueError(f"no generated blocks for {document}")
 
 

@@ -335,7 +335,7 @@ def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch 
     edge = np.nonzero(np.isin(model.contact_nodes, edge_nodes))[0]
     return Watch(rows=rows, gaps=np.asarray(gaps, dtype=float) / U, edge=edge,
                  candidate_gaps=np.asarray(candidate_gaps, dtype=float) / U,
-                 remedy=model.candidate_remedy)
+                 remedy=model.candidate_remedy, nodes=watched)
 
 
 def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,

@@ -46,10 +46,13 @@ from scipy.spatial import cKDTree
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.estimate import ErrorEstimate, estimate
+from signorini.fem.transfer import refined_model, with_candidates
 from signorini.fem.model import SceneModel
+from signorini.kkt import gap_scale
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes.families import get_scene, scene_reference
 from signorini.scenes.meshing import snap_to_circle
+from signorini.scenes.scenefile import build_scene_model, family_scene_values
 from signorini.solvers.registry import solve as solve_problem
 
 log = logging.getLogger(__name__)
@@ -158,12 +161,6 @@ def measured(found: ErrorEstimate, quantity: str) -> float:
     return found.relative if quantity == "energy" else found.pressure.relative
 
 
-def refine(mesh: Any, marked: np.ndarray, snap: Callable | None) -> Any:
-    """``mesh`` refined conformingly at ``marked`` elements, new boundary nodes snapped."""
-    refined = mesh.refined(marked)
-    return snap(refined) if snap is not None else refined
-
-
 def _rebuild(family, params: dict[str, Any], given: set[str], mesh: Any,
              contact_extent: float | None) -> SceneModel:
     """The scene on ``mesh``; load targeting starts from the candidates within ``contact_extent``."""
@@ -182,13 +179,100 @@ def _contact_extent(model: SceneModel, problem: ContactProblem,
     return float(np.max(model.mesh.p[0, model.contact_nodes][solution.lam > 0]))
 
 
+@dataclass
+class _Scene:
+    """What the loop rebuilds on each new mesh: a family that builds on a given mesh (and can
+    widen its candidates), or any 2D model carried onto the refinement
+    (:func:`signorini.fem.transfer.refined_model`)."""
+
+    name: str
+    model: SceneModel
+    family: Any = None
+    params: dict[str, Any] = field(default_factory=dict)
+    given: set[str] = field(default_factory=set)
+    snap: Callable | None = None
+
+    @property
+    def widens(self) -> bool:
+        return self.family is not None
+
+    def on(self, model: SceneModel, mesh: Any, solution: ContactSolution,
+           extent: float | None) -> SceneModel:
+        """The scene on ``mesh``, refined from ``model``'s (not yet snapped); ``solution`` is
+        ``model``'s, and load targeting starts from its contact."""
+        if self.family is not None:
+            return _rebuild(self.family, self.params, self.given,
+                            self.snap(mesh) if self.snap else mesh, extent)
+        return refined_model(model, mesh, solution.lam > 0, self.snap)
+
+
+def _scene(name: str, values: dict[str, Any]) -> _Scene:
+    """The scene ``name`` (a family or a ``.toml`` scene file) ready for the loop."""
+    if name.lower().endswith(".toml"):
+        found = family_scene_values(name, values)
+        if found is None:  # a mesh scene
+            scene, model = build_scene_model(name, values)
+            return _checked(_Scene(scene, model))
+        name, values = found
+    family = get_scene(name)
+    params = family.parse(values)
+    model = family.build(params, set(values))
+    snap = CURVED[name](params) if name in CURVED else None
+    builds_on_mesh = name in CURVED and "mesh" in inspect.signature(family.build).parameters
+    return _checked(_Scene(name, model, family if builds_on_mesh else None, params, set(values), snap))
+
+
+def _grown(scene: _Scene, model: SceneModel, problem: ContactProblem,
+           solution: ContactSolution) -> SceneModel | None:
+    """The model with more candidates after the contact outgrew them (None: nothing to add).
+
+    A family that builds on a mesh widens its candidate zone by :data:`GROWTH`;
+    any other model takes the boundary nodes beyond its candidates that went
+    through the obstacle, and those next to an edge candidate in contact.
+    """
+    if scene.widens:
+        scene.params = {**scene.params, "candidates": scene.params["candidates"] * GROWTH}
+        log.info("the contact outgrew the candidates; widened to %g half-widths",
+                 scene.params["candidates"])
+        return _rebuild(scene.family, scene.params, scene.given, model.mesh,
+                        _contact_extent(model, problem, solution))
+    extra = beyond_candidates(model, problem, solution)
+    if extra.size == 0:
+        return None
+    log.info("the contact outgrew the candidates; %d boundary node(s) added", extra.size)
+    return with_candidates(model, extra, solution.lam > 0)
+
+
+def beyond_candidates(model: SceneModel, problem: ContactProblem,
+                      solution: ContactSolution) -> np.ndarray:
+    """Boundary nodes beyond the candidates that went through the obstacle, and those sharing a
+    boundary facet with an edge candidate in contact (mesh node numbers)."""
+    watch = problem.watch
+    if watch is None or watch.nodes is None:
+        return np.zeros(0, dtype=int)
+    through = watch.nodes[-watch.gap(problem, solution.u) > 1e-9 * gap_scale(problem, solution.u)]
+    touching = np.asarray(model.contact_nodes)[watch.edge[solution.lam[watch.edge] > 0]]
+    mesh = model.mesh
+    ends = mesh.facets[:, mesh.boundary_facets()]
+    reach = np.isin(ends, touching).any(axis=0)
+    beside = np.intersect1d(ends[:, reach].ravel(), watch.nodes)
+    return np.union1d(through, beside)
+
+
+def _checked(scene: _Scene) -> _Scene:
+    if scene.model.mesh.p.shape[0] != 2 or not hasattr(scene.model.mesh, "refined"):
+        raise InputError(f"scene {scene.name!r} is 3D: target error refines 2D and axisymmetric "
+                         "scenes (marked triangles); refine a 3D scene uniformly with --set refine=N")
+    return scene
+
+
 def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: str = "pdas",
                    tol: float | None = None, max_iter: int | None = None,
                    max_dofs: int | None = None, theta: float = THETA, quantity: str | None = None,
                    on_step: Callable[[ContactProblem, ContactSolution, ErrorEstimate | None], None]
                    | None = None, **options: Any) -> AdaptiveRun:
-    """Refine scene ``name`` adaptively until the estimate of ``quantity`` meets ``target``
-    or the next mesh would exceed ``max_dofs``.
+    """Refine scene ``name`` (a family, or the path of a ``.toml`` scene file) adaptively until
+    the estimate of ``quantity`` meets ``target`` or the next mesh would exceed ``max_dofs``.
 
     ``quantity`` is ``"pressure"`` (the default where the scene has contact
     pressures) or ``"energy"``.
@@ -197,37 +281,29 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
     not converge) and is appended to the solution's message. ``on_step`` is
     called with every step's problem, solution and estimate (studies use it).
     """
-    family = get_scene(name)
-    if name not in CURVED or "mesh" not in inspect.signature(family.build).parameters:
-        raise InputError(f"scene {name!r} cannot be refined adaptively: target error works for "
-                         f"{', '.join(sorted(CURVED))}")
     if quantity is not None and quantity not in QUANTITIES:
         raise InputError(f"target quantity {quantity!r} is not one of {', '.join(QUANTITIES)}")
     max_dofs = DEFAULT_MAX_DOFS if max_dofs is None else int(max_dofs)
     if max_dofs <= 0:
         raise InputError(f"max dofs {max_dofs} must be positive")
-    given = set(values)
-    params = family.parse(values)
-    snap = CURVED[name](params)
-    model = family.build(params, given)
+    scene = _scene(name, values)
+    model = scene.model
     run = None
     steps: list[dict[str, Any]] = []
     growths = 0
     for step in range(MAX_STEPS):
         start = time.perf_counter()
         problem = assemble(model)
-        problem.scene, problem.reference = name, scene_reference(name)
+        problem.scene, problem.reference = scene.name, scene_reference(scene.name)
         solution = solve_problem(problem, method, tol=tol, max_iter=max_iter, **options)
         seconds = time.perf_counter() - start
         if solution.status == "model_inadequate" and growths < MAX_GROWTH:
-            growths += 1
-            params = {**params, "candidates": params["candidates"] * GROWTH}
-            log.info("step %d: the contact outgrew the candidates; widened to %g half-widths",
-                     step, params["candidates"])
-            model = _rebuild(family, params, given, model.mesh,
-                             _contact_extent(model, problem, solution))
-            steps.append(_row(step, problem, solution, None, 0, seconds, "candidates widened"))
-            continue
+            grown = _grown(scene, model, problem, solution)
+            if grown is not None:
+                growths += 1
+                model = grown
+                steps.append(_row(step, problem, solution, None, 0, seconds, "candidates widened"))
+                continue
         found = estimate(problem, solution) if solution.success else None
         if on_step is not None:
             on_step(problem, solution, found)
@@ -248,7 +324,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
             steps.append(_row(step, problem, solution, found, 0, seconds, "target met"))
             break
         marked = mark(model.mesh, found, quantity, theta)
-        mesh = refine(model.mesh, marked, snap)
+        mesh = model.mesh.refined(marked)
         dofs = mesh.p.size
         if dofs > max_dofs:
             run.reason = (f"max dofs {max_dofs} reached: {what} estimate {100 * value:.3g} % > target "
@@ -256,7 +332,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
             steps.append(_row(step, problem, solution, found, 0, seconds, "max dofs"))
             break
         steps.append(_row(step, problem, solution, found, len(marked), seconds, "refined"))
-        model = _rebuild(family, params, given, mesh, _contact_extent(model, problem, solution))
+        model = scene.on(model, mesh, solution, _contact_extent(model, problem, solution))
     else:
         run.reason = f"adaptive refinement stopped after {MAX_STEPS} steps"
     run.solution.message = f"{run.solution.message}; {run.reason}".lstrip("; ")

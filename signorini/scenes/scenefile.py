@@ -169,8 +169,23 @@ def build_scene_model(path: str | Path,
 # --- family scenes --------------------------------------------------------------------------
 
 
+def family_scene_values(path: str | Path,
+                        overrides: dict[str, Any] | None = None) -> tuple[str, dict[str, Any]] | None:
+    """``(family, parameter values)`` of a family scene file with ``overrides`` applied (None for
+    a mesh scene): what :func:`build_scene_model` builds, for callers that build it themselves."""
+    data, ctx = read_scene_file(path)
+    return _family_values(data, ctx, dict(overrides or {})) if "scene" in data else None
+
+
 def _family_scene(data: dict[str, Any], ctx: _Context,
                   overrides: dict[str, Any]) -> tuple[str, "SceneModel"]:
+    name, values = _family_values(data, ctx, overrides)
+    family = SCENES[name]
+    return name, family.build(family.parse(values), set(values))
+
+
+def _family_values(data: dict[str, Any], ctx: _Context,
+                   overrides: dict[str, Any]) -> tuple[str, dict[str, Any]]:
     name = data["scene"]
     if not isinstance(name, str) or name not in SCENES:
         raise ctx.error(f"{name!r} is not a scene family: choose one of {', '.join(sorted(SCENES))}",
@@ -200,8 +215,7 @@ def _family_scene(data: dict[str, Any], ctx: _Context,
         except InputError as exc:
             raise ctx.error(str(exc), origin[key], key) from None
     values.update(overrides)
-    params = family.parse(values)
-    return name, family.build(params, set(values))
+    return name, values
 
 
 # --- mesh scenes ----------------------------------------------------------------------------
