@@ -234,6 +234,13 @@ def solve_summary(record: dict[str, Any]) -> str:
                      f"{q['inner']:g}a: max {100 * q['pressure_max_rel']:.2f} %, "
                      f"L2 {100 * q['pressure_l2_rel']:.2f} %; edge node p = {q['edge_pressure']:.4g} "
                      f"(element {q['edge_h']:.3g} next to the edge)")
+    steps = record["extras"].get("adaptive", [])
+    if steps:
+        lines.append(f"  adaptive refinement, {len(steps)} solves in "
+                     f"{sum(step['seconds'] for step in steps):.2f} s (estimates: energy norm, pressure):")
+        lines += [f"    step {step['step']}: {step['dofs']:,} dofs, {step['candidates']} candidates, "
+                  f"{100 * step['estimate']:.3g} %, {100 * step['pressure_estimate']:.3g} %: "
+                  f"{step['action']}" for step in steps]
     for rank in record["extras"].get("per_rank", []):
         if "local_rows" in rank:
             lines.append(f"  rank {rank['rank']}: {rank['local_rows']} rows, set-up "

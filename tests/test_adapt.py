@@ -164,6 +164,11 @@ def test_the_command_line_refines_and_reports(tmp_path):
     record = json.loads(out.read_text())
     assert record["estimate"]["pressure"] <= 0.03
     assert record["extras"]["adaptive"][-1]["action"] == "target met"
+    shown = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",
+                            "--target-error", "0.5%"], capture_output=True, text=True)
+    steps = [line for line in shown.stdout.splitlines() if line.startswith("    step ")]
+    assert shown.returncode == 0 and "adaptive refinement, " in shown.stdout
+    assert len(steps) >= 2 and steps[-1].endswith("target met") and steps[0].endswith("refined")
     bad = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",
                           "--max-dofs", "1000"], capture_output=True, text=True)
     assert bad.returncode == 2 and "--target-error" in bad.stderr

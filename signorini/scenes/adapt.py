@@ -318,6 +318,8 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
             raise InputError(f"scene {name!r} has no contact pressure estimate: give quantity 'energy'")
         what = "pressure" if quantity == "pressure" else "energy-norm"
         value = measured(found, quantity)
+        log.info("step %d: %d dofs, %s estimate %.3g %% (target %.3g %%), %.2f s", step, problem.n,
+                 what, 100 * value, 100 * target, seconds)
         if value <= target:
             run.reason = (f"target {what} error {100 * target:.3g} % met: estimate {100 * value:.3g} % "
                           f"at {problem.n} dofs after {step + 1} solves")
