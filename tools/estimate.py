@@ -1,7 +1,7 @@
 """Effectivity of the a posteriori estimate (signorini.fem.estimate) on the Hertz scenes, and
 what adaptive refinement (signorini.scenes.adapt) reaches against uniform and hand-graded meshes.
 
-    .venv/bin/python tools/estimate.py [effectivity] [adaptive] [punch]   # all: ~15 min here;
+    .venv/bin/python tools/estimate.py [effectivity] [adaptive] [punch]   # adaptive 2.4 min, punch 13 s;
                                                                           # writes docs/estimate/runs.json
     .venv/bin/python tools/estimate.py figure                     # adaptive.png from the JSON
 
