@@ -27,9 +27,14 @@ Each step (:func:`solve_adaptive`):
    ``MeshTri.refined(marked)``), move new boundary nodes onto the curved
    boundary, and stop instead when the refined mesh would exceed ``max_dofs``.
 
-A family takes part when its ``build`` accepts ``mesh=`` (the scene rebuilt
-on a given mesh: boundary sets found by position) and :data:`CURVED` says
-how to put new nodes on its curved boundary.
+Every 2D and axisymmetric scene and scene file takes part. A family whose
+``build`` accepts ``mesh=`` and that :data:`CURVED` names (the Hertz scenes)
+is rebuilt on each new mesh, new nodes first moved onto its curved boundary,
+and widens its candidate zone by :data:`GROWTH` when the contact outgrows
+it. Any other model is carried onto the refinement
+(:func:`signorini.fem.transfer.refined_model`) and takes as new candidates
+the boundary nodes that went through the obstacle or border a candidate in
+contact at the zone's edge (:func:`beyond_candidates`). 3D scenes are refused.
 """
 
 from __future__ import annotations
