@@ -207,6 +207,7 @@ def test_where_adaptivity_pays_is_the_runs():
     """docs/estimate.md's and README's comparison with uniform and hand-graded meshes (ν = 0.3)."""
     rows = tool.load("adaptive")
     text = (ROOT / "docs" / "estimate.md").read_text()
+    readme = " ".join((ROOT / "README.md").read_text().split())
     for scene in ("hertz-cylinder", "hertz-sphere"):
         run = _adaptive(rows, scene, 0.3)
         stop = _first(run, 0.001)
@@ -219,6 +220,7 @@ def test_where_adaptivity_pays_is_the_runs():
         # the hand-graded mesh: the first adaptive step as good costs more dofs and time
         as_good = next(r for r in run if r["pressure_error"] <= hand["pressure_error"] + 2e-5)
         assert as_good["dofs"] > hand["dofs"] and as_good["seconds"] > hand["seconds"]
+        assert as_good["step"] + 1 == 4 and "solves four times to get there" in readme
         assert (f"{100 * hand['pressure_error']:.3f} % at {hand['dofs']:,}" in text
                 and f"{100 * as_good['pressure_error']:.3f} % at {as_good['dofs']:,}" in text)
     hand = [_adaptive(rows, scene, 0.3, "graded (40, 0.1)")[0]["effectivity"]
