@@ -46,7 +46,10 @@ log = logging.getLogger(__name__)
 
 LABELS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
           "pressure_max_rel": "pressure max error on the inner half",
-          "edge_over_centre": "edge node pressure / (P/πa)"}
+          "edge_over_centre": "edge node pressure / (P/πa)",
+          "estimate": "estimate η / ‖u_h‖ (energy norm)", "pressure_estimate": "pressure estimate"}
+#: the a posteriori estimates a study records next to the errors (signorini.fem.estimate)
+ESTIMATES = ("estimate", "pressure_estimate")
 #: the coarse mesh each study starts from unless ``--set`` says otherwise
 COARSE_START = {
     "hertz-cylinder": {"n_contact": 15, "grading": 0.6},
@@ -146,7 +149,7 @@ def level_task(scene: str, level: int, params: dict[str, Any], method: str, tol:
     """The runner's task of one method at one level: no exact answer, the errors against theory."""
     return Task("convergence", scene, level,
                 {"kind": "scene", "scene": scene, "params": {**params, "refine": level}}, method,
-                tol=tol, reference={"kind": "none"}, measure=("reference", "lam", "mesh"))
+                tol=tol, reference={"kind": "none"}, measure=("reference", "estimate", "lam", "mesh"))
 
 
 def level_results(rows: list[Row], metrics: tuple[str, ...]) -> list[LevelResult]:
@@ -157,8 +160,9 @@ def level_results(rows: list[Row], metrics: tuple[str, ...]) -> list[LevelResult
     for row in rows:
         status = "skipped" if row["status"] == "refused" else row["status"]
         converged = status == "converged"
+        found = {**row.get("reference", {}), **row.get("estimate", {})}
         errors = {k: float("nan") if v is None else float(v)
-                  for k, v in row.get("reference", {}).items() if k in metrics} if converged else {}
+                  for k, v in found.items() if k in metrics} if converged else {}
         lam = np.array(row.get("lam", []), dtype=float)
         if first is None and converged:
             first = lam
@@ -232,8 +236,9 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     rows: list[LevelResult] = []
     for level in range(levels + 1):
         rows += level_results([r for t, r in zip(tasks, done) if t.value == level],
-                              reference.convergence)
-    study = ConvergenceStudy(scene, {**base, "levels": levels}, reference.convergence, rows, fit_from=fit_from)
+                              reference.convergence + ESTIMATES)
+    study = ConvergenceStudy(scene, {**base, "levels": levels}, reference.convergence + ESTIMATES, rows,
+                             fit_from=fit_from)
     for name in study.methods:
         study.rates[name] = {}
         for metric in study.metrics:
@@ -336,12 +341,12 @@ def plot_convergence(study: ConvergenceStudy, ax=None, metrics: tuple[str, ...] 
     ax = _axes(ax)
     markers = "osd^v"
     for i, metric in enumerate(metrics or study.metrics):
-        for j, method in enumerate(study.methods):
+        for j, method in enumerate(study.methods[:1] if metric in ESTIMATES else study.methods):
             h, _, err = study.series(method, metric)
             if h.size == 0:
                 continue
             rate = study.rates.get(method, {}).get(metric, float("nan"))
-            style = "-" if j == 0 else "--"
+            style = ":" if metric in ESTIMATES else "-" if j == 0 else "--"
             ax.loglog(h, np.abs(err), style, color=f"C{i}", marker=markers[i % len(markers)],
                       ms=5 if j == 0 else 9, mfc="none" if j else None,
                       label=f"{LABELS.get(metric, metric)} ({method}): rate {rate:.2f}")

@@ -43,6 +43,7 @@ import numpy as np
 
 from signorini.diagnose import diagnose
 from signorini.errors import InputError
+from signorini.fem.estimate import estimate
 from signorini.files import plain
 from signorini.kkt import compare
 from signorini.problem import ContactProblem, ContactSolution
@@ -244,6 +245,10 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
     row.update(hertz_errors(problem, solution))
     if "reference" in task.measure:
         row["reference"] = reference_metrics(problem, solution)
+    found = estimate(problem, solution) if "estimate" in task.measure and solution.success else None
+    if found is not None:
+        row["estimate"] = {"estimate": found.relative, "pressure_estimate":
+                           found.pressure.relative if found.pressure is not None else float("nan")}
     if "patch" in task.measure:
         row["patch_lam_rel"] = compare(problem, force_controlled_exact(problem), solution).lam_rel
     finite = bool(np.all(np.isfinite(solution.lam)))

@@ -33,6 +33,7 @@ MEASURES = {
              "method_s)",
     "vs_reference": "signorini.kkt.compare with the exact answer (vs_reference)",
     "reference": "the errors against the analytic reference the problem declares (reference)",
+    "estimate": "the a posteriori estimates, energy norm and contact pressure (estimate)",
     "lam": "the contact forces (lam)",
     "answer": "the answer itself: u, λ, status and message (answer)",
     "exact": "the exact answer the task is held to, converged or not (exact)",
@@ -62,6 +63,7 @@ Row = TypedDict("Row", {
     # theory: Hertz's cylinder (the exact answer's prefixed ref_) and the declared reference
     "a_rel": float, "p0_rel": float, "pressure_l2_rel": float, "ref_a_rel": float,
     "ref_p0_rel": float, "ref_pressure_l2_rel": float, "reference": dict[str, float],
+    "estimate": dict[str, float],
     "profile": dict[str, Any], "lam": list[float], "answer": dict[str, Any],
     # what a method reports about itself
     "rho_over_bound": float, "lambda_max": float, "bound_at_solution": float,
