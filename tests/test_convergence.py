@@ -134,29 +134,38 @@ def test_cli_converge(tmp_path, capsys):
 
 
 def test_the_rates_docs_convergence_states_are_the_committed_studies():
-    """docs/convergence.md's fitted rates, as written, from the committed study JSONs
-    (docs/convergence/convergence-*.json), for both exact methods, which must agree."""
+    """docs/convergence.md's readings of the committed studies (docs/convergence/*.json; the
+    tables themselves are generated and held by test_readme_numbers): both exact methods agree,
+    the estimates converge at P1's rates where the solution is smooth, the punch's edge at −½."""
     import json
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    text = (root / "docs" / "convergence.md").read_text(encoding="utf-8")
+    text = " ".join((root / "docs" / "convergence.md").read_text(encoding="utf-8").split())
 
-    def rates(scene):
-        study = json.loads((root / "docs" / "convergence" / f"convergence-{scene}.json").read_text())
-        found = study["study"]["rates"]
-        assert set(found) >= {"pdas", "condensed"}
-        for metric, value in found["pdas"].items():
-            assert found["condensed"][metric] == pytest.approx(value, abs=1e-6)
-        return found["pdas"]
+    def study(scene, folder=""):
+        path = root / "docs" / "convergence" / folder / f"convergence-{scene}.json"
+        return json.loads(path.read_text())
 
-    cylinder = rates("hertz-cylinder")
-    assert (f"**p₀ {cylinder['p0_rel']:.2f}, a {cylinder['a_rel']:.2f}, pressure L2 "
-            f"{cylinder['pressure_l2_rel']:.2f}**") in text
-    punch = rates("punch")
-    assert (f"interior max error **{punch['pressure_max_rel']:.2f}**, interior L2 "
-            f"**{punch['pressure_l2_rel']:.2f}**, edge node pressure "
-            f"**{punch['edge_over_centre']:.2f}**").replace("-", "−") in text
-    reverse = rates("reverse-hertz")
-    assert f"p₀ {reverse['p0_rel']:.2f}, pressure L2 {reverse['pressure_l2_rel']:.2f}" in text
-    assert f"({reverse['a_rel']:.2f})".replace("-", "−") in text
+    differences = []
+    for scene in ("hertz-cylinder", "hertz-sphere", "punch", "reverse-hertz"):
+        found = study(scene)["study"]
+        assert set(found["rates"]) >= {"pdas", "condensed"}
+        for metric, value in found["rates"]["pdas"].items():
+            assert found["rates"]["condensed"][metric] == pytest.approx(value, abs=1e-6)
+        differences.append(f"{found['max_lam_rel_between_methods']:.0e}".replace("e-0", "e-"))
+        if scene != "punch":  # smooth solutions: η first order in h, the pressure estimate near it
+            assert 0.9 <= found["rates"]["pdas"]["estimate"] <= 1.1
+            assert 0.75 <= found["rates"]["pdas"]["pressure_estimate"] <= 1.1
+    assert f"{', '.join(differences[:3])} and {differences[3]} on the four scenes" in text
+    punch = study("punch")["study"]["rates"]["pdas"]
+    assert -0.6 < punch["edge_over_centre"] < -0.4
+    assert f"(rate {punch['edge_over_centre']:.2f})".replace("-", "−") in text
+    assert f"η converges at {punch['estimate']:.2f}" in text
+    assert f"(rate {punch['pressure_estimate']:.2f})" in text
+    grading = study("hertz-cylinder", "grading")
+    graded = {r["level"]: r["errors"] for r in grading["study"]["rows"]}
+    uniform = {r["level"]: r["errors"] for r in grading["uniform"]["rows"]}
+    ratio = uniform[0]["pressure_l2_rel"] / graded[3]["pressure_l2_rel"]
+    assert (f"{100 * graded[3]['pressure_l2_rel']:.2f} % against "
+            f"{100 * uniform[0]['pressure_l2_rel']:.1f} %, about {ratio:.0f}×") in text

@@ -195,7 +195,8 @@ def punch_table(rows: list[dict]) -> str:
         solved = [r for r in run if r["action"] != "candidates widened"]
         first, last = solved[0], solved[-1]
         lines.append(
-            f"| {key[0]} | {100 * key[1]:g} % ({key[2]}) | {len(run)} | {first['dofs']:,} → {last['dofs']:,} "
+            f"| {key[0]} | {100 * key[1]:g} % ({key[2]}) | {len(run)} "
+            f"| {first['dofs']:,} → {last['dofs']:,} "
             f"| {100 * first['energy']:.2f} % → {100 * last['energy']:.2f} % "
             f"| {100 * first['pressure']:.1f} % → {100 * last['pressure']:.1f} % "
             f"| {sum(r['action'] == 'candidates widened' for r in run)} "

@@ -1,5 +1,5 @@
-"""Write the generated blocks of README.md, docs/accuracy.md, docs/estimate.md and docs/peer.md from the committed
-artefacts they quote.
+"""Write the generated blocks of README.md and docs/ (accuracy, estimate, peer, convergence) from
+the committed artefacts they quote.
 
     .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`,
                                               # `signorini stability --out docs`, ...
@@ -31,7 +31,51 @@ README = ROOT / "README.md"
 ACCURACY = ROOT / "docs" / "accuracy.md"
 ESTIMATE = ROOT / "docs" / "estimate.md"
 PEER = ROOT / "docs" / "peer.md"
-DOCUMENTS = (README, ACCURACY, ESTIMATE, PEER)
+CONVERGENCE = ROOT / "docs" / "convergence.md"
+DOCUMENTS = (README, ACCURACY, ESTIMATE, PEER, CONVERGENCE)
+#: the contact half-width of each convergence study's scene at its defaults (h / a in the tables)
+STUDY_A = {"hertz-cylinder": 0.05, "hertz-sphere": 0.05, "reverse-hertz": 0.02, "punch": 1.0}
+STUDY_COLUMNS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
+                 "pressure_max_rel": "pressure max error, \\|x\\| ≤ a/2",
+                 "edge_over_centre": "edge node pressure / (P/πa)",
+                 "estimate": "estimate η / ‖u_h‖", "pressure_estimate": "pressure estimate"}
+
+
+def grading_table(path: Path) -> str:
+    """The graded study against the uniform one (``converge --uniform-levels``), level by level,
+    and the dofs each needs for the p₀ target, from the committed JSON."""
+    record = json.loads(path.read_text())
+    series = {name: [r for r in record[key]["rows"] if r["status"] == "converged"]
+              for name, key in (("graded", "study"), ("uniform", "uniform"))}
+    lines = ["| mesh | level | dofs | p₀ error | a error | pressure L2 error | estimate η / ‖u_h‖ |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for name, rows in series.items():
+        lines += [f"| {name} | {r['level']} | {r['dofs']:,} | {100 * r['errors']['p0_rel']:.3g} % "
+                  f"| {100 * r['errors']['a_rel']:.3g} % | {100 * r['errors']['pressure_l2_rel']:.3g} % "
+                  f"| {100 * r['errors']['estimate']:.3g} % |" for r in rows]
+    g = record["grading"]
+    lines += ["", f"For a p₀ error of {100 * g['target']:g} %: graded {g['graded_dofs']:,.0f} dofs "
+              f"({g['graded_how']}), uniform {g['uniform_dofs']:,.0f} ({g['uniform_how']}): "
+              f"grading saves {g['saving']:,.0f}× the dofs."]
+    return "\n".join(lines)
+
+
+def convergence_table(path: Path, method: str = "pdas") -> str:
+    """One committed convergence study (its JSON) as docs/convergence.md shows it: a row per
+    level of ``method``, the errors and both estimates, and every fitted rate."""
+    study = json.loads(path.read_text())["study"]
+    metrics, a = study["metrics"], STUDY_A[study["scene"]]
+    rows = [r for r in study["rows"] if r["method"] == method and r["status"] == "converged"]
+    lines = ["| level | dofs | h / a | " + " | ".join(STUDY_COLUMNS[m] for m in metrics) + " |",
+             "|---:|---:|---:|" + "---:|" * len(metrics)]
+    for r in rows:
+        cells = [f"{r['errors'][m]:.3g}" if m == "edge_over_centre" else f"{100 * r['errors'][m]:.3g} %"
+                 for m in metrics]
+        lines.append(f"| {r['level']} | {r['dofs']:,} | 1/{a / r['h']:.0f} | " + " | ".join(cells) + " |")
+    rates = study["rates"][method]
+    lines += ["", f"Fitted rates in h ({method}; `condensed` gives the same to 1e-6): "
+              + ", ".join(f"{STUDY_COLUMNS[m]} {rates[m]:.2f}" for m in metrics) + "."]
+    return "\n".join(lines)
 
 
 def one_million(run: Path) -> str:
@@ -88,6 +132,11 @@ def blocks(document: Path = README) -> dict[str, str]:
         return {"peer-runs": "\n".join(peer[:peer.index("")]),
                 "peer-summary": "\n".join(peer[peer.index("") + 1:]),
                 "startup": startup.table(startup.load()), "startup-reading": startup.reading(startup.load())}
+    if document == CONVERGENCE:
+        return {**{f"convergence-{scene}": convergence_table(
+            ROOT / "docs" / "convergence" / f"convergence-{scene}.json") for scene in STUDY_A},
+                "grading": grading_table(ROOT / "docs" / "convergence" / "grading"
+                                         / "convergence-hertz-cylinder.json")}
     if document == ESTIMATE:
         return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"),
                                     estimate_study.load("punch"))
