@@ -318,3 +318,20 @@ def test_the_punch_findings_are_the_runs():
     rounded = run("rounded, r = 0.2 a", "pressure")
     assert rounded[-1]["pressure"] < 0.1 * rounded[0]["pressure"]
     assert all(r["status"] == "converged" for r in rows if "status" in r)
+
+
+def test_the_start_findings_are_the_runs():
+    """docs/estimate.md and README: from a steeply graded start the estimate under-estimates and a
+    0.1 % target stops outside it (said, not hidden)."""
+    rows = tool.load("start")
+    text = " ".join((ROOT / "docs" / "estimate.md").read_text().split())
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    cylinder = [r for r in rows if r["scene"] == "hertz-cylinder"]
+    sphere = [r for r in rows if r["scene"] == "hertz-sphere"]
+    late = [r["effectivity"] for r in cylinder[-3:]]
+    assert max(late) < 0.6 and f"effectivity {_span(late)} over the cylinder's last three steps" in text
+    for run in (cylinder, sphere):
+        assert run[-1]["pressure_estimate"] <= 0.001 < run[-1]["pressure_error"]
+    stop = f"{100 * cylinder[-1]['pressure_error']:.3f} %"
+    assert f"stops there at a true {stop}" in text and f"a 0.1 % target stops at {stop}" in readme
+    assert f"({100 * sphere[-1]['pressure_error']:.3f} % on the sphere" in text

@@ -139,7 +139,7 @@ def blocks(document: Path = README) -> dict[str, str]:
                                          / "convergence-hertz-cylinder.json")}
     if document == ESTIMATE:
         return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"),
-                                    estimate_study.load("punch"))
+                                    estimate_study.load("punch"), estimate_study.load("start"))
     raise ValueError(f"no generated blocks for {document}")
 
 
