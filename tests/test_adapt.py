@@ -225,3 +225,10 @@ def test_a_sharp_punch_grows_its_candidates_around_the_corner():
     assert result.to_dict()["adequacy"]["penetrating_nodes"] == 0
     beyond = result.problem.contact_points[:, 0] > float(result.problem.params["a"]) * (1 + 1e-9)
     assert beyond.any() and np.any(result.solution.lam[beyond] > 0)
+
+
+def test_a_steeper_start_than_measured_is_warned():
+    steep = signorini.solve("hertz-cylinder", target_error="1%", params={"grading": 0.3})
+    assert "warning: the mesh started graded at 0.3" in steep.message
+    default = signorini.solve("hertz-cylinder", target_error="1%")
+    assert "warning" not in default.message

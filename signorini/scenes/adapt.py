@@ -264,6 +264,19 @@ def beyond_candidates(model: SceneModel, problem: ContactProblem,
     return np.union1d(through, beside)
 
 
+def _steeper_than_measured(scene: _Scene) -> str:
+    """A warning when a Hertz scene starts graded more steeply than its default: from there the
+    pressure estimate was measured at half the true error (docs/estimate.md, "the start matters")."""
+    if scene.family is None:
+        return ""
+    default = next(p.default for p in scene.family.params if p.name == "grading")
+    if scene.params["grading"] <= default:
+        return ""
+    return (f"; warning: the mesh started graded at {scene.params['grading']:g}, more steeply than "
+            f"the default {default:g}: from there the pressure estimate was measured below the true "
+            "error (docs/estimate.md); start from the default grading or finer")
+
+
 def _checked(scene: _Scene) -> _Scene:
     if scene.model.mesh.p.shape[0] != 2 or not hasattr(scene.model.mesh, "refined"):
         raise InputError(f"scene {scene.name!r} is 3D: target error refines 2D and axisymmetric "
@@ -342,6 +355,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
         model = scene.on(model, mesh, solution, _contact_extent(model, problem, solution))
     else:
         run.reason = f"adaptive refinement stopped after {MAX_STEPS} steps"
+    run.reason += _steeper_than_measured(scene)
     run.solution.message = f"{run.solution.message}; {run.reason}".lstrip("; ")
     run.solution.extras["adaptive"] = steps
     log.info("%s", run.reason)
