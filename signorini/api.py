@@ -236,7 +236,7 @@ def solve_summary(record: dict[str, Any]) -> str:
                      f"(element {q['edge_h']:.3g} next to the edge)")
     steps = record["extras"].get("adaptive", [])
     if steps:
-        lines.append(f"  adaptive refinement, {len(steps)} solves in "
+        lines.append(f"  adaptive refinement, {len(steps)} solve{'s' * (len(steps) != 1)} in "
                      f"{sum(step['seconds'] for step in steps):.2f} s (estimates: energy norm, pressure):")
         lines += [f"    step {step['step']}: {step['dofs']:,} dofs, {step['candidates']} candidates, "
                   f"{100 * step['estimate']:.3g} %, {100 * step['pressure_estimate']:.3g} %: "
