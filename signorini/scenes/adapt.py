@@ -340,7 +340,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
                  what, 100 * value, 100 * target, seconds)
         if value <= target:
             run.reason = (f"target {what} error {100 * target:.3g} % met: estimate {100 * value:.3g} % "
-                          f"at {problem.n} dofs after {step + 1} solves")
+                          f"at {problem.n} dofs after {step + 1} solve{'s' * (step > 0)}")
             steps.append(_row(step, problem, solution, found, 0, seconds, "target met"))
             break
         marked = mark(model.mesh, found, quantity, theta)
