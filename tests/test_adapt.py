@@ -191,12 +191,27 @@ def test_a_scene_without_its_own_mesh_builder_is_carried_onto_each_refinement(sc
 
 
 def test_a_mesh_scene_file_refines_and_stays_a_patch_test():
-    """The block from a Gmsh file: uniform pressure, exact in P1, on every refined mesh."""
+    """The block from a Gmsh file: uniform pressure, exact in P1, on every refined mesh. Its
+    estimate is zero, so the loop stops at once; the carried model is solved on a refinement of
+    half the elements here, which the loop would make."""
+    from signorini.fem.assembly import assemble
+    from signorini.fem.transfer import refined_model
+    from signorini.scenes.scenefile import build_scene_model
+    from signorini.solvers.registry import solve as solve_problem
+
     result = signorini.solve(str(EXAMPLES / "block-mesh.toml"), target_error="1%", target_on="energy")
     assert result.status == "converged"
     assert result.estimate.pressure.relative < 1e-10
     pressure = result.pressure[result.active]
     assert np.ptp(pressure) < 1e-9 * pressure.mean()
+    _, model = build_scene_model(str(EXAMPLES / "block-mesh.toml"))
+    mesh = model.mesh.refined(np.arange(0, model.mesh.t.shape[1], 2))
+    carried = refined_model(model, mesh)
+    assert len(carried.contact_nodes) > len(model.contact_nodes)
+    problem = assemble(carried)
+    solution = solve_problem(problem, "pdas")
+    pressure = solution.lam / problem.weights
+    assert solution.status == "converged" and np.ptp(pressure) < 1e-9 * pressure.mean()
 
 
 def test_the_carried_model_has_the_refined_boundary_sets():

@@ -169,3 +169,38 @@ def test_the_rates_docs_convergence_states_are_the_committed_studies():
     ratio = uniform[0]["pressure_l2_rel"] / graded[3]["pressure_l2_rel"]
     assert (f"{100 * graded[3]['pressure_l2_rel']:.2f} % against "
             f"{100 * uniform[0]['pressure_l2_rel']:.1f} %, about {ratio:.0f}×") in text
+
+
+def test_the_readings_docs_convergence_gives_are_the_committed_studies():
+    """The numbers docs/convergence.md reads off the committed studies, held to their JSONs."""
+    import json
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    text = " ".join((root / "docs" / "convergence.md").read_text(encoding="utf-8").split())
+
+    def levels(scene, key="study", folder=""):
+        path = root / "docs" / "convergence" / folder / f"convergence-{scene}.json"
+        rows = json.loads(path.read_text())[key]["rows"]
+        return [r["errors"] for r in rows if r["method"] == "pdas"]
+
+    def pct(value, digits=2):
+        return f"{100 * value:.{digits}f}".rstrip("0").rstrip(".") + " %"
+
+    cylinder = levels("hertz-cylinder")
+    assert (f"fall to {pct(cylinder[2]['p0_rel'])} and {pct(cylinder[2]['a_rel'], 3)} at level 2"
+            in text)
+    assert "settle at 0.05–0.06 % and 0.02–0.03 %" in text
+    assert all(0.05 <= round(100 * c["p0_rel"], 2) <= 0.06 and 0.02 <= round(100 * c["a_rel"], 2) <= 0.03
+               for c in cylinder[3:])
+    assert (f"({pct(cylinder[3]['pressure_l2_rel'])} → {pct(cylinder[4]['pressure_l2_rel'])})"
+            in text)
+    sphere = levels("hertz-sphere")
+    assert f"dips to {pct(sphere[1]['p0_rel'])} at level 1" in text
+    graded, uniform = levels("hertz-cylinder", folder="grading"), levels(
+        "hertz-cylinder", "uniform", "grading")
+    assert f"{pct(graded[3]['estimate'], 1)} against {pct(uniform[0]['estimate'], 1)}" in text
+    assert (f"({pct(uniform[1]['p0_rel'])} → {pct(uniform[2]['p0_rel'], 3)} in one refinement) "
+            f"while its a error is still {pct(uniform[2]['a_rel'])}") in text
+    reverse = levels("reverse-hertz")
+    assert f"settle at {pct(reverse[3]['p0_rel'])} and {pct(reverse[3]['a_rel'])}" in text

@@ -223,6 +223,23 @@ def test_where_adaptivity_pays_is_the_runs():
         assert as_good["step"] + 1 == 4 and "solves four times to get there" in readme
         assert (f"{100 * hand['pressure_error']:.3f} % at {hand['dofs']:,}" in text
                 and f"{100 * as_good['pressure_error']:.3f} % at {as_good['dofs']:,}" in text)
+    flat = " ".join(text.split())
+    scenes = ("hertz-cylinder", "hertz-sphere")
+    stops = [_first(_adaptive(rows, scene, 0.3), 0.001) for scene in scenes]
+    uniforms = [_adaptive(rows, scene, 0.3, "uniform, refine 2")[0] for scene in scenes]
+    saving = [u["dofs"] / r["dofs"] for u, r in zip(uniforms, stops)]
+    assert f"{min(saving):.1f} times fewer dofs" in flat and f"{min(saving):.1f}× fewer dofs" in readme
+    assert (f"take {stops[0]['seconds']:.1f} s and {stops[1]['seconds']:.1f} s, one uniform solve "
+            f"(nested) {uniforms[0]['seconds']:.1f} s and {uniforms[1]['seconds']:.1f} s") in flat
+    assert (f"({stops[0]['seconds']:.1f} s against {uniforms[0]['seconds']:.1f} s on the cylinder)"
+            in readme)
+    for scene in ("hertz-cylinder", "hertz-sphere"):
+        hand = _adaptive(rows, scene, 0.3, "graded (40, 0.1)")[0]
+        as_good = next(r for r in _adaptive(rows, scene, 0.3)
+                       if r["pressure_error"] <= hand["pressure_error"] + 2e-5)
+        assert f"{hand['dofs']:,} dofs in {hand['seconds']:.1f} s" in flat \
+            or f"{hand['dofs']:,} in {hand['seconds']:.1f} s" in flat
+        assert f"{as_good['dofs']:,} in {as_good['seconds']:.1f} s" in flat
     hand = [_adaptive(rows, scene, 0.3, "graded (40, 0.1)")[0]["effectivity"]
             for scene in ("hertz-cylinder", "hertz-sphere")]
     uniform = _adaptive(rows, "hertz-sphere", 0.3, "uniform, refine 2")[0]["effectivity"]
@@ -317,6 +334,10 @@ def test_the_punch_findings_are_the_runs():
     assert f"meets 2 % at {energy[-1]['dofs']:,} dofs" in " ".join(text.split())
     rounded = run("rounded, r = 0.2 a", "pressure")
     assert rounded[-1]["pressure"] < 0.1 * rounded[0]["pressure"]
+    flat = " ".join(text.split())
+    assert f"jumps to {100 * sharp[-1]['pressure']:.1f} %" in flat
+    assert (f"falls from {100 * rounded[0]['pressure']:.1f} % to {100 * rounded[-1]['pressure']:.1f} %"
+            in flat)
     assert all(r["status"] == "converged" for r in rows if "status" in r)
 
 

@@ -46,6 +46,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem.quadrature import get_quadrature
 
+from signorini.fem.topology import facets_on
 from signorini.fem.volumetric import nodal_volumetric_strain, simplex_gradients
 from signorini.kkt import active_set
 from signorini.problem import ContactProblem, ContactSolution
@@ -207,12 +208,11 @@ def candidate_nodes(mesh: Any, points: np.ndarray) -> np.ndarray:
 def candidate_edges(mesh: Any, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The boundary facets of a 2D mesh joining two candidates: facet numbers, their end nodes
     (2, k) and the ends' positions in ``nodes`` (2, k)."""
-    facets = mesh.boundary_facets()
+    facets = facets_on(mesh, nodes)
     ends = mesh.facets[:, facets]
     local = np.full(mesh.p.shape[1], -1)
     local[nodes] = np.arange(len(nodes))
-    both = (local[ends] >= 0).all(axis=0)
-    return facets[both], ends[:, both], local[ends[:, both]]
+    return facets, ends, local[ends]
 
 
 def zone_and_neighbours(mesh: Any, nodes: np.ndarray, active: np.ndarray) -> np.ndarray:

@@ -85,3 +85,10 @@ def moved(mesh: Any, p: np.ndarray) -> Any:
         if hasattr(mesh, name):
             object.__setattr__(new, name, getattr(mesh, name))
     return new
+
+
+def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
+    """The boundary facets whose ends are all among ``nodes`` (triangles or tetrahedra)."""
+    boundary = mesh.boundary_facets()
+    inside = np.isin(mesh.facets[:, boundary], nodes).all(axis=0)
+    return boundary[inside]

@@ -17,6 +17,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from signorini.fem.obstacles import ScaledQuery
+from signorini.fem.topology import facets_on
 
 
 def edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
@@ -110,14 +111,6 @@ def extend_nodes(nodes: np.ndarray, n_old: int, children: np.ndarray, parents: n
     return np.concatenate([nodes, children[inside]])[order]
 
 
-def facets_within(mesh: Any, nodes: np.ndarray) -> np.ndarray:
-    """The boundary facets of ``mesh`` with both ends among ``nodes``."""
-    member = np.zeros(mesh.p.shape[1], dtype=bool)
-    member[nodes] = True
-    facets = mesh.boundary_facets()
-    return facets[member[mesh.facets[:, facets]].all(axis=0)]
-
-
 def refined_model(model: Any, mesh: Any, in_contact: np.ndarray | None = None,
                   snap: Any = None) -> Any:
     """``model`` (a :class:`signorini.fem.model.SceneModel`) on ``mesh``, a conforming refinement
@@ -144,14 +137,14 @@ def refined_model(model: Any, mesh: Any, in_contact: np.ndarray | None = None,
         mesh = snap(mesh)
     changes: dict[str, Any] = {
         "mesh": mesh, "contact_nodes": candidates,
-        "contact_facets": facets_within(mesh, on_contact_facets),
+        "contact_facets": facets_on(mesh, on_contact_facets),
         "dirichlet": [(c, extend(nodes), value) for c, nodes, value in model.dirichlet],
         "load_dofs": (model.load_dofs[0], extend(model.load_dofs[1])),
     }
     _ask_at(changes, model.obstacle, mesh, candidates)
     if model.cut_load is not None:
         nodes = extend(model.cut_load.nodes)
-        changes["cut_load"] = replace(model.cut_load, nodes=nodes, facets=facets_within(mesh, nodes))
+        changes["cut_load"] = replace(model.cut_load, nodes=nodes, facets=facets_on(mesh, nodes))
     if in_contact is not None:
         touching = extend(np.asarray(model.contact_nodes)[np.asarray(in_contact, dtype=bool)])
         changes["predicted_contact"] = np.isin(candidates, touching)

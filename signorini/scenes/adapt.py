@@ -197,17 +197,14 @@ class _Scene:
     given: set[str] = field(default_factory=set)
     snap: Callable | None = None
 
-    @property
-    def widens(self) -> bool:
-        return self.family is not None
-
-    def on(self, model: SceneModel, mesh: Any, solution: ContactSolution,
-           extent: float | None) -> SceneModel:
-        """The scene on ``mesh``, refined from ``model``'s (not yet snapped); ``solution`` is
-        ``model``'s, and load targeting starts from its contact."""
+    def on(self, model: SceneModel, mesh: Any, problem: ContactProblem,
+           solution: ContactSolution) -> SceneModel:
+        """The scene on ``mesh``, refined from ``model``'s (not yet snapped); ``problem`` and
+        ``solution`` are ``model``'s, and load targeting starts from its contact."""
         if self.family is not None:
             return _rebuild(self.family, self.params, self.given,
-                            self.snap(mesh) if self.snap else mesh, extent)
+                            self.snap(mesh) if self.snap else mesh,
+                            _contact_extent(model, problem, solution))
         return refined_model(model, mesh, solution.lam > 0, self.snap)
 
 
@@ -235,7 +232,7 @@ def _grown(scene: _Scene, model: SceneModel, problem: ContactProblem,
     any other model takes the boundary nodes beyond its candidates that went
     through the obstacle, and those next to an edge candidate in contact.
     """
-    if scene.widens:
+    if scene.family is not None:
         scene.params = {**scene.params, "candidates": scene.params["candidates"] * GROWTH}
         log.info("the contact outgrew the candidates; widened to %g half-widths",
                  scene.params["candidates"])
@@ -352,7 +349,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
             steps.append(_row(step, problem, solution, found, 0, seconds, "max dofs"))
             break
         steps.append(_row(step, problem, solution, found, len(marked), seconds, "refined"))
-        model = scene.on(model, mesh, solution, _contact_extent(model, problem, solution))
+        model = scene.on(model, mesh, problem, solution)
     else:
         run.reason = f"adaptive refinement stopped after {MAX_STEPS} steps"
     run.reason += _steeper_than_measured(scene)

@@ -30,6 +30,7 @@ from signorini.errors import InputError
 from signorini.fem.assembly import assemble, boundary_weights
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.fem.obstacles import ScaledQuery
+from signorini.fem.topology import facets_on
 from signorini.problem import ContactProblem, ContactSolution, Scales
 from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, poisson_ratio, positive
 from signorini.solvers.pdas import solve as pdas
@@ -75,11 +76,10 @@ def _mesh_parts(p: dict[str, Any]) -> tuple[MeshTri, np.ndarray, np.ndarray, np.
     tol = 1e-12 * max(p["W"], p["H"])
     bottom = np.nonzero(np.abs(y) < tol)[0]
     bottom = bottom[np.argsort(x[bottom])]
-    facets = mesh.boundary_facets()
-    on_bottom = np.all(np.isin(mesh.facets[:, facets], bottom), axis=0)
+    bottom_facets = facets_on(mesh, bottom)
     top = np.nonzero(np.abs(y - p["H"]) < tol)[0]
     symmetry = np.nonzero(np.abs(x) < tol)[0]
-    return mesh, bottom, facets[on_bottom], top, symmetry
+    return mesh, bottom, bottom_facets, top, symmetry
 
 
 def _plain_model(p: dict[str, Any], contact_nodes: np.ndarray | None = None,

@@ -24,11 +24,10 @@ from typing import Any
 import numpy as np
 
 from signorini.fem.model import CutLoad, FlatObstacle3D, SceneModel
-from signorini.fem.topology import moved
+from signorini.fem.topology import facets_on, moved
 from signorini.scenes.base import CANDIDATE_REMEDY, LOADING, Param, SceneFamily, at_least, between
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, load_choice, recorded_params
 from signorini.scenes.meshing import (
-    facets_on,
     coarse_ball_octant,
     curved_boundary_facets,
     distance_to_disc,

@@ -20,7 +20,7 @@ from scipy.spatial import Delaunay
 from skfem import Mesh, MeshTet, MeshTri
 
 from signorini.fem.model import CutLoad
-from signorini.fem.topology import moved, with_topology
+from signorini.fem.topology import facets_on, moved, with_topology
 from signorini.scenes.relax import relax
 
 log = logging.getLogger(__name__)
@@ -263,13 +263,6 @@ def disc_loading(disc: GradedDisc, loading: str, target: float | None):
     if loading == "displacement" or target is None:
         return disc.top, None
     return np.array([disc.centre]), CutLoad(component=1, nodes=disc.top, facets=disc.top_facets)
-
-
-def facets_on(mesh: MeshTri, nodes: np.ndarray) -> np.ndarray:
-    """The boundary facets whose both ends are among ``nodes``."""
-    boundary = mesh.boundary_facets()
-    inside = np.isin(mesh.facets[:, boundary], nodes).all(axis=0)
-    return boundary[inside]
 
 
 def quarter_disc_distance(p: np.ndarray) -> np.ndarray:

@@ -33,6 +33,7 @@ from signorini.analytic import contact_modulus
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
+from signorini.fem.topology import facets_on
 from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, between, poisson_ratio, positive
 from signorini.scenes.meshing import distance_to_segment, refine_to_size
 
@@ -155,8 +156,7 @@ def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidat
     tol = 1e-12 * height
     bottom = np.nonzero(np.abs(y) <= tol)[0]
     top = np.nonzero(np.abs(y - height) <= tol)[0]
-    facets = mesh.boundary_facets()
-    on_bottom = np.all(np.isin(mesh.facets[:, facets], bottom), axis=0)
+    bottom_facets = facets_on(mesh, bottom)
     candidates = bottom[np.abs(x[bottom]) <= candidate_end * (1 + 1e-9)]
     candidates = candidates[np.argsort(x[candidates], kind="stable")]
     if half:
@@ -167,7 +167,7 @@ def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidat
     mesh = MeshTri(mesh.p * scale, mesh.t)
     return SceneModel(
         mesh=mesh, E=E, nu=nu, dirichlet=dirichlet, contact_nodes=candidates,
-        contact_facets=facets[on_bottom],
+        contact_facets=bottom_facets,
         obstacle=ScaledQuery(obstacle, mesh.p[:, candidates].T, scale),
         load_dofs=(1, top), length_scale=scale, force_multiplicity=2.0 if half else 1.0,
         target_load=target, params=params)
