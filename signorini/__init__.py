@@ -19,22 +19,25 @@ import logging
 from signorini.api import (
     DEFAULT_METHOD,
     Result,
+    at_load,
     build_problem,
     certificate,
     methods,
     scene_families,
     solve,
+    solve_adaptive,
 )
 from signorini.crosschecking import CrossCheck, crosscheck
 from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
 from signorini.kkt import Certificate
-from signorini.problem import ContactProblem, ContactSolution, Scales
+from signorini.problem import ContactProblem, ContactSolution, Discretisation, Scales
+from signorini.solution import WarmStart
 
 __version__ = "0.1.0"
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 __all__ = ["DEFAULT_METHOD", "BackendNotInstalled", "Certificate", "ContactProblem", "ContactSolution",
-           "CrossCheck", "InputError", "Result", "Scales", "SignoriniError", "SolverError",
-           "__version__", "build_problem", "certificate", "crosscheck", "methods", "scene_families",
-           "solve"]
+           "CrossCheck", "Discretisation", "InputError", "Result", "Scales", "SignoriniError",
+           "SolverError", "WarmStart", "__version__", "at_load", "build_problem", "certificate", "crosscheck",
+           "methods", "scene_families", "solve", "solve_adaptive"]

@@ -62,7 +62,7 @@ class Adequacy:
 
 def adequacy(problem: ContactProblem, solution: ContactSolution, accept: float) -> Adequacy | None:
     """Check the boundary beyond the candidates (None when the problem has no watch or no answer)."""
-    watch = problem.watch
+    watch = None if problem.discretisation is None else problem.discretisation.watch
     if watch is None or not np.all(np.isfinite(solution.u)):
         return None
     gaps = watch.gap(problem, solution.u)
@@ -79,14 +79,15 @@ def adequacy(problem: ContactProblem, solution: ContactSolution, accept: float) 
 def warnings(problem: ContactProblem) -> list[str]:
     """What may make an exact answer a poor model (the status stays)."""
     said = []
-    nu = problem.params.get("nu")
-    if isinstance(nu, (int, float)) and nu > LOCKING_NU and problem.params.get("volumetric") == "element":
+    disc = problem.discretisation
+    nu = None if disc is None else disc.nu
+    if nu is not None and nu > LOCKING_NU and disc.volumetric == "element":
         said.append(f"ν = {nu:g} > {LOCKING_NU:g}: P1 triangles lock, the pressure can be several "
                     "percent off (docs/accuracy.md); set the scene parameter volumetric=nodal "
                     "(the volumetric strain averaged at the nodes: no locking)")
-    watch = problem.watch
+    watch = None if disc is None else disc.watch
     if watch is not None and watch.candidate_gaps.size:
-        push = float(np.max(np.abs(problem.prescribed), initial=0.0))
+        push = float(np.max(np.abs(problem.discretisation.prescribed), initial=0.0))
         inside = float(-watch.candidate_gaps.min())
         if inside > 0 and inside > push:
             said.append(f"the obstacle starts {inside * problem.scales.displacement:.3g} inside the "

@@ -26,11 +26,14 @@ from signorini.kkt import Certificate, certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import Reference, reference_of
+from signorini import loading
+from signorini.loading import solve as load_control
 from signorini.scenes import SCENES, SceneFamily, build_problem
-from signorini.scenes.adapt import parse_target, solve_adaptive
+from signorini.scenes.adapt import parse_target
+from signorini.scenes.adapt import solve_adaptive as adapt
+from signorini.scenes.build import coarse_problem
 from signorini.solvers.registry import Method, check_request
 from signorini.solvers.registry import methods as _all_methods
-from signorini.solvers.registry import solve as _solve
 
 DEFAULT_METHOD = "auto"
 
@@ -178,8 +181,9 @@ class Result:
             "message": solution.message,
             "iterations": self.iterations, "dofs": problem.n,
             "contact_candidates": problem.m,
-            "time": {"assemble_s": problem.assemble_time, "build_s": solution.build_time,
-                     "solve_s": solution.solve_time},
+            "time": {"assemble_s": problem.discretisation.assemble_s if problem.discretisation
+                     else 0.0, "build_s": solution.build_time, "solve_s": solution.solve_time},
+            "work": solution.work,
             "kkt": self.certificate.as_dict(),
             "estimate": None if self.estimate is None else self.estimate.as_dict(),
         }
@@ -250,45 +254,24 @@ def solve_summary(record: dict[str, Any]) -> str:
 
 
 def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: float | None = None,
-          max_iter: int | None = None, params: dict[str, Any] | None = None,
-          target_error: float | str | None = None, max_dofs: int | None = None,
-          target_on: str | None = None, **options: Any) -> Result:
+          max_iter: int | None = None, warm_start: Any = None, params: dict[str, Any] | None = None,
+          **options: Any) -> Result:
     """Solve a problem (or a scene by name) and judge the answer with the KKT certificate.
 
     ``problem`` is a :class:`ContactProblem` (from :func:`build_problem`,
     :meth:`ContactProblem.from_qp` or :meth:`ContactProblem.load`) or the name
-    of a scene (see :func:`scenes`), built with ``params`` in the scene's units.
-    ``method`` is one of :func:`methods` (default ``auto``: ``pdas`` in 2D and axisymmetric
-    models, ``pdas-amg`` for large 3D ones; the result says which and why); ``tol`` the
-    relative KKT tolerance the answer must meet to be ``converged``; other
-    keyword arguments are the method's options. Bad input raises
-    :class:`signorini.InputError`; a method that fails returns a result whose
-    ``status`` says so.
-
-    ``target_error`` (a scene by name; ``0.001`` or ``"0.1%"``) refines the
-    scene's mesh adaptively until the estimated relative error is at most
-    that, or the next mesh would exceed ``max_dofs`` (default 100,000): with
-    ``target_on="pressure"`` (the default for 2D scenes with contact
-    pressures) the error of the contact pressure in L² over the candidates
-    (``result.estimate.pressure.relative``), with ``"energy"`` the energy
-    norm's (``result.estimate.relative``). The message says which stopped it, and
-    ``result.solution.extras["adaptive"]`` lists the steps
-    (:mod:`signorini.scenes.adapt`).
+    of a scene (see :func:`scene_families`), built with ``params`` in the
+    scene's units. A target load is matched first by load control
+    (:mod:`signorini.loading`). ``method`` is one of :func:`methods` (default
+    ``auto``: the fastest exact route; the result says which and why): a
+    method named here starts cold, or from ``warm_start`` (an earlier
+    :class:`Result`), and the iterations it reports are its own;
+    ``result.solution.work`` lists the work of every stage. ``tol`` is the
+    relative KKT tolerance the answer must meet to be ``converged`` (None:
+    the method's default); other keyword arguments are the method's options.
+    Bad input raises :class:`signorini.InputError`; a method that fails
+    returns a result whose ``status`` says so.
     """
-    if target_error is not None:
-        if not isinstance(problem, str):
-            raise InputError("target_error= refines a scene's mesh: give the scene by name, "
-                             "solve('hertz-cylinder', target_error=0.01)")
-        run = solve_adaptive(problem, params or {}, parse_target(target_error), method=method,
-                             tol=tol, max_iter=max_iter, max_dofs=max_dofs, quantity=target_on,
-                             **options)
-        result = Result(run.problem, run.solution, certificate(run.problem, run.solution))
-        result._estimate = run.estimate
-        return result
-    if max_dofs is not None or target_on is not None:
-        given = "max_dofs (--max-dofs)" if max_dofs is not None else "target_on (--target-on)"
-        raise InputError(f"{given} steers adaptive refinement: give target_error "
-                         "(--target-error) with it")
     if params is not None and not isinstance(params, dict):
         raise InputError(f"params must be a dict of scene parameters, got {type(params).__name__}: "
                          "e.g. params={'E': 2.1e11}")
@@ -302,10 +285,49 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
         raise InputError(f"problem must be a ContactProblem or a scene name, got "
                          f"{type(problem).__name__}: build one with signorini.build_problem(...) "
                          "or ContactProblem.from_qp(K, f, N, d)")
-    solution = _solve(problem, method, tol=tol, max_iter=max_iter, **options)
-    if solution.problem is not None:  # the target load was pending: matched with the answer
-        problem = solution.problem
+    problem, solution = load_control(problem, method, tol=tol, max_iter=max_iter,
+                                     warm_start=warm_start, coarse=coarse_problem, **options)
     return Result(problem, solution, certificate(problem, solution))
+
+
+def at_load(problem: ContactProblem) -> ContactProblem:
+    """``problem`` at its target load, or itself when it has none: the QP any method (or your
+    own code) can then solve as it is. Load control matches the push (:mod:`signorini.loading`)."""
+    return loading.at_load(problem, coarse_problem)
+
+
+def solve_adaptive(scene: str, target_error: float | str, method: str = DEFAULT_METHOD, *,
+                   tol: float | None = None, max_iter: int | None = None,
+                   params: dict[str, Any] | None = None, max_dofs: int | None = None,
+                   target_on: str | None = None, **options: Any) -> Result:
+    """Refine a scene's mesh adaptively until the estimated relative error meets ``target_error``.
+
+    ``target_error`` is ``0.001`` or ``"0.1%"``; the loop stops there, or
+    when the next mesh would exceed ``max_dofs`` (default 100,000). With
+    ``target_on="pressure"`` (the default for 2D scenes with contact
+    pressures) the error of the contact pressure in L² over the candidates
+    (``result.estimate.pressure.relative``), with ``"energy"`` the energy
+    norm's (``result.estimate.relative``). Each step is solved as
+    :func:`solve` would; the message says what stopped the loop and
+    ``result.solution.extras["adaptive"]`` lists the steps
+    (:mod:`signorini.scenes.adapt`).
+    """
+    if not isinstance(scene, str):
+        raise InputError("adaptive refinement refines a scene's mesh: give the scene by name, "
+                         "solve_adaptive('hertz-cylinder', 0.01)")
+    if params is not None and not isinstance(params, dict):
+        raise InputError(f"params must be a dict of scene parameters, got {type(params).__name__}")
+    check_request(method, tol, max_iter, options)
+
+    def solver(problem: ContactProblem):
+        return load_control(problem, method, tol=tol, max_iter=max_iter, coarse=coarse_problem,
+                            **options)
+
+    run = adapt(scene, params or {}, parse_target(target_error), solver, max_dofs=max_dofs,
+                quantity=target_on)
+    result = Result(run.problem, run.solution, certificate(run.problem, run.solution))
+    result._estimate = run.estimate
+    return result
 
 
 def methods(installed_only: bool = False) -> list[Method]:
@@ -321,5 +343,5 @@ def scene_families() -> dict[str, SceneFamily]:
     return dict(SCENES)
 
 
-__all__ = ["DEFAULT_METHOD", "Result", "build_problem", "certificate", "methods", "scene_families",
-           "solve", "solve_summary"]
+__all__ = ["DEFAULT_METHOD", "Result", "at_load", "build_problem", "certificate", "methods", "scene_families",
+           "solve", "solve_adaptive", "solve_summary"]

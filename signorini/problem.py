@@ -19,7 +19,7 @@ import io
 import json
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,10 +29,9 @@ from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
 from signorini.numerics.arrays import sparse_argument, vector_argument
 from signorini.numerics.factor import factorize
-from signorini.numerics.loading import calibrate_push
 from signorini.solution import STATUSES, ContactSolution
 
-__all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Push", "Scales", "WarmStart", "Watch"]
+__all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Discretisation", "Push", "Scales", "Watch"]
 
 #: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
 ITERATIVE_ENERGY_FROM = 300_000
@@ -80,10 +79,10 @@ class Push:
     forces per unit P; None when the push alone loads the body). Load
     sweeps and load targeting use it without assembling again.
 
-    ``target`` is the load (dimensionless, full body) that load targeting
-    matched, or None; ``pending`` says that it has not matched it yet: the
-    problem is at a nominal push and the method (``pdas-amg``) finds the push
-    with the answer, or :meth:`ContactProblem.matched` does first.
+    ``target`` is the load (dimensionless, full body) the scene asks for, or
+    None; ``pending`` says that no push has been matched to it yet: the
+    problem is at a nominal push, and load control
+    (:func:`signorini.loading.match`) finds the push whose load is the target.
     """
 
     f1: np.ndarray
@@ -105,23 +104,6 @@ class Push:
     def offset(self, scale: float, load: float | None = None) -> float:
         load = self.load if load is None else load
         return scale * self.offset1 + load * self.offset_load
-
-
-@dataclass
-class WarmStart:
-    """What load targeting learnt about a problem, for a solver to start from.
-
-    ``lam`` are the exact contact forces at the targeted load (None once the
-    load changes) and ``u`` the displacement with them (when load targeting
-    solved the full system; ``pdas`` starts from both); ``zone_solver`` is the :class:`~signorini.numerics.zone.ZoneSolver`
-    that holds K's factorisation with its final ``zone`` (the ``nested``
-    method reuses both while K is unchanged).
-    """
-
-    lam: np.ndarray | None = None
-    zone_solver: Any = None
-    zone: Any = None
-    u: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -150,8 +132,44 @@ class Watch:
 
 
 @dataclass
+class Discretisation:
+    """Where a problem came from: the mesh and the model a scene assembled it from.
+
+    ``mesh`` is in dimensionless coordinates; the full dof vector is the free
+    dofs ``free_dofs`` and the prescribed values ``prescribed`` (zero on free
+    dofs). The applied load of the full body is ``load_row @ u + load_offset``
+    (a reaction on the loaded boundary). ``E`` and ``nu`` are the material in
+    the scene's units, ``volumetric`` how K integrates the volumetric strain,
+    ``axisymmetric`` says the mesh is the meridian half-plane (r, z) of a body
+    of revolution (forces and weights per radian). ``reference`` names the
+    analytic reference in :data:`signorini.references.REFERENCES` ("" for
+    none) and ``params`` records the scene's parameters as built. ``push``
+    says how f, d and the load depend on the prescribed push (load control,
+    :mod:`signorini.loading`), ``predicted_contact`` which candidates the
+    scene expects in contact (where load control starts), ``watch`` the
+    boundary beyond the candidates (see :class:`Watch`).
+    """
+
+    mesh: Any
+    free_dofs: np.ndarray
+    prescribed: np.ndarray
+    load_row: np.ndarray | None = None
+    load_offset: float = 0.0
+    E: float = 1.0
+    nu: float = 0.0
+    volumetric: str = "element"
+    axisymmetric: bool = False
+    reference: str = ""
+    params: dict[str, Any] = field(default_factory=dict)
+    push: Push | None = None
+    predicted_contact: np.ndarray | None = None
+    watch: Watch | None = None
+    assemble_s: float = 0.0
+
+
+@dataclass
 class ContactProblem:
-    """Data of ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` (dimensionless).
+    """The QP ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` (dimensionless), and what its rows mean.
 
     Attributes
     ----------
@@ -162,49 +180,24 @@ class ContactProblem:
     weights : (m,) lumped boundary weights ``wᵢ = ∫ φᵢ ds`` of the candidates
         (None when unknown: then there is no pressure, only forces).
     contact_points : (m, dim) reference coordinates of the candidates (NaN when unknown).
-    free_dofs : (n,) indices of the free dofs inside the full dof vector.
-    prescribed : (n_full,) full dof vector holding the prescribed values (zero on free dofs).
-    load_row, load_offset : the total applied load of the full body is
-        ``load_row @ u + load_offset`` (a reaction on the loaded boundary), used
-        to check force balance against ``force_multiplicity · Σ λ``.
     force_multiplicity : how many copies of the model make the full body
-        (2 for a half model with one symmetry plane).
+        (2 for a half model with one symmetry plane; 2π times that for an
+        axisymmetric one).
     scales : the units of every array above.
-    scene, params : where the problem came from.
-    mesh : the scene's mesh (for plots and export), in dimensionless coordinates.
-    push : how f, d and the load offset depend on the prescribed push (or None).
-    axisymmetric : the mesh is the meridian half-plane (r, z) of a body of
-        revolution; forces and weights are per radian.
-    reference : the name of the scene's analytic reference in
-        :data:`signorini.references.REFERENCES` ("" for none).
-    coarse_model : a function of this problem returning a model of the same
-        scene about 16 times coarser (or None), for the ``nested`` method.
-    warm_start : what load targeting learnt (see :class:`WarmStart`).
-    watch : the boundary beyond the candidates, checked after a solve (see :class:`Watch`).
+    name : the scene (or the user's name for the problem).
+    discretisation : the mesh and model behind the QP (None for a QP given as arrays).
     """
 
     K: sp.csr_matrix
     f: np.ndarray
     N: sp.csr_matrix
     d: np.ndarray
-    weights: np.ndarray | None
-    contact_points: np.ndarray
-    free_dofs: np.ndarray
-    prescribed: np.ndarray
-    load_row: np.ndarray | None = None
-    load_offset: float = 0.0
+    weights: np.ndarray | None = None
+    contact_points: np.ndarray | None = None
     force_multiplicity: float = 1.0
     scales: Scales = field(default_factory=Scales)
-    scene: str = ""
-    params: dict[str, Any] = field(default_factory=dict)
-    mesh: Any = None
-    assemble_time: float = 0.0
-    push: Push | None = None
-    axisymmetric: bool = False
-    reference: str = ""
-    coarse_model: Callable[["ContactProblem"], "ContactProblem | None"] | None = None
-    warm_start: WarmStart = field(default_factory=WarmStart)
-    watch: Watch | None = None
+    name: str = ""
+    discretisation: Discretisation | None = None
 
     def __post_init__(self) -> None:
         self.K, self.N = sparse_argument(self.K, "K"), sparse_argument(self.N, "N")
@@ -234,6 +227,8 @@ class ContactProblem:
             raise InputError(
                 f"contact candidate {bad} has weight {self.weights[bad]:g} ≤ 0: "
                 "every candidate must lie on a boundary edge of positive length")
+        if self.contact_points is None:
+            self.contact_points = np.full((m, 2), np.nan)
         self._factor = None
         self._basis = None
 
@@ -257,13 +252,41 @@ class ContactProblem:
         if n and abs(K - K.T).max() > 1e-10 * abs(K).max():
             raise InputError("K must be symmetric: pass the stiffness matrix itself, or ½(K + Kᵀ)")
         N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")
-        m = N.shape[0]
-        if contact_points is None:
-            contact_points = np.full((m, 2), np.nan)
-        return cls(K=K, f=f, N=N, d=d, weights=weights,
-                   contact_points=np.asarray(contact_points, dtype=float),
-                   free_dofs=np.arange(n), prescribed=np.zeros(n),
-                   force_multiplicity=force_multiplicity, scene=name)
+        points = None if contact_points is None else np.asarray(contact_points, dtype=float)
+        return cls(K=K, f=f, N=N, d=d, weights=weights, contact_points=points,
+                   force_multiplicity=force_multiplicity, name=name)
+
+    # -- what the discretisation says (neutral values for a QP given as arrays) ---------------
+    @property
+    def scene(self) -> str:
+        return self.name
+
+    @property
+    def mesh(self) -> Any:
+        return None if self.discretisation is None else self.discretisation.mesh
+
+    @property
+    def axisymmetric(self) -> bool:
+        return self.discretisation is not None and self.discretisation.axisymmetric
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """The scene's parameters as built (empty for a QP given as arrays)."""
+        return {} if self.discretisation is None else self.discretisation.params
+
+    @property
+    def reference(self) -> str:
+        return "" if self.discretisation is None else self.discretisation.reference
+
+    @property
+    def push(self) -> Push | None:
+        return None if self.discretisation is None else self.discretisation.push
+
+    @property
+    def pending(self) -> bool:
+        """A target load is set and not matched yet: f and d are at a nominal push
+        (:func:`signorini.loading.match` finds the push)."""
+        return self.push is not None and self.push.pending
 
     @property
     def basis(self):
@@ -290,8 +313,10 @@ class ContactProblem:
 
     def expand(self, u: np.ndarray) -> np.ndarray:
         """Full dof vector (free and prescribed) from the free-dof vector ``u``."""
-        full = self.prescribed.copy()
-        full[self.free_dofs] = u
+        if self.discretisation is None:
+            return np.array(u, dtype=float)
+        full = self.discretisation.prescribed.copy()
+        full[self.discretisation.free_dofs] = u
         return full
 
     def gap(self, u: np.ndarray) -> np.ndarray:
@@ -324,9 +349,8 @@ class ContactProblem:
         of K (see :func:`signorini.kkt.primal_dual_gap`). From
         :data:`ITERATIVE_ENERGY_FROM` dofs, when no factorisation is at hand
         (a distributed solve never makes one), Jacobi-preconditioned CG to
-        ``ITERATIVE_ENERGY_RTOL`` replaces a serial factorisation; it is slow
-        on stiff 2D meshes (about 3 minutes on the 1M-dof cylinder), the last
-        resort; without convergence it factorises.
+        ``ITERATIVE_ENERGY_RTOL`` replaces a serial factorisation (slow on
+        stiff 2D meshes: the last resort); without convergence it factorises.
         """
         if self._factor is None and self.n >= ITERATIVE_ENERGY_FROM and np.any(r):
             from scipy.sparse.linalg import cg
@@ -353,92 +377,78 @@ class ContactProblem:
 
     def applied_load(self, u: np.ndarray) -> float:
         """Total load the boundary conditions apply to the full body (dimensionless)."""
-        if self.load_row is None:
+        if self.discretisation is None or self.discretisation.load_row is None:
             return float("nan")
-        return float(self.load_row @ u + self.load_offset)
+        return float(self.discretisation.load_row @ u + self.discretisation.load_offset)
 
     def pushed(self, scale: float, load: float | None = None) -> "ContactProblem":
         """The same body pushed by ``scale`` times the prescribed displacement.
 
         For a body loaded by a traction on a cut, ``load`` (dimensionless,
-        full body) sets the traction; by default it stays as assembled.
+        full body) sets the traction; by default it stays as assembled. The
+        problem returned is at that push (nothing pending); K, its cached
+        factorisation and its basis are shared.
         """
         if self.push is None:
             raise ValueError("this problem does not record how its load depends on the push")
-        pu = self.push
+        pu, old = self.push, self.discretisation
         ratio = scale / pu.scale
         load = pu.load if load is None else load
-        params = dict(self.params)
+        params = dict(old.params)
         if isinstance(params.get("delta"), float):
             params["delta"] *= ratio
         if pu.f_load is not None and isinstance(params.get("P"), float):
             params["P"] = load * self.scales.force
+        discretisation = dataclasses.replace(
+            old, load_offset=pu.offset(scale, load), prescribed=old.prescribed * ratio,
+            params=params, push=dataclasses.replace(pu, scale=scale, load=load, pending=False))
         new = self.with_data(f=pu.f(scale, load), d=pu.d0 + scale * pu.d1,
-                             load_offset=pu.offset(scale, load), prescribed=self.prescribed * ratio,
-                             params=params,
-                             push=dataclasses.replace(pu, scale=scale, load=load, pending=False),
-                             warm_start=WarmStart(zone_solver=self.warm_start.zone_solver,
-                                                  zone=self.warm_start.zone))
-        # K is unchanged: keep its factorisation, its basis and the zone solver (not the forces)
-        new._factor, new._basis = self._factor, self._basis
-        return new
-
-    @property
-    def pending(self) -> bool:
-        """The target load is not matched yet (see :class:`Push`): f and d are at a nominal push."""
-        return self.push is not None and self.push.pending
-
-    def matched(self) -> "ContactProblem":
-        """This problem at the push whose load is the target (itself when nothing is pending).
-
-        One sparse factorisation per active-set step
-        (:func:`signorini.numerics.loading.calibrate_push`); the answer it
-        found is the warm start of the problem returned.
-        """
-        if not self.pending:
-            return self
-        pu = self.push
-        f0 = pu.load * pu.f_load if pu.f_load is not None else None
-        scale, lam, u = calibrate_push(self.K, self.N, pu.f1, pu.d0, pu.d1, pu.target,
-                                       self.force_multiplicity, f0=f0)
-        new = self.pushed(scale)
-        new.warm_start = WarmStart(lam=lam, u=u)
+                             discretisation=discretisation)
+        new._factor, new._basis = self._factor, self._basis  # K is unchanged
         return new
 
     def with_data(self, **changes: Any) -> "ContactProblem":
-        """A copy with some fields replaced.
+        """A copy with some fields (or fields of its discretisation) replaced.
 
-        The cached factorisation and the warm start are dropped (they belong
-        to the old data) unless ``warm_start`` is one of the changes.
+        The cached factorisation is dropped (it belongs to the old K) unless
+        only fields other than K change and the caller restores it.
         """
-        changes.setdefault("warm_start", WarmStart())
-        return dataclasses.replace(self, **changes)
+        own = {name: changes.pop(name) for name in list(changes)
+               if name in ContactProblem.__dataclass_fields__}
+        if changes:
+            if self.discretisation is None:
+                raise ValueError(f"a problem without a discretisation has no {sorted(changes)}")
+            own.setdefault("discretisation", dataclasses.replace(self.discretisation, **changes))
+        return dataclasses.replace(self, **own)
 
     def save(self, path: str | os.PathLike) -> None:
         """Store the arrays of this problem (and its mesh) in ``path`` (.npz), atomically.
 
-        :meth:`load` gives it back; the cached factorisation, the warm start
-        and the coarse-model factory are not stored.
+        :meth:`load` gives it back (the cached factorisation is not stored).
         """
         K, N = self.K.tocsr(), self.N.tocsr()
-        pu = self.push
         arrays = dict(
             K_data=K.data, K_indices=K.indices, K_indptr=K.indptr, N_data=N.data,
             N_indices=N.indices, N_indptr=N.indptr, shape=np.array([self.n, self.m]), f=self.f,
             d=self.d, weights=self.weights if self.weights is not None else np.zeros(0),
-            contact_points=self.contact_points,
-            free_dofs=self.free_dofs, prescribed=self.prescribed,
-            load_row=self.load_row if self.load_row is not None else np.zeros(0))
-        if self.mesh is not None:  # node blocks and rigid modes for the petsc methods
-            arrays.update(mesh_p=self.mesh.p, mesh_t=self.mesh.t)
-        if pu is not None:
-            arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
-            if pu.f_load is not None:
-                arrays.update(push_f_load=pu.f_load)
-        meta = {"scene": self.scene, "params": self.params, "load_offset": self.load_offset,
-                "force_multiplicity": self.force_multiplicity, "scales": vars(self.scales),
-                "assemble_time": self.assemble_time, "axisymmetric": self.axisymmetric,
-                "reference": self.reference,
+            contact_points=self.contact_points)
+        meta: dict[str, Any] = {"scene": self.name, "force_multiplicity": self.force_multiplicity,
+                                "scales": vars(self.scales), "discretisation": None}
+        disc = self.discretisation
+        if disc is not None:
+            arrays.update(free_dofs=disc.free_dofs, prescribed=disc.prescribed,
+                          load_row=disc.load_row if disc.load_row is not None else np.zeros(0))
+            if disc.mesh is not None:  # node blocks and rigid modes for the petsc methods
+                arrays.update(mesh_p=disc.mesh.p, mesh_t=disc.mesh.t)
+            pu = disc.push
+            if pu is not None:
+                arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
+                if pu.f_load is not None:
+                    arrays.update(push_f_load=pu.f_load)
+            meta["discretisation"] = {
+                "load_offset": disc.load_offset, "E": disc.E, "nu": disc.nu,
+                "volumetric": disc.volumetric, "axisymmetric": disc.axisymmetric,
+                "reference": disc.reference, "params": disc.params, "assemble_s": disc.assemble_s,
                 "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
                                                  "offset_load": pu.offset_load, "load": pu.load,
                                                  "target": pu.target, "pending": pu.pending}}
@@ -453,24 +463,29 @@ class ContactProblem:
         z = np.load(path)
         meta = json.loads(bytes(z["meta"]).decode())
         n, m = (int(v) for v in z["shape"])
-        push = None
-        if meta["push"] is not None:
-            push = Push(z["push_f1"], z["push_d0"], z["push_d1"], meta["push"]["offset1"],
-                        meta["push"]["scale"], z["push_f_load"] if "push_f_load" in z else None,
-                        meta["push"].get("offset_load", 0.0), meta["push"].get("load", 0.0),
-                        meta["push"].get("target"), meta["push"].get("pending", False))
-        mesh = None
-        if "mesh_p" in z:
-            kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
-            mesh = kind(z["mesh_p"], z["mesh_t"])
+        discretisation = None
+        about = meta.get("discretisation")
+        if about is not None:
+            push = None
+            if about["push"] is not None:
+                p = about["push"]
+                push = Push(z["push_f1"], z["push_d0"], z["push_d1"], p["offset1"], p["scale"],
+                            z["push_f_load"] if "push_f_load" in z else None, p["offset_load"],
+                            p["load"], p["target"], p["pending"])
+            mesh = None
+            if "mesh_p" in z:
+                kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
+                mesh = kind(z["mesh_p"], z["mesh_t"])
+            discretisation = Discretisation(
+                mesh=mesh, free_dofs=z["free_dofs"], prescribed=z["prescribed"],
+                load_row=z["load_row"] if z["load_row"].size else None,
+                load_offset=about["load_offset"], E=about["E"], nu=about["nu"],
+                volumetric=about["volumetric"], axisymmetric=about["axisymmetric"],
+                reference=about["reference"], params=about["params"], push=push,
+                assemble_s=about["assemble_s"])
         return cls(
             K=sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]), shape=(n, n)),
             f=z["f"], N=sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
             d=z["d"], weights=z["weights"] if z["weights"].size else None,
-            contact_points=z["contact_points"],
-            free_dofs=z["free_dofs"], prescribed=z["prescribed"],
-            load_row=z["load_row"] if z["load_row"].size else None,
-            load_offset=meta["load_offset"], force_multiplicity=meta["force_multiplicity"],
-            scales=Scales(**meta["scales"]), scene=meta["scene"], params=meta["params"],
-            push=push, mesh=mesh, assemble_time=meta["assemble_time"],
-            axisymmetric=meta.get("axisymmetric", False), reference=meta.get("reference", ""))
+            contact_points=z["contact_points"], force_multiplicity=meta["force_multiplicity"],
+            scales=Scales(**meta["scales"]), name=meta["scene"], discretisation=discretisation)

@@ -12,6 +12,35 @@ STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "fa
             "model_inadequate")
 
 
+@dataclass(frozen=True)
+class WarmStart:
+    """Where a method may start, given explicitly: ``solve(problem, method, warm_start=...)``.
+
+    ``lam`` and ``u`` are an earlier answer's contact forces and displacement
+    (``pdas`` starts from both, ``pdas-amg`` from the active set of ``lam``);
+    ``zone_solver`` holds a factorisation of this K around the contact
+    ``zone`` (a :class:`~signorini.numerics.zone.ZoneSolver`; ``nested``
+    reuses both and costs back-solves only). A method never reads a warm
+    start from anywhere else.
+    """
+
+    lam: np.ndarray | None = None
+    u: np.ndarray | None = None
+    zone_solver: Any = None
+    zone: Any = None
+
+    @classmethod
+    def of(cls, earlier: Any) -> "WarmStart":
+        """A warm start from an earlier answer: a WarmStart, a ContactSolution or a Result."""
+        if isinstance(earlier, WarmStart):
+            return earlier
+        solution = getattr(earlier, "solution", earlier)
+        if not isinstance(solution, ContactSolution):
+            raise TypeError(f"warm_start must be an earlier Result, ContactSolution or WarmStart, "
+                            f"got {type(earlier).__name__}")
+        return cls(lam=solution.lam, u=solution.u)
+
+
 @dataclass
 class ContactSolution:
     """What a solver returns: ``u`` (free dofs), ``lam`` (contact forces), status.
@@ -42,9 +71,9 @@ class ContactSolution:
     #: a factorisation of the problem's K the method holds (a PinnedFactor, possibly with
     #: contact dofs pinned), which the certificate reuses for its duality gap and then lets go
     factor: Any = field(default=None, repr=False, compare=False)
-    #: the problem this answer solves when the method matched a pending target load itself
-    #: (the given problem pushed to the load: ``problem.pushed(s)``); None: the problem given
-    problem: Any = field(default=None, repr=False, compare=False)
+    #: the work of every stage that ran, by stage ("method", "load control"): active-set or
+    #: load-control steps, factorisations, back-solves, CG iterations
+    work: dict[str, dict[str, int]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:

@@ -11,6 +11,7 @@ import scipy.sparse.linalg as spla
 from skfem import asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
+import signorini
 from signorini.analytic import contact_modulus, hertz_cylinder_load
 from signorini.errors import InputError
 from signorini.kkt import certificate
@@ -24,17 +25,17 @@ STEEL = {"E": 2.1e11, "R": 0.01}
 
 @pytest.fixture(scope="module")
 def block():
-    return build_problem("block", **BLOCK)
+    return signorini.at_load(build_problem("block", **BLOCK))
 
 
 @pytest.fixture(scope="module")
 def hertz():
-    return build_problem("hertz-cylinder", **HERTZ)
+    return signorini.at_load(build_problem("hertz-cylinder", **HERTZ))
 
 
 @pytest.fixture(scope="module")
 def hertz_steel():
-    return build_problem("hertz-cylinder", **HERTZ, **STEEL)
+    return signorini.at_load(build_problem("hertz-cylinder", **HERTZ, **STEEL))
 
 
 @pytest.fixture(scope="module", params=["block", "hertz"])
@@ -253,8 +254,8 @@ def test_physical_pressure_scales_with_E(hertz, hertz_steel):
 ])
 @pytest.mark.slow
 def test_nondimensionalise_false_gives_the_same_physical_answer(units):
-    scaled = build_problem("hertz-cylinder", **HERTZ, **units)
-    raw = build_problem("hertz-cylinder", nondimensionalise=False, **HERTZ, **units)
+    scaled = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, **units))
+    raw = signorini.at_load(build_problem("hertz-cylinder", nondimensionalise=False, **HERTZ, **units))
     assert raw.scales.force == raw.scales.length == raw.scales.displacement == 1.0
     s_scaled, s_raw = exact(scaled), exact(raw)
     assert certificate(raw, s_raw).worst()[1] < 1e-9
@@ -269,8 +270,8 @@ def test_nondimensionalise_false_gives_the_same_physical_answer(units):
 
 
 def test_nondimensionalise_false_block_in_SI_units():
-    scaled = build_problem("block", **BLOCK)
-    raw = build_problem("block", nondimensionalise=False, **BLOCK)
+    scaled = signorini.at_load(build_problem("block", **BLOCK))
+    raw = signorini.at_load(build_problem("block", nondimensionalise=False, **BLOCK))
     s_scaled, s_raw = exact(scaled), exact(raw)
     E_star = contact_modulus(BLOCK["E"], BLOCK["nu"])
     p_raw = s_raw.lam / raw.weights
@@ -286,7 +287,7 @@ def test_nondimensionalise_false_block_in_SI_units():
     pytest.param({"P": 3.0e6, **STEEL}, id="steel-SI"),
 ])
 def test_target_load_is_reached(values):
-    problem = build_problem("hertz-cylinder", **HERTZ, **values)
+    problem = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, **values))
     solution = exact(problem)
     total = problem.total_contact_force(solution.lam) * problem.scales.force
     assert total == pytest.approx(values["P"], rel=1e-8)
@@ -305,8 +306,8 @@ def test_default_load_is_hertz_load_for_default_a_over_R(hertz):
 def test_consistent_a_over_R_and_P_give_the_same_problem():
     a_over_R, nu = 0.1, 0.3
     P = hertz_cylinder_load(a_over_R, 1.0, contact_modulus(1.0, nu))
-    by_width = build_problem("hertz-cylinder", **HERTZ, a_over_R=a_over_R)
-    by_load = build_problem("hertz-cylinder", **HERTZ, P=P)
+    by_width = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, a_over_R=a_over_R))
+    by_load = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, P=P))
     assert (by_width.n, by_width.m) == (by_load.n, by_load.m)
     assert rel_diff(by_width.K.toarray(), by_load.K.toarray()) < 1e-12
     assert rel_diff(by_width.N.toarray(), by_load.N.toarray()) < 1e-12
@@ -318,7 +319,7 @@ def test_consistent_a_over_R_and_P_give_the_same_problem():
 
 def test_P_and_a_over_R_together_raise():
     with pytest.raises(InputError, match="P") as info:
-        build_problem("hertz-cylinder", **HERTZ, P=0.004, a_over_R=0.05)
+        signorini.at_load(build_problem("hertz-cylinder", **HERTZ, P=0.004, a_over_R=0.05))
     assert "a_over_R" in str(info.value)
 
 

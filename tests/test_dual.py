@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from matplotlib.axes import Axes
 
+import signorini
 from signorini.errors import InputError
 from signorini.kkt import active_set
 from signorini.numerics.lcp import delassus
@@ -39,7 +40,7 @@ def hanging():
 
 @pytest.fixture(scope="module")
 def hertz():
-    return build_problem("hertz-cylinder", n_contact=16, grading=0.4)
+    return signorini.at_load(build_problem("hertz-cylinder", n_contact=16, grading=0.4))
 
 
 @pytest.fixture(scope="module")

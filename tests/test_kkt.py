@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import signorini
+from signorini import loading
 from signorini.kkt import (
     ACTIVE,
     INACTIVE,
@@ -30,7 +32,7 @@ RESIDUALS = ("primal", "stationarity", "dual_sign", "complementarity", "natural"
 
 @pytest.fixture(scope="module")
 def hertz():
-    return build_problem("hertz-cylinder", n_contact=20)
+    return signorini.at_load(build_problem("hertz-cylinder", n_contact=20))
 
 
 @pytest.fixture(scope="module")
@@ -66,8 +68,7 @@ def touching_problem():
     """
     return ContactProblem(
         K=sp.identity(2, format="csr"), f=np.array([-1.0, 0.0]), N=-sp.identity(2, format="csr"),
-        d=np.array([0.5, 0.0]), weights=np.ones(2), contact_points=np.zeros((2, 2)),
-        free_dofs=np.arange(2), prescribed=np.zeros(2), scene="touching")
+        d=np.array([0.5, 0.0]), weights=np.ones(2), contact_points=np.zeros((2, 2)), name="touching")
 
 
 # --- certificate -----------------------------------------------------------------------------
@@ -133,8 +134,8 @@ def test_non_finite_input_gives_inf(hertz, exact, field, value):
 
 
 def test_certificate_is_unit_free():
-    scaled = build_problem("block", nx=4, ny=4)
-    raw = build_problem("block", nx=4, ny=4, E=2.1e11, delta=1e-3, nondimensionalise=False)
+    scaled = signorini.at_load(build_problem("block", nx=4, ny=4))
+    raw = signorini.at_load(build_problem("block", nx=4, ny=4, E=2.1e11, delta=1e-3, nondimensionalise=False))
     s_scaled = registry.solve(scaled, "pdas", tol=1e-9)
     s_raw = registry.solve(raw, "pdas", tol=1e-9)
     assert s_scaled.status == s_raw.status == "converged"
@@ -231,8 +232,7 @@ def test_round_off_force_without_contact_is_not_active():
     # min ½|u|² − fᵀu s.t. u ≤ d with f = (0.5, 0.2), d = (1, 1): u = f is feasible, λ = 0
     problem = ContactProblem(
         K=sp.identity(2, format="csr"), f=np.array([0.5, 0.2]), N=sp.identity(2, format="csr"),
-        d=np.array([1.0, 1.0]), weights=np.ones(2), contact_points=np.zeros((2, 2)),
-        free_dofs=np.arange(2), prescribed=np.zeros(2))
+        d=np.array([1.0, 1.0]), weights=np.ones(2), contact_points=np.zeros((2, 2)))
     exact = ContactSolution("exact", np.array([0.5, 0.2]), np.zeros(2), "converged")
     round_off = ContactSolution("round-off", np.array([0.5, 0.2]), np.array([1e-15, 0.0]),
                                 "converged")
@@ -318,8 +318,8 @@ def test_duality_gap_by_conjugate_gradients_equals_the_factorised_one(hertz, exa
 def zoned():
     """A cylinder load-targeted on a predicted zone (nested then reuses that factorisation)."""
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(scene_build, "NESTED_FROM_DOFS", 0)
-        return build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4)
+        patch.setattr(loading, "ZONE_FROM_DOFS", 0)
+        return signorini.at_load(build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4))
 
 
 def refuse_the_fallback(monkeypatch):

@@ -3,13 +3,19 @@
 Layers, low to high (a module may import its own layer and the layers below):
 
 0. ``errors``, ``files``                 exceptions, atomic writes
-1. ``numerics``                          factorisations, dense LCP, zone kernel, load targeting
+1. ``numerics``                          factorisations, dense LCP, zone kernel, the push kernel
 2. ``problem``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
 3. ``solvers``                           the registry collects each backend's METHODS
-4. ``scenes``                            families, meshing, scene files, building problems
-5. ``api``, ``crosschecking``, the package: the public Python API
-6. ``studies``, ``output``, ``teaching`` one runner and its studies; reports, plots, export
-7. ``cli``                               parsing only
+4. ``loading``                           load control: the one driver around any method
+5. ``scenes``                            families, meshing, scene files, building problems
+6. ``api``, ``crosschecking``, the package: the public Python API
+7. ``studies``, ``output``, ``teaching`` one runner and its studies; reports, plots, export
+8. ``cli``                               parsing only
+
+Beyond the order, the data flow: scenes import no solver and no load control (building a
+scene solves nothing), solvers know no physics (no analytic reference, no mesh, no scene),
+fem imports nothing that solves (no solver, scene, load control, zone or push kernel), and
+output imports no study.
 
 Imports of the package's own modules sit at the top of a module; one inside a
 function is allowed only in ``cli/`` (each command loads what it needs, so
@@ -33,11 +39,21 @@ LAYERS = {
     "adequacy": 2,
     "fem": 2,
     "solvers": 3,
-    "scenes": 4,
-    "api": 5, "crosschecking": 5, "": 5,
-    "studies": 6, "output": 6, "teaching": 6,
-    "cli": 7,
+    "loading": 4,
+    "scenes": 5,
+    "api": 6, "crosschecking": 6, "": 6,
+    "studies": 7, "output": 7, "teaching": 7,
+    "cli": 8,
 }
+#: (package part, what it must not import): the data flow, beyond the order of the layers
+FORBIDDEN = [
+    ("signorini.scenes", ("signorini.solvers", "signorini.loading")),
+    ("signorini.solvers", ("signorini.references", "signorini.pressure", "signorini.analytic",
+                           "signorini.fem", "signorini.scenes")),
+    ("signorini.fem", ("signorini.solvers", "signorini.scenes", "signorini.loading",
+                       "signorini.numerics.zone", "signorini.numerics.loading")),
+    ("signorini.output", ("signorini.studies",)),
+]
 #: the package whose modules may import the package's own modules inside functions (with a comment)
 LAZY_ALLOWED = "signorini.cli"
 MAX_LINES = 500
@@ -103,6 +119,20 @@ def test_every_module_has_a_layer():
 def test_imports_run_down_the_layers(module):
     upward = [(target, line) for target, line, _ in imports(module) if layer(target) > layer(module)]
     assert not upward, f"{module} imports up the layers: {upward}"
+
+
+@pytest.mark.parametrize("part, forbidden", FORBIDDEN, ids=[part for part, _ in FORBIDDEN])
+def test_imports_follow_the_data_flow(part, forbidden):
+    found = [(module, target, line) for module in sorted(MODULES)
+             if module == part or module.startswith(part + ".")
+             for target, line, _ in imports(module)
+             if any(target == f or target.startswith(f + ".") for f in forbidden)]
+    assert not found, f"{part} imports what it must not: {found}"
+
+
+def test_the_data_flow_rules_can_fail():
+    """The rule's matcher sees a real import: the api imports load control."""
+    assert any(t == "signorini.loading" for t, _, _ in imports("signorini.api"))
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))

@@ -5,15 +5,17 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
+from signorini import loading
 
 from signorini.fem.assembly import assemble
 from signorini.kkt import certificate, compare
+from signorini.references import reference_of
 from signorini.numerics.factor import PinnedFactor, factorize
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.scenes import build as scenes
 from signorini.scenes import build_problem, coarse_values, get_scene
 from signorini.solvers.registry import solve
-from signorini.solvers.nested import analytic_zone
+from signorini.loading import analytic_zone
 from signorini.teaching.synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
@@ -37,8 +39,8 @@ def assert_same_answer(problem, first, second, lam_tol=1e-8):
 def zoned_build(name, **values):
     """build_problem with load targeting on a predicted zone even for a small model."""
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(scenes, "NESTED_FROM_DOFS", 0)
-        return build_problem(name, **values)
+        patch.setattr(loading, "ZONE_FROM_DOFS", 0)
+        return signorini.at_load(build_problem(name, **values))
 
 
 @pytest.fixture(scope="module")
@@ -61,10 +63,10 @@ def test_nested_equals_pdas_on_the_cylinder(cylinder):
                                        ("hertz-sphere", 0.45)])
 def test_the_analytic_zone_predicts_on_one_factorisation(scene, nu):
     """Hertz's a for the target load predicts the zone (the sphere at ν = 0 is 0.5 % off it)."""
-    problem = build_problem(scene, refine=1, nu=nu).with_data()
+    problem = signorini.at_load(build_problem(scene, refine=1, nu=nu))
     reference = solve(problem, "pdas")
-    nested = solve(problem, "nested")
-    assert nested.status == "converged" and "analytic zone" in nested.message
+    nested = solve(problem, "nested", zone=analytic_zone(problem))
+    assert nested.status == "converged" and "the given zone" in nested.message
     assert_same_answer(problem, reference, nested)
     assert "1 factorisation(s)" in nested.message and nested.extras["band"] <= 8
 
@@ -72,16 +74,17 @@ def test_the_analytic_zone_predicts_on_one_factorisation(scene, nu):
 def test_the_analytic_zone_predicts_the_3d_sphere_by_the_distance_from_the_axis():
     """In 3D the zone is a ring around Hertz's radius a (x² + y² against a²), as wide as the
     candidates' spacing there: nested is exact on one factorisation from it."""
-    problem = build_problem("hertz-sphere-3d").with_data()
-    zone, a = analytic_zone(problem)
+    problem = signorini.at_load(build_problem("hertz-sphere-3d"))
+    zone = analytic_zone(problem)
+    a = reference_of(problem).extent(problem.params) / problem.scales.length
     rho = np.hypot(problem.contact_points[:, 0], problem.contact_points[:, 1])
     assert rho[zone.core].max() < a < rho[zone.band].max()
     assert rho[zone.rest].min() > a and zone.band.sum() < problem.m / 2
     reference = solve(problem, "pdas")
-    nested = solve(problem, "nested")
-    assert nested.status == "converged" and "analytic zone" in nested.message
-    assert "1 factorisation(s)" in nested.message
-    assert_same_answer(problem, reference, nested)
+    nested = signorini.solve(problem, "nested")  # the API passes the scene's analytic zone
+    assert nested.status == "converged" and "the given zone" in nested.message
+    assert nested.solution.work["method"]["factorisations"] == 1
+    assert_same_answer(problem, reference, nested.solution)
 
 
 @pytest.mark.slow
@@ -91,34 +94,35 @@ def test_auto_reuses_the_load_targeting_factorisation_of_a_large_3d_model():
     from signorini.numerics.factor import COUNTS
 
     problem = build_problem("hertz-sphere-3d", refine=1)
-    assert problem.warm_start.zone_solver is not None
-    before = dict(COUNTS)
-    answer = solve(problem, "auto")
+    answer = signorini.solve(problem)
     assert answer.method == "nested" and answer.status == "converged"
-    assert COUNTS["factorisations"] == before["factorisations"]
-    assert answer.extras["auto"].startswith("K (")
-    assert solve(problem, "auto", c=2.0).method == "pdas"  # an option nested does not take
+    assert answer.solution.work["load control"]["factorisations"] == 1
+    assert "factorisations" not in answer.solution.work["method"]
+    assert answer.solution.extras["auto"].startswith("K (")
+    assert signorini.solve(problem, c=2.0).method == "pdas"  # an option nested does not take
 
 
 def test_a_wrong_analytic_zone_is_amended_not_trusted():
     """A zone predicted for a load 10 % lower (a 5 % too small): the answer stays exact."""
-    problem = build_problem("hertz-cylinder", refine=1).with_data()
-    zone, a = analytic_zone(problem)
+    problem = signorini.at_load(build_problem("hertz-cylinder", refine=1))
+    zone = analytic_zone(problem)
     shifted = analytic_zone(problem.with_data(params={**problem.params, "P": problem.params["P"] * 0.9}))
-    assert shifted is not None and shifted[0].core.sum() < zone.core.sum()
+    assert shifted is not None and shifted.core.sum() < zone.core.sum()
     reference = solve(problem, "pdas")
-    nested = solve(problem, "nested", zone=shifted[0])
+    nested = solve(problem, "nested", zone=shifted)
     assert nested.status == "converged"
     assert_same_answer(problem, reference, nested)
 
 
-def test_nested_reuses_the_load_targeting_factorisation(cylinder):
-    assert cylinder.warm_start.zone_solver is not None
-    before = cylinder.warm_start.zone_solver.factorisations
-    nested = solve(cylinder, "nested")
-    assert cylinder.warm_start.zone_solver.factorisations == before
-    assert "0 factorisation" in nested.message
-    assert_same_answer(cylinder, solve(cylinder, "pdas"), nested)
+def test_nested_reuses_the_factorisation_load_control_hands_it():
+    problem = build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4)
+    matched = loading.match(problem, analytic_zone(problem))
+    assert matched.how == "zone kernel" and matched.work["factorisations"] == 1
+    system = matched.warm_start.zone_solver
+    before = system.factorisations
+    nested = solve(matched.problem, "nested", warm_start=matched.warm_start)
+    assert system.factorisations == before and "0 factorisation" in nested.message
+    assert_same_answer(matched.problem, solve(matched.problem, "pdas"), nested)
 
 
 @pytest.mark.parametrize("scene,params", [
@@ -126,7 +130,7 @@ def test_nested_reuses_the_load_targeting_factorisation(cylinder):
     ("punch", {"refine": 1, "n_contact": 16}),
 ])
 def test_nested_equals_pdas_on_other_scenes(scene, params):
-    problem = build_problem(scene, **params).with_data()
+    problem = signorini.at_load(build_problem(scene, **params)).with_data()
     assert_same_answer(problem, solve(problem, "pdas"), solve(problem, "nested"))
 
 
@@ -159,11 +163,14 @@ def test_the_push_on_a_zone_equals_the_full_active_set_calibration():
     values = {"refine": 1, "n_contact": 24, "grading": 0.4}
     params = family.parse(values)
     model = family.build(params, set(values))
-    full = assemble(model)  # no zone: one factorisation per active-set step
-    zoned = zoned_build("hertz-cylinder", **values)
-    assert full.warm_start.zone_solver is None and zoned.warm_start.zone_solver is not None
-    assert zoned.push.scale == pytest.approx(full.push.scale, rel=1e-10)
-    assert_same_answer(full, solve(full, "pdas"), solve(zoned, "nested"))
+    nominal = assemble(model)
+    nominal.discretisation.reference = "hertz-2d"
+    full = loading.match(nominal)  # no zone: one factorisation per active-set step
+    zoned = loading.match(nominal, analytic_zone(nominal))
+    assert full.how == "full active set" and zoned.how == "zone kernel"
+    assert zoned.problem.push.scale == pytest.approx(full.problem.push.scale, rel=1e-10)
+    assert_same_answer(full.problem, solve(full.problem, "pdas"),
+                       solve(zoned.problem, "nested", warm_start=zoned.warm_start))
 
 
 def test_predicted_zone_follows_the_coarse_edge():
@@ -186,7 +193,7 @@ def test_coarse_values_drop_two_refinements_and_keep_the_load():
 
 
 def test_without_a_coarse_model_nested_says_it_used_pdas():
-    problem = build_problem("block", nx=6, ny=6)
+    problem = signorini.at_load(build_problem("block", nx=6, ny=6))
     nested = solve(problem, "nested")
     assert nested.status == "converged" and "pdas" in nested.message
     assert nested.extras["fallback"] == "pdas"
@@ -201,7 +208,7 @@ def test_zone_solver_refuses_rows_that_couple_dofs():
 @pytest.mark.parametrize("backend", sorted(MODULES))
 def test_pinned_factor_matches_superlu_on_the_free_block(backend):
     pytest.importorskip(MODULES[backend], reason=f"the {backend} backend is not installed")
-    problem = build_problem("hertz-cylinder", n_contact=16, grading=0.4)
+    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=16, grading=0.4))
     fixed = np.arange(0, problem.n, 7)
     rhs = np.column_stack([problem.f, problem.N.T @ np.ones(problem.m)])
     rhs[fixed] = np.linspace(-1, 1, len(fixed))[:, None]
@@ -216,7 +223,7 @@ def test_pinned_factor_matches_superlu_on_the_free_block(backend):
 
 def test_a_coarse_model_out_of_range_means_no_prediction(monkeypatch):
     """Coarser parameters a scene refuses give no coarse model (pdas), never an input error."""
-    problem = build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4).with_data()
+    problem = signorini.at_load(build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4)).with_data()
     monkeypatch.setattr(scenes, "coarse_values", lambda name, params: {"n_contact": 1})
     nested = solve(problem, "nested", analytic=False)
     assert nested.status == "converged" and nested.extras["fallback"] == "pdas"

@@ -4,6 +4,7 @@ the edge singularity under refinement, rounded corners, and agreement of the met
 import numpy as np
 import pytest
 
+import signorini
 from signorini.analytic import punch_load_between, punch_pressure
 from signorini.errors import InputError
 from signorini.kkt import compare
@@ -16,7 +17,7 @@ SMALL = {"n_contact": 16, "grading": 0.5}
 
 @pytest.fixture(scope="module")
 def punch():
-    problem = build_problem("punch", **SMALL)
+    problem = signorini.at_load(build_problem("punch", **SMALL))
     return problem, solve(problem, "pdas", tol=1e-10)
 
 
@@ -45,7 +46,7 @@ def test_force_balance_and_integral_of_pressure(punch):
 
 
 def test_pressure_away_from_the_edges_at_the_default_mesh():
-    problem = build_problem("punch")
+    problem = signorini.at_load(build_problem("punch"))
     result = compare_punch(problem, solve(problem, "pdas", tol=1e-10))
     assert result.pressure_max_rel < 0.01  # |x| ≤ a/2
     assert result.pressure_l2_rel < 0.01
@@ -56,7 +57,7 @@ def test_edge_pressure_grows_like_one_over_root_h():
     """The singularity in the discrete answer: halving h multiplies the edge pressure by √2."""
     ratios = []
     for level in (0, 1, 2):
-        problem = build_problem("punch", refine=level, **SMALL)
+        problem = signorini.at_load(build_problem("punch", refine=level, **SMALL))
         result = compare_punch(problem, solve(problem, "pdas", tol=1e-10))
         ratios.append((result.edge_h, result.edge_over_centre, result.pressure_max_rel))
     h, edge, inner = map(np.array, zip(*ratios))
@@ -67,7 +68,7 @@ def test_edge_pressure_grows_like_one_over_root_h():
 
 def test_whole_block_is_symmetric_and_equals_the_half(punch):
     half_problem, half = punch
-    problem = build_problem("punch", half=0, **SMALL)
+    problem = signorini.at_load(build_problem("punch", half=0, **SMALL))
     whole = solve(problem, "pdas", tol=1e-10)
     x = problem.contact_points[:, 0] * problem.scales.length
     p = contact_profile(problem, whole).pressure
@@ -91,8 +92,8 @@ def test_rounded_corners_spread_the_contact_and_bound_the_pressure():
     def peaks(radius):
         out = []
         for level in (1, 2):
-            problem = build_problem("punch", corner_radius=radius, load_ratio=0.02, refine=level,
-                                    **SMALL)
+            problem = signorini.at_load(build_problem("punch", corner_radius=radius, load_ratio=0.02, refine=level,
+                                    **SMALL))
             solution = solve(problem, "pdas", tol=1e-10)
             out.append((problem, solution, contact_profile(problem, solution).pressure.max()))
         return out
@@ -122,16 +123,16 @@ def test_rounded_corners_spread_the_contact_and_bound_the_pressure():
 ])
 def test_bad_punch_parameters_name_themselves(values, name):
     with pytest.raises(InputError, match=rf"\b{name}="):
-        build_problem("punch", **values)
+        signorini.at_load(build_problem("punch", **values))
 
 
 def test_two_load_parameters_raise():
     with pytest.raises(InputError, match="P and delta"):
-        build_problem("punch", P=0.01, delta=0.001)
+        signorini.at_load(build_problem("punch", P=0.01, delta=0.001))
 
 
 def test_prescribed_delta_without_target():
-    problem = build_problem("punch", delta=1e-3, **SMALL)
+    problem = signorini.at_load(build_problem("punch", delta=1e-3, **SMALL))
     solution = solve(problem, "pdas", tol=1e-10)
     assert problem.params["P"] is None
     assert compare_punch(problem, solution).force_balance < 1e-9

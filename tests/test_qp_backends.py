@@ -295,8 +295,7 @@ def big_sparse_problem(n: int) -> ContactProblem:
     return ContactProblem(
         K=sp.identity(n, format="csr"), f=-np.ones(n), N=sp.csr_matrix(
             (-np.ones(m), (np.arange(m), np.arange(m))), shape=(m, n)),
-        d=np.full(m, 0.5), weights=np.ones(m), contact_points=np.zeros((m, 2)),
-        free_dofs=np.arange(n), prescribed=np.zeros(n))
+        d=np.full(m, 0.5), weights=np.ones(m), contact_points=np.zeros((m, 2)))
 
 
 @pytest.mark.parametrize("method", DENSE_METHODS)

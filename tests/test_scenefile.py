@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from skfem import MeshTri
 
+import signorini
 from signorini.cli import main
 from signorini.errors import InputError
 from signorini.pressure import compare_uniform, contact_profile
@@ -39,13 +40,13 @@ def write(tmp_path, text, name="scene.toml"):
 
 def test_family_file_builds_what_the_parameters_build(tmp_path):
     path = write(tmp_path, FAMILY)
-    from_file = build_problem(str(path))
-    direct = build_problem("block", E=2.0, nu=0.25, nx=4, ny=3)
+    from_file = signorini.at_load(build_problem(str(path)))
+    direct = signorini.at_load(build_problem("block", E=2.0, nu=0.25, nx=4, ny=3))
     assert from_file.scene == "block"
     assert from_file.params == direct.params
     assert abs(from_file.K - direct.K).max() == 0.0
     # --set overrides a value of the file
-    finer = build_problem(str(path), nx="8")
+    finer = signorini.at_load(build_problem(str(path), nx="8"))
     assert finer.params["nx"] == 8
 
 
@@ -56,7 +57,7 @@ def line_of(text, needle):
 def test_syntax_error_names_the_line(tmp_path):
     text = FAMILY.replace("nu = 0.25", "nu = = 0.25")
     with pytest.raises(InputError, match=rf"line {line_of(text, 'nu = =')}\b"):
-        build_problem(str(write(tmp_path, text)))
+        signorini.at_load(build_problem(str(write(tmp_path, text))))
 
 
 @pytest.mark.parametrize("bad, needle, key", [
@@ -67,7 +68,7 @@ def test_syntax_error_names_the_line(tmp_path):
 def test_bad_value_names_table_key_and_line(tmp_path, bad, needle, key):
     text = FAMILY.replace(f"{key} = 2.0" if key == "E" else "nu = 0.25", bad)
     with pytest.raises(InputError) as info:
-        build_problem(str(write(tmp_path, text)))
+        signorini.at_load(build_problem(str(write(tmp_path, text))))
     message = str(info.value)
     assert f"[material] {key}" in message
     assert f"line {line_of(text, needle)}" in message
@@ -76,23 +77,23 @@ def test_bad_value_names_table_key_and_line(tmp_path, bad, needle, key):
 def test_unknown_key_lists_the_parameters(tmp_path):
     text = FAMILY.replace("ny = 3", "ny = 3\nradius = 2.0")
     with pytest.raises(InputError, match=r"\[mesh\] radius.*no parameter 'radius'.*nx, ny") as info:
-        build_problem(str(write(tmp_path, text)))
+        signorini.at_load(build_problem(str(write(tmp_path, text))))
     assert f"line {line_of(text, 'radius')}" in str(info.value)
 
 
 def test_a_parameter_set_twice_is_an_error(tmp_path):
     text = FAMILY + "\n[params]\nE = 3.0\n"
     with pytest.raises(InputError, match="set twice"):
-        build_problem(str(write(tmp_path, text)))
+        signorini.at_load(build_problem(str(write(tmp_path, text))))
 
 
 def test_unknown_family_and_missing_file(tmp_path):
     with pytest.raises(InputError, match="'ball' is not a scene family.*hertz-cylinder"):
-        build_problem(str(write(tmp_path, 'scene = "ball"\n')))
+        signorini.at_load(build_problem(str(write(tmp_path, 'scene = "ball"\n'))))
     with pytest.raises(InputError, match="does not exist"):
-        build_problem(str(tmp_path / "nothing.toml"))
+        signorini.at_load(build_problem(str(tmp_path / "nothing.toml")))
     with pytest.raises(InputError, match=r"scene = .*\[mesh\]"):
-        build_problem(str(write(tmp_path, "[material]\nE = 1.0\n")))
+        signorini.at_load(build_problem(str(write(tmp_path, "[material]\nE = 1.0\n"))))
 
 
 # --- mesh scenes -----------------------------------------------------------------------------
@@ -160,7 +161,7 @@ def test_gmsh_mesh_is_read_with_named_boundaries(tmp_path):
 
 def test_mesh_scene_passes_the_patch_test(tmp_path):
     write_block_msh(tmp_path / "block.msh")
-    problem = build_problem(str(write(tmp_path, MESH_SCENE)))
+    problem = signorini.at_load(build_problem(str(write(tmp_path, MESH_SCENE))))
     solution = solve(problem, "pdas", tol=1e-10)
     assert problem.scene.startswith("file:")
     problem.params.update(delta=0.02, H=1.0)  # what compare_uniform needs
@@ -174,7 +175,7 @@ def test_mesh_scene_with_line_selectors_a_target_load_and_a_circle(tmp_path):
     text = (MESH_SCENE.replace('boundary = "bottom"', "boundary = {y = 0.0}")
             .replace('type = "flat"', 'type = "circle"\ncentre = [0.0, -10.0]\nradius = 10.0')
             .replace("multiplicity = 2.0", "multiplicity = 2.0\ntarget = 0.05"))
-    problem = build_problem(str(write(tmp_path, text)))
+    problem = signorini.at_load(build_problem(str(write(tmp_path, text))))
     solution = solve(problem, "pdas", tol=1e-10)
     from signorini.pressure import load_resultant
     assert problem.m == 5
@@ -196,7 +197,7 @@ def test_mesh_scene_errors_say_where(tmp_path, change, pattern):
     write_block_msh(tmp_path / "block.msh")
     text = MESH_SCENE.replace(*change)
     with pytest.raises(InputError, match=pattern) as info:
-        build_problem(str(write(tmp_path, text)))
+        signorini.at_load(build_problem(str(write(tmp_path, text))))
     assert re.search(r"line \d+", str(info.value))
 
 
@@ -204,7 +205,7 @@ def test_second_dirichlet_table_is_located(tmp_path):
     write_block_msh(tmp_path / "block.msh")
     text = MESH_SCENE.replace("value = -0.02", 'value = "down"')
     with pytest.raises(InputError) as info:
-        build_problem(str(write(tmp_path, text)))
+        signorini.at_load(build_problem(str(write(tmp_path, text))))
     line = line_of(text, 'value = "down"')
     assert f"line {line}" in str(info.value) and "[dirichlet] value" in str(info.value)
 
@@ -242,5 +243,5 @@ def test_cli_solves_a_scene_file_and_reports_errors_in_one_line(tmp_path, capsys
     ("block-mesh.toml", {}),
 ])
 def test_examples_build_and_solve(example, overrides):
-    problem = build_problem(str(EXAMPLES / example), **overrides)
+    problem = signorini.at_load(build_problem(str(EXAMPLES / example), **overrides))
     assert solve(problem, "pdas", tol=1e-9).status == "converged"

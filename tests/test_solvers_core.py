@@ -5,6 +5,7 @@ import itertools
 import numpy as np
 import pytest
 
+import signorini
 from signorini.errors import InputError
 from signorini.kkt import certificate, compare
 from signorini.numerics.lcp import solve_lcp
@@ -14,12 +15,12 @@ from signorini.solvers import pdas, registry
 
 @pytest.fixture(scope="module")
 def block():
-    return build_problem("block", nx=6, ny=6)
+    return signorini.at_load(build_problem("block", nx=6, ny=6))
 
 
 @pytest.fixture(scope="module")
 def hertz():
-    return build_problem("hertz-cylinder", n_contact=20)
+    return signorini.at_load(build_problem("hertz-cylinder", n_contact=20))
 
 
 @pytest.fixture(scope="module", params=["block", "hertz"])

@@ -13,6 +13,7 @@ import textwrap
 import numpy as np
 import pytest
 
+import signorini
 from signorini.diagnose import diagnose, regularise
 from signorini.errors import InputError
 from signorini.kkt import certificate, classify, compare
@@ -32,12 +33,12 @@ TINY_BLOCK = {"nx": 4, "ny": 4}
 
 @pytest.fixture(scope="module")
 def hertz():
-    return build_problem("hertz-cylinder", **TINY_HERTZ)
+    return signorini.at_load(build_problem("hertz-cylinder", **TINY_HERTZ))
 
 
 @pytest.fixture(scope="module")
 def block():
-    return build_problem("block", **TINY_BLOCK)
+    return signorini.at_load(build_problem("block", **TINY_BLOCK))
 
 
 # --- Uzawa's step bound -------------------------------------------------------------------------
@@ -106,9 +107,9 @@ def test_verdict_flags_a_converged_status_with_a_wrong_answer():
 
 def test_the_touching_block_has_weakly_active_nodes_and_keeps_its_default(block):
     assert block.params["touching"] == 0.0
-    plain = build_problem("block", **TINY_BLOCK, touching=0.0)
+    plain = signorini.at_load(build_problem("block", **TINY_BLOCK, touching=0.0))
     assert abs(plain.K - block.K).max() == 0 and np.array_equal(plain.d, block.d)
-    problem = build_problem("block", **TINY_BLOCK, touching=0.5)
+    problem = signorini.at_load(build_problem("block", **TINY_BLOCK, touching=0.5))
     exact = solve(problem, "pdas", tol=1e-9)
     labels = classify(problem, exact)
     assert np.sum(labels == "weak") >= 2 and np.sum(labels == "active") >= 2
@@ -116,7 +117,7 @@ def test_the_touching_block_has_weakly_active_nodes_and_keeps_its_default(block)
 
 
 def test_a_weakly_active_node_is_not_misclassified():
-    problem = build_problem("block", **TINY_BLOCK, touching=0.5)
+    problem = signorini.at_load(build_problem("block", **TINY_BLOCK, touching=0.5))
     exact = solve(problem, "pdas", tol=1e-9)
     weak = classify(problem, exact) == "weak"
     lam = exact.lam.copy()
@@ -133,7 +134,7 @@ def test_a_weakly_active_node_is_not_misclassified():
 
 
 def test_a_small_touching_fraction_leaves_the_outer_corner_touching():
-    problem = build_problem("block", nx=4, ny=4, touching=0.01)
+    problem = signorini.at_load(build_problem("block", nx=4, ny=4, touching=0.01))
     labels = classify(problem, solve(problem, "pdas", tol=1e-9))
     assert labels[-1] == "weak" and np.sum(labels == "weak") == 1
 

@@ -1,4 +1,4 @@
-"""The work of an everyday solve, counted (factorisations and back-solves), not timed (issue 16)."""
+"""The work of an everyday solve, counted (factorisations and back-solves), not timed."""
 
 from __future__ import annotations
 
@@ -16,11 +16,25 @@ def test_the_default_solve_costs_at_most_three_factorisations(scene):
     result.to_dict()
     factorisations = COUNTS["factorisations"] - before["factorisations"]
     assert factorisations <= 3, f"{factorisations} factorisations"
-    # load targeting starts from the analytic zone and pdas from its answer: one step each
+    # load control starts from the analytic zone and auto's pdas from its answer: one step each
     assert result.iterations == 1
+    work = result.solution.work
+    assert work["load control"]["steps"] == 1 and work["method"]["steps"] == 1
+    assert work["load control"]["factorisations"] + work["method"]["factorisations"] <= factorisations
 
 
-def test_a_cold_pdas_still_iterates():
-    problem = signorini.build_problem("hertz-cylinder").with_data()  # no warm start
-    result = signorini.solve(problem)
-    assert result.converged and result.iterations > 1
+def test_a_named_method_starts_cold_and_reports_its_own_steps():
+    """pdas named by the caller is not handed what load control found: its steps are its own."""
+    result = signorini.solve(signorini.build_problem("hertz-cylinder"), "pdas")
+    assert result.converged and result.iterations >= 2
+    assert result.solution.work["method"]["steps"] == result.iterations
+    assert result.solution.work["load control"]["steps"] >= 1
+    again = signorini.solve(result.problem, "pdas", warm_start=result)  # explicitly warm
+    assert again.converged and again.iterations == 1
+    assert abs(again.total_force - result.total_force) <= 1e-12 * abs(result.total_force)
+
+
+def test_a_warm_start_is_refused_by_a_method_that_cannot_use_one():
+    result = signorini.solve("block", "pdas")
+    with pytest.raises(signorini.InputError, match="takes no warm start"):
+        signorini.solve(result.problem, "uzawa", warm_start=result)

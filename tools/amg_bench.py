@@ -204,13 +204,13 @@ def crossover() -> dict:
 
 def petsc_350k(params: dict = SPHERE_350K, method: str = "pdas-amg") -> dict:
     from signorini.kkt import compare
+    from signorini.loading import solve as load_control
     from signorini.scenes import build_problem
     from signorini.solvers.registry import solve
 
     problem = build_problem("hertz-sphere-3d", solved_by=method, **params)
     before = load()
-    ours = solve(problem, method)
-    problem = ours.problem if ours.problem is not None else problem  # a target load, matched
+    problem, ours = load_control(problem, method)  # a target load matched with the answer
     theirs = solve(problem, "petsc-vi")
     agreement = compare(problem, ours, theirs)
     return {"dofs": problem.n, "load_before": before, "load_after": load(), "ours": ours.method,

@@ -11,7 +11,7 @@ from signorini.errors import InputError
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.api import Result, build_problem, solve  # per command (start-up)
+    from signorini.api import Result, at_load, build_problem, solve, solve_adaptive  # per command
     from signorini.files import check_output_file, to_json  # per command (start-up)
     from signorini.kkt import certificate  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
@@ -27,6 +27,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if time_limit is not None and args.target_error is not None:
         raise InputError("--time-limit runs one solve in a worker process and --target-error "
                          "refines in this one: give one of them")
+    if args.target_error is None and (args.max_dofs is not None or args.target_on is not None):
+        given = "--max-dofs (max_dofs)" if args.max_dofs is not None else "--target-on (target_on)"
+        raise InputError(f"{given} steers adaptive refinement: give --target-error (target_error) "
+                         "with it")
     if args.json not in (None, "-"):
         check_output_file(args.json, "--json")  # every output checked before the solve
     if args.vtk:
@@ -36,19 +40,18 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.target_error is not None:  # adaptive refinement of the scene (signorini.scenes.adapt)
         if args.raw_units:
             raise InputError("--target-error refines a non-dimensionalised scene: drop --raw-units")
-        result = solve(args.scene, args.method, tol=tol, max_iter=max_iter, params=params,
-                       target_error=args.target_error, max_dofs=args.max_dofs,
-                       target_on=args.target_on, **options)
+        result = solve_adaptive(args.scene, args.target_error, args.method, tol=tol,
+                                max_iter=max_iter, params=params, max_dofs=args.max_dofs,
+                                target_on=args.target_on, **options)
         problem = result.problem
     else:
-        # the worker of --time-limit builds the problem again, matching its target load itself
         problem = build_problem(args.scene, nondimensionalise=not args.raw_units,
-                                solved_by=args.method if time_limit is None else None, **params)
+                                solved_by=args.method, **params)
         if time_limit is None:
-            result = solve(problem, args.method, tol=tol, max_iter=max_iter, max_dofs=args.max_dofs,
-                           target_on=args.target_on, **options)
+            result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
             problem = result.problem
         else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
+            problem = at_load(problem)  # the worker builds it again and matches it the same way
             from signorini.studies.runner import solve_within  # per command (start-up)
 
             spec = {"kind": "scene", "scene": args.scene, "params": params,

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import logging
 import time
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -43,10 +43,7 @@ from signorini.fem.model import SceneModel
 from signorini.fem.stiffness import plane_strain_stiffness, solid_stiffness
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import volumetric_stiffness
-from signorini.numerics.factor import FactorTooLarge
-from signorini.numerics.loading import calibrate_push
-from signorini.numerics.zone import ZoneSolver
-from signorini.problem import ContactProblem, Push, Scales, WarmStart, Watch
+from signorini.problem import ContactProblem, Discretisation, Push, Scales, Watch
 
 log = logging.getLogger(__name__)
 
@@ -166,17 +163,13 @@ def displacement_scale(model: SceneModel) -> float:
     return largest if largest > 0 else model.length_scale
 
 
-def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None,
-             defer: Callable[[ContactProblem], bool] | None = None) -> ContactProblem:
-    """Assemble the contact QP of ``model``; adjust δ first when a target load is set.
+def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProblem:
+    """The contact QP of ``model`` at its nominal push: K, f, N, d, weights, points, scales.
 
-    ``zone`` (a :class:`signorini.numerics.zone.Zone` over the contact candidates)
-    predicts the contact zone: load targeting then costs one factorisation
-    and a few back-solves, and the solver it used is kept on the problem
-    for the ``nested`` method to reuse. When ``defer(problem)`` says so for
-    the problem at the nominal push, that problem is returned with its target
-    load pending (``problem.push.pending``): the method matches it (no
-    factorisation here).
+    Pure linear algebra: no contact is solved here. A scene with a target
+    load gets a problem whose target is pending (``problem.pending``): f and
+    d are at the nominal push, and load control (:mod:`signorini.loading`)
+    finds the push whose load is the target, from ``problem.push``.
     """
     start = time.perf_counter()
     L = model.length_scale if nondimensionalise else 1.0
@@ -239,26 +232,21 @@ def assemble(model: SceneModel, nondimensionalise: bool = True, zone=None,
     params = dict(model.params, volumetric=model.volumetric)  # auto resolved: what K integrates
     if model.target_load is not None:
         params["delta"] = -min(v for c, _, v in model.dirichlet if c == model.load_dofs[0])
-    weights = contact_weights(mesh, model.contact_facets, nodes, axisymmetric)
-    problem = ContactProblem(
-        K=K_II, f=f, N=N_free, d=d, weights=weights, contact_points=mesh.p[:, nodes].T,
-        free_dofs=free, prescribed=full, load_row=load_full[free], load_offset=load_offset,
-        force_multiplicity=model.force_multiplicity,
-        scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
-        params=params, mesh=mesh, axisymmetric=axisymmetric,
+    discretisation = Discretisation(
+        mesh=mesh, free_dofs=free, prescribed=full, load_row=load_full[free],
+        load_offset=load_offset, E=float(model.E), nu=float(model.nu),
+        volumetric=model.volumetric, axisymmetric=axisymmetric, params=params,
         push=_push(lifted, 1.0, None if f_load is None else f_load[free], offset_load, target),
-        watch=boundary_watch(model, dof_table, U))
-    if target is not None and defer is not None and defer(problem):
-        log.info("load targeting left to the method (%d free dofs)", problem.n)
-    elif target is not None:
-        scale, calibration, zone_solver = _calibrate(
-            K_II, N_free, lifted, target, model.force_multiplicity, zone, model.predicted_contact)
-        problem = problem.pushed(scale)
-        problem.warm_start = WarmStart(calibration[0], *(zone_solver or (None, None)),
-                                       u=calibration[1])
-    problem.assemble_time = time.perf_counter() - start
+        predicted_contact=model.predicted_contact, watch=boundary_watch(model, dof_table, U))
+    problem = ContactProblem(
+        K=K_II, f=f, N=N_free, d=d, weights=contact_weights(mesh, model.contact_facets, nodes,
+                                                            axisymmetric),
+        contact_points=mesh.p[:, nodes].T, force_multiplicity=model.force_multiplicity,
+        scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
+        discretisation=discretisation)
+    discretisation.assemble_s = time.perf_counter() - start
     log.info("assembled %d free dofs, %d contact candidates in %.2f s",
-             problem.n, problem.m, problem.assemble_time)
+             problem.n, problem.m, discretisation.assemble_s)
     return problem
 
 
@@ -346,35 +334,3 @@ def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
     return Push(f1=f1 - f0, d0=d0, d1=d_one - d0, offset1=offset_one - offset0, scale=scale,
                 f_load=f_load, offset_load=offset_load if f_load is not None else 0.0,
                 load=load if f_load is not None else 0.0, target=load, pending=load is not None)
-
-
-def _calibrate(K: sp.csr_matrix, N: sp.csr_matrix, lifted, target: float,
-               multiplicity: float, zone=None,
-               start: np.ndarray | None = None) -> tuple[float, tuple, Any]:
-    """The factor on the prescribed displacement whose contact force is ``target``.
-
-    The load is affine in the factor. With a predicted ``zone``,
-    :class:`signorini.numerics.zone.ZoneSolver` finds it on one factorisation and
-    returns itself with the final zone for reuse; otherwise (or should that
-    fail) :func:`signorini.numerics.loading.calibrate_push` solves the augmented
-    active-set system (one factorisation per step) from the active set
-    ``start`` (the scene's analytic estimate, when it has one). Returns the
-    factor, ``(λ, u)`` at it (None from the zone) and the zone solver.
-    """
-    f0, d0 = lifted(0.0)[:2]
-    f1, d_one = lifted(1.0)[:2]
-    if zone is not None:
-        try:
-            system = ZoneSolver(K, N)
-            scale, _, lam, final = system.push_for_load(f1 - f0, d0, d_one - d0, target,
-                                                        multiplicity, zone, f0=f0)
-            log.info("load targeted on a predicted zone (%s): %d factorisation(s), %d back-solves",
-                     final.counts(), system.factorisations, system.back_solves)
-            return scale, (lam, None), (system, final)
-        except FactorTooLarge:
-            raise  # a refusal, not a failed prediction: the full active set would factorise too
-        except (ValueError, ArithmeticError) as exc:
-            log.info("load targeting on the predicted zone failed (%s): full active set", exc)
-    scale, lam, u = calibrate_push(K, N, f1 - f0, d0, d_one - d0, target, multiplicity, f0=f0,
-                                   start=start)
-    return scale, (lam, u), None

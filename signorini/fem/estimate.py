@@ -283,7 +283,7 @@ def unit_normals(problem: ContactProblem, dim: int) -> np.ndarray:
     N = problem.N.tocsr()
     normals = np.zeros((problem.m, dim))
     rows = np.repeat(np.arange(problem.m), np.diff(N.indptr))
-    full = problem.free_dofs[N.indices]
+    full = problem.discretisation.free_dofs[N.indices]
     np.add.at(normals, (rows, full % dim), N.data)
     length = np.linalg.norm(normals, axis=1)
     return normals / np.where(length > 0, length, 1.0)[:, None]
@@ -348,13 +348,13 @@ def material_units(problem: ContactProblem) -> tuple[float, float] | None:
     (k = 1 in axisymmetric and 3D models), which is E itself for a scene made
     dimensionless and 1 otherwise.
     """
-    params = problem.params
-    if problem.mesh is None or "E" not in params or "nu" not in params:
+    disc = problem.discretisation
+    if disc is None or getattr(disc.mesh, "p", None) is None:  # no finite-element mesh
         return None
     s = problem.scales
-    k = 1 if (problem.axisymmetric or problem.mesh.p.shape[0] == 3) else 0
+    k = 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
     stress = s.force / (s.displacement * s.length ** k)
-    return float(params["E"]) / stress, float(params["nu"])
+    return disc.E / stress, disc.nu
 
 
 def _by_quadrature(problem: ContactProblem, mesh: Any, u: np.ndarray, Lambda: float,
@@ -365,7 +365,7 @@ def _by_quadrature(problem: ContactProblem, mesh: Any, u: np.ndarray, Lambda: fl
     rule = quadrature(mesh, axisymmetric)
     eps = strains(mesh, u, rule, axisymmetric)
     theta = theta_points = jump = None
-    if problem.params.get("volumetric") == "nodal":
+    if problem.discretisation.volumetric == "nodal":
         # K's λ-part sees the volumetric strain averaged at the nodes, θ̄: a continuous P1 field
         # that is already ZZ's recovery of tr ε_h. Recovered once more (θ*), it smooths the
         # one-sided averages of the boundary nodes: on the default Hertz meshes at ν = 0.45 the
@@ -425,7 +425,7 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
     Lambda, Mu = lame(E, nu)
     dim = mesh.p.shape[0]
     u = problem.expand(solution.u).reshape(-1, dim)
-    if axisymmetric or problem.params.get("volumetric") == "nodal":
+    if axisymmetric or problem.discretisation.volumetric == "nodal":
         energy, squares, nodal, theta = _by_quadrature(problem, mesh, u, Lambda, Mu)
     else:
         energy, squares, nodal = _constant_strains(mesh, u, Lambda, Mu)

@@ -29,6 +29,10 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 
+#: 3D models of at least this many free dofs are solved by multigrid (``auto`` picks pdas-amg when
+#: load control precedes the method, and leaves a pending target load to it): their
+#: factorisations fill in like n^(4/3)
+AMG_FROM_DOFS = 50_000
 #: hierarchies built and CG iterations done in this process (read before and after a step)
 COUNTS = {"hierarchies": 0, "cg_iterations": 0, "cg_solves": 0}
 #: CG restarts from the true residual when the recursive one says done but the true one does not

@@ -79,10 +79,9 @@ def element_stress(problem: ContactProblem, solution: ContactSolution,
     any) adds the hoop strain ``u_r / r`` at each element's centroid; a 2D
     model is otherwise in plane strain.
     """
-    params = problem.params
-    if "E" not in params or "nu" not in params:
-        raise InputError("stresses need the material: the problem's params carry no E and nu")
-    E, nu = float(params["E"]), float(params["nu"])
+    if problem.discretisation is None or problem.mesh is None:
+        raise InputError("stresses need the mesh and the material: this problem has neither")
+    E, nu = problem.discretisation.E, problem.discretisation.nu
     lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu = E / (2 * (1 + nu))
     mesh = problem.mesh

@@ -17,7 +17,6 @@ from signorini.output import plots
 from signorini.pressure import contact_profile, load_resultant
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_of
-from signorini.studies.suite import LIMITS, REFERENCE_LABEL, SuiteResult
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
             "proxsuite", "piqp", "scs", "ecos", "highspy", "daqp", "quadprog", "qpalm", "cvxopt")
@@ -72,7 +71,7 @@ def runs_table(runs: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
-def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dict[str, Path]:
+def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, Path]:
     """Write report.md, report.json and the figures of a suite run to ``out``."""
     directory = writable_directory(out)
     info = provenance()
@@ -86,7 +85,7 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
             hertz = reference.compare(problem, ref)
             others = [(label, contact_profile(problem, s).pressure)
                       for label, s in result.solutions.items()
-                      if label != REFERENCE_LABEL and s.status != "failed" and np.all(np.isfinite(s.lam))]
+                      if label != suite.reference_label and s.status != "failed" and np.all(np.isfinite(s.lam))]
             ax = plots.pressure_profile(profile.x, profile.pressure, a_ref=hertz.a_ref,
                                         p0_ref=hertz.p0_ref, label="pdas", others=others)
             ax.set_title(f"{name}: contact pressure, every method against Hertz", fontsize=9)
@@ -126,16 +125,16 @@ def write_suite_report(suite: SuiteResult, out: str | Path, command: str) -> dic
         for key in (f"{result.case.name}-pressure", f"{result.case.name}-kkt-time"):
             if key in figures:
                 md += ["", f"![{key}]({figures[key].name})"]
-    md += ["", "## Limits", ""] + [f"- `{k}`: {v:g}" for k, v in LIMITS.items()]
+    md += ["", "## Limits", ""] + [f"- `{k}`: {v:g}" for k, v in suite.limits.items()]
     atomic_write_text(directory / "report.md", "\n".join(md) + "\n")
     payload = {"command": command, "passed": suite.passed, "elapsed_s": suite.elapsed_s,
                "provenance": info,
-               "checks": [vars(c) for c in suite.checks], "runs": suite.runs, "limits": LIMITS}
+               "checks": [vars(c) for c in suite.checks], "runs": suite.runs, "limits": suite.limits}
     atomic_write_text(directory / "report.json", to_json(payload))
     return {"report.md": directory / "report.md", "report.json": directory / "report.json", **figures}
 
 
-def checks_summary(suite: SuiteResult) -> str:
+def checks_summary(suite: Any) -> str:
     """The checks as a plain-text table for the terminal."""
     width = max(len(c.name) for c in suite.checks)
     lines = [f"{'case':<18} {'check':<{width}}  {'value':>9}  {'limit':>7}  result"]

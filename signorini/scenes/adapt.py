@@ -58,7 +58,6 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes.families import get_scene, scene_reference
 from signorini.scenes.meshing import snap_to_circle
 from signorini.scenes.scenefile import build_scene_model, family_scene_values
-from signorini.solvers.registry import solve as solve_problem
 
 log = logging.getLogger(__name__)
 
@@ -249,7 +248,7 @@ def beyond_candidates(model: SceneModel, problem: ContactProblem,
                       solution: ContactSolution) -> np.ndarray:
     """Boundary nodes beyond the candidates that went through the obstacle, and those sharing a
     boundary facet with an edge candidate in contact (mesh node numbers)."""
-    watch = problem.watch
+    watch = problem.discretisation.watch
     if watch is None or watch.nodes is None:
         return np.zeros(0, dtype=int)
     through = watch.nodes[-watch.gap(problem, solution.u) > 1e-9 * gap_scale(problem, solution.u)]
@@ -281,13 +280,19 @@ def _checked(scene: _Scene) -> _Scene:
     return scene
 
 
-def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: str = "pdas",
-                   tol: float | None = None, max_iter: int | None = None,
+Solver = Callable[[ContactProblem], "tuple[ContactProblem, ContactSolution]"]
+
+
+def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Solver, *,
                    max_dofs: int | None = None, theta: float = THETA, quantity: str | None = None,
                    on_step: Callable[[ContactProblem, ContactSolution, ErrorEstimate | None], None]
-                   | None = None, **options: Any) -> AdaptiveRun:
+                   | None = None) -> AdaptiveRun:
     """Refine scene ``name`` (a family, or the path of a ``.toml`` scene file) adaptively until
     the estimate of ``quantity`` meets ``target`` or the next mesh would exceed ``max_dofs``.
+
+    ``solver`` solves each step's problem (matching its target load) and
+    returns the problem solved and the judged solution
+    (:func:`signorini.solve_adaptive` passes load control with the method).
 
     ``quantity`` is ``"pressure"`` (the default where the scene has contact
     pressures) or ``"energy"``.
@@ -309,8 +314,9 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, *, method: 
     for step in range(MAX_STEPS):
         start = time.perf_counter()
         problem = assemble(model)
-        problem.scene, problem.reference = scene.name, scene_reference(scene.name)
-        solution = solve_problem(problem, method, tol=tol, max_iter=max_iter, **options)
+        problem.name = scene.name
+        problem.discretisation.reference = scene_reference(scene.name)
+        problem, solution = solver(problem)
         seconds = time.perf_counter() - start
         if solution.status == "model_inadequate" and growths < MAX_GROWTH:
             grown = _grown(scene, model, problem, solution)

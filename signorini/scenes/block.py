@@ -31,9 +31,10 @@ from signorini.fem.assembly import assemble, boundary_weights
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.fem.obstacles import ScaledQuery
 from signorini.fem.topology import facets_on
+from signorini.numerics.factor import factorize
+from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution, Scales
 from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, poisson_ratio, positive
-from signorini.solvers.pdas import solve as pdas
 
 PARAMS = (
     Param("W", 1.0, "half-width of the block", check=positive),
@@ -106,7 +107,7 @@ def _touching_model(p: dict[str, Any]) -> SceneModel:
     """Bottom supported on ``x < (1 − touching) W``; the rest meets an obstacle at its own deflection.
 
     The problem with only the supported nodes as candidates is solved first
-    (PDAS, exact); under each outer bottom node the obstacle is then placed at
+    (exactly, on its condensed LCP); under each outer bottom node the obstacle is then placed at
     that node's deflected height. The solution of the full problem is the same
     one, and at the outer nodes both the gap and the force are zero.
     """
@@ -115,11 +116,14 @@ def _touching_model(p: dict[str, Any]) -> SceneModel:
     # the outer corner x = W always touches
     supported = bottom[x[bottom] < (1.0 - p["touching"]) * p["W"] * (1 - 1e-12)]
     problem = assemble(_plain_model(p, contact_nodes=supported))
-    solution = pdas(problem)
-    if solution.status != "converged":  # pragma: no cover - PDAS is exact on this small LCP
+    factor = factorize(problem.K)
+    try:
+        lam, _ = solve_lcp(delassus(problem.N, factor), problem.N @ factor.solve(problem.f) - problem.d)
+    except ArithmeticError as exc:  # pragma: no cover - the LCP of an SPD W is solvable
         raise InputError(f"scene parameter touching={p['touching']!r}: the supported block did not "
-                         f"solve ({solution.message})")
-    full = problem.expand(solution.u) * problem.scales.displacement
+                         f"solve ({exc})") from None
+    u = factor.solve(problem.f - problem.N.T @ lam)
+    full = problem.expand(u) * problem.scales.displacement
     deflection = full[problem.basis.nodal_dofs[1, bottom]]
     height = np.where(np.isin(bottom, supported), 0.0, deflection)
     profile = HeightProfile(tuple(x[bottom]), tuple(height))
@@ -188,11 +192,11 @@ def force_controlled_problem(pressure: float = 0.01, nondimensionalise: bool = T
     load = np.zeros(basis.N)
     load[basis.nodal_dofs[1, top]] = -p["pressure"] * weights / force
     problem = problem.with_data(
-        f=load[problem.free_dofs], load_row=np.zeros(problem.n),
+        f=load[problem.discretisation.free_dofs], load_row=np.zeros(problem.n),
         load_offset=2.0 * p["W"] * p["pressure"] / force, push=None,
-        scales=Scales(length=L, displacement=U, force=force, weight=L), params=dict(p))
+        scales=Scales(length=L, displacement=U, force=force, weight=L), params=dict(p),
+        name="block (force control)")
     problem.basis = basis
-    problem.scene = "block (force control)"
     return problem
 
 
@@ -208,7 +212,7 @@ def force_controlled_exact(problem: ContactProblem) -> ContactSolution:
     full = np.zeros(problem.basis.N)
     full[problem.basis.nodal_dofs[0]] = q * nu * (1.0 + nu) * x / E
     full[problem.basis.nodal_dofs[1]] = -q * (1.0 - nu ** 2) * y / E
-    u = full[problem.free_dofs] / s.displacement
+    u = full[problem.discretisation.free_dofs] / s.displacement
     lam = q * problem.weights * s.weight / s.force
     return ContactSolution(method="exact", u=u, lam=lam, status="converged",
                            message="patch solution of the force-controlled block")

@@ -23,7 +23,7 @@ factorising method has to weigh on its own. Two 3D paths are measured apart
 (docs/amg/): a prescribed push (``delta``) goes to ``pdas-amg`` by default,
 no factorisation — 1.3 GB at 350,532 dofs, 3.85 GB at 1,093,024, taken as
 5 kB per dof; so does a target load that ``pdas-amg`` matches itself (the
-method ``auto`` picks from :data:`~signorini.solvers.auto.AMG_FROM_DOFS` 3D
+method ``auto`` picks from :data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D
 dofs, see :func:`~signorini.solvers.auto.defers_load_targeting`: 1.0 GB at
 351,076 dofs, 3.0 GB at 1,093,568, docs/amg/bench.md); a target load met by load targeting on one factorisation of
 K (any other method: 4.7 GB at 351,076 dofs, 13.4 kB per dof) has a fill
@@ -45,7 +45,7 @@ from signorini.errors import InputError
 from signorini.fem.volumetric import resolve
 from signorini.numerics.factor import gigabytes_from
 from signorini.scenes.meshing import MAX_ELEMENTS
-from signorini.solvers.auto import AMG_FROM_DOFS
+from signorini.numerics.multigrid import AMG_FROM_DOFS
 
 #: the environment variable that raises (or lowers) the memory a scene may take, in GB
 MEMORY_VARIABLE = "SIGNORINI_MAX_MEMORY_GB"

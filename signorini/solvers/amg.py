@@ -9,15 +9,15 @@ pinned SPD system is solved by conjugate gradients preconditioned with
 algebraic multigrid given the rigid-body modes as near-null space
 (:mod:`signorini.numerics.multigrid`), never factorised. Then:
 
-- the first active set comes from a coarse model of the scene, as for
-  ``nested`` (its contact forces, nearest candidate's side), or from load
-  targeting's answer, so that few steps remain;
-- a target load that is still pending (``problem.pending``: ``auto`` leaves it
-  to this method for large 3D models) is matched with the answer: the push is
-  one more unknown of every CG system (:class:`LoadBorder`), preconditioned by
-  block elimination (:func:`border_preconditioner`), so no factorisation of K
-  is ever made; the answer's problem is the given one pushed to that load
-  (``solution.problem``);
+- the first active set is given (``active0``: ``signorini.solve`` passes the
+  one a coarser model of the scene predicts), or comes from a warm start's
+  forces or from a coarse QP (``coarse``), so that few steps remain;
+- a target load that is still pending (``problem.pending``: load control,
+  :mod:`signorini.loading`, leaves it to this method for large 3D models) is
+  matched with the answer: the push is one more unknown of every CG system
+  (:class:`LoadBorder`), preconditioned by block elimination
+  (:func:`border_preconditioner`), so no factorisation of K is ever made; the
+  push found is ``solution.extras["push"]`` (``push0`` the first guess);
 - **one hierarchy** is built, for K with the first active set pinned; later
   sets differ in a few rows and CG pays for them in iterations;
 - CG starts from the last step's displacement, and its tolerance follows
@@ -66,7 +66,8 @@ log = logging.getLogger(__name__)
 DEFAULT_TOL = 1e-9
 MAX_ITER = 50
 AMG_CHOICES = ("auto", "petsc", "pyamg")
-DEFAULTS = {"amg": "auto", "c": 1.0, "active0": None, "coarse": None, "callback": None}
+DEFAULTS = {"amg": "auto", "c": 1.0, "active0": None, "coarse": None, "callback": None,
+            "warm_start": None, "push0": None}
 #: stationarity is driven to SAFETY · tol so that the certificate's other residuals have room
 SAFETY = 0.1
 #: Eisenstat–Walker: γ, the exponent, the largest and smallest forcing terms (the first
@@ -261,9 +262,9 @@ def border_factor(problem: ContactProblem) -> float | None:
     """β of :class:`LoadBorder` for a problem whose target load is pending, or None (nothing
     pending, the pushed dofs do not move together, or the push moves a contact candidate)."""
     pu = problem.push
-    if not problem.pending or problem.load_row is None or np.any(pu.d1 != 0):
+    if not problem.pending or problem.discretisation.load_row is None or np.any(pu.d1 != 0):
         return None
-    f1, row = pu.f1, problem.load_row
+    f1, row = pu.f1, problem.discretisation.load_row
     beta = float(row @ f1) / max(float(f1 @ f1), 1e-300)
     if not beta or np.linalg.norm(row - beta * f1) > 1e-9 * np.linalg.norm(row):
         return None
@@ -312,32 +313,29 @@ def _embedded(form: BoundForm, v: np.ndarray) -> np.ndarray:
     return full
 
 
-def _initial_active(problem: ContactProblem,
-                    opts: dict[str, Any]) -> tuple[np.ndarray, str, float | None]:
-    """The first active set, where it came from, and the coarse model's push ``delta`` (a first
-    push for a pending target load; None without a coarse model)."""
+def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.ndarray, str]:
+    """The first active set and where it came from."""
     if opts["active0"] is not None:
         active = np.asarray(opts["active0"], dtype=bool)
         if active.shape != (problem.m,):
             raise InputError(f"method 'pdas-amg': option active0 must be {problem.m} booleans")
-        return active, "given", None
-    if problem.warm_start.lam is not None:
-        return problem.warm_start.lam > 0, "load targeting", None
+        return active, "given"
+    warm = opts["warm_start"]
+    if warm is not None and warm.lam is not None:
+        return warm.lam > 0, "the warm start"
     coarse = opts["coarse"]
-    if coarse is None and problem.coarse_model is not None:
-        coarse = problem.coarse_model(problem)
     if coarse is None:
-        return np.zeros(problem.m, dtype=bool), "none (no coarse model)", None
-    lam = coarse.warm_start.lam
-    if lam is None:
-        solver = pdas.solve if coarse.n < DIRECT_BELOW else solve
-        solution = solver(coarse, tol=DEFAULT_TOL, amg=opts["amg"]) if solver is solve \
-            else solver(coarse)
-        if solution.status != "converged":
-            return np.zeros(problem.m, dtype=bool), "none (the coarse model did not solve)", None
-        lam = solution.lam
-    zone = predict_zone(problem.contact_points, coarse.contact_points, lam > 0, neighbours=1)
-    return zone.core, f"coarse model of {coarse.n} dofs", coarse.params.get("delta")
+        return np.zeros(problem.m, dtype=bool), "none (no prediction)"
+    if coarse.pending:
+        raise InputError("method 'pdas-amg': option coarse must be a problem at its load (its "
+                         "target is not matched yet: signorini.loading.match(coarse).problem)")
+    solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse, tol=DEFAULT_TOL,
+                                                                        amg=opts["amg"])
+    if solution.status != "converged":
+        return np.zeros(problem.m, dtype=bool), "none (the coarse model did not solve)"
+    zone = predict_zone(problem.contact_points, coarse.contact_points, solution.lam > 0,
+                        neighbours=1)
+    return zone.core, f"coarse model of {coarse.n} dofs"
 
 
 def _forcing(eta: float, r0: float, r0_last: float | None) -> float:
@@ -361,16 +359,17 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     tol = DEFAULT_TOL if tol is None else tol
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
     start = time.perf_counter()
-    given = problem
     if problem.pending and border_factor(problem) is None:
-        problem = problem.matched()  # a push that moves more than one rigid set: factorised
+        raise InputError("method 'pdas-amg': the push of this problem does not move one rigid "
+                         "set of dofs, so its target load cannot be a CG unknown: match the load "
+                         "first (signorini.solve does)")
     try:
         form = bound_form(problem)
     except NoBoundForm as exc:
         return ContactSolution.failure("pdas-amg", problem, exc.status, str(exc),
                                        solve_time=time.perf_counter() - start)
     system, border = PinnedSystem(form), load_border(problem, form)
-    active, source, coarse_delta = _initial_active(problem, opts)
+    active, source = _initial_active(problem, opts)
     active &= system.bounded
     if border is not None and not active.any():  # the push needs a contact to hold the body
         active, source = first_contact(problem.d) & system.bounded, "the first point of contact"
@@ -380,12 +379,11 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     hierarchy = system.hierarchy
     xs = np.zeros(form.n + 1)  # the unknowns, and the push last (used only with a border)
     x = xs[:form.n]
-    if problem.warm_start.u is not None:
-        x[:] = form.T.T @ _embedded(form, problem.warm_start.u)
+    if opts["warm_start"] is not None and opts["warm_start"].u is not None:
+        x[:] = form.T.T @ _embedded(form, opts["warm_start"].u)
     operator, rhs, free_of, precondition = system.K, form.f, (lambda free: free), hierarchy.apply
     if border is not None:
-        nominal = problem.params.get("delta")
-        xs[-1] = problem.push.scale * (coarse_delta / nominal if nominal and coarse_delta else 1.0)
+        xs[-1] = problem.push.scale if opts["push0"] is None else float(opts["push0"])
         operator = Bordered(system.K, border.g, border.k)
         rhs = np.append(border.f0, border.h)
         free_of = lambda free: np.append(free, True)  # noqa: E731
@@ -434,10 +432,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             if result.final_inf <= SAFETY * tighten * tol * force:
                 candidate = ContactSolution(method="pdas-amg", u=form.displacement(x), lam=lam,
                                             status="converged")
-                if border is not None:
-                    problem = problem.pushed(float(xs[-1]))
-                    candidate.problem = problem
-                name, worst = certificate(problem, candidate, duality_gap=False).worst()
+                judged = problem.pushed(float(xs[-1])) if border is not None else problem
+                name, worst = certificate(judged, candidate, duality_gap=False).worst()
                 if worst <= tol:
                     status = "converged"
                     how = "repeated" if changes == 0 else \
@@ -465,20 +461,19 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         active, final = new_active, False
     counts = {key: COUNTS[key] - counts[key] for key in COUNTS}
     u = form.displacement(x)
+    extras = {"amg": hierarchy.backend, "hierarchies": counts["hierarchies"],
+              "cg_iterations": counts["cg_iterations"], "hierarchy_s": hierarchy.setup_s,
+              "levels": hierarchy.levels, "first_active": source}
+    judged = problem
     if border is not None:
-        if problem.pending or problem.push.scale != float(xs[-1]):  # not already certified there
-            problem = problem.pushed(float(xs[-1]))
-        message += "; the load targeted with the push as one more unknown (no factorisation)"
+        judged, extras["push"] = problem.pushed(float(xs[-1])), float(xs[-1])
+        message += "; the load matched with the push as one more unknown (no factorisation)"
     solution = ContactSolution(
         method="pdas-amg", u=u, lam=lam, status=status,
         message=(f"{message}; first active set from {source}; one {hierarchy.backend} hierarchy "
                  f"({hierarchy.setup_s:.2f} s), {counts['cg_iterations']} CG iterations"),
         iterations=step, build_time=build_time, solve_time=time.perf_counter() - start - build_time,
-        history=history,
-        extras={"amg": hierarchy.backend, "hierarchies": counts["hierarchies"],
-                "cg_iterations": counts["cg_iterations"], "hierarchy_s": hierarchy.setup_s,
-                "levels": hierarchy.levels, "first_active": source},
-        factor=PinnedCG(problem, system, active), problem=None if problem is given else problem)
+        history=history, extras=extras, factor=PinnedCG(judged, system, active))
     return solution
 
 

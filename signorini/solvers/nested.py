@@ -1,22 +1,19 @@
 """Nested: a predicted contact zone, made exact on one factorisation.
 
-The prediction is, in this order: a zone given as an option; the analytic
-contact half-width of the scene's reference for its target load (Hertz's a,
-:attr:`signorini.references.Reference.extent`), trusted to its
-``extent_margin`` of a — it costs nothing; or the coarse model of the same
-scene (about 16× fewer dofs; see
-:func:`signorini.scenes.coarse_values`) is solved first, by this method
-again, down to a model with no coarser one (solved by ``pdas``). Its contact
-zone predicts the fine one; :class:`signorini.numerics.zone.ZoneSolver` then pins
-the predicted core, condenses the uncertain band onto a small dense LCP and
+The prediction is a zone given as the option ``zone`` (``signorini.solve``
+passes the scene's: the analytic contact half-width of its reference, else
+a coarser model's contact zone, see :mod:`signorini.loading`), or the zone
+a coarser model of the same QP predicts (option ``coarse``, solved here by
+``pdas``). :class:`signorini.numerics.zone.ZoneSolver` then pins the
+predicted core, condenses the uncertain band onto a small dense LCP and
 amends the prediction until every KKT condition holds, so the answer is
-exact whatever the prediction. Cost: one factorisation of K, a back-solve per
-band node and the coarse solve; time includes building the coarse model.
+exact whatever the prediction. Cost: one factorisation of K and a
+back-solve per band node.
 
-When load targeting already ran on a predicted zone (the solver is kept on
-the problem) the factorisation is reused and the solve costs back-solves only.
-Problems with no coarse model, or whose rows of N do not each bound one dof
-(curved obstacles), are solved by ``pdas``; the message says so.
+A ``warm_start`` holding a zone solver for this K (load control leaves one)
+is reused: the solve then costs back-solves only. Problems with no
+prediction, or whose rows of N do not each bound one dof (curved
+obstacles), are solved by ``pdas``; the message says so.
 """
 
 from __future__ import annotations
@@ -30,9 +27,9 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import selection_dofs
-from signorini.numerics.zone import Zone, ZoneSolver, predict_zone, zone_around_points
+from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import reference_of
+from signorini.solution import WarmStart
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
 from signorini.solvers.options import Option, declare, take_options
@@ -43,63 +40,40 @@ DEFAULT_TOL = 1e-9
 DEFAULTS = declare(
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)),
     Option("coarse", "object", types=(ContactProblem,)), Option("zone", "object", types=(Zone,)),
-    Option("neighbours", "count"), Option("analytic", "bool", True))
-
-
-def analytic_zone(problem: ContactProblem) -> tuple[Zone, float] | None:
-    """The zone from the reference's contact half-width (radius) a and a, in the problem's length
-    units (:func:`signorini.numerics.zone.zone_around_points`: 2D, axisymmetric and 3D models);
-    None without."""
-    reference = reference_of(problem)
-    if reference is None or reference.extent is None:
-        return None
-    a = reference.extent(problem.params)
-    if a is None:
-        return None
-    a /= problem.scales.length
-    zone = zone_around_points(problem.contact_points, a, reference.extent_margin)
-    return None if zone is None else (zone, a)
+    Option("neighbours", "count"), Option("analytic", "bool", True),
+    Option("warm_start", "object", types=(WarmStart,)))
 
 
 def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | None, str]:
-    """The predicted zone and where it came from (None when there is no coarse model)."""
+    """The predicted zone and where it came from (None when there is none)."""
     if opts["zone"] is not None:
         zone = opts["zone"]
         if not isinstance(zone, Zone) or zone.core.shape != (problem.m,):
             raise InputError(f"method 'nested': option zone must be a signorini.numerics.zone.Zone "
                              f"over the {problem.m} candidates")
-        return zone, "given zone"
-    if opts["analytic"] and opts["coarse"] is None:
-        found = analytic_zone(problem)
-        if found is not None:
-            return found[0], f"the reference's analytic zone (a = {found[1]:.4g})"
+        return zone, "the given zone"
     coarse = opts["coarse"]
-    if coarse is None and problem.coarse_model is not None:
-        coarse = problem.coarse_model(problem)
     if coarse is None:
         return None, ""
-    zone = zone_from_coarse(problem.contact_points, coarse, opts["neighbours"])
-    return zone, f"coarse model of {coarse.n} dofs"
+    if coarse.pending:
+        raise InputError("method 'nested': option coarse must be a problem at its load (its "
+                         "target is not matched yet: signorini.loading.match(coarse).problem)")
+    return zone_from_coarse(problem.contact_points, coarse, opts["neighbours"]), \
+        f"coarse model of {coarse.n} dofs"
 
 
-def zone_from_coarse(points: np.ndarray, coarse, neighbours: int | None = None) -> Zone | None:
-    """The zone at ``points`` predicted by the coarse model ``coarse`` (a ContactProblem).
-
-    Its contact forces come from its load targeting when that ran (exact
-    already), else from solving it with the ``nested`` method; None when
-    that does not converge.
-    """
-    lam = coarse.warm_start.lam
-    if lam is None:
-        try:
-            solution = judge(coarse, solve(coarse), DEFAULT_TOL)
-        except Exception as exc:  # noqa: BLE001 - any failure of the coarse solve: no prediction
-            log.info("the coarse model did not solve (%s): no prediction", exc)
-            return None
-        if solution.status != "converged":
-            return None
-        lam = solution.lam
-    return predict_zone(points, coarse.contact_points, lam > 0, neighbours)
+def zone_from_coarse(points: np.ndarray, coarse: ContactProblem,
+                     neighbours: int | None = None) -> Zone | None:
+    """The zone at ``points`` predicted by the coarse model ``coarse`` (solved by ``pdas``);
+    None when that does not converge."""
+    try:
+        solution = judge(coarse, pdas.solve(coarse), DEFAULT_TOL)
+    except Exception as exc:  # noqa: BLE001 - any failure of the coarse solve: no prediction
+        log.info("the coarse model did not solve (%s): no prediction", exc)
+        return None
+    if solution.status != "converged":
+        return None
+    return predict_zone(points, coarse.contact_points, solution.lam > 0, neighbours)
 
 
 def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
@@ -107,9 +81,10 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     """Exact contact from a coarse model's contact zone on one factorisation."""
     opts = take_options("nested", options, DEFAULTS)
     start = time.perf_counter()
-    system = problem.warm_start.zone_solver
+    warm = opts["warm_start"]
+    system = None if warm is None else warm.zone_solver
     if system is not None and opts["zone"] is None and opts["coarse"] is None:
-        zone, source = problem.warm_start.zone, "the load targeting's zone and factorisation"
+        zone, source = warm.zone, "the warm start's zone and factorisation"
     else:
         system = None
         if selection_dofs(problem.N) is None:
@@ -127,7 +102,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         system = ZoneSolver(problem.K, problem.N, opts["backend"])
     factorisations, back_solves = system.factorisations, system.back_solves
     u, lam, final = system.solve(problem.f, problem.d, zone)
-    problem.warm_start.zone_solver, problem.warm_start.zone = system, final
     moved = int((final.band & ~zone.band).sum())
     return ContactSolution(
         method="nested", u=u, lam=lam, status="converged",
@@ -141,7 +115,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 METHODS = (
     Method(name="nested", function=solve, family="active set", exact=True,
-           summary="analytic or coarse-model contact zone; one factorisation + exact band LCP",
+           summary="predicted contact zone (the scene's); one factorisation + exact band LCP",
            default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
            typed_options=DEFAULTS),
 )

@@ -16,10 +16,9 @@ cycle through active sets when W is not an M-matrix; a set seen before (but
 not the last one) is a cycle, and the method then finishes on the condensed
 LCP with Murty's least-index pivoting, which terminates for SPD W. After the
 first step ``c`` no longer matters (closed gaps are zero on A, forces zero
-off A), so ``c`` only weighs a warm start ``lam0`` against the gaps.
-Without ``lam0`` a load-targeted problem starts from the answer its load
-targeting found (``problem.warm_start``: the push is one more unknown of the
-same active-set iteration), so one step confirms it.
+off A), so ``c`` only weighs a warm start against the gaps. Without one it
+starts cold, from no contact; ``warm_start`` (an earlier answer's λ and u,
+see :class:`signorini.solution.WarmStart`) or ``lam0`` start it elsewhere.
 
 Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 """
@@ -37,11 +36,13 @@ from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import ActiveSetSolver, factorize
 from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.solution import WarmStart
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare, take_options
 
 DEFAULTS = declare(
     Option("c", "positive", 1.0), Option("lam0", "vector"), Option("callback", "callable"),
+    Option("warm_start", "object", types=(WarmStart,)),
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)))
 MAX_ITER = 100
 
@@ -63,9 +64,12 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     max_iter = MAX_ITER if max_iter is None else int(max_iter)
     start = time.perf_counter()
     system = ActiveSetSolver(problem.K, problem.N, opts["backend"])
-    warm = problem.warm_start
-    if opts["lam0"] is None and warm.lam is not None and warm.u is not None:
-        u, lam = warm.u, warm.lam  # load targeting solved this load: one step confirms it
+    warm = opts["warm_start"]
+    if opts["lam0"] is None and warm is not None and warm.lam is not None and warm.u is not None:
+        u, lam = warm.u, warm.lam  # an earlier answer at this load: one step confirms it
+    elif opts["lam0"] is None and warm is not None and warm.lam is not None:
+        lam = np.maximum(warm.lam, 0.0)
+        u = problem.displacement_for(lam)
     elif opts["lam0"] is None:
         u, lam = system.solve(np.zeros(problem.m, dtype=bool), problem.f, problem.d)
     else:

@@ -18,7 +18,10 @@ from pathlib import Path
 from typing import Any
 
 from signorini.errors import BackendNotInstalled, InputError
+from signorini.numerics.factor import COUNTS
+from signorini.numerics.multigrid import COUNTS as MULTIGRID_COUNTS
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol,
                                     hold_to_contract, judge)
@@ -114,22 +117,29 @@ def check_request(method: str, tol: Any = None, max_iter: Any = None,
     return spec, tol, max_iter, checked
 
 
-def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
-          max_iter: int | None = None, **options: Any) -> ContactSolution:
-    """Solve ``problem`` with ``method`` and judge the answer with the KKT certificate.
+def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
+        max_iter: int | None = None, warm_start: WarmStart | None = None,
+        **options: Any) -> tuple[ContactProblem, ContactSolution]:
+    """Run ``method`` on ``problem`` and judge its answer: ``(problem solved, solution)``.
 
-    The method's own claim of success becomes ``converged`` only when every
-    relative residual of :func:`signorini.kkt.certificate` is within
-    ``ACCEPT_FACTOR × tol``; otherwise the status is ``inaccurate`` and the
-    message says by how much it missed. A backend exception becomes a
-    ``failed`` solution; bad input (unknown options, non-positive tolerances)
-    raises :class:`InputError`.
+    The problem solved is ``problem`` itself, or, for a method that matches
+    a pending target load with the answer (``targets_load``), ``problem``
+    at the push it reports (``solution.extras["push"]``). The method's work
+    (factorisations, back-solves, CG iterations) is counted into
+    ``solution.work["method"]``. See :func:`solve`.
     """
     spec, tol, max_iter, options = check_request(method, tol, max_iter, options)
-    start = time.perf_counter()
-    given = problem
     if problem.pending and not spec.targets_load:
-        problem = problem.matched()  # the target load first (factorised), then the method
+        raise InputError(f"method {method!r} solves the QP as it is, and this problem's target "
+                         "load is not matched yet: solve it with signorini.solve (load control "
+                         "finds the push), or match it first with signorini.loading.match")
+    if warm_start is not None:
+        if "warm_start" not in spec.options:
+            takers = ", ".join(m.name for m in REGISTRY.values() if "warm_start" in m.options)
+            raise InputError(f"method {method!r} takes no warm start: give warm_start to one of "
+                             f"{takers}")
+        options["warm_start"] = warm_start
+    start, before = time.perf_counter(), dict(COUNTS, **MULTIGRID_COUNTS)
     try:
         solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
     except InputError:
@@ -144,17 +154,40 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
             method, problem, "failed", f"the method called sys.exit({exc.code!r})",
             solve_time=time.perf_counter() - start)
     solution = hold_to_contract(problem, method, solution)
-    if solution.problem is None and problem is not given:
-        solution.problem = problem
-    problem = solution.problem if solution.problem is not None else problem
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
+    now = dict(COUNTS, **MULTIGRID_COUNTS)
+    solution.work["method"] = {"steps": int(solution.iterations), **{
+        key: now[key] - before[key] for key in ("factorisations", "back_solves", "cg_iterations",
+                                                "hierarchies") if now[key] != before[key]}}
     if "auto" not in solution.extras:  # auto names the method it picked
         solution.method = method
-    return judge(problem, solution, tol if tol is not None else spec.default_tol)
+    if problem.pending:
+        if "push" not in solution.extras:
+            solution = ContactSolution.failure(method, problem, solution.status if
+                                               solution.status != "converged" else "failed",
+                                               f"{solution.message}; the target load was not matched")
+            return problem, solution
+        problem = problem.pushed(float(solution.extras["push"]))
+    return problem, judge(problem, solution, tol if tol is not None else spec.default_tol)
 
 
+def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
+          max_iter: int | None = None, warm_start: WarmStart | None = None,
+          **options: Any) -> ContactSolution:
+    """Solve ``problem`` with ``method`` and judge the answer with the KKT certificate.
+
+    The method's own claim of success becomes ``converged`` only when every
+    relative residual of :func:`signorini.kkt.certificate` is within
+    ``ACCEPT_FACTOR × tol``; otherwise the status is ``inaccurate`` and the
+    message says by how much it missed. A backend exception becomes a
+    ``failed`` solution; bad input (unknown options, non-positive tolerances)
+    raises :class:`InputError`. ``warm_start`` is where the method starts
+    (see :class:`signorini.solution.WarmStart`); without it every method
+    starts cold.
+    """
+    return run(problem, method, tol=tol, max_iter=max_iter, warm_start=warm_start, **options)[1]
 
 
 __all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_ACCEPT", "Method", "REGISTRY", "check_request",
-           "get_method", "judge", "methods", "register", "solve"]
+           "get_method", "judge", "methods", "register", "run", "solve"]

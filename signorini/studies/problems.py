@@ -35,6 +35,7 @@ from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.model import FlatObstacle
 from signorini.files import atomic_write_bytes
+from signorini.loading import at_load
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes import block, build_problem, coarse_problem
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
@@ -50,10 +51,9 @@ REFERENCE_TOL = 1e-9
 
 
 def _scene(spec: dict[str, Any]) -> ContactProblem:
-    problem = build_problem(spec["scene"], nondimensionalise=spec.get("nondimensionalise", True),
-                            **spec.get("params", {}))
-    # "cold": without what load targeting learnt, so that a method's own iterations are measured
-    return problem.with_data() if spec.get("cold") else problem
+    # a study runs every method, cold, on the QP at the scene's load (matched once)
+    return at_load(build_problem(spec["scene"], nondimensionalise=spec.get("nondimensionalise", True),
+                                 **spec.get("params", {})), coarse_problem)
 
 
 def _force_controlled(spec: dict[str, Any]) -> ContactProblem:
@@ -67,9 +67,7 @@ def _ill_posed(spec: dict[str, Any]) -> ContactProblem:
 
 
 def _stored(spec: dict[str, Any]) -> ContactProblem:
-    problem = ContactProblem.load(spec["path"])
-    problem.coarse_model = coarse_problem  # nested's coarse model is the scene's, not stored
-    return problem
+    return at_load(ContactProblem.load(spec["path"]), coarse_problem)
 
 
 #: the kinds of problem spec and how each is built
@@ -136,7 +134,7 @@ def ill_posed_problem(case: str, **values: Any) -> ContactProblem:
     elif case == "never-touches":
         model.obstacle = FlatObstacle(-0.1 * p["H"])
     problem = assemble(model)
-    problem.scene = f"block ({case})"
+    problem.name = f"block ({case})"
     return problem
 
 

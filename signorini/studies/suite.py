@@ -319,6 +319,10 @@ class SuiteResult:
     checks: list[Check]
     elapsed_s: float
 
+    #: what its report shows: the acceptance limits and the label of the reference runs
+    limits = LIMITS
+    reference_label = REFERENCE_LABEL
+
     @property
     def passed(self) -> bool:
         return all(c.passed for c in self.checks)

@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.problem import ContactProblem
+from signorini.problem import ContactProblem, Discretisation
 
 
 def random_problem(n: int = 8, m: int = 3, seed: int = 0, condition: float = 10.0,
@@ -39,9 +39,7 @@ def random_problem(n: int = 8, m: int = 3, seed: int = 0, condition: float = 10.
     d = np.abs(N @ u_free_fall) * rng.uniform(0.0, 1.5, m)
     return ContactProblem(
         K=sp.csr_matrix(K), f=f, N=N, d=d, weights=np.ones(m),
-        contact_points=np.column_stack([np.arange(m, dtype=float), np.zeros(m)]),
-        free_dofs=np.arange(n), prescribed=np.zeros(n), scene="random",
-        params={"n": n, "m": m, "seed": seed, "condition": condition})
+        contact_points=np.column_stack([np.arange(m, dtype=float), np.zeros(m)]), name="random")
 
 
 def _beam_element_stiffness(length: float, bending_stiffness: float) -> np.ndarray:
@@ -121,12 +119,13 @@ def bogie(*, half_length: float = 1.0, bending_stiffness: float = 10.0,
     load_row[2] = k_v  # mount force on the frame: k_v (δ + w_c), carried by the wheels
     return ContactProblem(
         K=sp.csr_matrix(K), f=f, N=N, d=gap, weights=np.ones(2),
-        contact_points=np.column_stack([nodes[[0, 2]], np.zeros(2)]),
-        free_dofs=np.arange(6), prescribed=np.zeros(6), load_row=load_row,
-        load_offset=k_v * float(lowering), scene="bogie", mesh=nodes,
-        params={"half_length": ell, "bending_stiffness": float(bending_stiffness),
-                "mount_stiffness": k_v, "tilt_stiffness": k_t, "lowering": float(lowering),
-                "gaps": (float(gap[0]), float(gap[1]))})
+        contact_points=np.column_stack([nodes[[0, 2]], np.zeros(2)]), name="bogie",
+        discretisation=Discretisation(
+            mesh=nodes, free_dofs=np.arange(6), prescribed=np.zeros(6), load_row=load_row,
+            load_offset=k_v * float(lowering),
+            params={"half_length": ell, "bending_stiffness": float(bending_stiffness),
+                    "mount_stiffness": k_v, "tilt_stiffness": k_t, "lowering": float(lowering),
+                    "gaps": (float(gap[0]), float(gap[1]))}))
 
 
 def bogie_compliance(problem: ContactProblem) -> np.ndarray:
