@@ -275,6 +275,10 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     if params is not None and not isinstance(params, dict):
         raise InputError(f"params must be a dict of scene parameters, got {type(params).__name__}: "
                          "e.g. params={'E': 2.1e11}")
+    adaptive = sorted(set(options) & {"target_error", "max_dofs", "target_on"})
+    if adaptive:
+        raise InputError(f"{', '.join(adaptive)} steer{'s' * (len(adaptive) == 1)} adaptive "
+                         "refinement: call signorini.solve_adaptive(scene, target_error, ...)")
     if isinstance(problem, str):
         check_request(method, tol, max_iter, options)  # bad options fail before the scene is built
         problem = build_problem(problem, solved_by=method, **(params or {}))

@@ -356,8 +356,9 @@ def load_resultant(problem: ContactProblem, lam: np.ndarray, component: int = -1
     """
     dim = problem.contact_points.shape[1]
     component = component % dim
-    full = np.zeros(problem.discretisation.prescribed.size)
-    full[problem.discretisation.free_dofs] = problem.N.T @ np.asarray(lam, dtype=float)
+    size, free = problem.dofs()
+    full = np.zeros(size)
+    full[free] = problem.N.T @ np.asarray(lam, dtype=float)
     basis = getattr(problem, "basis", None)
     dofs = basis.nodal_dofs[component] if basis is not None else \
         np.arange(component, full.size, dim)

@@ -311,6 +311,12 @@ class ContactProblem:
         """Number of contact candidates."""
         return self.N.shape[0]
 
+    def dofs(self) -> tuple[int, np.ndarray]:
+        """The size of the full dof vector (free and prescribed) and the free dofs' places in it."""
+        if self.discretisation is None:
+            return self.n, np.arange(self.n)
+        return self.discretisation.prescribed.size, self.discretisation.free_dofs
+
     def expand(self, u: np.ndarray) -> np.ndarray:
         """Full dof vector (free and prescribed) from the free-dof vector ``u``."""
         if self.discretisation is None:

@@ -55,7 +55,7 @@ def test_the_quarter_disc_is_found_again_on_its_own_mesh():
 
 @pytest.mark.slow
 def test_the_cylinder_refines_until_the_energy_target():
-    result = signorini.solve("hertz-cylinder", target_error="2%", target_on="energy")
+    result = signorini.solve_adaptive("hertz-cylinder", "2%", target_on="energy")
     steps = result.solution.extras["adaptive"]
     assert result.status == "converged" and "target energy-norm error 2 % met" in result.message
     assert result.estimate.relative <= 0.02 and result.problem.n < 30_000
@@ -73,7 +73,7 @@ def test_the_cylinder_refines_until_the_energy_target():
 
 @pytest.mark.slow
 def test_the_dof_limit_stops_the_loop_and_says_so():
-    result = signorini.solve("hertz-sphere", target_error=0.001, max_dofs=10_000)
+    result = signorini.solve_adaptive("hertz-sphere", 0.001, max_dofs=10_000)
     assert result.status == "converged"
     assert "max dofs 10000 reached" in result.message
     assert result.problem.n <= 10_000 and result.estimate.pressure.relative > 0.001
@@ -82,7 +82,7 @@ def test_the_dof_limit_stops_the_loop_and_says_so():
 @pytest.mark.slow
 def test_the_candidates_grow_with_the_contact():
     """Pushed much further than the default a/R = 0.05: the contact outgrows the candidates."""
-    result = signorini.solve("hertz-cylinder", target_error=0.05, params={"delta": 0.02})
+    result = signorini.solve_adaptive("hertz-cylinder", 0.05, params={"delta": 0.02})
     actions = [s["action"] for s in result.solution.extras["adaptive"]]
     assert actions[0] == "candidates widened"
     assert result.status == "converged"
@@ -92,16 +92,16 @@ def test_the_candidates_grow_with_the_contact():
 
 def test_what_cannot_be_refined_says_so():
     with pytest.raises(InputError, match="is 3D: .*refine=N"):
-        signorini.solve("hertz-sphere-3d", target_error=0.01)
+        signorini.solve_adaptive("hertz-sphere-3d", 0.01)
     problem = signorini.build_problem("hertz-cylinder")
     with pytest.raises(InputError, match="by name"):
-        signorini.solve(problem, target_error=0.01)
-    with pytest.raises(InputError, match="target_error"):
+        signorini.solve_adaptive(problem, 0.01)
+    with pytest.raises(InputError, match="solve_adaptive"):
         signorini.solve("hertz-cylinder", max_dofs=1000)
-    with pytest.raises(InputError, match="target_error"):
+    with pytest.raises(InputError, match="solve_adaptive"):
         signorini.solve("hertz-cylinder", target_on="pressure")
     with pytest.raises(InputError, match="target quantity"):
-        signorini.solve("hertz-cylinder", target_error=0.01, target_on="stress")
+        signorini.solve_adaptive("hertz-cylinder", 0.01, target_on="stress")
 
 
 #: issue 15's done-when on the default Hertz scenes (a/R = 0.05), ν from 0 to 0.45: the pressure
@@ -117,7 +117,7 @@ SPHERE_FROM_HERTZ = {0.0: (0.005, 0.009), 0.3: (0.001, 0.0016), 0.45: (0.001, 0.
 @pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])
 @pytest.mark.parametrize("scene", ["hertz-cylinder", "hertz-sphere"])
 def test_the_pressure_target_is_met_within_its_dofs(scene, nu, target, dofs):
-    result = signorini.solve(scene, target_error=target, params={"nu": nu})
+    result = signorini.solve_adaptive(scene, target, params={"nu": nu})
     assert result.status == "converged" and f"target pressure error {target[:-1]} % met" in result.message
     assert result.problem.n <= dofs
     assert result.estimate.pressure.relative <= float(target[:-1]) / 100
@@ -128,8 +128,8 @@ def test_the_pressure_target_is_met_within_its_dofs(scene, nu, target, dofs):
 
 @pytest.mark.slow
 def test_the_pressure_target_does_not_depend_on_the_units():
-    default = signorini.solve("hertz-cylinder", target_error="0.3%")
-    aluminium = signorini.solve("hertz-cylinder", target_error="0.3%",
+    default = signorini.solve_adaptive("hertz-cylinder", "0.3%")
+    aluminium = signorini.solve_adaptive("hertz-cylinder", "0.3%",
                                 params={"E": 70e9, "R": 25.0})
     assert aluminium.problem.n == default.problem.n
     assert aluminium.hertz.p0_rel == pytest.approx(default.hertz.p0_rel, abs=1e-6)
@@ -140,7 +140,7 @@ def test_the_pressure_target_does_not_depend_on_the_units():
 @pytest.mark.slow
 def test_a_harder_push_ends_converged_within_its_target():
     """`signorini solve hertz-cylinder --set delta=0.02 --target-error 0.5%` (issue 15)."""
-    result = signorini.solve("hertz-cylinder", target_error="0.5%", params={"delta": 0.02})
+    result = signorini.solve_adaptive("hertz-cylinder", "0.5%", params={"delta": 0.02})
     assert result.status == "converged" and "target pressure error 0.5 % met" in result.message
     assert result.to_dict()["adequacy"]["penetrating_nodes"] == 0
     assert abs(result.hertz.a_rel) <= 0.005 and abs(result.hertz.p0_rel) <= 0.005
@@ -181,7 +181,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 def test_a_scene_without_its_own_mesh_builder_is_carried_onto_each_refinement(scene):
     """reverse-hertz (a block on a rigid cylinder) has no build(mesh=): the loop carries its model
     (candidates, prescribed displacements, load dofs) onto each refined mesh."""
-    result = signorini.solve(scene, target_error="0.2%")
+    result = signorini.solve_adaptive(scene, "0.2%")
     steps = result.solution.extras["adaptive"]
     assert result.status == "converged" and "target pressure error 0.2 % met" in result.message
     assert len(steps) >= 3 and steps[-1]["dofs"] > steps[0]["dofs"]
@@ -199,7 +199,7 @@ def test_a_mesh_scene_file_refines_and_stays_a_patch_test():
     from signorini.scenes.scenefile import build_scene_model
     from signorini.solvers.registry import solve as solve_problem
 
-    result = signorini.solve(str(EXAMPLES / "block-mesh.toml"), target_error="1%", target_on="energy")
+    result = signorini.solve_adaptive(str(EXAMPLES / "block-mesh.toml"), "1%", target_on="energy")
     assert result.status == "converged"
     assert result.estimate.pressure.relative < 1e-10
     pressure = result.pressure[result.active]
@@ -233,7 +233,7 @@ def test_a_sharp_punch_grows_its_candidates_around_the_corner():
     """Refined near a sharp corner, the bottom just beyond it goes into the punch (the linear
     solution moves it sideways by more than its distance to the corner): the loop makes those
     nodes candidates and goes on; the energy target is met, the pressure's is not meaningful."""
-    result = signorini.solve("punch", target_error="2%", target_on="energy")
+    result = signorini.solve_adaptive("punch", "2%", target_on="energy")
     actions = [s["action"] for s in result.solution.extras["adaptive"]]
     assert result.status == "converged" and "candidates widened" in actions
     assert result.estimate.relative <= 0.02
@@ -243,7 +243,7 @@ def test_a_sharp_punch_grows_its_candidates_around_the_corner():
 
 
 def test_a_steeper_start_than_measured_is_warned():
-    steep = signorini.solve("hertz-cylinder", target_error="1%", params={"grading": 0.3})
+    steep = signorini.solve_adaptive("hertz-cylinder", "1%", params={"grading": 0.3})
     assert "warning: the mesh started graded at 0.3" in steep.message
-    default = signorini.solve("hertz-cylinder", target_error="1%")
+    default = signorini.solve_adaptive("hertz-cylinder", "1%")
     assert "warning" not in default.message

@@ -11,6 +11,7 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
+from signorini import loading
 from signorini.errors import InputError
 from signorini.kkt import certificate, compare
 from signorini.numerics import factor, multigrid
@@ -159,14 +160,16 @@ def test_auto_picks_pdas_for_axisymmetric_and_small_3d(problems):
 
 
 def test_auto_leaves_a_pushed_3d_model_to_pdas_amg_sooner_than_a_load_targeted_one(monkeypatch):
-    """Between the two thresholds a push goes to pdas-amg, a target load (met by factorisation
-    in the assembly) to the method that reuses it."""
+    """Between the two thresholds a push goes to pdas-amg, a target load (matched by
+    factorisation) to the method that reuses what load control found."""
     monkeypatch.setattr(auto, "PUSHED_AMG_FROM_DOFS", 1_000)
-    pushed = signorini.at_load(build_problem("hertz-sphere-3d", delta=0.0025))
-    loaded = signorini.at_load(build_problem("hertz-sphere-3d"))
-    assert pushed.n < auto.AMG_FROM_DOFS and loaded.warm_start.lam is not None
+    pushed = build_problem("hertz-sphere-3d", delta=0.0025)
+    loaded = build_problem("hertz-sphere-3d")
+    assert pushed.n < auto.AMG_FROM_DOFS and loaded.pending
     assert auto.choose(pushed)[0] == "pdas-amg"
     assert auto.choose(loaded)[0] == "pdas"
+    matched = loading.match(loaded)
+    assert auto.choose(matched.problem, (), matched.warm_start)[0] == "pdas"
 
 
 def test_auto_picks_pdas_amg_for_large_3d(problems, monkeypatch):

@@ -59,7 +59,7 @@ def rigid_modes(problem):
     """Two translations and the infinitesimal rotation (−y, x) as full dof vectors."""
     x, y = problem.mesh.p
     dofs = problem.basis.nodal_dofs
-    n_full = problem.prescribed.size
+    n_full = problem.discretisation.prescribed.size
     modes = np.zeros((3, n_full))
     modes[0, dofs[0]] = 1.0
     modes[1, dofs[1]] = 1.0
@@ -96,7 +96,7 @@ def test_free_stiffness_is_positive_definite(scene):
 
 def test_free_stiffness_is_the_condensed_full_stiffness(scene):
     K_full = full_stiffness(scene)
-    free = scene.free_dofs
+    free = scene.discretisation.free_dofs
     assert abs(K_full[free][:, free] - scene.K).max() <= 1e-13 * abs(K_full).max()
 
 
@@ -126,8 +126,8 @@ def test_gap_rows_are_unit_normals_towards_the_obstacle(scene):
     row_norms = np.sqrt(np.asarray(scene.N.multiply(scene.N).sum(axis=1)).ravel())
     np.testing.assert_allclose(row_norms, 1.0, rtol=0, atol=1e-14)
     # each row acts on its own node's vertical dof with −1 (the flat y = 0 lies below)
-    full = np.zeros((scene.m, scene.prescribed.size))
-    full[:, scene.free_dofs] = scene.N.toarray()
+    full = np.zeros((scene.m, scene.discretisation.prescribed.size))
+    full[:, scene.discretisation.free_dofs] = scene.N.toarray()
     nodes = [int(np.argmin(np.hypot(*(scene.mesh.p - point[:, None]))))
              for point in scene.contact_points]
     y_dofs = scene.basis.nodal_dofs[1, nodes]

@@ -41,8 +41,8 @@ def references():
 
 
 def full_vector(problem, u):
-    out = np.zeros(problem.prescribed.size)
-    out[problem.free_dofs] = u
+    out = np.zeros(problem.discretisation.prescribed.size)
+    out[problem.discretisation.free_dofs] = u
     return out
 
 

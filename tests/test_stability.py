@@ -147,7 +147,7 @@ def test_force_controlled_block_is_singular_and_its_patch_solution_is_exact():
     exact = force_controlled_exact(problem)
     cert = certificate(problem, exact, duality_gap=False)
     assert cert.worst()[1] < 1e-12
-    assert problem.total_contact_force(exact.lam) == pytest.approx(problem.load_offset, rel=1e-12)
+    assert problem.total_contact_force(exact.lam) == pytest.approx(problem.discretisation.load_offset, rel=1e-12)
     assert any("singular" in line for line in diagnose(problem))
 
 

@@ -32,6 +32,8 @@ from signorini.fem.estimate import element_energies, estimate, material_units
 from signorini.fem.transfer import uniform_prolongation
 from signorini.files import atomic_write_text, to_json
 from signorini.references import reference_of
+from signorini.loading import solve as load_control
+from signorini.scenes import coarse_problem
 from signorini.scenes.adapt import solve_adaptive
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -208,7 +210,7 @@ def run_punch() -> list[dict]:
     rows = []
     for label, params, target, on in PUNCH_RUNS:
         start = time.perf_counter()
-        result = signorini.solve("punch", target_error=target, target_on=on, max_dofs=PUNCH_DOFS,
+        result = signorini.solve_adaptive("punch", target, target_on=on, max_dofs=PUNCH_DOFS,
                                  params=params)
         seconds = time.perf_counter() - start
         for s in result.solution.extras["adaptive"]:
@@ -303,7 +305,10 @@ def adaptive_steps(scene: str, params: dict, target: float, max_dofs: int):
               f"{100 * found.pressure.relative:.3f} %", file=sys.stderr)
 
     # pdas's default tolerance 1e-9: at 1e-10 the sphere at ν = 0.45 ends `inaccurate` at 66k dofs
-    run = solve_adaptive(scene, params, target, tol=1e-9, max_dofs=max_dofs, on_step=step)
+    def solver(problem):
+        return load_control(problem, "pdas", tol=1e-9, coarse=coarse_problem)
+
+    run = solve_adaptive(scene, params, target, solver, max_dofs=max_dofs, on_step=step)
     return steps, run
 
 

@@ -153,6 +153,8 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
                 break
             z = mask * precondition(r)
             rz, rz_old = float(r @ z), rz
+            if not rz > 0:  # the preconditioned residual vanished: nothing left to correct
+                break
             p = z + (rz / rz_old) * p
         r = mask * (f - K @ x)  # the true residual: confirm, or restart from it
         if iterations >= max_iter:

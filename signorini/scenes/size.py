@@ -24,7 +24,7 @@ factorising method has to weigh on its own. Two 3D paths are measured apart
 no factorisation — 1.3 GB at 350,532 dofs, 3.85 GB at 1,093,024, taken as
 5 kB per dof; so does a target load that ``pdas-amg`` matches itself (the
 method ``auto`` picks from :data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D
-dofs, see :func:`~signorini.solvers.auto.defers_load_targeting`: 1.0 GB at
+dofs, see :mod:`signorini.loading`: 1.0 GB at
 351,076 dofs, 3.0 GB at 1,093,568, docs/amg/bench.md); a target load met by load targeting on one factorisation of
 K (any other method: 4.7 GB at 351,076 dofs, 13.4 kB per dof) has a fill
 that grows like n^⅓ per dof: 20 kB × (dofs / 350k)^⅓ from 350k dofs on.

@@ -312,9 +312,6 @@ def solve_recorded(problem: ContactProblem, method: str, *, tol: float | None = 
                          "use objectives(problem, solution.u, solution.lam) on its final point)")
     if "callback" in options:
         raise InputError("solve_recorded sets the callback itself: drop the option 'callback'")
-    # from a cold start: a load-targeted problem carries the answer its load targeting found,
-    # from which pdas would only confirm (signorini.problem.WarmStart); the lesson is the path
-    problem = problem.with_data()
     recorder = IterationRecorder(problem, keep_multipliers=keep_multipliers)
     solution = solve(problem, method, tol=tol, max_iter=max_iter,
                      callback=getattr(recorder, _CALLBACKS[method]), **options)
