@@ -74,7 +74,7 @@ from signorini.studies.task import (
     task_row,
     verdict,
 )
-from signorini.studies.worker import Worker
+from signorini.studies.worker import Worker, die_with_parent
 
 log = logging.getLogger(__name__)
 
@@ -271,6 +271,7 @@ def serve_worker() -> None:
     ranks serve its distributed solves until stdin closes.
     """
     logging.disable(logging.WARNING)
+    die_with_parent()
     if cluster.launched_size() > 1 and cluster.rank() != 0:
         os.dup2(2, 1)  # nothing of this rank may reach the rows
         cluster.serve()
