@@ -47,8 +47,8 @@ def _where(path: str | os.PathLike) -> tuple[str, Path | int]:
     target = Path(os.path.abspath(path))
     try:
         found = os.stat(target)  # follows links
-    except FileNotFoundError:
-        return "replace", Path(os.path.realpath(target))  # a new file, or the target of a dangling link
+    except OSError:  # a new file, the target of a dangling link (or a name too long, said later)
+        return "replace", Path(os.path.realpath(target))
     for fd in (1, 2):
         with contextlib.suppress(OSError):
             if os.path.samestat(found, os.fstat(fd)):

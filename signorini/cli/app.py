@@ -160,7 +160,7 @@ def _run(argv: Sequence[str] | None, ranks: int) -> int:
         _say("error: standard output was closed while the command ran (by a method?): "
              "the output was not written")
         return EXIT_FAILED
-    except (SystemExit, GeneratorExit):
+    except (Exception, SystemExit, GeneratorExit):  # a bug shows its traceback; --help exits
         raise
     except BaseException as exc:  # not an Exception: raised by a method of the user's
         _say(f"error: the run was ended by {type(exc).__name__}: {exc} (a method raised it; "
