@@ -12,7 +12,9 @@ import argparse
 import contextlib
 import logging
 import os
+import select
 import signal
+import stat
 import sys
 import threading
 from typing import Sequence
@@ -118,6 +120,18 @@ def _stdout_closed() -> bool:
     return sys.stdout is None or sys.stdout.closed
 
 
+def _reader_gone() -> bool:
+    """Whether stdout is a pipe whose reader has closed it (``| head`` stopped reading)."""
+    try:
+        if not stat.S_ISFIFO(os.fstat(1).st_mode):
+            return False
+        poll = select.poll()
+        poll.register(1, 0)  # POLLERR is always reported: the read end is closed
+        return any(events & select.POLLERR for _, events in poll.poll(0))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def _run(argv: Sequence[str] | None, ranks: int) -> int:
     try:
         if _stdout_closed():  # nothing printed would be seen, and fd 1 could be a file's
@@ -128,7 +142,11 @@ def _run(argv: Sequence[str] | None, ranks: int) -> int:
                             format="%(levelname)s %(name)s: %(message)s")
         if ranks > 1:
             _check_distributed(args, ranks)
-        return args.run(args)
+        code = args.run(args)
+        sys.stdout.flush()
+        if _reader_gone():  # written into the pipe's buffer, yet never read: as a broken pipe
+            raise BrokenPipeError
+        return code
     except InputError as exc:
         _say(f"error: {exc}")
         return EXIT_USAGE

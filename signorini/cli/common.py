@@ -101,6 +101,24 @@ def input_files(scene: str | None = None, methods: Sequence[str] = ()) -> dict[s
 
 
 @contextlib.contextmanager
+def user_methods_in_workers(names: Sequence[str]) -> Iterator[None]:
+    """While the block runs, each user method (``file.py:function``) named runs in a worker
+    process (:func:`signorini.studies.runner.in_worker`): a method that ends its process,
+    closes stdout or raises what is not an Exception cannot take this run down or fake its exit."""
+    from signorini.solvers.registry import REGISTRY, get_method  # per command (start-up)
+    from signorini.studies.runner import in_worker  # per command (start-up)
+
+    added = [name for name in dict.fromkeys(names)
+             if name not in REGISTRY and get_method(name).family == "user"]
+    REGISTRY.update({name: in_worker(get_method(name)) for name in added})
+    try:
+        yield
+    finally:
+        for name in added:
+            REGISTRY.pop(name, None)
+
+
+@contextlib.contextmanager
 def stdout_to_stderr(active: bool = True) -> Iterator[None]:
     """While the work runs, whatever prints goes to stderr (file descriptor 1 too): stdout is
     left to the result (``--json -``)."""
@@ -110,12 +128,12 @@ def stdout_to_stderr(active: bool = True) -> Iterator[None]:
     sys.stdout.flush()
     saved, real = os.dup(1), sys.stdout
     os.dup2(2, 1)
-    sys.stdout = sys.stderr
+    sys.stdout = os.fdopen(os.dup(2), "w", buffering=1)  # closing it closes no one else's
     try:
         yield
     finally:
         with contextlib.suppress(OSError, ValueError):
-            sys.stderr.flush()
+            sys.stdout.close()
         os.dup2(saved, 1)
         os.close(saved)
         sys.stdout = real

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 
 from signorini.cli.common import (EXIT_FAILED, input_files, option_value, pairs, parse_tol,
-                                  stdout_to_stderr, write_output)
+                                  stdout_to_stderr, user_methods_in_workers,
+                                  write_output)
 from signorini.errors import InputError
 
 
@@ -33,7 +34,8 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
                             inputs=input_files(args.scene, methods))
     params = pairs(args.set, "--set")
     tol = parse_tol(args.tol) if args.tol is not None else None
-    with stdout_to_stderr(STDOUT in outputs.values()):  # what a method prints stays off the record
+    # what a method prints stays off the record; a user's method runs in a worker process
+    with stdout_to_stderr(STDOUT in outputs.values()), user_methods_in_workers(methods):
         check = crosscheck(args.scene, methods, tol=DEFAULT_TOL if tol is None else tol,
                            params=params, options=method_options(args.opt))
     texts = {"--json": to_json(check.to_dict()) + "\n", "--md": check.markdown().rstrip("\n") + "\n"}

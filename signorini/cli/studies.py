@@ -7,7 +7,8 @@ import shlex
 import sys
 
 from signorini.errors import InputError
-from signorini.cli.common import EXIT_FAILED, input_files, out_folder, pairs, parse_time_limit
+from signorini.cli.common import (EXIT_FAILED, input_files, out_folder, pairs, parse_time_limit,
+                                  user_methods_in_workers)
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
@@ -23,8 +24,9 @@ def cmd_converge(args: argparse.Namespace) -> int:
     out = out_folder(args.out, input_files(args.scene, args.method))
     check_study(args.scene, args.levels, params, args.method or None, args.fit_from)
     say = (lambda line: print(line, file=sys.stderr))
-    study = run_study(args.scene, args.levels, params, methods=args.method or None,
-                      fit_from=args.fit_from, progress=say)
+    with user_methods_in_workers(args.method):  # a user's method runs in a worker process
+        study = run_study(args.scene, args.levels, params, methods=args.method or None,
+                          fit_from=args.fit_from, progress=say)
     comparison = None
     if args.uniform_levels is not None:
         comparison = grading_comparison(args.scene, study, args.uniform_levels, params, progress=say)
