@@ -128,7 +128,7 @@ def check_output_folder(path: str | os.PathLike, flag: str = "--out") -> str:
     existing = next(p for p in (folder, *folder.parents) if p.exists() or p.is_symlink())
     if not existing.is_dir():
         raise _refuse(flag, path, f"cannot be a folder: {str(existing)!r} is a file",
-                      "choose another folder")
+                      "choose a writable folder")
     _probe(existing, flag, path)
     return str(folder)
 
