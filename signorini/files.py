@@ -260,11 +260,11 @@ def _write_through(target: Path | int, data: bytes) -> None:
         else:
             with open(target, "wb") as handle:
                 handle.write(data)
-    except BrokenPipeError:
+    except BrokenPipeError:  # the command says so (signorini.cli.app)
         raise
     except OSError as exc:
-        raise OutputError(f"cannot write {str(target)!r} ({exc.strerror}): nothing was written "
-                          "there whole; free some space or choose another path") from None
+        raise OutputError(f"cannot write {str(target)!r} ({exc.strerror}): free some space or "
+                          "choose another path") from None
 
 
 def atomic_write(path: str | os.PathLike, produce: Callable[[str], None], suffix: str = "") -> None:
@@ -279,8 +279,8 @@ def atomic_write(path: str | os.PathLike, produce: Callable[[str], None], suffix
     folder = target.parent if kind == "replace" else None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}.", suffix=suffix, dir=folder)
-    except OSError as exc:
-        raise OutputError(f"cannot write {str(path)!r} ({exc.strerror}): choose a writable path") \
+    except OSError as exc:  # no such folder, or one that takes no files: the path is at fault
+        raise InputError(f"cannot write {str(path)!r} ({exc.strerror}): choose a writable path") \
             from None
     os.close(fd)
     try:

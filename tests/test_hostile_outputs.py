@@ -315,3 +315,19 @@ def test_a_signal_ends_the_workers_with_the_command(here, argv, signum, group):
     _, alive = psutil.wait_procs(workers, timeout=30)  # generous: they were killed before the exit
     assert alive == []
     assert not (here / "v").exists()  # a folder that nothing was written into is not left
+
+
+def test_every_output_is_made_absolute_before_any_work(here):
+    from signorini.files import check_outputs
+
+    got = check_outputs({"--json": "r.json", "--md": "-"}, {"--out": "report/deeper"})
+    assert got == {"--json": str(here / "r.json"), "--md": "-", "--out": str(here / "report/deeper")}
+    assert listing(here) == [("m.py", stat.S_IFREG), ("s.toml", stat.S_IFREG)]  # nothing made
+
+
+def test_a_replaced_file_keeps_its_permissions(capsys, here):
+    (here / "r.json").write_text("old\n")
+    (here / "r.json").chmod(0o640)
+    assert main(["solve", "block", "--json", "r.json"]) == 0
+    assert stat.S_IMODE((here / "r.json").stat().st_mode) == 0o640
+    assert json.loads((here / "r.json").read_text())["status"] == "converged"
