@@ -20,3 +20,7 @@ class BackendNotInstalled(InputError):
 
 class SolverError(SignoriniError):
     """A backend failed in a way that is not the user's input (re-raised ``from`` it)."""
+
+
+class OutputError(SignoriniError):
+    """An output that could not be written (a full disk, say): nothing was left half-written."""

@@ -149,7 +149,7 @@ def test_a_missing_backend_is_a_row_not_an_error():
     (["--method", "pdas", "--method", "uzawa", "--opt", "polish=false"], "METHOD:key=value"),
     (["--tol", "2"], "--tol"),
     (["--json", "."], "is a directory"),
-    (["--md", "/no/such/dir/x.md"], "no directory"),
+    (["--md", "/no/such/dir/x.md"], "does not exist"),
 ])
 def test_bad_input_exits_2_before_any_solve(capsys, argv, words, monkeypatch):
     import signorini.crosschecking as module

@@ -9,14 +9,19 @@ to exit codes.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
+import select
+import signal
+import stat
 import sys
+import threading
 from typing import Sequence
 
 from signorini.cli import bench, crosscheck, listing, solve, studies
 from signorini.cli.common import EXIT_FAILED, EXIT_USAGE, Parser
-from signorini.errors import InputError, SignoriniError
+from signorini.errors import InputError, OutputError, SignoriniError
 
 COMMANDS = (solve, crosscheck, studies, bench, listing)
 
@@ -68,28 +73,114 @@ def _main_ranks(argv: Sequence[str] | None) -> int:
         cluster.release()
 
 
+class Stopped(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised where the command was, so that its clean-up runs."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _stop(signum: int, frame) -> None:
+    raise Stopped(signum)
+
+
 def _main(argv: Sequence[str] | None, ranks: int = 1) -> int:
+    handled = (signal.SIGTERM, signal.SIGHUP)
+    main_thread = threading.current_thread() is threading.main_thread()
+    before = {s: signal.signal(s, _stop) for s in handled} if main_thread else {}
     try:
+        return _run(argv, ranks)
+    finally:
+        _clean_up()
+        for number, handler in before.items():
+            signal.signal(number, handler)
+
+
+def _clean_up() -> None:
+    """No worker process outlives the command; no folder it made stays empty."""
+    worker = sys.modules.get("signorini.studies.worker")
+    if worker is not None:
+        worker.stop_all()
+    files = sys.modules.get("signorini.files")
+    if files is not None:
+        files.remove_empty_folders()
+
+
+def _say(message: str) -> None:
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        print(f"signorini: {message}", file=sys.stderr)
+
+
+def _stdout_closed() -> bool:
+    try:
+        os.fstat(1)
+    except OSError:
+        return True
+    return sys.stdout is None or sys.stdout.closed
+
+
+def _reader_gone() -> bool:
+    """Whether stdout is a pipe whose reader has closed it (``| head`` stopped reading)."""
+    try:
+        if not stat.S_ISFIFO(os.fstat(1).st_mode):
+            return False
+        poll = select.poll()
+        poll.register(1, 0)  # POLLERR is always reported: the read end is closed
+        return any(events & select.POLLERR for _, events in poll.poll(0))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def _run(argv: Sequence[str] | None, ranks: int) -> int:
+    try:
+        if _stdout_closed():  # nothing printed would be seen, and fd 1 could be a file's
+            raise InputError("standard output is closed: run with it open (> /dev/null "
+                             "discards what is printed)")
         args = build_parser().parse_args(argv)
         logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                             format="%(levelname)s %(name)s: %(message)s")
         if ranks > 1:
             _check_distributed(args, ranks)
-        return args.run(args)
+        code = args.run(args)
+        sys.stdout.flush()
+        if _reader_gone():  # written into the pipe's buffer, yet never read: as a broken pipe
+            raise BrokenPipeError
+        return code
     except InputError as exc:
-        print(f"signorini: error: {exc}", file=sys.stderr)
+        _say(f"error: {exc}")
         return EXIT_USAGE
-    except SignoriniError as exc:
-        print(f"signorini: {type(exc).__name__}: {exc}", file=sys.stderr)
+    except OutputError as exc:
+        _say(f"error: {exc}")
         return EXIT_FAILED
-    except KeyboardInterrupt:
-        print("signorini: interrupted", file=sys.stderr)
-        return 130
+    except SignoriniError as exc:
+        _say(f"{type(exc).__name__}: {exc}")
+        return EXIT_FAILED
+    except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM and SIGHUP through _stop
+        signum = getattr(exc, "signum", signal.SIGINT)
+        for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # one stop is enough
+            with contextlib.suppress(ValueError):
+                signal.signal(number, signal.SIG_IGN)
+        _clean_up()
+        _say(f"stopped by {signal.Signals(signum).name}: worker processes ended, "
+             "no output left half-written")
+        return 128 + signum
     except BrokenPipeError:  # e.g. piped into `head`: say so once, on stderr, and fail
         try:  # what is still buffered for the closed stdout must not raise again at exit
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         except (OSError, ValueError):
             pass
-        print("signorini: error: standard output was closed before the output was written",
-              file=sys.stderr)
+        _say("error: standard output was closed before the output was written")
+        return EXIT_FAILED
+    except ValueError:
+        if not _stdout_closed():
+            raise
+        _say("error: standard output was closed while the command ran (by a method?): "
+             "the output was not written")
+        return EXIT_FAILED
+    except (Exception, SystemExit, GeneratorExit):  # a bug shows its traceback; --help exits
+        raise
+    except BaseException as exc:  # not an Exception: raised by a method of the user's
+        _say(f"error: the run was ended by {type(exc).__name__}: {exc} (a method raised it; "
+             "it must return a ContactSolution)")
         return EXIT_FAILED

@@ -9,11 +9,12 @@ import sys
 from pathlib import Path
 
 from signorini.errors import InputError
-from signorini.cli.common import pairs, parse_sizes
+from signorini.cli.common import input_files, out_folder, pairs, parse_sizes
 
 
 def _bench_peer(args: argparse.Namespace) -> int:
     # each command loads what it needs (the peer report starts matplotlib)
+    from signorini.files import all_or_none
     from signorini.output.report import provenance
     from signorini.studies import peer  # as above
 
@@ -21,11 +22,12 @@ def _bench_peer(args: argparse.Namespace) -> int:
                          None if args.sizes is None else parse_sizes(args.sizes), pairs(args.set, "--set"))
     if args.repeat < 1:
         raise InputError(f"--repeat {args.repeat} must be at least 1")
+    out = out_folder(args.out or "peer-report")
     missing = peer.getfem_missing()
-    if missing:  # issue 16: skipped with a word where GetFEM is not installed
+    if missing:  # skipped with a word where GetFEM is not installed
         print(f"signorini: {missing}; the peer benchmark is skipped, nothing written")
         return 0
-    out, load = args.out or "peer-report", {"before": os.getloadavg()}
+    load = {"before": os.getloadavg()}
     rows = peer.run_peer(points, repeat=args.repeat, timeout=args.time_limit,
                          progress=lambda line: print(line, file=sys.stderr))
     load["after"] = os.getloadavg()
@@ -34,7 +36,8 @@ def _bench_peer(args: argparse.Namespace) -> int:
             "load_average": load,
             "signorini_command": peer.our_command(), "PYTHONPATH": os.environ.get("PYTHONPATH"),
             "getfem": next((r["versions"]["getfem"] for r in rows if "versions" in r), None)}
-    paths = peer.write_peer(rows, out, f"signorini bench {given or '--peer getfem'}", meta)
+    with all_or_none():  # the whole report, or none of it
+        paths = peer.write_peer(rows, out, f"signorini bench {given or '--peer getfem'}", meta)
     print("\n".join(peer.peer_table(rows)))
     print(f"report: {paths['md']}")
     return 0
@@ -46,10 +49,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
     import math
 
     # each command loads what it needs (the benchmark's report starts matplotlib)
-    from signorini.files import writable_directory
+    from signorini.files import all_or_none, writable_directory
     from signorini.scenes import get_scene  # as above
     from signorini.scenes.size import check_size  # as above
-    from signorini.solvers.registry import get_method, methods  # as above
+    from signorini.solvers.registry import check_request, methods  # as above
     from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
 
     family = get_scene(args.scene or "hertz-cylinder")
@@ -61,7 +64,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
     unknown = [t for t in tolerances if t not in TOLERANCES]
     if unknown:
         raise InputError(f"--tolerance {unknown[0]!r} is not one of {', '.join(TOLERANCES)}")
-    chosen = [get_method(m) for m in args.method] if args.method else \
+    out = out_folder(args.out or "bench-report", input_files(methods=args.method))
+    csv_path = Path(out) / "bench.csv"
+    if args.report_only and not csv_path.is_file():
+        raise InputError(f"--report-only: there is no {csv_path}: run the benchmark into --out "
+                         f"{args.out or 'bench-report'} first (without --report-only)")
+    # a method that is named must be installed, as for 'solve --method'
+    chosen = [check_request(m)[0] for m in args.method] if args.method else \
         [m for m in methods(installed_only=True) if not m.dense and m.family != "user"]
     try:
         ranks = sorted({int(x) for x in args.ranks.split(",")})
@@ -90,12 +99,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
         print(f"[{i}/{n}] {run.size} {run.label}@{run.tolerance}: {row['status']} "
               f"{row.get('time_s', float('nan')):.3g} s", file=sys.stderr)
 
-    out = writable_directory(args.out or "bench-report")  # only once the input is accepted
-    if not args.report_only:
-        run_benchmark(runs, Path(out), time_limit=args.time_limit, progress=progress)
+    if not args.report_only:  # the CSV grows run by run (resumable): the folder is made now
+        run_benchmark(runs, writable_directory(out), time_limit=args.time_limit, progress=progress)
     given = [a for a in sys.argv[2:] if a != "--report-only"]  # the command that made the CSV
     command = "signorini bench " + " ".join(given) if given else "signorini bench"
-    print(f"report: {write_report(Path(out) / 'bench.csv', command)}")
+    with all_or_none():  # the report and its figures, or none of them
+        report = write_report(csv_path, command)
+    print(f"report: {report}")
     return 0
 
 

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import sys
-from typing import Any, Sequence
+from typing import Any, Iterator, Sequence
 
 from signorini.errors import InputError
 
@@ -65,13 +67,76 @@ def parse_time_limit(text: str | None, flag: str = "--time-limit") -> float | No
     return seconds
 
 
-def write_json(path: str, text: str) -> None:
-    from signorini.files import atomic_write_text  # per command (start-up)
+def write_output(path: str, text: str) -> None:
+    """``text`` to the file at ``path`` whole, or to stdout for ``-``."""
+    from signorini.files import STDOUT, atomic_write_text, write_stdout  # per command (start-up)
 
-    if path == "-":
-        sys.stdout.write(text + "\n")
+    if path == STDOUT:
+        write_stdout(text)
     else:
-        atomic_write_text(path, text + "\n")
+        atomic_write_text(path, text)
+
+
+def out_folder(path: str, inputs: dict[str, str] | None = None) -> str:
+    """The absolute path of the ``--out`` folder, checked before any work (nothing created)."""
+    from signorini.files import check_outputs  # per command (start-up)
+
+    return check_outputs(folders={"--out": path}, inputs=inputs or {})["--out"]
+
+
+def input_files(scene: str | None = None, methods: Sequence[str] = ()) -> dict[str, str]:
+    """The command's input files (a scene file, a method's file) by what they are.
+
+    InputError for one that exists but is not a regular file (a FIFO would
+    wait forever); outputs are later checked not to be one of them.
+    """
+    from signorini.files import check_input_file  # per command (start-up)
+
+    found = {"scene file": scene} if scene and scene.lower().endswith(".toml") else {}
+    found.update({f"file of --method {m}": m.rpartition(":")[0] for m in methods
+                  if m.rpartition(":")[0].endswith(".py")})
+    for what, path in found.items():
+        check_input_file(path, what)
+    return found
+
+
+@contextlib.contextmanager
+def user_methods_in_workers(names: Sequence[str]) -> Iterator[None]:
+    """While the block runs, each user method (``file.py:function``) named runs in a worker
+    process (:func:`signorini.studies.runner.in_worker`): a method that ends its process,
+    closes stdout or raises what is not an Exception cannot take this run down or fake its exit."""
+    from signorini.solvers.registry import REGISTRY, get_method  # per command (start-up)
+    from signorini.studies.runner import in_worker  # per command (start-up)
+
+    added = [name for name in dict.fromkeys(names)
+             if name not in REGISTRY and get_method(name).family == "user"]
+    REGISTRY.update({name: in_worker(get_method(name)) for name in added})
+    try:
+        yield
+    finally:
+        for name in added:
+            REGISTRY.pop(name, None)
+
+
+@contextlib.contextmanager
+def stdout_to_stderr(active: bool = True) -> Iterator[None]:
+    """While the work runs, whatever prints goes to stderr (file descriptor 1 too): stdout is
+    left to the result (``--json -``)."""
+    if not active:
+        yield
+        return
+    sys.stdout.flush()
+    saved, real = os.dup(1), sys.stdout
+    os.dup2(2, 1)
+    sys.stdout = os.fdopen(os.dup(2), "w", buffering=1)  # closing it closes no one else's
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError, ValueError):
+            sys.stdout.close()
+        os.dup2(saved, 1)
+        os.close(saved)
+        sys.stdout = real
 
 
 def parse_sizes(text: str) -> list[int]:

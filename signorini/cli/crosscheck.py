@@ -3,26 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import os
-from pathlib import Path
 
-from signorini.cli.common import EXIT_FAILED, option_value, pairs, parse_tol
+from signorini.cli.common import (EXIT_FAILED, input_files, option_value, pairs, parse_tol,
+                                  stdout_to_stderr, user_methods_in_workers,
+                                  write_output)
 from signorini.errors import InputError
-
-
-def check_output(path: str | None, flag: str) -> None:
-    """A result file ``flag`` can write, checked before anything is solved."""
-    if path is None or path == "-":
-        return
-    target = Path(path)
-    if target.is_dir():
-        raise InputError(f"{flag} {path!r} is a directory: give a file name, "
-                         f"e.g. {flag} {target / 'crosscheck'}{'.json' if 'json' in flag else '.md'}")
-    parent = target.parent if str(target.parent) else Path(".")
-    if not parent.is_dir():
-        raise InputError(f"{flag} {path!r}: no directory {str(parent)!r}: create it first")
-    if not os.access(parent, os.W_OK):
-        raise InputError(f"{flag} {path!r}: directory {str(parent)!r} is not writable")
 
 
 def method_options(items: list[str]) -> dict[str, dict]:
@@ -40,27 +25,25 @@ def method_options(items: list[str]) -> dict[str, dict]:
 
 def cmd_crosscheck(args: argparse.Namespace) -> int:
     from signorini.crosschecking import DEFAULT_METHODS, DEFAULT_TOL, crosscheck  # per command (start-up)
-    from signorini.files import atomic_write_text, to_json  # per command (start-up)
+    from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # as above
 
-    check_output(args.json, "--json")
-    check_output(args.md, "--md")
-    if args.json == "-" and args.md == "-":
+    if args.json == args.md == STDOUT:
         raise InputError("--json - and --md - both ask for stdout: give one of them a file name")
+    methods = args.method or list(DEFAULT_METHODS)
+    outputs = check_outputs({"--json": args.json, "--md": args.md},
+                            inputs=input_files(args.scene, methods))
     params = pairs(args.set, "--set")
     tol = parse_tol(args.tol) if args.tol is not None else None
-    methods = args.method or list(DEFAULT_METHODS)
-    check = crosscheck(args.scene, methods, tol=DEFAULT_TOL if tol is None else tol, params=params,
-                       options=method_options(args.opt))
-    record = check.to_dict()
-    if args.json == "-":
-        print(to_json(record))
-    elif args.json:
-        atomic_write_text(args.json, to_json(record) + "\n")
-    if args.md == "-":
-        print(check.markdown())
-    elif args.md:
-        atomic_write_text(args.md, check.markdown())
-    if "-" not in (args.json, args.md):
+    # what a method prints stays off the record; a user's method runs in a worker process
+    with stdout_to_stderr(STDOUT in outputs.values()), user_methods_in_workers(methods):
+        check = crosscheck(args.scene, methods, tol=DEFAULT_TOL if tol is None else tol,
+                           params=params, options=method_options(args.opt))
+    texts = {"--json": to_json(check.to_dict()) + "\n", "--md": check.markdown().rstrip("\n") + "\n"}
+    with all_or_none():  # both files, or neither
+        for flag, path in outputs.items():
+            if path is not None:
+                write_output(path, texts[flag])
+    if STDOUT not in outputs.values():
         print(check.summary())
     return 0 if check.passed else EXIT_FAILED
 

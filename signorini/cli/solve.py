@@ -5,14 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from signorini.cli.common import (EXIT_FAILED, option_value, pairs, parse_time_limit, parse_tol,
-                                  write_json)
+from signorini.cli.common import (EXIT_FAILED, input_files, option_value, pairs,
+                                  parse_time_limit, parse_tol, stdout_to_stderr, write_output)
 from signorini.errors import InputError
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.api import Result, at_load, build_problem, solve, solve_adaptive  # per command
-    from signorini.files import check_output_file, to_json  # per command (start-up)
+    from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
     from signorini.kkt import certificate  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
 
@@ -20,8 +20,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
     texts = pairs(args.opt, "--opt")
     max_iter = option_value(texts.pop("max_iter")) if "max_iter" in texts else None
     tol = parse_tol(args.tol) if args.tol is not None else None
+    inputs = input_files(args.scene, [args.method])  # before the method's file is imported
     # every option read as its declared kind and checked before the scene is built
-    options = get_method(args.method).parse_options(texts)
+    method = get_method(args.method)
+    options = method.parse_options(texts)
     check_request(args.method, tol, max_iter, options)
     time_limit = parse_time_limit(args.time_limit)
     if time_limit is not None and args.target_error is not None:
@@ -31,47 +33,58 @@ def cmd_solve(args: argparse.Namespace) -> int:
         given = "--max-dofs (max_dofs)" if args.max_dofs is not None else "--target-on (target_on)"
         raise InputError(f"{given} steers adaptive refinement: give --target-error (target_error) "
                          "with it")
-    if args.json not in (None, "-"):
-        check_output_file(args.json, "--json")  # every output checked before the solve
+    # a method of the user's runs in a worker process: whatever it does to its process (exits,
+    # closes stdout, changes folder, prints) costs its run only, never this one's exit code
+    if method.family == "user" and args.target_error is not None:
+        raise InputError(f"--method {args.method} runs in a worker process and --target-error "
+                         "refines in this one: drop --target-error")
+    if method.family == "user" and time_limit is None:
+        time_limit = float("inf")
     if args.vtk:
         from signorini.output.export import check_vtk_path  # per command (start-up)
 
         check_vtk_path(args.vtk)  # a bad export path fails before the solve
-    if args.target_error is not None:  # adaptive refinement of the scene (signorini.scenes.adapt)
-        if args.raw_units:
-            raise InputError("--target-error refines a non-dimensionalised scene: drop --raw-units")
-        result = solve_adaptive(args.scene, args.target_error, args.method, tol=tol,
-                                max_iter=max_iter, params=params, max_dofs=args.max_dofs,
-                                target_on=args.target_on, **options)
-        problem = result.problem
-    else:
-        problem = build_problem(args.scene, nondimensionalise=not args.raw_units,
-                                solved_by=args.method, **params)
-        if time_limit is None:
-            result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
+    outputs = check_outputs({"--json": args.json, "--vtk": args.vtk}, inputs=inputs)
+    json_path, vtk_path = outputs["--json"], outputs["--vtk"]
+    with stdout_to_stderr(json_path == STDOUT):  # what a method prints cannot corrupt the JSON
+        if args.target_error is not None:  # adaptive refinement (signorini.scenes.adapt)
+            if args.raw_units:
+                raise InputError("--target-error refines a non-dimensionalised scene: drop --raw-units")
+            result = solve_adaptive(args.scene, args.target_error, args.method, tol=tol,
+                                    max_iter=max_iter, params=params, max_dofs=args.max_dofs,
+                                    target_on=args.target_on, **options)
             problem = result.problem
-        else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
-            problem = at_load(problem)  # the worker builds it again and matches it the same way
-            from signorini.studies.runner import solve_within  # per command (start-up)
+        else:
+            problem = build_problem(args.scene, nondimensionalise=not args.raw_units,
+                                    solved_by=args.method, **params)
+            if time_limit is None:
+                result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
+                problem = result.problem
+            else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
+                from signorini.studies.runner import solve_within  # per command (start-up)
 
-            spec = {"kind": "scene", "scene": args.scene, "params": params,
-                    "nondimensionalise": not args.raw_units}
-            solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
-                                    max_iter=max_iter, options=options)
-            result = Result(problem, solution, certificate(problem, solution))
+                problem = at_load(problem)  # the worker builds it again, matched the same way
+                spec = {"kind": "scene", "scene": args.scene, "params": params,
+                        "nondimensionalise": not args.raw_units}
+                solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
+                                        max_iter=max_iter, options=options)
+                result = Result(problem, solution, certificate(problem, solution))
     record = result.to_dict()
-    if args.json:
-        write_json(args.json, to_json(record))
-    if args.json != "-":
-        print(result.summary())
-    if args.vtk:
-        from signorini.output.export import export_vtk  # per command (start-up)
+    finite = record["contact"] is not None
+    with all_or_none():  # every output, or none of them
+        if json_path:
+            write_output(json_path, to_json(record) + "\n")
+        if vtk_path and finite:
+            from signorini.output.export import export_vtk  # per command (start-up)
 
-        if record["contact"] is None:
-            print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
-            return EXIT_FAILED
-        export_vtk(problem, result.solution, args.vtk)
-        print(f"written: {args.vtk}", file=sys.stderr if args.json == "-" else sys.stdout)
+            export_vtk(problem, result.solution, vtk_path)
+    if json_path != STDOUT:
+        print(result.summary())
+    if vtk_path and not finite:
+        print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
+        return EXIT_FAILED
+    if vtk_path:
+        print(f"written: {args.vtk}", file=sys.stderr if json_path == STDOUT else sys.stdout)
     return 0 if result.converged else EXIT_FAILED
 
 

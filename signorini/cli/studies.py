@@ -5,15 +5,15 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
-from pathlib import Path
 
 from signorini.errors import InputError
-from signorini.cli.common import EXIT_FAILED, pairs, parse_time_limit
+from signorini.cli.common import (EXIT_FAILED, input_files, out_folder, pairs, parse_time_limit,
+                                  user_methods_in_workers)
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
     # each command loads what it needs (the studies start matplotlib)
-    from signorini.files import writable_directory
+    from signorini.files import all_or_none
     from signorini.studies.convergence import check_study, grading_comparison, run_study, study_table, write_study  # as above
 
     if args.levels < 0 or args.levels > 6:
@@ -21,17 +21,19 @@ def cmd_converge(args: argparse.Namespace) -> int:
     if args.uniform_levels is not None and not 0 <= args.uniform_levels <= 4:
         raise InputError(f"--uniform-levels {args.uniform_levels} must be in 0..4")
     params = pairs(args.set, "--set")
+    out = out_folder(args.out, input_files(args.scene, args.method))
     check_study(args.scene, args.levels, params, args.method or None, args.fit_from)
-    writable_directory(args.out)  # only once the input is accepted
     say = (lambda line: print(line, file=sys.stderr))
-    study = run_study(args.scene, args.levels, params, methods=args.method or None,
-                      fit_from=args.fit_from, progress=say)
+    with user_methods_in_workers(args.method):  # a user's method runs in a worker process
+        study = run_study(args.scene, args.levels, params, methods=args.method or None,
+                          fit_from=args.fit_from, progress=say)
     comparison = None
     if args.uniform_levels is not None:
         comparison = grading_comparison(args.scene, study, args.uniform_levels, params, progress=say)
     command = "signorini converge " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
         if len(sys.argv) > 2 and sys.argv[1] == "converge" else f"signorini converge {args.scene} --levels {args.levels}"
-    paths = write_study(study, args.out, command, comparison)
+    with all_or_none():  # the whole report, or none of it
+        paths = write_study(study, out, command, comparison)
     print("\n".join(study_table(study)))
     if comparison is not None:
         print(f"{comparison.metric} {100 * comparison.target:g} %: graded {comparison.graded_dofs:,.0f} dofs "
@@ -48,18 +50,18 @@ def cmd_converge(args: argparse.Namespace) -> int:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     # each command loads what it needs (the report starts matplotlib)
-    from signorini.files import writable_directory
+    from signorini.files import all_or_none
     from signorini.output.report import checks_summary, write_suite_report  # as above
     from signorini.studies.suite import run_suite, select_cases  # as above
 
-    from signorini.solvers.registry import get_method  # as above
+    from signorini.solvers.registry import check_request  # as above
 
     time_limit = parse_time_limit(args.time_limit)
     methods = args.method or None
+    out = out_folder(args.out, input_files(methods=args.method))
     for name in args.method:
-        get_method(name)  # an unknown method is refused before the report folder is made
+        check_request(name)  # an unknown or missing method is refused before any work
     cases = select_cases(args.case)
-    writable_directory(args.out)
     limit = {} if time_limit is None else {"time_limit": time_limit}
     suite = run_suite(cases, method_names=methods,
                       progress=lambda line: print(line, file=sys.stderr), **limit)
@@ -69,31 +71,34 @@ def cmd_validate(args: argparse.Namespace) -> int:
         command += f" --time-limit {args.time_limit}"
     if args.out != "validation-report":
         command += f" --out {shlex.quote(args.out)}"
-    paths = write_suite_report(suite, args.out, command)
+    with all_or_none():  # the whole report, or none of it
+        paths = write_suite_report(suite, out, command)
     print(checks_summary(suite))
     print(f"report: {paths['report.md']}")
     return 0 if suite.passed else EXIT_FAILED
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from signorini.files import atomic_write_text, save_figure, to_json, writable_directory  # per command (start-up)
+    from signorini.files import all_or_none, atomic_write_text, save_figure, to_json, writable_directory  # per command (start-up)
     from signorini.scenes import build_problem  # per command (start-up)
     from signorini.studies.sweep import parse_loads, plot_sweep, sweep_loads  # per command (start-up)
 
     loads = parse_loads(args.load)
+    out = out_folder(args.out, input_files(args.scene))
     problem = build_problem(args.scene, **pairs(args.set, "--set"))
-    directory = writable_directory(args.out)  # only once the input is accepted
     levels = sweep_loads(problem, loads, progress=lambda i, n: print(
         f"\r  load level {i}/{n}", end="" if i < n else "\n", file=sys.stderr))
     rows = [vars(level) for level in levels]
     header = list(rows[0])
     csv = "\n".join([",".join(header)] + [",".join(f"{row[k]}" for k in header) for row in rows])
-    atomic_write_text(directory / "sweep.csv", csv + "\n")
-    atomic_write_text(directory / "sweep.json", to_json({"scene": args.scene, "params": problem.params,
-                                                         "levels": rows}))
     ax = plot_sweep(levels)
     ax.set_title(f"{args.scene}: {len(levels)} loads, one factorisation", fontsize=9)
-    save_figure(ax.figure, directory / "sweep.png")
+    with all_or_none():  # the three files, or none of them
+        directory = writable_directory(out)
+        atomic_write_text(directory / "sweep.csv", csv + "\n")
+        atomic_write_text(directory / "sweep.json", to_json({"scene": args.scene,
+                                                             "params": problem.params, "levels": rows}))
+        save_figure(ax.figure, directory / "sweep.png")
     print(f"{'load':>12} {'a':>12} {'a Hertz':>12} {'p0':>12} {'p0 Hertz':>12}")
     for lv in levels:
         print(f"{lv.total_force:12.6g} {lv.a:12.6g} {lv.a_ref or float('nan'):12.6g} "
@@ -104,12 +109,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 def cmd_stability(args: argparse.Namespace) -> int:
     # each command loads what it needs (the atlas starts matplotlib and every backend)
-    from signorini.files import writable_directory
+    from signorini.files import all_or_none
     from signorini.studies.atlas import run_atlas, select_axes, wrapper_record, write_report  # as above
 
     axes = select_axes(args.axis)
     time_limit = parse_time_limit(args.time_limit)
-    writable_directory(Path(args.out) / "stability")
+    out = out_folder(args.out)
 
     def progress(axis, i, n, task, row):
         print(f"[axis {axis.number} {axis.name} {i}/{n}] {task.case} {task.method}: {row['status']} "
@@ -120,7 +125,8 @@ def cmd_stability(args: argparse.Namespace) -> int:
     command = "signorini stability" + "".join(f" --axis {a}" for a in args.axis)
     command += " --quick" * args.quick + (f" --out {shlex.quote(args.out)}"
                                           if args.out != "stability-report" else "")
-    paths = write_report(result, args.out, command)
+    with all_or_none():  # the whole report, or none of it
+        paths = write_report(result, out, command)
     right, runs, _ = wrapper_record(result.rows)
     print(f"{runs} runs in {result.elapsed_s:.0f} s; the package's status was right in "
           f"{right} of {runs}")

@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import logging
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.files import atomic_write, check_output_file
 from signorini.fem.estimate import candidate_nodes as mesh_nodes_at
 from signorini.pressure import contact_profile
 from signorini.problem import ContactProblem, ContactSolution
@@ -177,16 +177,17 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
                        point_data=point_data, cell_data=cell_data)
 
 
-def check_vtk_path(path: str | os.PathLike) -> tuple[Path, str]:
-    """``(path, meshio format)`` for an export target; InputError for a bad suffix or directory."""
-    target = Path(path)
-    file_format = FORMATS.get(target.suffix.lower())
-    if file_format is None:
-        raise InputError(f"--vtk {str(target)!r}: the file name must end in "
+def check_vtk_path(path: str | os.PathLike) -> tuple[str, str]:
+    """``(absolute path, meshio format)`` of an export target, checked before any work.
+
+    InputError for an empty path, a bad suffix, a directory or a path that
+    cannot be written (see :func:`signorini.files.check_output_file`).
+    """
+    file_format = FORMATS.get(Path(path).suffix.lower())
+    if str(path) and file_format is None:
+        raise InputError(f"--vtk {str(path)!r}: the file name must end in "
                          f"{' or '.join(FORMATS)} (VTU is ParaView's XML format)")
-    if not target.parent.is_dir():
-        raise InputError(f"--vtk {str(target)!r}: the directory {str(target.parent)!r} does not exist")
-    return target, file_format
+    return check_output_file(path, "--vtk"), file_format
 
 
 def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | os.PathLike, *,
@@ -194,26 +195,14 @@ def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | o
     """Write the solved scene to ``path`` (``.vtu`` or ``.vtk``) whole or not at all.
 
     The file is written under a temporary name in the same directory and
-    renamed, so an existing file is replaced only by a complete one.
+    renamed, so an existing file is replaced only by a complete one
+    (:func:`signorini.files.atomic_write`).
     """
-    target, file_format = check_vtk_path(path)
-    directory = target.parent
-    data = export_mesh(problem, solution, deformed=deformed, axisymmetric=axisymmetric)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix, dir=directory)
-    except OSError as exc:
-        raise InputError(f"--vtk {str(target)!r} cannot be written ({exc.strerror})") from None
-    os.close(fd)
-    try:
-        import meshio  # as above
+    import meshio  # only when exporting (start-up)
 
-        meshio.write(tmp, data, file_format=file_format)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp made it private; give it the usual permissions
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    target, file_format = check_vtk_path(path)
+    data = export_mesh(problem, solution, deformed=deformed, axisymmetric=axisymmetric)
+    atomic_write(target, lambda name: meshio.write(name, data, file_format=file_format),
+                 suffix=Path(path).suffix)
     log.info("wrote %s (%d points, %d cells)", target, data.points.shape[0], len(data.cells[0].data))
-    return target
+    return Path(target)

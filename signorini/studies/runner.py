@@ -32,10 +32,12 @@ restarted and the study goes on. A ``fresh`` task gets a process of its own
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import os
 import sys
+import tempfile
 import time
 from typing import Any, Callable, Sequence
 
@@ -52,6 +54,7 @@ from signorini.scenes.block import force_controlled_exact
 from signorini.solvers import cluster
 from signorini.loading import solve as load_control
 from signorini.scenes import coarse_problem
+from signorini.solvers.base import Method
 from signorini.solvers.registry import ACCEPT_FACTOR, DEFAULT_ACCEPT, get_method
 from signorini.studies.measures import (
     answer_from,
@@ -76,7 +79,7 @@ from signorini.studies.task import (
     task_row,
     verdict,
 )
-from signorini.studies.worker import Worker
+from signorini.studies.worker import Worker, die_with_parent
 
 log = logging.getLogger(__name__)
 
@@ -98,7 +101,7 @@ EXTRA_STATUSES = ("built", "refused", "input-error", "raised", "timeout", "crash
 
 __all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "DEFAULT_TIME_LIMIT",
            "EXTRA_STATUSES", "ITERATION_CAPS", "MEASURES", "NEAR_FACTOR", "NUMERIC", "Row", "Task",
-           "Worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "task_row"]
+           "Worker", "in_worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "task_row"]
 #: the verdicts on a row (the name the tests know)
 _verdict = verdict
 
@@ -275,6 +278,7 @@ def serve_worker() -> None:
     ranks serve its distributed solves until stdin closes.
     """
     logging.disable(logging.WARNING)
+    die_with_parent()
     if cluster.launched_size() > 1 and cluster.rank() != 0:
         os.dup2(2, 1)  # nothing of this rank may reach the rows
         cluster.serve()
@@ -324,6 +328,24 @@ def solve_within(problem: ContactProblem, spec: dict[str, Any], method: str, tim
         return answer_from(row["answer"])
     return ContactSolution.failure(method, problem, "failed",
                                    row.get("message") or f"the run ended {row.get('status')}")
+
+
+def in_worker(method: Method, time_limit: float = float("inf")) -> Method:
+    """``method`` run in a worker process of its own on a stored copy of each problem.
+
+    Whatever the method does to its process (ends it, closes stdout, prints,
+    changes the working folder) costs its run only: the answer is then a
+    ``failed`` solution saying so.
+    """
+    def function(problem: ContactProblem, *, tol: float | None = None,
+                 max_iter: int | None = None, **options: Any) -> ContactSolution:
+        with tempfile.TemporaryDirectory(prefix="signorini-") as folder:
+            path = os.path.join(folder, "problem.npz")
+            problem.save(path)
+            return solve_within(problem, {"kind": "stored", "path": path}, method.name,
+                                time_limit, tol=tol, max_iter=max_iter, options=options)
+
+    return dataclasses.replace(method, function=function)
 
 
 def run_tasks(tasks: Sequence[Task], *, isolate: bool = True, time_limit: float = DEFAULT_TIME_LIMIT,

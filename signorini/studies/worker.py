@@ -6,6 +6,7 @@ takes longer than the limit, or a child that dies, costs one row and a new child
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -15,6 +16,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import weakref
 
 from signorini.errors import InputError
 from signorini.files import plain
@@ -22,6 +24,28 @@ from signorini.solvers import cluster
 from signorini.studies.task import DEFAULT_TIME_LIMIT, Row, Task, task_row, verdict
 
 log = logging.getLogger(__name__)
+#: the workers of this process that may have a child running (see :func:`stop_all`)
+_LIVE: "weakref.WeakSet[Worker]" = weakref.WeakSet()
+
+
+def stop_all() -> None:
+    """Kill every worker child of this process at once, with its process group (on a signal)."""
+    for worker in list(_LIVE):
+        worker.stop(grace=0.0)
+
+
+def die_with_parent() -> None:
+    """In a worker: be killed when the parent process dies, however it dies (Linux).
+
+    A parent that died before this took hold closed the worker's input: the
+    worker then ends by itself.
+    """
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
 class Worker:
@@ -50,13 +74,16 @@ class Worker:
                                       stderr=self._stderr, env=env, start_new_session=True)
         self._buffer = b""
         self._ranks = ranks
+        _LIVE.add(self)
 
     def stop(self, grace: float = 10.0) -> None:
         """Stop the worker (it is restarted by the next task): end of input, then a kill."""
+        _LIVE.discard(self)
         if self._proc is not None:
             try:
                 self._proc.stdin.close()
-                self._proc.wait(timeout=grace)
+                if grace > 0:
+                    self._proc.wait(timeout=grace)
             except (OSError, subprocess.TimeoutExpired):
                 pass
             if self._proc.poll() is None:
@@ -82,7 +109,18 @@ class Worker:
         return lines[-1] if lines else ""
 
     def run(self, task: Task) -> Row:
-        """The row of ``task``, or a ``timeout``/``crashed`` row."""
+        """The row of ``task``, or a ``timeout``/``crashed`` row.
+
+        Interrupted (a signal, Ctrl-C), the child is killed before the
+        interruption goes on.
+        """
+        try:
+            return self._run(task)
+        except BaseException:
+            self.stop(grace=0.0)
+            raise
+
+    def _run(self, task: Task) -> Row:
         alive = self._proc is not None and self._proc.poll() is None
         if task.fresh or task.ranks != self._ranks or not alive:
             self.stop()
@@ -102,7 +140,8 @@ class Worker:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     return self._lost(task, "timeout")
-                ready, _, _ = select.select([fd], [], [], remaining)
+                ready, _, _ = select.select([fd], [], [], None if remaining == float("inf")
+                                            else remaining)
                 if not ready:
                     continue
                 chunk = os.read(fd, 1 << 16)
