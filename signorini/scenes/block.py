@@ -32,12 +32,12 @@ from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.fem.obstacles import ScaledQuery
 from signorini.fem.topology import facets_on
 from signorini.problem import ContactProblem, ContactSolution, Scales
-from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, poisson_ratio, positive
+from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, length, poisson_ratio, positive
 from signorini.solvers.pdas import solve as pdas
 
 PARAMS = (
-    Param("W", 1.0, "half-width of the block", check=positive),
-    Param("H", 1.0, "height of the block", check=positive),
+    Param("W", 1.0, "half-width of the block", check=length),
+    Param("H", 1.0, "height of the block", check=length),
     Param("E", 1.0, "Young's modulus", check=positive),
     Param("nu", 0.3, "Poisson's ratio", check=poisson_ratio),
     VOLUMETRIC,
