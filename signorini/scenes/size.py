@@ -174,6 +174,14 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
     if found is None:
         return
     dofs, dim = found
+    if dim == 3:  # the mesher's limit first (as the tetrahedra reach it long before memory)
+        _check_graded(family, params, dofs, dim)
+    _check_memory(family, params, dofs, dim, solved_by)
+    _check_graded(family, params, dofs, dim)
+
+
+def _check_graded(family: str, params: dict[str, Any], dofs: float, dim: int) -> None:
+    """InputError when the graded mesh, before uniform refinement, exceeds the mesher's limit."""
     graded = dofs / 2.0 ** (dim * params.get("refine", 0)) * ELEMENTS_PER_DOF[dim]
     if "grading" in params and graded > GRADED_LIMIT[dim]:
         raise InputError(
@@ -182,6 +190,11 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
             f"({graded / ELEMENTS_PER_DOF[dim]:,.0f} dofs) before any uniform refinement, over "
             f"the mesher's {GRADED_LIMIT[dim]:,}: make the grading larger or n_contact smaller, "
             "and refine (refine=1, 2...) to go finer")
+
+
+def _check_memory(family: str, params: dict[str, Any], dofs: float, dim: int,
+                  solved_by: str | None) -> None:
+    """InputError when building and solving the scene would exceed :func:`memory_limit`."""
     need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
     if need <= limit:
         return
@@ -191,8 +204,9 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
         f"scene {family!r} with {mesh} would have about {dofs:,.0f} dofs and take about "
         f"{need / 1e9:,.1f} GB to build and solve, over the limit of {limit / 1e9:,.1f} GB "
         f"(¾ of this machine's memory unless {MEMORY_VARIABLE} says otherwise): make the mesh "
-        f"coarser ({', '.join(names)}), or raise the limit, e.g. "
-        f"{MEMORY_VARIABLE}={math.ceil(need / 1e9) + 1}" + _push_hint(dim, dofs, params, limit))
+        f"coarser ({', '.join(names)})" + (f", or raise the limit, e.g. {MEMORY_VARIABLE}="
+                                          f"{math.ceil(need / 1e9) + 1}" if math.isfinite(need) else "")
+        + _push_hint(dim, dofs, params, limit))
 
 
 def _push_hint(dim: int, dofs: float, params: dict[str, Any], limit: float) -> str:
