@@ -27,7 +27,12 @@ from skfem import MeshTet, MeshTri
 
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
-from signorini.numerics.arrays import sparse_argument, vector_argument
+from signorini.numerics.arrays import (
+    multiplicity_argument,
+    points_argument,
+    sparse_argument,
+    vector_argument,
+)
 from signorini.numerics.factor import factorize
 from signorini.numerics.loading import calibrate_push
 from signorini.solution import STATUSES, ContactSolution
@@ -257,9 +262,8 @@ class ContactProblem:
         if n and abs(K - K.T).max() > 1e-10 * abs(K).max():
             raise InputError("K must be symmetric: pass the stiffness matrix itself, or ½(K + Kᵀ)")
         N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")
-        m = N.shape[0]
-        if contact_points is None:
-            contact_points = np.full((m, 2), np.nan)
+        contact_points = points_argument(contact_points, N)
+        force_multiplicity = multiplicity_argument(force_multiplicity)
         return cls(K=K, f=f, N=N, d=d, weights=weights,
                    contact_points=np.asarray(contact_points, dtype=float),
                    free_dofs=np.arange(n), prescribed=np.zeros(n),

@@ -43,6 +43,8 @@ from signorini.fem.topology import _packed, with_topology
 
 #: an element whose measure is at most this times its longest edge to the dimension is degenerate
 DEGENERATE = 1e-12
+#: the range of a length (and of a mesh's coordinates): squares and cubes stay representable
+LENGTH_RANGE = (1e-100, 1e100)
 #: a candidate's gap below minus this times the length scale: the obstacle starts inside the body
 OUTSIDE = 1e-8
 #: a candidate whose obstacle normal has at most this component along the body's outward
@@ -77,6 +79,11 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> 
     if np.any(bad):
         raise InputError(f"{what}: node {int(np.argmax(bad))} has a non-finite coordinate: "
                          "give every node finite coordinates")
+    largest = float(np.max(np.abs(p), initial=0.0))
+    if largest > LENGTH_RANGE[1]:
+        raise InputError(f"{what}: its coordinates reach {largest:g}, beyond {LENGTH_RANGE[1]:g} "
+                         "(areas and volumes must be representable in double precision): choose a "
+                         "length unit nearer the body's size")
     if t.size and (t.min() < 0 or t.max() >= p.shape[1]):
         element = int(np.argmax(np.any((t < 0) | (t >= p.shape[1]), axis=0)))
         raise InputError(f"{what}: {kind} {element} (nodes {_nodes(t, element)}) names a node the "

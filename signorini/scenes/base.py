@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from signorini.errors import InputError
+from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel
 from signorini.fem.volumetric import CHOICES
 
@@ -92,10 +93,6 @@ def representable(x: Any) -> str | None:
 
 def positive(x: float) -> str | None:
     return None if x > 0 else "> 0"
-
-
-#: the range of a length: its square and cube (areas, volumes, 3D loads) stay representable
-LENGTH_RANGE = (1e-100, 1e100)
 
 
 def length(x: float) -> str | None:
