@@ -65,6 +65,13 @@ def vector_argument(value: Any, name: str) -> np.ndarray:
     return vector
 
 
+def flag_argument(value: Any, name: str) -> bool:
+    """A yes-or-no argument: a bool (or NumPy's), never a string or a number taken as true."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{name}={value!r} must be True or False")
+    return bool(value)
+
+
 def multiplicity_argument(value: Any) -> float:
     """A model's ``force_multiplicity`` (copies of it in the whole body): a finite number > 0."""
     if isinstance(value, bool) or not isinstance(value, Real) or not (math.isfinite(value) and value > 0):

@@ -14,6 +14,7 @@ from typing import Any
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.model import SceneModel
+from signorini.numerics.arrays import flag_argument
 from signorini.numerics.zone import zone_around_points
 from signorini.problem import ContactProblem, Scales
 from signorini.references import REFERENCES
@@ -106,6 +107,7 @@ def build_problem(name: str, nondimensionalise: bool = True, *, solved_by: str |
     (:func:`signorini.solvers.auto.defers_load_targeting`: no factorisation of
     K in the assembly) and the problem's target is ``pending``.
     """
+    nondimensionalise = flag_argument(nondimensionalise, "nondimensionalise")
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
                          f"{type(name).__name__}: e.g. build_problem('hertz-cylinder')")
@@ -118,6 +120,8 @@ def build_problem(name: str, nondimensionalise: bool = True, *, solved_by: str |
         check_size(name, params, solved_by)  # too big for this machine: refused before meshing
         try:
             model = family.build(params, set(values))
+        except InputError:  # the model's own checks (signorini.fem.checks): said as they are
+            raise
         except (RuntimeError, ValueError, ArithmeticError, IndexError, MemoryError) as exc:
             # the mesher gave up (too many elements, a relaxation that folded the mesh) or ran
             # out of memory: the parameters asked for a mesh it cannot make
