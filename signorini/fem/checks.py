@@ -51,6 +51,7 @@ OUTSIDE = 1e-8
 #: normal faces away from the obstacle
 FACING = -1e-6
 NAMES = {2: ("triangle", "area", "edge"), 3: ("tetrahedron", "volume", "face")}
+PLURAL = {"triangle": "triangles", "tetrahedron": "tetrahedra"}
 
 
 def _nodes(t: np.ndarray, element: int) -> str:
@@ -121,7 +122,7 @@ def _check_duplicates(t: np.ndarray, what: str, kind: str) -> None:
     if np.any(same):
         k = int(np.argmax(same))
         first, second = sorted((int(order[k]), int(order[k + 1])))
-        raise InputError(f"{what}: {kind}s {first} and {second} are the same {kind} (nodes "
+        raise InputError(f"{what}: {PLURAL[kind]} {first} and {second} are the same {kind} (nodes "
                          f"{_nodes(t, first)}): remove one of them")
 
 
@@ -140,7 +141,7 @@ def _check_facets(p: np.ndarray, t: np.ndarray, what: str, kind: str, facet: str
         k = int(np.argmax(shared))
         owners = sorted(int(element[order[i]]) for i in range(k, k + 3))
         raise InputError(f"{what}: the {facet} (nodes {', '.join(map(str, nodes[:, order[k]]))}) "
-                         f"bounds {kind}s {', '.join(map(str, owners))}, more than two: the mesh "
+                         f"bounds {PLURAL[kind]} {', '.join(map(str, owners))}, more than two: the mesh "
                          "overlaps itself there; remesh it")
     pairs = np.nonzero(same)[0]
     first, second = order[pairs], order[pairs + 1]
@@ -151,7 +152,7 @@ def _check_facets(p: np.ndarray, t: np.ndarray, what: str, kind: str, facet: str
     if np.any(folded):
         k = int(np.argmax(folded))
         a, b = sorted((int(element[first[k]]), int(element[second[k]])))
-        raise InputError(f"{what}: {kind}s {a} and {b} overlap: they lie on the same side of "
+        raise InputError(f"{what}: {PLURAL[kind]} {a} and {b} overlap: they lie on the same side of "
                          f"their shared {facet} (nodes {', '.join(map(str, base[:, k]))}), so the "
                          "mesh is folded there (an inverted element); remesh it or move its nodes")
 

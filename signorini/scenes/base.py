@@ -45,8 +45,8 @@ class Param:
             raise InputError(f"scene parameter {self.name}={value!r} is not a valid "
                              f"{self.kind.__name__}: pass --set {self.name}=<{self.kind.__name__}>")
         if isinstance(value, str) and len(value) > MAX_DIGITS:  # before int() spends time on it
-            raise InputError(f"scene parameter {self.name}={shown(value)} is too long for a "
-                             f"{self.kind.__name__}: give at most {MAX_DIGITS} characters")
+            raise InputError(f"scene parameter {self.name}={shown(value)} is too long for a number: "
+                             f"give at most {MAX_DIGITS} characters")
         try:
             if self.kind is int:
                 converted = int(value)
@@ -79,7 +79,7 @@ MAX_INT = 2 ** 53
 def shown(value: Any) -> str:
     """``value`` as a message shows it: its repr, the middle of a long one left out."""
     text = repr(value)
-    return text if len(text) <= MAX_DIGITS else f"{text[:12]}…{text[-6:]} ({len(text)} characters)"
+    return text if len(text) <= MAX_DIGITS else f"{text[:12]}…{text[-6:]} ({len(str(value))} characters)"
 
 
 def representable(x: Any) -> str | None:
