@@ -267,9 +267,10 @@ def test_a_timed_out_validation_is_a_failed_row_not_a_traceback(capsys, tmp_path
     out, err = capsys.readouterr()
     assert got == 1, err
     assert "Traceback" not in out + err
-    runs = json.loads((tmp_path / "out" / "report.json").read_text())["cases"][0]["runs"]
-    timed_out = [r for r in runs if r["method"] == "uzawa"]
-    assert timed_out and timed_out[0]["status"] == "timeout"
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    timed_out = [r for r in report["runs"] if r["method"] == "uzawa"]
+    assert not report["passed"] and timed_out and timed_out[0]["status"] == "timeout"
+    assert timed_out[0]["kkt_worst"] is None  # unmeasured, written as null
 
 
 @pytest.fixture(scope="module")
