@@ -20,25 +20,9 @@ from signorini.cli import main
 from signorini.errors import InputError
 from signorini.fem.checks import check_mesh
 from signorini.references import reference_metrics
+from test_catalogue import SCENE_TOML  # the mesh scene of the catalogue, on a flat
 
 DIGITS_400 = "1" + "0" * 399
-MESH_SCENE = """[mesh]
-file = "{mesh}"
-[material]
-E = 1.0
-nu = 0.3
-[[dirichlet]]
-boundary = {{y = 1.0}}
-component = "y"
-value = -0.01
-[contact]
-boundary = {{y = 0.0}}
-[obstacle]
-{obstacle}
-[load]
-boundary = {{y = 1.0}}
-component = "y"
-"""
 FLAT = 'type = "flat"\nheight = 0.0'
 
 #: (argv, words the one line must contain); {inputs} is the folder of input files
@@ -120,8 +104,8 @@ def inputs(tmp_path_factory):
             ("fan", "fan.msh", FLAT),
             ("inside", "square.msh", 'type = "circle"\ncentre = [0.5, 0.5]\nradius = 0.2'),
             ("overlapping", "square.msh", 'type = "flat"\nheight = 0.1')):
-        (folder / f"{name}.toml").write_text(MESH_SCENE.format(mesh=mesh, obstacle=obstacle))
-    (folder / "tiny.toml").write_text(MESH_SCENE.format(mesh="square.msh", obstacle=FLAT)
+        (folder / f"{name}.toml").write_text(SCENE_TOML.format(mesh=mesh).replace(FLAT, obstacle))
+    (folder / "tiny.toml").write_text(SCENE_TOML.format(mesh="square.msh")
                                       .replace("[material]", "length_scale = 1e-300\n[material]"))
     (folder / "nested.toml").write_text("x = " + "[" * 20_000 + "]" * 20_000 + "\n")
     return folder
