@@ -39,8 +39,7 @@ on them::
     multiplicity = 2.0          # copies of the model in the whole body
     target = 0.02               # optional: scale the prescribed displacements to this load
 
-Errors name the file, the table and key, and the line when it can be found
-(TOML syntax errors always carry their line).
+Errors name the file, the table, key and line (a TOML syntax error always has its line).
 """
 
 from __future__ import annotations
@@ -148,8 +147,7 @@ def read_scene_file(path: str | Path) -> tuple[dict[str, Any], _Context]:
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"scene file {path}: invalid TOML: {exc}") from None
     except RecursionError:  # tomllib parses nested arrays and tables by recursion
-        raise InputError(f"scene file {path}: its arrays or tables are nested too deeply to read: "
-                         "a scene file nests them at most a few levels") from None
+        raise InputError(f"scene file {path}: arrays or tables nested too deeply to read") from None
     return data, _Context(path, _Locator(text))
 
 
@@ -449,11 +447,9 @@ def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) 
     mesh = mesh_info.mesh
     extent = float(np.ptp(mesh.p, axis=1).max())
     length_scale = _number(ctx, "mesh", mesh_table, "length_scale", default=extent, positive=True)
-    problem = length(length_scale)
-    if problem:
-        raise ctx.error(f"{'length_scale' if 'length_scale' in mesh_table else 'the mesh extent'} = "
-                        f"{length_scale:g} must be {problem}", "mesh",
-                        "length_scale" if "length_scale" in mesh_table else "file")
+    if length(length_scale):  # given, or the mesh's extent
+        key = "length_scale" if "length_scale" in mesh_table else "file"
+        raise ctx.error(f"the length {length_scale:g} must be {length(length_scale)}", "mesh", key)
 
     E = _number(ctx, "material", material, "E", positive=True)
     nu = _number(ctx, "material", material, "nu")
