@@ -2,11 +2,22 @@
 
 An elastic body on a rigid flat has the contact modulus ``E* = E / (1 − ν²)``
 (plane strain in 2D).
+
+The formulas are written so that no intermediate product leaves the range of
+the quantities themselves (``P/E*`` is a length in 2D, an area in 3D): a
+result that double precision cannot hold comes back infinite or zero, never
+as an exception or a warning, and the scenes refuse it by name.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+
+
+def _quiet() -> np.errstate:
+    """No warning for an overflow or underflow: the caller checks what comes back."""
+    return np.errstate(over="ignore", under="ignore", divide="ignore")
 
 
 def contact_modulus(E: float, nu: float) -> float:
@@ -16,12 +27,14 @@ def contact_modulus(E: float, nu: float) -> float:
 
 def hertz_cylinder_half_width(P: float, R: float, E_star: float) -> float:
     """Contact half-width of a cylinder on a flat: ``a = √(4PR / (πE*))`` (P per unit length)."""
-    return float(np.sqrt(4.0 * P * R / (np.pi * E_star)))
+    with _quiet():
+        return float(np.sqrt(4.0 / np.pi * (np.float64(P) / E_star) * R))
 
 
 def hertz_cylinder_load(a: float, R: float, E_star: float) -> float:
     """The load per unit length that gives half-width ``a``: ``P = πE*a² / (4R)``."""
-    return float(np.pi * E_star * a ** 2 / (4.0 * R))
+    with _quiet():
+        return float(np.pi / 4.0 * np.float64(E_star) * (np.float64(a) / R) * a)
 
 
 def hertz_cylinder_peak(P: float, a: float) -> float:
@@ -40,12 +53,14 @@ def hertz_pressure(x: np.ndarray, a: float, p0: float) -> np.ndarray:
 
 def hertz_sphere_radius(P: float, R: float, E_star: float) -> float:
     """Contact radius of a sphere on a flat: ``a = (3PR / (4E*))^(1/3)`` (P the total load)."""
-    return float(np.cbrt(3.0 * P * R / (4.0 * E_star)))
+    with _quiet():
+        return float(np.cbrt(0.75 * (np.float64(P) / E_star) * R))
 
 
 def hertz_sphere_load(a: float, R: float, E_star: float) -> float:
     """The load that gives contact radius ``a``: ``P = 4E*a³ / (3R)``."""
-    return float(4.0 * E_star * a ** 3 / (3.0 * R))
+    with _quiet():
+        return float(4.0 / 3.0 * np.float64(E_star) * (np.float64(a) / R) * (np.float64(a) * a))
 
 
 def hertz_sphere_peak(P: float, a: float) -> float:
@@ -71,7 +86,7 @@ def punch_pressure(x: np.ndarray, a: float, P: float) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     inside = np.abs(x) < a
     out = np.full(x.shape, np.nan)
-    out[inside] = P / (np.pi * np.sqrt(a ** 2 - x[inside] ** 2))
+    out[inside] = P / (np.pi * a * np.sqrt(1.0 - (x[inside] / a) ** 2))
     return out
 
 

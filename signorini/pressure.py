@@ -2,7 +2,10 @@
 
 The nodal contact force ``λᵢ`` is the consistent nodal force of the contact
 traction, so ``pᵢ = λᵢ / wᵢ`` with the lumped weight ``wᵢ = ∫ φᵢ ds`` is the
-nodal pressure. Everything here is in physical units.
+nodal pressure. Everything here is in physical units; every fit and norm
+divides positions and pressures by their largest magnitude before it forms
+squares or products (:func:`unit_of`), so that a comparison means the same
+in any units in which the solve itself is representable.
 """
 
 from __future__ import annotations
@@ -68,6 +71,23 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
         applied_load=problem.applied_load(solution.u) * s.force)
 
 
+def unit_of(values: np.ndarray) -> float:
+    """The largest finite magnitude among ``values`` (1 when there is none): what a fit or a
+    norm divides by before it squares them."""
+    values = np.abs(np.asarray(values, dtype=float))
+    values = values[np.isfinite(values)]
+    largest = float(values.max()) if values.size else 0.0
+    return largest if largest > 0 else 1.0
+
+
+def _line_through_squares(x: np.ndarray, pressure: np.ndarray) -> tuple[float, float, float, float]:
+    """``(slope, intercept)`` of a line through ``(x², p²)`` in units of the largest x and p,
+    and those two units."""
+    xs, ps = unit_of(x), unit_of(pressure)
+    slope, intercept = np.polyfit((x / xs) ** 2, (pressure / ps) ** 2, 1)
+    return float(slope), float(intercept), xs, ps
+
+
 def contact_half_width(profile: ContactProfile) -> float:
     """Half-width of the contact zone from the nodal pressures.
 
@@ -84,9 +104,9 @@ def contact_half_width(profile: ContactProfile) -> float:
     upper = profile.x[last + 1] if last + 1 < profile.x.size else profile.x[last]
     fit = active[-4:-1] if active.size >= 4 else active
     if fit.size >= 2 and np.ptp(profile.x[fit]) > 0:
-        slope, intercept = np.polyfit(profile.x[fit] ** 2, profile.pressure[fit] ** 2, 1)
+        slope, intercept, xs, _ = _line_through_squares(profile.x[fit], profile.pressure[fit])
         if slope < 0:
-            return float(np.clip(np.sqrt(-intercept / slope), profile.x[last], upper))
+            return float(np.clip(xs * np.sqrt(-intercept / slope), profile.x[last], upper))
     return float(0.5 * (profile.x[last] + upper))
 
 
@@ -103,18 +123,26 @@ def hertz_fit(x: np.ndarray, pressure: np.ndarray, active: np.ndarray) -> tuple[
     idx = idx[np.argsort(x[idx])][:-1]
     if idx.size < 2 or np.ptp(x[idx]) == 0:
         return float("nan"), float("nan")
-    slope, intercept = np.polyfit(x[idx] ** 2, pressure[idx] ** 2, 1)
+    slope, intercept, xs, ps = _line_through_squares(x[idx], pressure[idx])
     if not (intercept > 0 and slope < 0):
         return float("nan"), float("nan")
-    return float(np.sqrt(intercept)), float(np.sqrt(-intercept / slope))
+    return float(ps * np.sqrt(intercept)), float(xs * np.sqrt(-intercept / slope))
 
 
 def _l2_relative(x: np.ndarray, numeric: np.ndarray, reference) -> float:
     """‖p_h − p_ref‖ / ‖p_ref‖ on [0, x_max], p_h the piecewise-linear nodal interpolant."""
-    grid = np.linspace(0.0, float(x.max()), 20_001)
-    ref = reference(grid)
-    diff = np.interp(grid, x, numeric) - ref
-    return float(np.sqrt(np.trapezoid(diff ** 2, grid) / np.trapezoid(ref ** 2, grid)))
+    grid, ref, numeric = _on_unit_grid(x, numeric, reference)
+    diff = np.interp(grid, x / x.max(), numeric) - ref
+    return float(np.sqrt(np.trapezoid(diff ** 2) / np.trapezoid(ref ** 2)))  # the step cancels
+
+
+def _on_unit_grid(x: np.ndarray, numeric: np.ndarray, reference) -> tuple[np.ndarray, ...]:
+    """A grid over [0, 1] in units of the largest x, the reference on it and ``numeric``, both
+    in units of the reference's largest value: an interpolation's slopes stay representable."""
+    grid = np.linspace(0.0, 1.0, 20_001)
+    ref = reference(grid * float(x.max()))
+    unit = unit_of(ref)
+    return grid, ref / unit, numeric / unit
 
 
 @dataclass(frozen=True)
@@ -249,10 +277,9 @@ def _l2_relative_disc(r: np.ndarray, numeric: np.ndarray, reference) -> float:
     The norm is that of the contact plane, ``∫ p² 2πρ dρ`` (the 2π cancels).
     """
     order = np.argsort(r)
-    grid = np.linspace(0.0, float(r.max()), 20_001)
-    diff = np.interp(grid, r[order], numeric[order]) - reference(grid)
-    ref = reference(grid)
-    return float(np.sqrt(np.trapezoid(diff ** 2 * grid, grid) / np.trapezoid(ref ** 2 * grid, grid)))
+    grid, ref, numeric = _on_unit_grid(r, numeric, reference)
+    diff = np.interp(grid, r[order] / r.max(), numeric[order]) - ref
+    return float(np.sqrt(np.trapezoid(diff ** 2 * grid) / np.trapezoid(ref ** 2 * grid)))
 
 
 def _l2_relative_surface(problem: ContactProblem, pressure: np.ndarray, reference,
@@ -274,19 +301,21 @@ def _l2_relative_surface(problem: ContactProblem, pressure: np.ndarray, referenc
     local = position[facets]
     local = local[:, np.all(local >= 0, axis=0)]  # (3, triangles) candidate indices
     xy = problem.contact_points[:, :2] * problem.scales.length
+    length, unit = unit_of(xy), unit_of(reference(np.zeros(1)))  # areas and squares in these units
     k = subdivisions
     bary = [((i + 1 / 3) / k, (j + 1 / 3) / k) for i in range(k) for j in range(k - i)] + \
            [((i + 2 / 3) / k, (j + 2 / 3) / k) for i in range(k - 1) for j in range(k - 1 - i)]
     corners = xy[local]  # (3, triangles, 2)
     e1, e2 = corners[1] - corners[0], corners[2] - corners[0]
-    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    u1, u2 = e1 / length, e2 / length
+    area = 0.5 * np.abs(u1[:, 0] * u2[:, 1] - u1[:, 1] * u2[:, 0])  # in units of length²
     num = den = 0.0
     for s, t in bary:
         point = corners[0] + s * e1 + t * e2
         p_h = (1 - s - t) * pressure[local[0]] + s * pressure[local[1]] + t * pressure[local[2]]
         p_ref = reference(np.hypot(point[:, 0], point[:, 1]))
-        num += float(np.sum(area * (p_h - p_ref) ** 2))
-        den += float(np.sum(area * p_ref ** 2))
+        num += float(np.sum(area * ((p_h - p_ref) / unit) ** 2))
+        den += float(np.sum(area * (p_ref / unit) ** 2))
     return float(np.sqrt(num / den)) if den > 0 else float("nan")
 
 

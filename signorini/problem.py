@@ -27,7 +27,12 @@ from skfem import MeshTet, MeshTri
 
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
-from signorini.numerics.arrays import sparse_argument, vector_argument
+from signorini.numerics.arrays import (
+    multiplicity_argument,
+    points_argument,
+    sparse_argument,
+    vector_argument,
+)
 from signorini.numerics.factor import factorize
 from signorini.solution import STATUSES, ContactSolution
 
@@ -252,9 +257,9 @@ class ContactProblem:
         if n and abs(K - K.T).max() > 1e-10 * abs(K).max():
             raise InputError("K must be symmetric: pass the stiffness matrix itself, or ½(K + Kᵀ)")
         N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")
-        points = None if contact_points is None else np.asarray(contact_points, dtype=float)
-        return cls(K=K, f=f, N=N, d=d, weights=weights, contact_points=points,
-                   force_multiplicity=force_multiplicity, name=name)
+        return cls(K=K, f=f, N=N, d=d, weights=weights,
+                   contact_points=points_argument(contact_points, N),
+                   force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
 
     # -- what the discretisation says (neutral values for a QP given as arrays) ---------------
     @property

@@ -19,9 +19,7 @@ def _bench_peer(args: argparse.Namespace) -> int:
     from signorini.studies import peer  # as above
 
     points = peer.ladder([args.scene] if args.scene else list(peer.SCENES),
-                         None if args.sizes is None else parse_sizes(args.sizes), pairs(args.set, "--set"))
-    if args.repeat < 1:
-        raise InputError(f"--repeat {args.repeat} must be at least 1")
+                         None if args.sizes is None else _sizes(args.sizes, ""), pairs(args.set, "--set"))
     out = out_folder(args.out or "peer-report")
     missing = peer.getfem_missing()
     if missing:  # skipped with a word where GetFEM is not installed
@@ -43,7 +41,20 @@ def _bench_peer(args: argparse.Namespace) -> int:
     return 0
 
 
+def _sizes(text: str | None, default: str) -> list[int]:
+    """``--sizes`` as distinct levels (``default`` when not given; an empty list is refused)."""
+    levels = parse_sizes(default if text is None else text)
+    if len(set(levels)) != len(levels):
+        raise InputError(f"--sizes {text!r} names a size twice: give each once, e.g. --sizes 0,1")
+    return levels
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
+    if args.repeat < 1:
+        raise InputError(f"--repeat {args.repeat} must be at least 1")
+    if args.default_only_from is not None and args.default_only_from < 0:
+        raise InputError(f"--default-only-from {args.default_only_from} must be a refinement "
+                         "level >= 0, e.g. --default-only-from 3")
     if args.peer:
         return _bench_peer(args)
     import math
@@ -56,7 +67,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
 
     family = get_scene(args.scene or "hertz-cylinder")
-    levels = parse_sizes(args.sizes or "0,1")
+    levels = _sizes(args.sizes, "0,1")
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
                          "e.g. --time-limit 120")

@@ -86,6 +86,13 @@ class SceneModel:
     #: what to change when the contact outgrows the candidates (signorini.adequacy)
     candidate_remedy: str = "extend the scene's contact candidates or lower the load"
 
+    def __post_init__(self) -> None:
+        """Refuse a model that cannot be assembled right (:mod:`signorini.fem.checks`): a bad
+        mesh, an obstacle that starts inside the body, units beyond double precision."""
+        from signorini.fem.checks import check_model  # it checks models: imported when one is made
+
+        check_model(self)
+
     @property
     def volumetric(self) -> str:
         """How K integrates λ (tr ε)²: ``element`` (plain P1) or ``nodal`` (signorini.fem.volumetric).

@@ -1,7 +1,14 @@
-"""Arrays a user hands in, converted or refused with the argument's name (never a NumPy traceback)."""
+"""Arrays a user hands in, converted or refused with the argument's name (never a NumPy traceback).
+
+Complex values are refused rather than cast (the cast drops the imaginary
+part with only a warning), and so are ``None`` entries (NumPy would turn them
+into NaN, or a sparse matrix into zeros).
+"""
 
 from __future__ import annotations
 
+import math
+from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -10,8 +17,32 @@ import scipy.sparse as sp
 from signorini.errors import InputError
 
 
+def _refuse_complex_or_none(value: Any, name: str) -> None:
+    """InputError when ``value`` holds complex numbers or ``None`` entries."""
+    if sp.issparse(value):
+        raw = value.data
+    else:
+        try:
+            raw = np.asarray(value)
+        except (TypeError, ValueError):  # ragged or odd: the conversion says what it is
+            return
+    if np.iscomplexobj(raw):
+        raise InputError(f"{name} must be real, got complex values: pass its real part "
+                         f"(np.real({name})) if the imaginary part is zero")
+    if raw.dtype == object:
+        flat = raw.ravel()
+        if any(v is None for v in flat):
+            where = next(i for i, v in enumerate(flat) if v is None)
+            at = tuple(int(i) for i in np.unravel_index(where, raw.shape))
+            raise InputError(f"{name} has None at entry {at if len(at) > 1 else at[0]}: "
+                             "give a number for every entry (0 where there is none)")
+        if any(isinstance(v, complex) for v in flat):
+            raise InputError(f"{name} must be real, got complex values: pass its real part")
+
+
 def sparse_argument(value: Any, name: str) -> sp.csr_matrix:
     """``value`` (a SciPy sparse matrix or a 2D array of numbers) as CSR floats, or InputError."""
+    _refuse_complex_or_none(value, name)
     try:
         matrix = sp.csr_matrix(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -24,6 +55,7 @@ def sparse_argument(value: Any, name: str) -> sp.csr_matrix:
 
 def vector_argument(value: Any, name: str) -> np.ndarray:
     """``value`` as a 1D float array, or InputError naming ``name``."""
+    _refuse_complex_or_none(value, name)
     try:
         vector = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -31,3 +63,52 @@ def vector_argument(value: Any, name: str) -> np.ndarray:
     if vector.ndim != 1:
         raise InputError(f"{name} must be a 1D array of numbers, got shape {vector.shape}")
     return vector
+
+
+def flag_argument(value: Any, name: str) -> bool:
+    """A yes-or-no argument: a bool (or NumPy's), never a string or a number taken as true."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{name}={value!r} must be True or False")
+    return bool(value)
+
+
+def multiplicity_argument(value: Any) -> float:
+    """A model's ``force_multiplicity`` (copies of it in the whole body): a finite number > 0."""
+    if isinstance(value, bool) or not isinstance(value, Real) or not (math.isfinite(value) and value > 0):
+        raise InputError(f"force_multiplicity={value!r} must be a finite number > 0: how many "
+                         "copies of the model make the whole body (1 for the whole body, 2 for a "
+                         "half model)")
+    return float(value)
+
+
+def dimension_of(N: sp.csr_matrix) -> int | None:
+    """The dimension (2 or 3) N's rows show, or None when they show neither or both.
+
+    A candidate's row holds its normal on the dofs of one node, numbered in
+    blocks of ``dim`` consecutive dofs, so its nonzeros lie in one block.
+    """
+    rows, cols = N.nonzero()
+    fits = [dim for dim in (2, 3) if N.shape[1] % dim == 0 and
+            np.all(np.diff(cols // dim)[np.diff(rows) == 0] == 0)]
+    return fits[0] if len(fits) == 1 else None
+
+
+def points_argument(value: Any, N: sp.csr_matrix) -> np.ndarray:
+    """Contact points (m, dim) for the rows of ``N`` (NaN when ``value`` is None), or InputError."""
+    m = N.shape[0]
+    if value is None:
+        return np.full((m, dimension_of(N) or 2), np.nan)
+    _refuse_complex_or_none(value, "contact_points")
+    try:
+        points = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"contact_points must be an (m, 2) or (m, 3) array of numbers, got "
+                         f"{type(value).__name__}") from None
+    if points.ndim != 2 or points.shape[0] != m or points.shape[1] not in (2, 3):
+        raise InputError(f"contact_points must have shape ({m}, 2) or ({m}, 3), one row per "
+                         f"candidate, got {points.shape}")
+    dim = dimension_of(N)
+    if dim is not None and points.shape[1] != dim:
+        raise InputError(f"contact_points have {points.shape[1]} columns but N's rows are those of a "
+                         f"{dim}D problem (each on {dim} consecutive dofs of one node): give ({m}, {dim})")
+    return points

@@ -81,7 +81,10 @@ def kkt_against_time(rows: list[dict], *, ax=None, title: str = ""):
     ax.set_xlabel("build + solve time [s]")
     ax.set_ylabel("worst relative KKT residual")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=6, ncol=2)
+    if shown:  # no run measured (every one timed out or failed): no legend to draw
+        ax.legend(fontsize=6, ncol=2)
+    else:
+        ax.text(0.5, 0.5, "no run has a measured residual", transform=ax.transAxes, ha="center")
     if title:
         ax.set_title(title, fontsize=9)
     return ax

@@ -10,10 +10,12 @@ function that turns checked parameter values into a
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
 from signorini.errors import InputError
+from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel
 from signorini.fem.volumetric import CHOICES
 
@@ -42,6 +44,9 @@ class Param:
         if isinstance(value, bool):
             raise InputError(f"scene parameter {self.name}={value!r} is not a valid "
                              f"{self.kind.__name__}: pass --set {self.name}=<{self.kind.__name__}>")
+        if isinstance(value, str) and len(value) > MAX_DIGITS:  # before int() spends time on it
+            raise InputError(f"scene parameter {self.name}={shown(value)} is too long for a number: "
+                             f"give at most {MAX_DIGITS} characters")
         try:
             if self.kind is int:
                 converted = int(value)
@@ -53,19 +58,49 @@ class Param:
                 converted = self.kind(value)
         except (TypeError, ValueError, OverflowError):
             raise InputError(
-                f"scene parameter {self.name}={value!r} is not a valid {self.kind.__name__}: "
+                f"scene parameter {self.name}={shown(value)} is not a valid {self.kind.__name__}: "
                 f"pass --set {self.name}=<{self.kind.__name__}> ({self.doc})") from None
         if isinstance(converted, float) and not math.isfinite(converted):
-            raise InputError(f"scene parameter {self.name}={value!r} must be a finite number")
-        if self.check is not None:
+            raise InputError(f"scene parameter {self.name}={shown(value)} must be a finite number")
+        problem = representable(converted)
+        if problem is None and self.check is not None:
             problem = self.check(converted)
-            if problem:
-                raise InputError(f"scene parameter {self.name}={value!r} must be {problem}")
+        if problem:
+            raise InputError(f"scene parameter {self.name}={shown(value)} must be {problem}")
         return converted
+
+
+#: the most characters a parameter's value may have (a float's repr has at most 24)
+MAX_DIGITS = 40
+#: integer parameters (counts of elements, refinements, flags) stay below 2⁵³: exact as floats
+MAX_INT = 2 ** 53
+
+
+def shown(value: Any) -> str:
+    """``value`` as a message shows it: its repr, the middle of a long one left out."""
+    text = repr(value)
+    return text if len(text) <= MAX_DIGITS else f"{text[:12]}…{text[-6:]} ({len(str(value))} characters)"
+
+
+def representable(x: Any) -> str | None:
+    """Every number a scene takes: an int exact as a float, a float zero or normal (not subnormal)."""
+    if isinstance(x, int) and abs(x) >= MAX_INT:
+        return f"less than 2^53 = {MAX_INT} in magnitude (a count of elements or refinements)"
+    if isinstance(x, float) and x != 0 and abs(x) < sys.float_info.min:
+        return (f"0 or at least {sys.float_info.min:.3g} in magnitude (a smaller value loses its "
+                "digits in double precision): choose units nearer the value")
 
 
 def positive(x: float) -> str | None:
     return None if x > 0 else "> 0"
+
+
+def length(x: float) -> str | None:
+    """A length of the scene: > 0, within :data:`LENGTH_RANGE`."""
+    lo, hi = LENGTH_RANGE
+    return None if lo <= x <= hi else (
+        f"a length in [{lo:g}, {hi:g}] (areas and volumes of the model must be representable in "
+        "double precision): choose a length unit nearer the body's size, e.g. mm or km")
 
 
 def poisson_ratio(x: float) -> str | None:
@@ -107,8 +142,45 @@ def at_least(bound: float) -> Callable[[float], str | None]:
     return lambda x: None if x >= bound else f">= {bound:g}"
 
 
+#: the largest block around a contact, in contact half-widths: the graded mesh's largest
+#: element over its smallest (about size · n_contact) squares into K's condition number
+MAX_BLOCK = 1e4
+
+
+def block_size(smallest: float) -> Callable[[float], str | None]:
+    """The check of a block's ``size`` (in contact half-widths): in [smallest, :data:`MAX_BLOCK`]."""
+    return lambda x: None if smallest <= x <= MAX_BLOCK else (
+        f"in [{smallest:g}, {MAX_BLOCK:g}] (a larger block squares the spread of its element "
+        "sizes into K's condition number; the contact sees a half-plane long before)")
+
+
 def between(lo: float, hi: float) -> Callable[[float], str | None]:
     return lambda x: None if lo < x <= hi else f"in ({lo:g}, {hi:g}]"
+
+
+#: contact half-width (radius) over the radius a Hertz scene meshes: below it the gaps over the
+#: contact, about (a/R)² R, keep fewer than 8 digits next to R; above it Hertz's half-space
+#: theory does not hold
+A_OVER_R_RANGE = (1e-4, 0.5)
+
+
+def contact_ratio(x: float) -> str | None:
+    """The check of the ``a_over_R`` parameters (:data:`A_OVER_R_RANGE`)."""
+    lo, hi = A_OVER_R_RANGE
+    return None if lo <= x <= hi else f"in [{lo:g}, {hi:g}]"
+
+
+def checked_ratio(a_over_R: float, name: str, value: float) -> float:
+    """``a_over_R`` that the load parameter ``name=value`` gives, refused outside :data:`A_OVER_R_RANGE`."""
+    lo, hi = A_OVER_R_RANGE
+    if not a_over_R <= hi:
+        raise InputError(f"scene parameter {name}={value:g} gives a/R = {a_over_R:.2f} > {hi:g}: "
+                         f"Hertz's half-space theory needs a/R small; lower {name}")
+    if not a_over_R >= lo:
+        raise InputError(f"scene parameter {name}={value:g} gives a/R = {a_over_R:.2g} < {lo:g}: "
+                         f"the gaps over so small a contact lose their digits next to R in double "
+                         f"precision; raise {name} (or choose R nearer the contact's size)")
+    return a_over_R
 
 
 @dataclass(frozen=True)
@@ -120,13 +192,25 @@ class SceneFamily:
     params: tuple[Param, ...]
     build: Callable[[dict[str, Any], set[str]], SceneModel]
     reference: str = ""
+    #: ``loads(p, given)``: the load the checked parameters set, target P (None: a push) first;
+    #: raises InputError for a load the family cannot model. Run by :meth:`parse`.
+    loads: Callable[[dict[str, Any], set[str]], tuple] | None = None
 
     def parse(self, values: dict[str, Any]) -> dict[str, Any]:
-        """Defaults overridden by ``values``; unknown names and bad values raise InputError."""
+        """Defaults overridden by ``values``; unknown names, bad values and loads the family
+        cannot model raise InputError (before any mesh is made)."""
         known = {p.name: p for p in self.params}
         unknown = sorted(set(values) - set(known))
         if unknown:
             raise InputError(
                 f"scene {self.name!r} has no parameter {unknown[0]!r}: "
                 f"--set takes {', '.join(known)}")
-        return {name: p.parse(values.get(name, p.default)) for name, p in known.items()}
+        parsed = {name: p.parse(values.get(name, p.default)) for name, p in known.items()}
+        target = self.loads(parsed, set(values))[0] if self.loads is not None else None
+        if target is not None and not sys.float_info.min <= target < math.inf:
+            given = ", ".join(f"{k}={parsed[k]:g}" for k in sorted(values)
+                              if isinstance(parsed[k], float))
+            raise InputError(f"scene {self.name!r} with {given} has a load P = {target:g} that double "
+                             "precision cannot hold: choose units in which E and the lengths are "
+                             "nearer 1 (e.g. MPa and mm)")
+        return parsed

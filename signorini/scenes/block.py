@@ -34,11 +34,11 @@ from signorini.fem.topology import facets_on
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution, Scales
-from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, poisson_ratio, positive
+from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, length, poisson_ratio, positive
 
 PARAMS = (
-    Param("W", 1.0, "half-width of the block", check=positive),
-    Param("H", 1.0, "height of the block", check=positive),
+    Param("W", 1.0, "half-width of the block", check=length),
+    Param("H", 1.0, "height of the block", check=length),
     Param("E", 1.0, "Young's modulus", check=positive),
     Param("nu", 0.3, "Poisson's ratio", check=poisson_ratio),
     VOLUMETRIC,

@@ -12,6 +12,7 @@ from typing import Any
 
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
+from signorini.numerics.arrays import flag_argument
 from signorini.problem import ContactProblem, Scales
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
@@ -76,6 +77,7 @@ def build_problem(name: str, nondimensionalise: bool = True, *, solved_by: str |
     is solved). ``solved_by`` names the method that will solve it, for the
     size guard (a method that never factorises needs less memory).
     """
+    nondimensionalise = flag_argument(nondimensionalise, "nondimensionalise")
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
                          f"{type(name).__name__}: e.g. build_problem('hertz-cylinder')")
@@ -87,6 +89,8 @@ def build_problem(name: str, nondimensionalise: bool = True, *, solved_by: str |
         check_size(name, params, solved_by)  # too big for this machine: refused before meshing
         try:
             model = family.build(params, set(values))
+        except InputError:  # the model's own checks (signorini.fem.checks): said as they are
+            raise
         except (RuntimeError, ValueError, ArithmeticError, IndexError, MemoryError) as exc:
             # the mesher gave up (too many elements, a relaxation that folded the mesh) or ran
             # out of memory: the parameters asked for a mesh it cannot make

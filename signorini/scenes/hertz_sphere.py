@@ -33,19 +33,22 @@ from signorini.scenes.base import (
     SceneFamily,
     at_least,
     between,
+    checked_ratio,
+    contact_ratio,
+    length,
     poisson_ratio,
     positive,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on
 
 COMMON_PARAMS = (
-    Param("R", 1.0, "sphere radius", check=positive),
+    Param("R", 1.0, "sphere radius", check=length),
     Param("E", 1.0, "Young's modulus", check=positive),
     Param("nu", 0.3, "Poisson's ratio", check=poisson_ratio),
     VOLUMETRIC,
     Param("P", None, "total load on the sphere (exclusive with a_over_R, delta)", check=positive),
     Param("a_over_R", 0.05, "contact radius over sphere radius: sets P by Hertz's formula",
-          check=between(0.0, 0.5)),
+          check=contact_ratio),
     Param("delta", None, "prescribed downward displacement of the centre cut (no load targeting)",
           check=positive),
 )
@@ -76,17 +79,9 @@ def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float
                          "give only one of P, a_over_R, delta")
     R, E_star = p["R"], contact_modulus(p["E"], p["nu"])
     if "delta" in chosen:
-        a_over_R = float(np.sqrt(p["delta"] / R))
-        if a_over_R > 0.5:
-            raise InputError(f"scene parameter delta={p['delta']:g} gives a/R ≈ {a_over_R:.2f} > 0.5: "
-                             "Hertz's half-space theory needs a/R small; lower delta")
-        return None, a_over_R
+        return None, checked_ratio(float(np.sqrt(p["delta"] / R)), "delta", p["delta"])
     if "P" in chosen:
-        a_over_R = hertz_sphere_radius(p["P"], R, E_star) / R
-        if a_over_R > 0.5:
-            raise InputError(f"scene parameter P={p['P']:g} gives a/R = {a_over_R:.2f} > 0.5: "
-                             "Hertz's half-space theory needs a/R small; lower P")
-        return p["P"], a_over_R
+        return p["P"], checked_ratio(hertz_sphere_radius(p["P"], R, E_star) / R, "P", p["P"])
     return hertz_sphere_load(p["a_over_R"] * R, R, E_star), p["a_over_R"]
 
 
@@ -125,4 +120,4 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
 FAMILY = SceneFamily(
     name="hertz-sphere",
     summary="elastic sphere on a rigid flat, axisymmetric (r, z) model graded to the contact",
-    params=PARAMS, build=build, reference="hertz-3d")
+    params=PARAMS, build=build, loads=load_choice, reference="hertz-3d")

@@ -100,4 +100,4 @@ FAMILY = SceneFamily(
     name="hertz-sphere-3d",
     summary="elastic sphere on a rigid flat, 3D quarter model (two symmetry planes) "
             "graded to the contact",
-    params=PARAMS, build=build, reference="hertz-3d")
+    params=PARAMS, build=build, loads=load_choice, reference="hertz-3d")

@@ -26,6 +26,8 @@ from signorini.scenes.relax import relax
 log = logging.getLogger(__name__)
 
 MAX_PASSES = 40
+#: the most triangles a graded 2D mesh may reach (before any uniform refinement)
+MAX_TRIANGLES = 400_000
 
 
 def longest_edges(mesh: MeshTri) -> np.ndarray:
@@ -37,7 +39,7 @@ def longest_edges(mesh: MeshTri) -> np.ndarray:
 
 def refine_to_size(mesh: MeshTri, target: Callable[[np.ndarray], np.ndarray],
                    snap: Callable[[MeshTri], MeshTri] | None = None,
-                   max_elements: int = 400_000) -> MeshTri:
+                   max_elements: int = MAX_TRIANGLES) -> MeshTri:
     """Refine ``mesh`` until every element's longest edge is ≤ ``target(centroid)``."""
     for _ in range(MAX_PASSES):
         centroids = mesh.p[:, mesh.t].mean(axis=1)

@@ -34,7 +34,17 @@ from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
 from signorini.fem.topology import facets_on
-from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import (
+    VOLUMETRIC,
+    Param,
+    SceneFamily,
+    at_least,
+    between,
+    block_size,
+    length,
+    poisson_ratio,
+    positive,
+)
 from signorini.scenes.meshing import distance_to_segment, refine_to_size
 
 
@@ -51,10 +61,10 @@ def _flag(k: int) -> str | None:
 
 
 PARAMS = (
-    Param("a", 1.0, "half-width of the punch's flat face", check=positive),
+    Param("a", 1.0, "half-width of the punch's flat face", check=length),
     Param("corner_radius", 0.0, "radius of the punch's rounded corners (0: sharp)",
           check=_non_negative),
-    Param("size", 20.0, "block half-width and height in units of a", check=at_least(2.0)),
+    Param("size", 20.0, "block half-width and height in units of a", check=block_size(2.0)),
     Param("E", 1.0, "Young's modulus of the block", check=positive),
     Param("nu", 0.3, "Poisson's ratio of the block", check=poisson_ratio),
     VOLUMETRIC,
@@ -173,15 +183,20 @@ def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidat
         target_load=target, params=params)
 
 
+def checked_load(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
+    """:func:`load_choice` for the punch's half-width, once the corners fit in the block."""
+    if p["corner_radius"] > 0.5 * p["size"] * p["a"]:
+        raise InputError(f"scene parameter corner_radius={p['corner_radius']:g} must be less than "
+                         f"half the block (size · a / 2 = {0.5 * p['size'] * p['a']:g})")
+    return load_choice(p, given, p["a"])
+
+
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The punch scene in physical units."""
     given = set() if given is None else given
     a, r = p["a"], p["corner_radius"]
-    target, delta = load_choice(p, given, a)
+    target, delta = checked_load(p, given)
     E_star = contact_modulus(p["E"], p["nu"])
-    if r > 0.5 * p["size"] * a:
-        raise InputError(f"scene parameter corner_radius={r:g} must be less than half the block "
-                         f"(size · a / 2 = {0.5 * p['size'] * a:g})")
     zone = 1.0 + r / a
     mesh = graded_half_block(p["size"], p["size"], zone, p["n_contact"], p["grading"], p["refine"])
     if not p["half"]:
@@ -201,4 +216,4 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
 FAMILY = SceneFamily(
     name="punch",
     summary="rigid flat punch (sharp or rounded corners) pressed into an elastic block, plane strain",
-    params=PARAMS, build=build, reference="punch")
+    params=PARAMS, build=build, loads=checked_load, reference="punch")

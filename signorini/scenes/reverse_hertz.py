@@ -24,25 +24,37 @@ from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle
-from signorini.scenes.base import VOLUMETRIC, Param, SceneFamily, at_least, between, poisson_ratio, positive
+from signorini.scenes.base import (
+    VOLUMETRIC,
+    Param,
+    SceneFamily,
+    at_least,
+    between,
+    block_size,
+    checked_ratio,
+    contact_ratio,
+    length,
+    poisson_ratio,
+    positive,
+)
 from signorini.scenes.punch import bottom_contact_model, graded_half_block, mirrored_about_x0
 
 #: the mesh is uniformly fine on the bottom up to this multiple of the half-width
 FINE_END = 1.25
 
 PARAMS = (
-    Param("R", 1.0, "radius of the rigid cylinder", check=positive),
+    Param("R", 1.0, "radius of the rigid cylinder", check=length),
     Param("E", 1.0, "Young's modulus of the block", check=positive),
     Param("nu", 0.3, "Poisson's ratio of the block", check=poisson_ratio),
     VOLUMETRIC,
     Param("P", None, "vertical load per unit thickness of the whole block "
           "(exclusive with a_over_R, delta)", check=positive),
     Param("a_over_R", 0.02, "contact half-width over radius: sets P by Hertz's formula "
-          "(with delta: only sizes the mesh)", check=between(0.0, 0.5)),
+          "(with delta: only sizes the mesh)", check=contact_ratio),
     Param("delta", None, "prescribed downward displacement of the top (no load targeting)",
           check=positive),
     Param("size", 20.0, "block half-width and height in units of the half-width a",
-          check=at_least(4.0)),
+          check=block_size(4.0)),
     Param("n_contact", 128, "elements across the contact half-width (rounded up to a power of two)",
           kind=int, check=at_least(4)),
     Param("grading", 0.3, "growth of the element size with distance from the contact zone",
@@ -66,10 +78,7 @@ def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float
     if "delta" in chosen:
         return None, p["delta"], p["a_over_R"]
     if "P" in chosen:
-        a_over_R = hertz_cylinder_half_width(p["P"], R, E_star) / R
-        if a_over_R > 0.5:
-            raise InputError(f"scene parameter P={p['P']:g} gives a/R = {a_over_R:.2f} > 0.5: "
-                             "Hertz's half-space theory needs a/R small; lower P")
+        a_over_R = checked_ratio(hertz_cylinder_half_width(p["P"], R, E_star) / R, "P", p["P"])
         return p["P"], None, a_over_R
     return hertz_cylinder_load(p["a_over_R"] * R, R, E_star), None, p["a_over_R"]
 
@@ -98,4 +107,4 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
 FAMILY = SceneFamily(
     name="reverse-hertz",
     summary="elastic block pressed onto a rigid cylinder (a curved obstacle), plane strain",
-    params=PARAMS, build=build, reference="reverse-hertz")
+    params=PARAMS, build=build, loads=load_choice, reference="reverse-hertz")

@@ -39,8 +39,7 @@ on them::
     multiplicity = 2.0          # copies of the model in the whole body
     target = 0.02               # optional: scale the prescribed displacements to this load
 
-Errors name the file, the table and key, and the line when it can be found
-(TOML syntax errors always carry their line).
+Errors name the file, the table, key and line (a TOML syntax error always has its line).
 """
 
 from __future__ import annotations
@@ -57,10 +56,11 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.fem.checks import check_mesh
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery
 from signorini.fem.volumetric import CHOICES
-from signorini.scenes.base import poisson_ratio
+from signorini.scenes.base import length, poisson_ratio
 from signorini.scenes.families import SCENES
 
 if sys.version_info >= (3, 11):
@@ -146,6 +146,8 @@ def read_scene_file(path: str | Path) -> tuple[dict[str, Any], _Context]:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"scene file {path}: invalid TOML: {exc}") from None
+    except RecursionError:  # tomllib parses nested arrays and tables by recursion
+        raise InputError(f"scene file {path}: arrays or tables nested too deeply to read") from None
     return data, _Context(path, _Locator(text))
 
 
@@ -310,6 +312,7 @@ def read_mesh(path: str | Path) -> MeshWithBoundaries:
         raise InputError(f"mesh file {path} has no triangles (cells: {', '.join(kinds) or 'none'}): "
                          "mesh the surface with 3-node triangles")
     t = np.vstack(triangles)
+    check_mesh(points.T, t.T, f"mesh file {path} (nodes counted from 0 in the file's order)")
     used = np.unique(t)
     renumber = np.full(points.shape[0], -1)
     renumber[used] = np.arange(used.size)
@@ -444,6 +447,9 @@ def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) 
     mesh = mesh_info.mesh
     extent = float(np.ptp(mesh.p, axis=1).max())
     length_scale = _number(ctx, "mesh", mesh_table, "length_scale", default=extent, positive=True)
+    if length(length_scale):  # given, or the mesh's extent
+        key = "length_scale" if "length_scale" in mesh_table else "file"
+        raise ctx.error(f"the length {length_scale:g} must be {length(length_scale)}", "mesh", key)
 
     E = _number(ctx, "material", material, "E", positive=True)
     nu = _number(ctx, "material", material, "nu")
@@ -482,9 +488,12 @@ def _mesh_scene(data: dict[str, Any], ctx: _Context, overrides: dict[str, Any]) 
                         "component to scale", "load", "target")
     params = {"file": str(ctx.path), "mesh": str(mesh_path), "E": E, "nu": nu, "P": target,
               "length_scale": length_scale, "multiplicity": multiplicity, "volumetric": volumetric}
-    return SceneModel(
-        mesh=mesh, E=E, nu=nu, dirichlet=dirichlet, contact_nodes=candidates,
-        contact_facets=facets,
-        obstacle=ScaledQuery(obstacle, mesh.p[:, candidates].T, length_scale),
-        load_dofs=(component, load_nodes), length_scale=length_scale,
-        force_multiplicity=multiplicity, target_load=target, params=params)
+    try:  # the model's own checks (signorini.fem.checks), said about the file
+        return SceneModel(
+            mesh=mesh, E=E, nu=nu, dirichlet=dirichlet, contact_nodes=candidates,
+            contact_facets=facets,
+            obstacle=ScaledQuery(obstacle, mesh.p[:, candidates].T, length_scale),
+            load_dofs=(component, load_nodes), length_scale=length_scale,
+            force_multiplicity=multiplicity, target_load=target, params=params)
+    except InputError as exc:
+        raise ctx.error(str(exc), "obstacle" if "obstacle" in str(exc) else None) from None

@@ -41,11 +41,13 @@ import os
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from signorini.errors import InputError
 from signorini.fem.volumetric import resolve
 from signorini.numerics.factor import gigabytes_from
-from signorini.scenes.meshing import MAX_ELEMENTS
 from signorini.numerics.multigrid import AMG_FROM_DOFS
+from signorini.scenes.meshing import MAX_ELEMENTS, MAX_TRIANGLES
 
 #: the environment variable that raises (or lowers) the memory a scene may take, in GB
 MEMORY_VARIABLE = "SIGNORINI_MAX_MEMORY_GB"
@@ -57,6 +59,13 @@ BYTES_PER_DOF_3D_PUSHED = 5_000
 FILL_GROWS_FROM = 350_000
 #: tetrahedra per dof of the 3D octant's meshes (664,768 at 351,076 dofs, hertz-sphere-3d refine=2)
 TETRAHEDRA_PER_DOF = 1.9
+#: elements per dof of the graded meshes: a triangle mesh has about twice as many triangles as
+#: nodes, one per dof
+ELEMENTS_PER_DOF = {2: 1.0, 3: TETRAHEDRA_PER_DOF}
+#: the estimate a graded mesh may reach: the 3D mesher's limit; twice the 2D mesher's (the
+#: estimate is within a factor 1.5, and the last refinement pass may overshoot the limit)
+GRADED_LIMIT = {2: 2 * MAX_TRIANGLES, 3: MAX_ELEMENTS}
+ELEMENT_NAMES = {2: "triangles", 3: "tetrahedra"}
 #: peak memory with the volumetric strain averaged at the nodes over plain P1, same scene and
 #: default method, measured here at ν = 0.45: 1.75 GB against 0.79 GB for hertz-cylinder
 #: refine=3 (297,984 dofs), 1.41 GB against 0.54 GB for hertz-sphere-3d refine=1 (46,964 dofs)
@@ -107,15 +116,19 @@ class SizeModel:
         return 300.0 if self.dim == 2 else 1000.0
 
     def estimate(self, p: dict[str, Any]) -> float:
-        dofs = (self.dofs - self.far_field) * (p["n_contact"] / self.n_contact) ** self.alpha
-        dofs *= (self.grading / p["grading"]) ** self.beta
-        if self.a_over_R is not None and p.get("a_over_R") is not None \
-                and p["a_over_R"] < self.a_over_R:
-            dofs *= 1.0 + 0.25 * math.log(self.a_over_R / p["a_over_R"])
-        dofs += self.far_field
-        if self.uniform is not None:  # no finer than uniform at the contact's element size
-            dofs = min(dofs, self.uniform * (p["n_contact"] / p.get("a_over_R", 1.0)) ** self.dim)
-        return dofs * 2.0 ** (self.dim * p.get("refine", 0))
+        """The dofs of a mesh with checked parameters ``p``: inf where they overflow a float
+        (the size check then refuses them, naming the mesh parameters)."""
+        with np.errstate(over="ignore", divide="ignore"):  # an overflow is an infinite estimate
+            dofs = (self.dofs - self.far_field) * (np.float64(p["n_contact"]) / self.n_contact) ** self.alpha
+            dofs *= (self.grading / np.float64(p["grading"])) ** self.beta
+            if self.a_over_R is not None and p.get("a_over_R") is not None \
+                    and p["a_over_R"] < self.a_over_R:
+                dofs *= 1.0 + 0.25 * math.log(self.a_over_R / p["a_over_R"])
+            dofs += self.far_field
+            if self.uniform is not None:  # no finer than uniform at the contact's element size
+                dofs = min(dofs, self.uniform
+                           * (np.float64(p["n_contact"]) / p.get("a_over_R", 1.0)) ** self.dim)
+            return float(dofs * 2.0 ** (self.dim * p.get("refine", 0)))
 
 
 #: measured at each family's defaults (signorini commit 66f74ea: hertz-cylinder 4,866 dofs,
@@ -161,13 +174,27 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
     if found is None:
         return
     dofs, dim = found
-    graded = dofs / 2.0 ** (dim * params.get("refine", 0)) * TETRAHEDRA_PER_DOF
-    if dim == 3 and graded > MAX_ELEMENTS:
+    if dim == 3:  # the mesher's limit first (as the tetrahedra reach it long before memory)
+        _check_graded(family, params, dofs, dim)
+    _check_memory(family, params, dofs, dim, solved_by)
+    _check_graded(family, params, dofs, dim)
+
+
+def _check_graded(family: str, params: dict[str, Any], dofs: float, dim: int) -> None:
+    """InputError when the graded mesh, before uniform refinement, exceeds the mesher's limit."""
+    graded = dofs / 2.0 ** (dim * params.get("refine", 0)) * ELEMENTS_PER_DOF[dim]
+    if "grading" in params and graded > GRADED_LIMIT[dim]:
         raise InputError(
             f"scene {family!r} with grading={params['grading']:g}, n_contact={params['n_contact']:g} "
-            f"would be graded to about {graded:,.0f} tetrahedra before any uniform refinement, "
-            f"over the mesher's {MAX_ELEMENTS:,}: make the grading larger or n_contact smaller, "
+            f"would be graded to about {graded:,.0f} {ELEMENT_NAMES[dim]} "
+            f"({graded / ELEMENTS_PER_DOF[dim]:,.0f} dofs) before any uniform refinement, over "
+            f"the mesher's {GRADED_LIMIT[dim]:,}: make the grading larger or n_contact smaller, "
             "and refine (refine=1, 2...) to go finer")
+
+
+def _check_memory(family: str, params: dict[str, Any], dofs: float, dim: int,
+                  solved_by: str | None) -> None:
+    """InputError when building and solving the scene would exceed :func:`memory_limit`."""
     need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
     if need <= limit:
         return
@@ -177,8 +204,9 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
         f"scene {family!r} with {mesh} would have about {dofs:,.0f} dofs and take about "
         f"{need / 1e9:,.1f} GB to build and solve, over the limit of {limit / 1e9:,.1f} GB "
         f"(¾ of this machine's memory unless {MEMORY_VARIABLE} says otherwise): make the mesh "
-        f"coarser ({', '.join(names)}), or raise the limit, e.g. "
-        f"{MEMORY_VARIABLE}={math.ceil(need / 1e9) + 1}" + _push_hint(dim, dofs, params, limit))
+        f"coarser ({', '.join(names)})" + (f", or raise the limit, e.g. {MEMORY_VARIABLE}="
+                                          f"{math.ceil(need / 1e9) + 1}" if math.isfinite(need) else "")
+        + _push_hint(dim, dofs, params, limit))
 
 
 def _push_hint(dim: int, dofs: float, params: dict[str, Any], limit: float) -> str:

@@ -64,6 +64,10 @@ RUN_COLUMNS = ("method", "label", "tol", "status", "claimed_status", "message", 
                "case", "scene", "dofs", "candidates")
 SKIPPED_COLUMNS = ("method", "label", "tol", "status", "message", "time_s", "kkt_worst", "case",
                    "scene", "dofs", "candidates")
+#: what a run that stopped before it was measured (a timeout, a crash) shows in the measured columns
+UNMEASURED = {"build_s": float("nan"), "solve_s": float("nan"),
+              "kkt": {}, "kkt_worst": float("nan"), "vs_reference": {}, "dofs": float("nan"),
+              "candidates": float("nan")}
 
 #: the claims the suite checks, with their limits
 LIMITS = {
@@ -165,8 +169,9 @@ def case_tasks(case: Case, chosen: list[Method]) -> list[Task]:
 
 
 def suite_row(row: Row, case: Case | None = None) -> Row:
-    """A runner row as the report writes a run (:data:`RUN_COLUMNS`); a refusal is ``skipped``."""
-    values = dict(row, label=row["value"])
+    """A runner row as the report writes a run (:data:`RUN_COLUMNS`); a refusal is ``skipped``,
+    and a run stopped before it was measured has :data:`UNMEASURED` in the measured columns."""
+    values = {**UNMEASURED, **row, "label": row["value"]}
     if case is not None:
         values.update(case=case.name, scene=case.scene)
     if row["status"] == "refused":  # e.g. a dense backend refusing a large problem

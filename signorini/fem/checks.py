@@ -1,0 +1,242 @@
+"""What every scene model is checked for before assembly: its mesh, its obstacle and its units.
+
+A mesh (triangles in 2D, tetrahedra in 3D) is refused, with the first bad
+element named by its index and its nodes, when
+
+- a node has a non-finite coordinate, or an element names a node it does not have;
+- an element is **degenerate**: its area (volume) is at most
+  :data:`DEGENERATE` times its longest edge squared (cubed), which includes
+  an element with a repeated node;
+- two elements are the **same** (the same nodes in any order);
+- a facet (an edge in 2D, a face in 3D) bounds **more than two** elements
+  (the mesh is not a manifold there);
+- two elements that share a facet lie on the **same side** of it: one of
+  them is folded over the other (an inverted element among its neighbours).
+
+Orientation: scikit-fem integrates every element with ``|det J|``, so the
+order of an element's nodes (clockwise or not) is no convention of this
+package and is accepted either way; what matters is that neighbours lie on
+opposite sides of their shared facet, which the last check holds. Together
+these catch duplicated, degenerate, inverted-in-place and folded elements.
+They do not catch two parts of a mesh that overlap without sharing a facet
+(two separate layers laid on top of each other): that needs a search of
+every pair of nearby elements, which no scene here makes.
+
+The obstacle must start outside the undeformed body: no contact candidate
+may have a gap below ``-OUTSIDE · length_scale``, and at every candidate on
+a contact facet the obstacle's normal (from the body towards the obstacle)
+must not point into the body. The units must be representable: the force
+unit ``E · U · L^k`` and the weight unit ``L^(k+1)`` of
+:class:`~signorini.problem.Scales`, and a target load, finite and normal.
+"""
+
+from __future__ import annotations
+
+import sys
+from itertools import combinations
+from typing import Any
+
+import numpy as np
+
+from signorini.errors import InputError
+from signorini.fem.topology import _packed, with_topology
+
+#: an element whose measure is at most this times its longest edge to the dimension is degenerate
+DEGENERATE = 1e-12
+#: the range of a length (and of a mesh's coordinates): squares and cubes stay representable
+LENGTH_RANGE = (1e-100, 1e100)
+#: a candidate's gap below minus this times the length scale: the obstacle starts inside the body
+OUTSIDE = 1e-8
+#: a candidate whose obstacle normal has at most this component along the body's outward
+#: normal faces away from the obstacle
+FACING = -1e-6
+NAMES = {2: ("triangle", "area", "edge"), 3: ("tetrahedron", "volume", "face")}
+PLURAL = {"triangle": "triangles", "tetrahedron": "tetrahedra"}
+
+
+def _nodes(t: np.ndarray, element: int) -> str:
+    return ", ".join(str(int(n)) for n in t[:, element])
+
+
+def signed_measures(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """``det[p₁ − p₀, …, p_d − p₀]`` of each simplex (d! times its signed area or volume)."""
+    rows = np.ascontiguousarray(p.T)  # gathering rows is several times faster than columns
+    origin = rows[t[0]]
+    edges = [rows[t[i]] - origin for i in range(1, t.shape[0])]
+    if len(edges) == 2:
+        return edges[0][:, 0] * edges[1][:, 1] - edges[0][:, 1] * edges[1][:, 0]
+    return np.einsum("ij,ij->i", edges[0], np.cross(edges[1], edges[2]))
+
+
+def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> None:
+    """InputError naming the first bad element of the simplex mesh ``(p, t)`` (see the module)."""
+    p, t = np.asarray(p, dtype=float), np.asarray(t)
+    dim = p.shape[0]
+    kind, measure, facet = NAMES.get(dim, ("element", "measure", "facet"))
+    if dim not in NAMES or t.shape[0] != dim + 1:
+        raise InputError(f"{what} must be made of {dim + 1}-node simplices in 2D or 3D, got "
+                         f"{t.shape[0]}-node elements in {dim}D")
+    bad = ~np.all(np.isfinite(p), axis=0)
+    if np.any(bad):
+        raise InputError(f"{what}: node {int(np.argmax(bad))} has a non-finite coordinate: "
+                         "give every node finite coordinates")
+    largest = float(np.max(np.abs(p), initial=0.0))
+    if largest > LENGTH_RANGE[1]:
+        raise InputError(f"{what}: its coordinates reach {largest:g}, beyond {LENGTH_RANGE[1]:g} "
+                         "(areas and volumes must be representable in double precision): choose a "
+                         "length unit nearer the body's size")
+    if t.size and (t.min() < 0 or t.max() >= p.shape[1]):
+        element = int(np.argmax(np.any((t < 0) | (t >= p.shape[1]), axis=0)))
+        raise InputError(f"{what}: {kind} {element} (nodes {_nodes(t, element)}) names a node the "
+                         f"mesh does not have (it has {p.shape[1]})")
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is a degenerate element
+        rows = np.ascontiguousarray(p.T)
+        longest = np.max([np.linalg.norm(rows[t[i]] - rows[t[j]], axis=1)
+                          for i, j in combinations(range(dim + 1), 2)], axis=0)
+        volume = signed_measures(p, t)
+        degenerate = ~(np.abs(volume) > DEGENERATE * longest ** dim)
+    if np.any(degenerate):
+        element = int(np.argmax(degenerate))
+        raise InputError(f"{what}: {kind} {element} (nodes {_nodes(t, element)}) has zero {measure} "
+                         f"(its nodes lie on one {'line' if dim == 2 else 'plane'}): remove it or "
+                         "move its nodes apart")
+    _check_duplicates(t, what, kind)
+    _check_facets(p, t, what, kind, facet)
+
+
+def _first_equal_neighbours(keys: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The order sorting the columns of ``keys`` (node indices below ``count``) and where a
+    sorted column equals the next: one int64 per column where they fit, else a lexsort."""
+    packed = _packed(keys, count)
+    if packed is None:
+        order = np.lexsort(keys[::-1])
+        ordered = keys[:, order]
+        return order, np.all(ordered[:, 1:] == ordered[:, :-1], axis=0)
+    order = np.argsort(packed)
+    ordered = packed[order]
+    return order, ordered[1:] == ordered[:-1]
+
+
+def _check_duplicates(t: np.ndarray, what: str, kind: str) -> None:
+    order, same = _first_equal_neighbours(np.sort(t, axis=0), t.max(initial=0) + 1)
+    if np.any(same):
+        k = int(np.argmax(same))
+        first, second = sorted((int(order[k]), int(order[k + 1])))
+        raise InputError(f"{what}: {PLURAL[kind]} {first} and {second} are the same {kind} (nodes "
+                         f"{_nodes(t, first)}): remove one of them")
+
+
+def _check_facets(p: np.ndarray, t: np.ndarray, what: str, kind: str, facet: str) -> None:
+    """At most two elements on a facet, and two on either side of it."""
+    corners = t.shape[0]
+    local = [[i for i in range(corners) if i != j] for j in range(corners)]
+    nodes = np.sort(np.hstack([t[f] for f in local]), axis=0)  # (dim, corners · elements)
+    opposite = np.concatenate([t[j] for j in range(corners)])
+    element = np.tile(np.arange(t.shape[1]), corners)
+    order, same = _first_equal_neighbours(nodes, p.shape[1])
+    if same.size == 0:
+        return
+    shared = same[1:] & same[:-1]  # three in a row
+    if np.any(shared):
+        k = int(np.argmax(shared))
+        owners = sorted(int(element[order[i]]) for i in range(k, k + 3))
+        raise InputError(f"{what}: the {facet} (nodes {', '.join(map(str, nodes[:, order[k]]))}) "
+                         f"bounds {PLURAL[kind]} {', '.join(map(str, owners))}, more than two: the mesh "
+                         "overlaps itself there; remesh it")
+    pairs = np.nonzero(same)[0]
+    first, second = order[pairs], order[pairs + 1]
+    base = nodes[:, first]  # the shared facet's nodes, sorted: one orientation for both sides
+    side = [np.sign(signed_measures(p, np.vstack([base, opposite[which]])))
+            for which in (first, second)]
+    folded = side[0] == side[1]
+    if np.any(folded):
+        k = int(np.argmax(folded))
+        a, b = sorted((int(element[first[k]]), int(element[second[k]])))
+        raise InputError(f"{what}: {PLURAL[kind]} {a} and {b} overlap: they lie on the same side of "
+                         f"their shared {facet} (nodes {', '.join(map(str, base[:, k]))}), so the "
+                         "mesh is folded there (an inverted element); remesh it or move its nodes")
+
+
+def _outward_normals(mesh: Any, facets: np.ndarray) -> np.ndarray:
+    """Unit normals (facets, dim) of boundary ``facets`` pointing out of the body."""
+    mesh = with_topology(mesh)
+    p = mesh.p
+    corners = p[:, mesh.facets[:, facets]]  # (dim, facet nodes, facets)
+    if p.shape[0] == 2:
+        edge = corners[:, 1] - corners[:, 0]
+        normal = np.vstack([edge[1], -edge[0]])
+    else:
+        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0], axis=0)
+    inside = p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
+    normal *= np.where(np.einsum("ij,ij->j", normal, corners.mean(axis=1) - inside) < 0, -1.0, 1.0)
+    return (normal / np.linalg.norm(normal, axis=0)).T
+
+
+def check_obstacle_outside(model: Any) -> None:
+    """InputError when the obstacle starts inside the undeformed body (see the module)."""
+    nodes = np.asarray(model.contact_nodes)
+    if nodes.size == 0:
+        return
+    points = model.mesh.p[:, nodes].T
+    normals, gaps = model.obstacle.normals_and_gaps(points)
+    normals, gaps = np.asarray(normals, dtype=float), np.asarray(gaps, dtype=float)
+    if not np.all(np.isfinite(gaps)):
+        i = int(np.argmax(~np.isfinite(gaps)))
+        raise InputError(f"the obstacle gives contact candidate {i} (node {nodes[i]}) the gap "
+                         f"{gaps[i]:g}: give an obstacle with a finite distance to the body")
+    inside = gaps < -OUTSIDE * model.length_scale
+    if np.any(inside):
+        i = int(np.argmin(gaps))
+        raise InputError(f"the obstacle starts inside the body: contact candidate {i} (node "
+                         f"{nodes[i]}, at {_at(points[i])}) is {-gaps[i]:g} inside it; move the "
+                         "obstacle out of the undeformed body (every initial gap must be >= 0)")
+    facets = np.asarray(model.contact_facets)
+    if facets.size == 0:
+        return
+    outward = np.zeros_like(model.mesh.p.T)
+    facet_normals = _outward_normals(model.mesh, facets)
+    for row in model.mesh.facets[:, facets]:
+        np.add.at(outward, row, facet_normals)
+    along = np.einsum("ij,ij->i", normals, outward[nodes])
+    away = along < FACING * np.linalg.norm(outward[nodes], axis=1)
+    if np.any(away):
+        i = int(np.argmax(away))
+        raise InputError(f"the obstacle lies on the body's side of contact candidate {i} (node "
+                         f"{nodes[i]}, at {_at(points[i])}): its normal there points into the body, "
+                         "so the obstacle starts inside it (or the candidates face away from it); "
+                         "move the obstacle outside the undeformed body, facing the candidates")
+
+
+def _at(point: np.ndarray) -> str:
+    return "(" + ", ".join(f"{c:g}" for c in point) + ")"
+
+
+def _normal(value: float) -> bool:
+    return bool(np.isfinite(value) and abs(value) >= sys.float_info.min)
+
+
+def check_units(model: Any) -> None:
+    """InputError when the model's units or load are not representable (see the module)."""
+    k = 1 if (model.axisymmetric or model.mesh.p.shape[0] == 3) else 0
+    L, E = float(model.length_scale), float(model.E)
+    U = max((abs(float(v)) for _, nodes, v in model.dirichlet if len(nodes)), default=0.0) or L
+    with np.errstate(over="ignore", under="ignore"):  # what is not representable is refused below
+        units = {"length scale L": L, "modulus E": E, "displacement unit U": U,
+                 "force unit E·U·L^k": E * U * np.float64(L) ** k,
+                 "weight unit L^(k+1)": np.float64(L) ** (k + 1)}
+    if model.target_load is not None:
+        units["target load"] = float(model.target_load)
+    for name, value in units.items():
+        if not _normal(value):
+            given = ", ".join(f"{key}={v:g}" for key, v in model.params.items()
+                              if isinstance(v, float))
+            raise InputError(f"the scene's {name} = {value:g} is not representable in double "
+                             f"precision (from {given or 'its parameters'}): choose units in "
+                             "which E, the lengths and the load are nearer 1 (e.g. MPa and mm)")
+
+
+def check_model(model: Any) -> None:
+    """Every check of this module on a :class:`~signorini.fem.model.SceneModel`."""
+    check_mesh(model.mesh.p, model.mesh.t)
+    check_units(model)
+    check_obstacle_outside(model)
