@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from signorini.errors import BackendNotInstalled, InputError
+from signorini.fingerprint import fingerprint, held_to_problem
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol,
@@ -130,6 +131,7 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     given = problem
     if problem.pending and not spec.targets_load:
         problem = problem.matched()  # the target load first (factorised), then the method
+    before = fingerprint(problem)
     try:
         solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
     except InputError:
@@ -144,6 +146,7 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
             method, problem, "failed", f"the method called sys.exit({exc.code!r})",
             solve_time=time.perf_counter() - start)
     solution = hold_to_contract(problem, method, solution)
+    solution = held_to_problem(problem, before, solution, method, may_push=spec.targets_load)
     if solution.problem is None and problem is not given:
         solution.problem = problem
     problem = solution.problem if solution.problem is not None else problem
