@@ -1,7 +1,9 @@
 """KKT certificates, active sets and comparisons: computed here, never by a solver.
 
 For ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with multipliers ``λ`` every residual is
-relative, so that the same threshold means the same thing in any units.
+relative, so that the same threshold means the same thing in any units; the forward
+error of λ itself comes from one Newton correction on the active set
+(:mod:`signorini.forward_error`, docs/certificate.md).
 """
 
 from __future__ import annotations
@@ -11,7 +13,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.forward_error import ForwardError, forward_error
 from signorini.numerics.factor import selection_dofs
+from signorini import problem as problem_module
 from signorini.problem import ContactProblem, ContactSolution
 
 #: normalised force and gap below which a node counts as touching with zero force
@@ -19,6 +23,11 @@ WEAK_TOL = 1e-6
 #: forces are judged against max(‖λ‖∞, FORCE_FLOOR · ‖f‖∞): with no contact at all,
 #: λ is round-off and relative measures against ‖λ‖∞ alone would be meaningless
 FORCE_FLOOR = 1e-5
+#: ... unless the candidate carrying the largest force touches the obstacle and that force
+#: is above this fraction of ‖f‖∞ (450 ε): then it is a contact force, judged against itself.
+#: A load lifted from a prescribed displacement can be 10¹¹ times the contact forces
+#: (ν → ½), and against FORCE_FLOOR · ‖f‖∞ every force there would count as zero
+FORCE_ROUNDOFF = 1e-13
 #: a factorisation offered to the certificate is one of the problem's K when ``K x`` by both
 #: agrees to this (relative, for a fixed random x: the two sum in different orders)
 SAME_MATRIX_RTOL = 1e-12
@@ -36,9 +45,21 @@ def _positive(x: float) -> float:
     return x if x > 0 else 1.0
 
 
-def force_scale(problem: ContactProblem, lam: np.ndarray) -> float:
-    """``max(‖λ‖∞, FORCE_FLOOR · ‖f‖∞)``: the force against which forces are judged."""
-    return _positive(max(_inf_norm(lam), FORCE_FLOOR * _inf_norm(problem.f)))
+def force_scale(problem: ContactProblem, lam: np.ndarray, u: np.ndarray | None = None) -> float:
+    """``max(‖λ‖∞, FORCE_FLOOR · ‖f‖∞)``: the force against which forces are judged.
+
+    With ``u`` given, ``‖λ‖∞`` alone when the candidate carrying the largest force
+    touches (its gap within :data:`WEAK_TOL` of the gap scale) and that force is
+    above ``FORCE_ROUNDOFF · ‖f‖∞``: a contact force is never floored by a load
+    that does not reach the contact (see :data:`FORCE_ROUNDOFF`).
+    """
+    norm, load = _inf_norm(lam), _inf_norm(problem.f)
+    if u is not None and lam.size and norm > FORCE_ROUNDOFF * load and np.all(np.isfinite(u)):
+        top = int(np.argmax(np.abs(lam)))
+        gap = float(problem.d[top] - (problem.N[top] @ u)[0])
+        if lam[top] > 0 and gap <= WEAK_TOL * gap_scale(problem, u):
+            return norm
+    return _positive(max(norm, FORCE_FLOOR * load))
 
 
 def gap_scale(problem: ContactProblem, u: np.ndarray) -> float:
@@ -73,9 +94,20 @@ class Certificate:
       good as ``λ⁺``: a bound on how far the energy of ``u`` is above the
       optimum (see :func:`primal_dual_gap`, which reuses the method's own
       factorisation of K: one back-solve, no factorisation).
+    - ``force_error``: ``‖λ − λ*‖∞ / ‖λ‖∞`` with ``(u*, λ*)`` one Newton
+      correction of ``(u, λ)`` on the active set A (:func:`active_set`): the
+      forward error of the contact force itself, which none of the residuals
+      above bounds (they are small against the load, λ can be far smaller).
+    - ``displacement_error``: ``‖u − u*‖∞ / ‖u*‖∞``, the same step's.
+    - ``force_error_floor``: the force change of a second Newton step: what
+      double precision resolves of λ on this system (about ``force_error``
+      when the system is too ill-conditioned for the first step to be trusted).
+      See :mod:`signorini.forward_error` (no factorisation when the method
+      holds one; NaN when not estimated).
 
     Force norms are floored at ``FORCE_FLOOR · ‖f‖∞`` so that a problem with
-    no contact (λ = 0 up to round-off) is judged against its loads.
+    no contact (λ = 0 up to round-off) is judged against its loads (not a
+    contact force: see :func:`force_scale`).
     Residuals are ``inf`` when ``u`` or ``λ`` is not finite.
     """
 
@@ -85,20 +117,32 @@ class Certificate:
     complementarity: float
     natural: float
     duality_gap: float
+    force_error: float = float("nan")
+    displacement_error: float = float("nan")
+    force_error_floor: float = float("nan")
+    #: back-solves the forward error took (not a residual)
+    back_solves: int = 0
+
+    def residuals(self) -> dict[str, float]:
+        """Every relative residual and error by name (the work count left out)."""
+        return {k: v for k, v in asdict(self).items() if k != "back_solves"}
 
     def worst(self) -> tuple[str, float]:
         """The largest residual and its name."""
-        items = {k: v for k, v in asdict(self).items() if not np.isnan(v)}
+        items = {k: v for k, v in self.residuals().items() if not np.isnan(v)}
         name = max(items, key=lambda k: items[k])
         return name, items[name]
 
     def as_dict(self) -> dict[str, float]:
-        return asdict(self)
+        return self.residuals()
 
 
 def certificate(problem: ContactProblem, solution: ContactSolution,
                 duality_gap: bool = True) -> Certificate:
     """Relative KKT residuals of ``solution`` for ``problem`` (see :class:`Certificate`).
+
+    ``duality_gap=False`` leaves out what needs K⁻¹: the duality gap and the
+    forward error (for a singular K).
 
     The result is kept on the solution (for these same arrays, problem and
     options): judging a solution and then reporting it costs one evaluation.
@@ -125,12 +169,12 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     u, lam = solution.u, solution.lam
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(lam))):
         inf = float("inf")
-        return Certificate(inf, inf, inf, inf, inf, inf)
+        return Certificate(inf, inf, inf, inf, inf, inf, inf, inf, inf)
     violation = problem.N @ u - problem.d
     scale_gap = gap_scale(problem, u)
     NT_lam = problem.N.T @ lam
-    floor = FORCE_FLOOR * _inf_norm(problem.f)
-    lam_norm = force_scale(problem, lam)
+    lam_norm = force_scale(problem, lam, u)
+    floor = lam_norm if lam_norm > _inf_norm(lam) else 0.0
     primal = max(float(np.max(violation, initial=0.0)), 0.0) / scale_gap
     Ku = problem.K @ u
     residual = Ku - problem.f + NT_lam
@@ -138,13 +182,75 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     dual_sign = max(float(np.max(-lam, initial=0.0)), 0.0) / lam_norm + 0.0
     complementarity = _inf_norm(lam * violation) / (lam_norm * scale_gap)
     natural = _inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))
-    gap = float("nan")
+    gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:
+        forward = _forward(problem, solution, lam_norm)
         energy = float(0.5 * u @ Ku - problem.f @ u)
         absolute = primal_dual_gap(problem, u, lam, (solution.factor, problem.cached_factor), Ku)
         solution.factor = None  # used: a kept solution no longer keeps a factorisation alive
         gap = abs(absolute) / _positive(max(abs(energy), abs(energy - absolute)))
-    return Certificate(primal, stationarity, dual_sign, complementarity, natural, gap)
+    return Certificate(primal, stationarity, dual_sign, complementarity, natural, gap,
+                       forward.force, forward.displacement, forward.floor, forward.back_solves)
+
+
+def _forward(problem: ContactProblem, solution: ContactSolution, scale: float) -> ForwardError:
+    """The forward error on the certificate's active set, by the first usable factorisation.
+
+    The method's (its pinned set checked as for the duality gap), else the
+    problem's cached one, else a factorisation of K — the one the duality gap
+    makes anyway — except from :data:`signorini.problem.ITERATIVE_ENERGY_FROM` dofs, where the
+    duality gap uses CG and the forward error is not estimated (read when called).
+    """
+    offered = [f for f in (solution.factor, problem.cached_factor)
+               if f is not None and _pinned_rows(problem, f) is not None]
+    if not offered and problem.n < problem_module.ITERATIVE_ENERGY_FROM:
+        offered = [problem.factor()]
+    if not offered:
+        return ForwardError.unknown()
+    return forward_error(problem.K, problem.f, problem.N, problem.d, solution.u, solution.lam,
+                         active_set(problem, solution), offered[0], scale)
+
+
+#: what the certificate says when it cannot vouch for the contact force, by the error's name
+FORCE_SHORTFALL = {
+    "force_error": "the contact force is not certified (force_error {value:.1e} > {accept:.0e}): "
+                   "one Newton step on the active set moves λ by {value:.1e} (relative)",
+    "displacement_error": "the displacement is not certified (displacement_error {value:.1e} > "
+                          "{accept:.0e}): one Newton step on the active set moves u by "
+                          "{value:.1e} (relative)",
+    "force_error_floor": "the contact force is not certified (force_error_floor {floor:.1e} > "
+                         "{accept:.0e}): the system on the active set is too ill-conditioned "
+                         "for double precision to resolve λ to {accept:.0e} (one Newton step "
+                         "moves it by {force:.1e}, a second one still by {floor:.1e}, relative)",
+}
+
+
+def shortfall(cert: Certificate, accept: float) -> str | None:
+    """Why ``cert`` does not back a claim of convergence at ``accept`` (None when it does).
+
+    What the forward error says about the contact force comes first (see
+    :data:`FORCE_SHORTFALL`); then the worst of the other residuals.
+    """
+    name, worst = cert.worst()
+    if np.isfinite(worst) and worst <= accept:
+        return None
+    said = []
+    errors = {k: v for k, v in cert.residuals().items() if k in FORCE_SHORTFALL and v > accept}
+    if errors:
+        name = max(errors, key=errors.get)
+        floor = cert.force_error_floor
+        if name != "displacement_error" and floor > accept and floor >= 0.5 * cert.force_error:
+            name = "force_error_floor"  # the first step is noise of the same size: conditioning
+        said.append(FORCE_SHORTFALL[name].format(value=errors[name], accept=accept,
+                                                 force=cert.force_error, floor=floor))
+    others = {k: v for k, v in cert.residuals().items() if k not in FORCE_SHORTFALL
+              and not np.isnan(v)}
+    name = max(others, key=others.get)
+    if not np.isfinite(others[name]) or others[name] > accept:
+        said.append(f"the method claimed success but the KKT certificate's {name} residual is "
+                    f"{others[name]:.1e} > {accept:.0e}: tighten the tolerance or use an exact "
+                    "method (pdas)")
+    return "; ".join(said)
 
 
 def primal_dual_gap(problem: ContactProblem, u: np.ndarray, lam: np.ndarray, factors=(),
@@ -266,7 +372,7 @@ def classify(problem: ContactProblem, solution: ContactSolution,
     one of the two is zero; for an inexact one the larger decides.
     """
     u, lam = solution.u, solution.lam
-    lam_n = np.maximum(lam, 0.0) / force_scale(problem, lam)
+    lam_n = np.maximum(lam, 0.0) / force_scale(problem, lam, u)
     gap_n = np.maximum(problem.gap(u), 0.0) / gap_scale(problem, u)
     labels = np.where(lam_n > gap_n, ACTIVE, INACTIVE).astype(object)
     labels[(lam_n <= weak_tol) & (gap_n <= weak_tol)] = WEAK

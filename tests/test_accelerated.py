@@ -18,7 +18,11 @@ def test_nesterov_reaches_the_exact_answer_in_fewer_iterations(hertz):
     exact = solve(hertz, "pdas", tol=1e-9)
     plain = solve(hertz, "uzawa", tol=1e-9)
     fast = solve(hertz, "uzawa-nesterov", tol=1e-9)
-    assert fast.status == "converged" and plain.status == "converged"
+    assert plain.status == "converged"
+    # its stopping test (the contraction of its steps) leaves λ 1.4e-8 off at tol 1e-9: it claims
+    # convergence and the certificate's forward error of λ turns it down (docs/certificate.md)
+    assert fast.claimed_status == "converged" and fast.status == "inaccurate"
+    assert "contact force is not certified" in fast.message
     agreement = compare(hertz, exact, fast)
     assert agreement.lam_rel < 1e-6 and agreement.misclassified == 0
     assert fast.iterations * 5 < plain.iterations

@@ -99,12 +99,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         atomic_write_text(directory / "sweep.json", to_json({"scene": args.scene,
                                                              "params": problem.params, "levels": rows}))
         save_figure(ax.figure, directory / "sweep.png")
-    print(f"{'load':>12} {'a':>12} {'a Hertz':>12} {'p0':>12} {'p0 Hertz':>12}")
+    print(f"{'load':>12} {'a':>12} {'a Hertz':>12} {'p0':>12} {'p0 Hertz':>12}  status")
     for lv in levels:
         print(f"{lv.total_force:12.6g} {lv.a:12.6g} {lv.a_ref or float('nan'):12.6g} "
-              f"{lv.p0:12.6g} {lv.p0_ref or float('nan'):12.6g}")
+              f"{lv.p0:12.6g} {lv.p0_ref or float('nan'):12.6g}  {lv.status}")
+    for lv in levels:
+        if lv.status != "converged":
+            print(f"load {lv.load:g}: {lv.status}: {lv.message}")
     print(f"written: {directory / 'sweep.csv'}, sweep.json, sweep.png")
-    return 0
+    return 0 if all(lv.status == "converged" for lv in levels) else EXIT_FAILED
 
 
 def cmd_stability(args: argparse.Namespace) -> int:

@@ -18,7 +18,7 @@ import numpy as np
 
 from signorini.adequacy import adequacy, warnings
 from signorini.errors import InputError
-from signorini.kkt import certificate
+from signorini.kkt import certificate, shortfall
 from signorini.problem import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.options import Option, check_names, guess_value
 
@@ -159,14 +159,11 @@ def judge(problem: ContactProblem, solution: ContactSolution,
         cert = certificate(problem, solution)
     except np.linalg.LinAlgError:  # K singular: no dual function; judge on the other residuals
         cert = certificate(problem, solution, duality_gap=False)
-    worst_name, worst = cert.worst()
-    if not np.isfinite(worst) or worst > accept:
+    reason = shortfall(cert, accept)
+    if reason is not None:
         solution.claimed_status = "converged"
         solution.status = "inaccurate"
-        solution.message = (
-            f"{solution.message}; the method claimed success but the KKT certificate's "
-            f"{worst_name} residual is {worst:.1e} > {accept:.0e}: tighten the tolerance "
-            "or use an exact method (pdas)").lstrip("; ")
+        solution.message = f"{solution.message}; {reason}".lstrip("; ")
         return solution
     found = adequacy(problem, solution, accept)
     if found is not None:

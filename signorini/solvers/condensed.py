@@ -14,6 +14,7 @@ import time
 from typing import Any
 
 from signorini.errors import InputError
+from signorini.forward_error import WithDelassus
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
@@ -46,7 +47,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                 f"({factor.backend} factorisation)",
         iterations=steps, build_time=build_time,
         solve_time=time.perf_counter() - start - build_time,
-        extras={"backend": factor.backend}, factor=factor)
+        extras={"backend": factor.backend}, factor=WithDelassus(factor, problem.N, W))
 
 
 METHODS = (

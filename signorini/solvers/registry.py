@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from signorini.errors import BackendNotInstalled, InputError
+from signorini.fingerprint import fingerprint, held_to_problem
 from signorini.numerics.factor import COUNTS
 from signorini.numerics.multigrid import COUNTS as MULTIGRID_COUNTS
 from signorini.problem import ContactProblem, ContactSolution
@@ -140,6 +141,7 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
                              f"{takers}")
         options["warm_start"] = warm_start
     start, before = time.perf_counter(), dict(COUNTS, **MULTIGRID_COUNTS)
+    held = fingerprint(problem)
     try:
         solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
     except InputError:
@@ -154,6 +156,7 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
             method, problem, "failed", f"the method called sys.exit({exc.code!r})",
             solve_time=time.perf_counter() - start)
     solution = hold_to_contract(problem, method, solution)
+    solution = held_to_problem(problem, held, solution, method)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
     now = dict(COUNTS, **MULTIGRID_COUNTS)

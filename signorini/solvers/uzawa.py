@@ -11,9 +11,11 @@ By default ``ρ = step_fraction · 2 / λ_max`` with ``λ_max`` from power
 iteration. Stops when the relative primal infeasibility and
 natural residual (stationarity and the sign of λ hold by construction) are
 below ``tol`` and the distance to the fixed point, estimated from the
-observed contraction of the steps, ``‖Δλ‖ q / (1 − q)``, is below ``tol ‖λ‖``
-(the paper's own test is on ``‖Δλ‖``; without the factor ``q / (1 − q)`` it
-stops far from the answer when the dual is ill-conditioned).
+observed contraction of the steps, ``‖Δλ‖ q / (1 − q)``, is below
+``DISTANCE_MARGIN · tol ‖λ‖`` (the paper's own test is on ``‖Δλ‖``; without the
+factor ``q / (1 − q)`` it stops far from the answer when the dual is
+ill-conditioned; the margin because that estimate lands on the tolerance itself,
+and the certificate's forward error of λ then just above it).
 
 With ``operator="delassus"`` (the default when m ≤ 2000) the m × m matrix
 ``W`` is formed once by m back-solves and each iteration costs a dense
@@ -58,6 +60,9 @@ DELASSUS_MAX_CANDIDATES = 2000
 RATE_WINDOW = 20
 DEFAULT_TOL = 1e-8
 MAX_ITER = 50_000
+#: stop when the estimated distance to the fixed point is below this fraction of tol ‖λ‖:
+#: at 1 the forward error of λ came out 1.0001–1.0015 × tol on Hertz's cylinder
+DISTANCE_MARGIN = 0.5
 
 
 def dual_residuals(problem: ContactProblem, gap_violation: np.ndarray, Nu: np.ndarray,
@@ -156,7 +161,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         primal, natural = dual_residuals(problem, violation, Nu, lam, u_norm)
         kkt = max(primal, natural)
         lam_norm = float(np.max(lam)) or 1.0
-        if kkt <= tol and _distance_estimate(history["step"]) <= tol * lam_norm:
+        if kkt <= tol and _distance_estimate(history["step"]) <= DISTANCE_MARGIN * tol * lam_norm:
             u_norm = float(np.max(np.abs(displacement(lam))))
             primal, natural = dual_residuals(problem, violation, Nu, lam, u_norm)
             kkt = max(primal, natural)
@@ -164,7 +169,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         history["natural"].append(natural)
         if opts["callback"] is not None:
             opts["callback"](iteration, lam, displacement)
-        if kkt <= tol and _distance_estimate(history["step"]) <= tol * lam_norm:
+        if kkt <= tol and _distance_estimate(history["step"]) <= DISTANCE_MARGIN * tol * lam_norm:
             status, message = "converged", f"KKT residual {kkt:.1e} ≤ {tol:.0e} ({choice} operator)"
             break
         if accelerated and Nu_prev is not None:

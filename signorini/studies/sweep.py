@@ -5,6 +5,13 @@ with ``b₁ = N K⁻¹ f₁ − d₁`` and ``b₀ = P N K⁻¹ f_load − d₀``
 traction of a unit load P on a cut, when the scene loads the body so). Each load level is then a small
 dense problem on the candidates (:func:`signorini.numerics.loading.push_for_load_condensed`)
 and one back-solve for the displacement.
+
+Every level is judged as ``solve`` judges a method's answer
+(:func:`signorini.solvers.base.judge`): the KKT certificate with the forward error of
+its contact force (the sweep's factorisation and Delassus operator reused: a few
+back-solves, no factorisation), then the boundary beyond the candidates
+(:mod:`signorini.adequacy`): a level whose contact reached the edge of the candidates
+or beyond is ``model_inadequate``, not ``converged``.
 """
 
 from __future__ import annotations
@@ -17,13 +24,19 @@ from typing import Callable
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.forward_error import WithDelassus
+from signorini.kkt import certificate
 from signorini.numerics.lcp import delassus
 from signorini.numerics.loading import push_for_load_condensed
 from signorini.output.plots import axes as _axes
 from signorini.pressure import compare_hertz, contact_half_width, contact_profile
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.base import judge
 
 log = logging.getLogger(__name__)
+
+#: the accepted relative residuals and force error of a level (the condensed method's default)
+SWEEP_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -37,6 +50,9 @@ class SweepLevel:
     p0: float
     a_ref: float | None
     p0_ref: float | None
+    status: str = "converged"
+    message: str = ""
+    force_error: float = float("nan")
 
 
 #: most loads one sweep solves
@@ -62,7 +78,8 @@ def parse_loads(text: str) -> np.ndarray:
 
 def sweep_loads(problem: ContactProblem, loads: np.ndarray,
                 progress: Callable[[int, int], None] | None = None) -> list[SweepLevel]:
-    """Solve ``problem`` exactly at every load of ``loads`` (physical units, full body)."""
+    """Solve ``problem`` exactly at every load of ``loads`` (physical units, full body), each
+    level judged (its ``status``: ``converged`` only when certified and the model adequate)."""
     if problem.push is None:
         raise InputError(f"scene {problem.scene!r} is not loaded by a prescribed push: "
                          "it cannot be swept over loads")
@@ -83,14 +100,19 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
                                          problem.force_multiplicity)
         level_problem = problem.pushed(s, load=target)
         u = factor.solve(level_problem.f - problem.N.T @ lam)
-        solution = ContactSolution("condensed", u, lam, "converged")
+        solution = judge(level_problem, ContactSolution(
+            "condensed", u, lam, "converged", factor=WithDelassus(factor, problem.N, W)), SWEEP_TOL)
+        if solution.status != "converged":
+            log.warning("load %g: %s: %s", load, solution.status, solution.message)
         profile = contact_profile(level_problem, solution)
         ref = compare_hertz(level_problem, solution) if hertz else None
         levels.append(SweepLevel(
             load=float(load), total_force=profile.total_force,
             delta=float(level_problem.params.get("delta") or np.nan),
             a=contact_half_width(profile), p0=float(profile.pressure[np.argmin(profile.x)]),
-            a_ref=ref.a_ref if ref else None, p0_ref=ref.p0_ref if ref else None))
+            a_ref=ref.a_ref if ref else None, p0_ref=ref.p0_ref if ref else None,
+            status=solution.status, message=solution.message,
+            force_error=certificate(level_problem, solution).force_error))
         if progress is not None:
             progress(i + 1, len(loads))
     return levels

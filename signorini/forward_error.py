@@ -1,0 +1,238 @@
+"""Forward error of the contact force: one Newton correction on the active set.
+
+On an active set A the exact answer ``(u*, λ*)`` (``λ* = 0`` off A) solves the
+saddle-point system ``M [u*; λ*_A] = [f; d_A]`` with::
+
+    M = [ K    N_Aᵀ ]
+        [ N_A  0    ]
+
+For a candidate ``(u, λ)`` let ``λ̄`` be λ on A and 0 off it, and the residuals
+``r = K u − f + N_Aᵀ λ̄_A`` and ``g = N_A u − d_A``. Then, exactly,
+``(u*, λ*) = (u, λ̄) + (δu, δλ)`` with ``M [δu; δλ_A] = −[r; g]``: the error of λ is
+``λ − λ* = (λ − λ̄) − δλ``. This is what a stationarity residual scaled by the load
+cannot give: ``‖δλ‖ ≤ ‖M⁻¹‖ ‖(r, g)‖``, and ``‖M⁻¹‖`` (through the Delassus operator
+``N_A K⁻¹ N_Aᵀ`` on A) can be large where ‖f‖ is huge and λ small — a nearly
+incompressible body pushed by a prescribed displacement has a lifted load 10¹¹ times
+its contact forces, so a residual of 10⁻⁵‖f‖ says nothing about λ.
+
+The correction is computed in double precision, so it is itself only as good as
+the residual ``(r, g)`` is above round-off and ``M`` is conditioned. A second Newton
+step from ``(u, λ̄) + δ`` measures that: where double precision resolves the answer
+on A, the second step is much smaller than the first; where it does not, both are
+of the size of the noise. ``floor = ‖δλ₂‖∞ / ‖λ‖`` is what double precision can
+vouch for on this system; the certificate vouches for λ to ``max(force, floor)``.
+
+Cost: no factorisation. ``M`` is solved by the factorisation the method holds
+(:class:`~signorini.numerics.factor.PinnedFactor` or any object with its
+interface: ``matrix``, ``fixed``, ``solve``), or the problem's cached one of K.
+A factorisation with the dofs of A pinned solves M in one back-solve; each row in
+which its pinned set and A differ costs one more back-solve (a bordered Schur
+complement, as for the duality gap), and a plain factorisation of K costs
+``|A|`` back-solves for the Delassus operator on A (``N_A K⁻¹ N_Aᵀ``); then two
+back-solves per Newton step. Beyond :data:`MAX_BORDER` such rows the estimate is
+not made (NaN).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+
+from signorini.numerics.factor import selection_dofs
+
+#: the certificate borders a factorisation with at most this many rows (back-solves) to reach
+#: the active set's system; beyond, the forward error is not estimated
+MAX_BORDER = 1000
+#: floats of right-hand sides solved at once while bordering (bounds the memory: 160 MB)
+BLOCK_FLOATS = 20_000_000
+
+
+@dataclass(frozen=True)
+class ForwardError:
+    """The Newton correction on the active set, relative to ``scale`` (forces) and ‖u‖∞.
+
+    ``force``: ``‖λ − λ*‖∞ / scale`` with ``λ* = λ̄ + δλ₁`` (the first step);
+    ``displacement``: ``‖δu₁‖∞ / ‖u‖∞``; ``floor``: ``‖δλ₂‖∞ / scale``, the second
+    step (how far double precision resolves λ on this system); ``back_solves`` what
+    it cost. NaN when not estimated.
+    """
+
+    force: float
+    displacement: float
+    floor: float
+    back_solves: int
+
+    @classmethod
+    def unknown(cls) -> "ForwardError":
+        nan = float("nan")
+        return cls(nan, nan, nan, 0)
+
+
+class _Counted:
+    """A factorisation's ``solve`` that counts its right-hand sides."""
+
+    def __init__(self, factor):
+        self.factor, self.count = factor, 0
+
+    def __call__(self, rhs: np.ndarray) -> np.ndarray:
+        self.count += 1 if rhs.ndim == 1 else rhs.shape[1]
+        return self.factor.solve(rhs)
+
+
+def _blocks(solve: Callable, columns: Callable[[np.ndarray], np.ndarray], k: int, n: int,
+            reduce: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """``reduce(solve(columns(j)))`` stacked over blocks ``j`` of ``range(k)`` (bounded memory)."""
+    block = max(1, min(k, BLOCK_FLOATS // max(n, 1)))
+    parts = [reduce(solve(columns(np.arange(start, min(start + block, k)))))
+             for start in range(0, k, block)]
+    return np.hstack(parts) if parts else np.zeros((0, 0))
+
+
+def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.ndarray,
+                   coef: np.ndarray):
+    """``M⁻¹`` on the rows ``dofs`` (coefficients ``coef``) from a factor pinning ``fixed``.
+
+    The factor gives x with ``x[fixed] = rhs[fixed]`` and ``(K x)[free] = rhs[free]``.
+    M pins ``dofs`` instead: the dofs it pins beyond the factor's (P) take a load ρ
+    that brings them to their value, those the factor pins beyond M's (Q) a value y
+    that frees their load — one back-solve per dof of P and Q, once.
+    """
+    n = K.shape[0]
+    P = np.setdiff1d(dofs, fixed)
+    Q = np.setdiff1d(fixed, dofs)
+    border = np.concatenate([Q, P])
+    k = border.size
+
+    def unit(j):
+        E = np.zeros((n, j.size))
+        E[border[j], np.arange(j.size)] = 1.0
+        return E
+
+    B = _blocks(solve, unit, k, n, lambda Z: np.vstack([(K @ Z)[Q], Z[P]]))
+    lu = np.linalg.inv(B) if k else None  # k ≤ MAX_BORDER, dense and small
+
+    def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        value = np.zeros(n)
+        value[dofs] = -g / coef
+        rhs = -r.copy()
+        rhs[fixed] = value[fixed]
+        if k:
+            x0 = solve(rhs)
+            miss = np.concatenate([-r[Q] - (K @ x0)[Q], value[P] - x0[P]])
+            rhs[border] += lu @ miss
+        x = solve(rhs)
+        return x, (-r - K @ x)[dofs] / coef
+
+    return apply, k
+
+
+class WithDelassus:
+    """A plain factorisation of K offered with the Delassus operator ``W = N K⁻¹ Nᵀ`` it made.
+
+    The forward error then reads ``N_A K⁻¹ N_Aᵀ`` from W (no back-solves for it).
+    """
+
+    fixed = np.zeros(0, dtype=int)
+
+    def __init__(self, factor, N: sp.csr_matrix, W: np.ndarray):
+        self.factor, self.matrix, self.N, self.delassus = factor, factor.matrix, N, W
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return self.factor.solve(b)
+
+
+def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.ndarray):
+    """``M⁻¹`` from a plain factorisation of K, through ``S = N_A K⁻¹ N_Aᵀ`` (|A| back-solves,
+    none when the factorisation comes with the Delassus operator of N: :class:`WithDelassus`)."""
+    N_A = N[rows]
+    NT = sp.csc_matrix(N_A.T)
+    k = N_A.shape[0]
+    offered = solve.factor
+    if isinstance(offered, WithDelassus) and offered.N.shape == N.shape \
+            and (offered.N != N).nnz == 0:
+        S = offered.delassus[np.ix_(rows, rows)]
+    else:
+        S = _blocks(solve, lambda j: NT[:, j].toarray(), k, K.shape[0], lambda Z: N_A @ Z)
+    lu = np.linalg.inv(S) if k else None
+
+    def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x0 = solve(-r)
+        if not k:
+            return x0, np.zeros(0)
+        mu = lu @ (N_A @ x0 + g)
+        return solve(-r - NT @ mu), mu
+
+    return apply, k
+
+
+def _system(K: sp.spmatrix, N: sp.csr_matrix, rows: np.ndarray, solve: _Counted):
+    """``(r, g) ↦ M⁻¹(−r, −g)`` on the rows ``rows`` by the factorisation behind ``solve``
+    (pinned or plain); None when it cannot (more than :data:`MAX_BORDER` rows to border, or a
+    pinned factorisation while the rows of N do not each bound one dof)."""
+    fixed = np.asarray(solve.factor.fixed, dtype=int)
+    if not fixed.size:
+        return _schur_system(K, solve, N, rows)[0] if rows.size <= MAX_BORDER else None
+    dofs = selection_dofs(N)
+    if dofs is None or np.setxor1d(dofs[rows], fixed).size > MAX_BORDER:
+        return None
+    return _pinned_system(K, solve, fixed, dofs[rows], np.asarray(N[rows, dofs[rows]]).ravel())[0]
+
+
+def forward_error(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray, u: np.ndarray,
+                  lam: np.ndarray, active: np.ndarray, factor, scale: float) -> ForwardError:
+    """Two Newton steps on the active set ``active`` from ``(u, λ)`` with ``factor`` (see module).
+
+    ``factor`` is a factorisation of K (plain or pinned on rows of N that bound
+    one dof each); ``scale`` the force λ's error is measured against.
+    """
+    solve = _Counted(factor)
+    rows = np.flatnonzero(active)
+    apply = _system(K, N, rows, solve)
+    if apply is None:
+        return ForwardError.unknown()
+    N_A, d_A = N[rows], d[rows]
+    lam_bar = np.zeros_like(lam)
+    lam_bar[rows] = lam[rows]
+
+    def residuals(x, mu):
+        return K @ x - f + N_A.T @ mu, N_A @ x - d_A
+
+    du, dlam = apply(*residuals(u, lam_bar[rows]))
+    u1, lam1 = u + du, lam_bar[rows] + dlam
+    _, dlam2 = apply(*residuals(u1, lam1))
+    corrected = lam_bar.copy()
+    corrected[rows] = lam1
+    u_norm = float(np.max(np.abs(u1), initial=0.0)) or 1.0
+    force = float(np.max(np.abs(lam - corrected), initial=0.0)) / scale
+    floor = float(np.max(np.abs(dlam2), initial=0.0)) / scale
+    return ForwardError(force, float(np.max(np.abs(du), initial=0.0)) / u_norm, floor, solve.count)
+
+
+def refined_on_active_set(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray,
+                          u: np.ndarray, lam: np.ndarray, active: np.ndarray, factor,
+                          steps: int = 30) -> tuple[np.ndarray, np.ndarray]:
+    """``(u*, λ*)`` on ``active`` by iterative refinement with residuals in ``np.longdouble``.
+
+    The corrections come from ``factor`` in double precision (as in
+    :func:`forward_error`); the residuals and the sums are long double (80-bit
+    on x86: 11 more bits), so the refinement converges below double's round-off
+    wherever ``κ(M) ε_double < 1``. A reference for tests and studies, not for the
+    certificate (each step is a long-double product with K).
+    """
+    ld = np.longdouble
+    rows = np.flatnonzero(active)
+    apply = _system(K, N, rows, _Counted(factor))
+    K_l, N_l = K.astype(ld), N[rows].astype(ld)
+    f_l, d_l = f.astype(ld), d[rows].astype(ld)
+    x, mu = u.astype(ld), lam[rows].astype(ld)
+    for _ in range(steps):
+        r = K_l @ x - f_l + N_l.T @ mu
+        g = N_l @ x - d_l
+        du, dmu = apply(r.astype(float), g.astype(float))
+        x, mu = x + du.astype(ld), mu + dmu.astype(ld)
+    out = np.zeros(lam.shape, dtype=ld)
+    out[rows] = mu
+    return x, out
