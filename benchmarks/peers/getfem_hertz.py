@@ -1,27 +1,28 @@
 """Hertz's contact solved by GetFEM: the peer that ``signorini bench --peer getfem`` runs.
 
 A standalone script for the *system* Python (Debian's ``python3-getfem`` and
-``python3-gmsh``), started in a subprocess by :mod:`signorini.studies.peer`; it
-imports only getfem, gmsh, numpy and the standard library, never the package.
+``python3-gmsh``), started in a subprocess by :mod:`signorini.studies.peer`
+from a checkout of the repository; it imports only getfem, gmsh, numpy and the
+standard library, never the package.
 
-    /usr/bin/python3 peer_getfem.py '{"scene": "sphere", "h_contact": 0.03125, "nu": 0.45}'
+    /usr/bin/python3 benchmarks/peers/getfem_hertz.py '{"scene": "sphere", "h_contact": 0.03125}'
 
-The model is that of the GetFEM runs quoted in issue 15: the lower quarter of the
-disc (x ≥ 0, y ≤ R; the sphere's meridian for ``"scene": "sphere"``, then
-r = x and the weak form carries the weight r and the hoop strain u_r/r), a
-symmetry plane on x = 0 (u_x = 0), a uniform downward traction on the cut
-through the centre y = R whose resultant is Hertz's load for ``a_over_R``
-(cylinder: P = πE*a²/(4R) per unit thickness; sphere: P = 4E*a³/(3R)), a tiny
-spring ``stabilisation · E/R² · u`` over the body that removes the rigid
-vertical mode, and GetFEM's nodal contact brick (``add_nodal_contact_with_
-rigid_obstacle_brick``, Alart–Curnier augmented Lagrangian, Newton) on the arc
-with x ≤ ``candidates`` · a against the rigid flat y ≤ 0. P1 triangles on a
-gmsh mesh whose size is ``h_contact`` · a within ``fine_radius`` · a of the
-first point of contact and grows by ``growth`` per unit distance beyond it up
-to ``h_max`` · R. The model is solved in units of R and E (see :func:`solve`)
-by ``Model.solve`` (MUMPS), Newton starting from a rigid push by Hertz's
-approach a²/R: from zero, the first step (the rigid mode held by one node
-and the tiny spring) sent the sphere's Newton into 100 damped steps at 72k dofs.
+The model: the lower quarter of the disc (x ≥ 0, y ≤ R; the sphere's meridian
+for ``"scene": "sphere"``, then r = x and the weak form carries the weight r
+and the hoop strain u_r/r), a symmetry plane on x = 0 (u_x = 0), a uniform
+downward traction on the cut through the centre y = R whose resultant is
+Hertz's load for ``a_over_R`` (cylinder: P = πE*a²/(4R) per unit thickness;
+sphere: P = 4E*a³/(3R)), a tiny spring ``stabilisation · E/R² · u`` over the
+body that removes the rigid vertical mode, and GetFEM's nodal contact brick
+(``add_nodal_contact_with_rigid_obstacle_brick``, Alart–Curnier augmented
+Lagrangian, Newton) on the arc with x ≤ ``candidates`` · a against the rigid
+flat y ≤ 0. P1 triangles on a gmsh mesh whose size is ``h_contact`` · a within
+``fine_radius`` · a of the first point of contact and grows by ``growth`` per
+unit distance beyond it up to ``h_max`` · R. The model is solved in units of R
+and E (see :func:`solve`) by ``Model.solve`` (MUMPS), Newton starting from a
+rigid push by Hertz's approach a²/R: from zero, the first step (the rigid mode
+held by one node and the tiny spring) sent the sphere's Newton into 100 damped
+steps at 72k dofs.
 
 Output, one JSON line on stdout: dofs (GetFEM's displacement dofs), contact
 nodes, p0 and a from the least-squares fit :func:`fit_hertz` of the nodal
@@ -72,10 +73,19 @@ def fit_hertz(x, p, rel=1e-9):
     idx = idx[np.argsort(x[idx])][:-1]
     if idx.size < 2 or np.ptp(x[idx]) == 0:
         return math.nan, math.nan, int(active.sum())
-    slope, intercept = np.polyfit(x[idx] ** 2, p[idx] ** 2, 1)
+    # in units of the largest x and p, so that their squares stay representable
+    xs, ps = (_unit_of(v) for v in (x[idx], p[idx]))
+    slope, intercept = np.polyfit((x[idx] / xs) ** 2, (p[idx] / ps) ** 2, 1)
     if not (intercept > 0 and slope < 0):
         return math.nan, math.nan, int(active.sum())
-    return float(np.sqrt(intercept)), float(np.sqrt(-intercept / slope)), int(active.sum())
+    return float(ps * np.sqrt(intercept)), float(xs * np.sqrt(-intercept / slope)), int(active.sum())
+
+
+def _unit_of(values):
+    """The largest finite magnitude among ``values`` (1 when there is none)."""
+    values = np.abs(values[np.isfinite(values)])
+    largest = float(values.max()) if values.size else 0.0
+    return largest if largest > 0 else 1.0
 
 
 def hertz(scene, R, E_star, a):
@@ -129,7 +139,7 @@ def solve(q):
     times = {"import_s": time.perf_counter() - START}
     tic = time.perf_counter()
     if q["scene"] not in ("cylinder", "sphere"):
-        raise SystemExit(f"peer_getfem: scene {q['scene']!r} is not cylinder or sphere")
+        raise SystemExit(f"getfem_hertz: scene {q['scene']!r} is not cylinder or sphere")
     # GetFEM's Newton test is relative to the first residual, which mixes forces (contact,
     # Dirichlet multipliers) and lengths (their constraints): in SI units (E = 2.1e11 Pa,
     # R = 1 cm) it stalls with tensile contact forces. Solve in units of R and E, then scale.
@@ -215,7 +225,7 @@ def main(argv):
     given = json.loads(argv[1]) if len(argv) > 1 else {}
     unknown = sorted(set(given) - set(DEFAULTS))
     if unknown:
-        raise SystemExit(f"peer_getfem: unknown parameters {unknown}; known: {sorted(DEFAULTS)}")
+        raise SystemExit(f"getfem_hertz: unknown parameters {unknown}; known: {sorted(DEFAULTS)}")
     print(json.dumps(solve({**DEFAULTS, **given})))
 
 
