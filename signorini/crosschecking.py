@@ -236,7 +236,7 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
                          f"({', '.join(names)}): add it with --method {stray[0]}")
     tol = check_tol(tol)
     if isinstance(problem, str):
-        problem = build_problem(problem, **(params or {}))
+        problem = build_problem(problem, params=params)
     elif params:
         raise InputError("params= builds a scene by name: give crosscheck('hertz-cylinder', "
                          "params=...) or build the problem with those parameters first")

@@ -67,7 +67,7 @@ def test_forces_are_in_the_scene_units_and_equal_the_cli_json(tmp_path):
 
 def test_the_result_does_not_depend_on_the_solver_units():
     scaled = signorini.solve("hertz-cylinder", params=SI, tol=1e-10)
-    raw = signorini.solve(signorini.build_problem("hertz-cylinder", nondimensionalise=False, **SI),
+    raw = signorini.solve(signorini.build_problem("hertz-cylinder", params=SI, nondimensionalise=False),
                           tol=1e-10)
     assert raw.problem.scales.force == 1.0
     np.testing.assert_allclose(raw.force, scaled.force, rtol=1e-6, atol=1e-9 * scaled.force.max())

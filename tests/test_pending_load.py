@@ -38,9 +38,9 @@ def factorisations() -> int:
 def pair(request):
     """(pending problem, the same scene load-targeted by factorisation)."""
     before = factorisations()
-    pending = build_problem(SCENE, solved_by="pdas-amg", **request.param)
+    pending = build_problem(SCENE, params=request.param, solved_by="pdas-amg")
     assert factorisations() == before, "a pending problem is assembled without a factorisation"
-    return pending, build_problem(SCENE, **request.param)
+    return pending, build_problem(SCENE, params=request.param)
 
 
 def test_the_target_is_pending_until_matched(pair):

@@ -55,8 +55,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
                                     target_on=args.target_on, **options)
             problem = result.problem
         else:
-            problem = build_problem(args.scene, nondimensionalise=not args.raw_units,
-                                    solved_by=args.method, **params)
+            problem = build_problem(args.scene, params=params, nondimensionalise=not args.raw_units,
+                                    solved_by=args.method)
             if time_limit is None:
                 result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
                 problem = result.problem
