@@ -269,7 +269,9 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     :class:`Result`), and the iterations it reports are its own;
     ``result.solution.work`` lists the work of every stage. ``tol`` is the
     relative KKT tolerance the answer must meet to be ``converged`` (None:
-    the method's default); other keyword arguments are the method's options.
+    the method's default; a QP backend then runs at its own settings and its
+    answer is held to :data:`signorini.DEFAULT_TOL`); other keyword arguments
+    are the method's options.
     Bad input raises :class:`signorini.InputError`; a method that fails
     returns a result whose ``status`` says so.
     """
