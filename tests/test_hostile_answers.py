@@ -24,6 +24,7 @@ from signorini.kkt import ACTIVE, FORCE_FLOOR, active_set, certificate, classify
 from signorini.numerics.factor import COUNTS, factorize
 from signorini.pressure import compare_hertz
 from signorini.problem import ContactSolution
+from signorini import at_load
 from signorini.scenes import build_problem
 from signorini.solvers import registry
 from signorini.studies.atlas import poisson
@@ -56,12 +57,12 @@ def spent(step):
 
 @pytest.fixture(scope="module")
 def hertz():
-    return build_problem("hertz-cylinder", params={"n_contact": 20})
+    return at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
 
 
 @pytest.fixture(scope="module")
 def near_half():
-    return build_problem("hertz-cylinder", params={"n_contact": 20, "nu": NEAR_HALF})
+    return at_load(build_problem("hertz-cylinder", params={"n_contact": 20, "nu": NEAR_HALF}))
 
 
 # --- the forward error of λ -------------------------------------------------------------------
@@ -109,7 +110,7 @@ def test_the_contact_is_found_near_half(near_half):
 
 def test_no_contact_forces_are_still_judged_against_the_load():
     """A body that does not reach the obstacle: round-off forces count as zero."""
-    problem = build_problem("hertz-cylinder", params={"n_contact": 20})
+    problem = at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
     lifted = problem.with_data(d=problem.d + 10.0)  # the obstacle moved far away
     exact = registry.solve(lifted, "pdas")
     assert not np.any(exact.lam)
@@ -129,7 +130,7 @@ def test_well_conditioned_answers_stay_converged(hertz, method, tol):
 
 def test_qpalm_at_its_defaults_is_caught():
     pytest.importorskip("qpalm")
-    problem = build_problem("hertz-cylinder", params={"n_contact": 20})
+    problem = at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
     solution = registry.solve(problem, "qp-qpalm")
     assert solution.claimed_status == "converged" and solution.status == "inaccurate"
     error = lam_error(solution, reference_lam(problem))
@@ -152,7 +153,7 @@ def test_the_forward_error_on_a_plain_factorisation_adds_no_factorisation(hertz)
 
 
 def test_the_sweep_judges_every_level_without_factorising(hertz):
-    problem = build_problem("hertz-cylinder", params={"n_contact": 24, "grading": 0.3})
+    problem = at_load(build_problem("hertz-cylinder", params={"n_contact": 24, "grading": 0.3}))
     problem.factor()
     loads = np.array([0.6, 1.0]) * problem.params["P"]
     cost, levels = spent(lambda: sweep_loads(problem, loads))
@@ -226,19 +227,19 @@ def hostile(tmp_path, monkeypatch):
     ("answers_a_pushed_problem", "answer to another problem"),
 ])
 def test_a_method_that_changes_or_swaps_the_problem_fails(hostile, function, words):
-    problem = build_problem("hertz-cylinder", params={"n_contact": 8})
+    problem = at_load(build_problem("hertz-cylinder", params={"n_contact": 8}))
     solution = registry.solve(problem, f"hostile:{function}")
     assert solution.status == "failed" and words in solution.message, solution.message
     assert not np.isfinite(solution.lam).any()
 
 
 def test_an_honest_user_method_converges(hostile):
-    problem = build_problem("hertz-cylinder", params={"n_contact": 8})
+    problem = at_load(build_problem("hertz-cylinder", params={"n_contact": 8}))
     assert registry.solve(problem, "hostile:honest").status == "converged"
 
 
 def test_a_method_that_matches_the_load_may_answer_the_pushed_problem():
-    problem = build_problem("hertz-cylinder", params={"n_contact": 16, "grading": 0.4})
+    problem = at_load(build_problem("hertz-cylinder", params={"n_contact": 16, "grading": 0.4}))
     if not registry.get_method("pdas-amg").installed:
         pytest.skip("pdas-amg needs petsc4py")
     solution = registry.solve(problem, "pdas-amg")
