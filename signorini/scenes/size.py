@@ -12,22 +12,17 @@ b = 1000 for the 3D octant: b is the coarse far field that every mesh has;
 the last factor counts the uniform refinements, the one before it the longer
 grading from a smaller contact), but never more than the uniform mesh at the
 contact's element size, ``c · (n_contact / (a/R))^d · 2^(d · refine)`` (c
-measured at grading 1e-6: 5.2 for the discs, 2.66 reverse-hertz, 6,082 for
-the punch, whose size is not scaled by a). The block's dofs are exact. Memory is
-the peak resident size per dof of building the scene and solving it with
-``pdas``, measured here (Python's own ~0.3 GB included): 4.2 kB per dof for
-hertz-cylinder refine=3 (298k dofs), 22 kB for hertz-sphere-3d refine=1 (47k
-dofs); taken as 4 kB (2D) and 20 kB (3D). A 3D factorisation grows faster
-than the dofs (``pdas`` at 350k 3D dofs was killed at 21 GB), which a
-factorising method has to weigh on its own. Two 3D paths are measured apart
-(docs/amg/): a prescribed push (``delta``) goes to ``pdas-amg`` by default,
-no factorisation — 1.3 GB at 350,532 dofs, 3.85 GB at 1,093,024, taken as
-5 kB per dof; so does a target load that ``pdas-amg`` matches itself (the
-method ``auto`` picks from :data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D
-dofs, see :mod:`signorini.loading`: 1.0 GB at
-351,076 dofs, 3.0 GB at 1,093,568, docs/amg/bench.md); a target load met by load targeting on one factorisation of
-K (any other method: 4.7 GB at 351,076 dofs, 13.4 kB per dof) has a fill
-that grows like n^⅓ per dof: 20 kB × (dofs / 350k)^⅓ from 350k dofs on.
+per family, in :data:`SIZE_MODELS`). The block's dofs are exact.
+
+Memory is the peak resident size of building the scene and solving it, in
+bytes per dof: :data:`BYTES_PER_DOF` with a factorising method;
+:data:`BYTES_PER_DOF_3D_PUSHED` in 3D without one (a prescribed push, or a
+target load that ``pdas-amg`` matches itself: the method ``auto`` picks from
+:data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D dofs, see
+:mod:`signorini.loading`); a 3D factorisation's fill grows like n^⅓ per dof
+from :data:`FILL_GROWS_FROM` dofs on; :data:`NODAL_MEMORY` scales it all when
+the volumetric strain is averaged at the nodes. The constants were chosen
+from measurements (docs/calibration.md).
 
 A scene whose estimate exceeds :func:`memory_limit` — by default three
 quarters of this machine's physical memory, or ``SIGNORINI_MAX_MEMORY_GB`` —
@@ -57,7 +52,7 @@ BYTES_PER_DOF = {2: 4_000, 3: 20_000}
 BYTES_PER_DOF_3D_PUSHED = 5_000
 #: from this many 3D dofs a factorisation's bytes per dof grow like (dofs / this)^⅓
 FILL_GROWS_FROM = 350_000
-#: tetrahedra per dof of the 3D octant's meshes (664,768 at 351,076 dofs, hertz-sphere-3d refine=2)
+#: tetrahedra per dof of the 3D octant's meshes (chosen from measurements, docs/calibration.md)
 TETRAHEDRA_PER_DOF = 1.9
 #: elements per dof of the graded meshes: a triangle mesh has about twice as many triangles as
 #: nodes, one per dof
@@ -67,8 +62,7 @@ ELEMENTS_PER_DOF = {2: 1.0, 3: TETRAHEDRA_PER_DOF}
 GRADED_LIMIT = {2: 2 * MAX_TRIANGLES, 3: MAX_ELEMENTS}
 ELEMENT_NAMES = {2: "triangles", 3: "tetrahedra"}
 #: peak memory with the volumetric strain averaged at the nodes over plain P1, same scene and
-#: default method, measured here at ν = 0.45: 1.75 GB against 0.79 GB for hertz-cylinder
-#: refine=3 (297,984 dofs), 1.41 GB against 0.54 GB for hertz-sphere-3d refine=1 (46,964 dofs)
+#: default method (chosen from measurements at ν = 0.45, docs/calibration.md)
 NODAL_MEMORY = {2: 2.2, 3: 2.6}
 
 
@@ -131,8 +125,8 @@ class SizeModel:
             return float(dofs * 2.0 ** (self.dim * p.get("refine", 0)))
 
 
-#: measured at each family's defaults (signorini commit 66f74ea: hertz-cylinder 4,866 dofs,
-#: hertz-sphere 6,824, hertz-sphere-3d 7,284, punch 7,948, reverse-hertz 6,118)
+#: each family's default mesh (dim, dofs, n_contact, grading, a/R) and the uniform bound's c,
+#: measured on the meshes built (docs/calibration.md)
 SIZE_MODELS = {
     "hertz-cylinder": SizeModel(2, 4866, 40, 0.15, 0.05, uniform=5.2),
     "hertz-sphere": SizeModel(2, 6824, 60, 0.15, 0.05, uniform=5.2),
