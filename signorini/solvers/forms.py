@@ -210,8 +210,8 @@ def _kkt_on(problem: ContactProblem, form: Formulation, active: np.ndarray):
 
     The dual holds W: ``W_AA λ_A = b_A`` and one back-solve. The other forms
     factorise K once with the active dofs pinned (the saddle-point matrix when
-    a row of N bounds more than one dof): measured at 75k dofs, cheaper than
-    the |A| ≈ 260 back-solves of a Schur complement on the shifted form's factor.
+    a row of N bounds more than one dof): cheaper than the |A| back-solves of a
+    Schur complement on the shifted form's factor (docs/calibration.md).
     """
     if form.W is None:
         solver = ActiveSetSolver(problem.K, problem.N)
