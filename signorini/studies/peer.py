@@ -1,6 +1,6 @@
 """A peer, side by side: Hertz's cylinder and sphere by GetFEM and by this package.
 
-``signorini bench --peer getfem`` (issue 16, item 6). GetFEM runs in the system
+``signorini bench --peer getfem``. GetFEM runs in the system
 Python (Debian's ``python3-getfem`` and ``python3-gmsh``) through our own script
 :mod:`signorini.studies.peer_getfem`; this package runs as ``signorini solve SCENE
 --json -``. Both are separate processes, timed from start to exit (whole-process
@@ -55,7 +55,7 @@ OUR_LADDER = {
     "hertz-sphere": ({"n_contact": 12}, {"n_contact": 25}, {"n_contact": 50},
                      {"n_contact": 100}, {"n_contact": 100, "refine": 1}),
 }
-#: accuracies at which the report compares the codes' fastest runs (issue 16: 0.3 % and 0.1 %)
+#: accuracies at which the report compares the codes' fastest runs: p₀ and a within 0.3 % and 0.1 %
 TARGETS = (0.003, 0.001)
 
 

@@ -6,7 +6,7 @@ imports only getfem, gmsh, numpy and the standard library, never the package.
 
     /usr/bin/python3 peer_getfem.py '{"scene": "sphere", "h_contact": 0.03125, "nu": 0.45}'
 
-The model is that of the GetFEM runs quoted in issue 15: the lower quarter of the
+The model: the lower quarter of the
 disc (x ≥ 0, y ≤ R; the sphere's meridian for ``"scene": "sphere"``, then
 r = x and the weak form carries the weight r and the hoop strain u_r/r), a
 symmetry plane on x = 0 (u_x = 0), a uniform downward traction on the cut
@@ -20,8 +20,9 @@ gmsh mesh whose size is ``h_contact`` · a within ``fine_radius`` · a of the
 first point of contact and grows by ``growth`` per unit distance beyond it up
 to ``h_max`` · R. The model is solved in units of R and E (see :func:`solve`)
 by ``Model.solve`` (MUMPS), Newton starting from a rigid push by Hertz's
-approach a²/R: from zero, the first step (the rigid mode held by one node
-and the tiny spring) sent the sphere's Newton into 100 damped steps at 72k dofs.
+approach a²/R: from zero, the first step moves the body by its nearly free
+rigid mode (held by one node and the tiny spring) and the line search damps
+Newton for many steps (docs/peer.md).
 
 Output, one JSON line on stdout: dofs (GetFEM's displacement dofs), contact
 nodes, p0 and a from the least-squares fit :func:`fit_hertz` of the nodal
