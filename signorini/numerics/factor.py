@@ -50,8 +50,8 @@ def available_backends() -> list[str]:
 
 
 #: ``auto`` leaves matrices below this many dofs to CHOLMOD or SuperLU: time does not matter
-#: there, and on the tutorials' smallest problem PARDISO's solve was the least accurate of the
-#: three (docs/speed.md, §1)
+#: there, and on the tutorials' smallest problem PARDISO's solve missed the 1e-12 residual the
+#: other two met (docs/speed.md, §1)
 PARDISO_FROM = 5_000
 #: with CHOLMOD installed, ``auto`` leaves it the matrices below this many dofs: there a whole
 #: solve is faster with CHOLMOD, in less memory, than with PARDISO and the cost of importing it
