@@ -262,9 +262,7 @@ class ContactProblem:
                    force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
 
     # -- what the discretisation says (neutral values for a QP given as arrays) ---------------
-    @property
-    def scene(self) -> str:
-        return self.name
+    scene = property(lambda self: self.name, doc="The scene's name (``name``).")
 
     @property
     def mesh(self) -> Any:
@@ -344,10 +342,8 @@ class ContactProblem:
             self._factor = factorize(self.K)
         return self._factor
 
-    @property
-    def cached_factor(self):
-        """The factorisation of K :meth:`factor` made, or None when none was asked for yet."""
-        return self._factor
+    cached_factor = property(lambda self: self._factor,
+                             doc="The factorisation of K :meth:`factor` made, or None so far.")
 
     def displacement_for(self, lam: np.ndarray) -> np.ndarray:
         """``u(λ) = K⁻¹ (f − Nᵀλ)``, the minimiser of the Lagrangian."""
