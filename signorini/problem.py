@@ -88,6 +88,10 @@ class Push:
     None; ``pending`` says that no push has been matched to it yet: the
     problem is at a nominal push, and load control
     (:func:`signorini.loading.match`) finds the push whose load is the target.
+    The load is the contact forces' resultant along the push,
+    ``μ Σ cᵢ λᵢ`` with ``cᵢ`` each candidate's ``resultant`` weight (the
+    cosine of its normal's tilt; None when every normal points along the
+    push, ``cᵢ = 1``).
     """
 
     f1: np.ndarray
@@ -100,6 +104,7 @@ class Push:
     load: float = 0.0
     target: float | None = None
     pending: bool = False
+    resultant: np.ndarray | None = None
 
     def f(self, scale: float, load: float | None = None) -> np.ndarray:
         """The load vector at push ``scale`` (and target ``load``, default the assembled one)."""
@@ -478,7 +483,8 @@ class ContactProblem:
                 p = about["push"]
                 push = Push(z["push_f1"], z["push_d0"], z["push_d1"], p["offset1"], p["scale"],
                             z["push_f_load"] if "push_f_load" in z else None, p["offset_load"],
-                            p["load"], p["target"], p["pending"])
+                            p["load"], p["target"], p["pending"],
+                            z["push_resultant"] if "push_resultant" in z else None)
             mesh = None
             if "mesh_p" in z:
                 kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
