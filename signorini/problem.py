@@ -88,10 +88,8 @@ class Push:
     None; ``pending`` says that no push has been matched to it yet: the
     problem is at a nominal push, and load control
     (:func:`signorini.loading.match`) finds the push whose load is the target.
-    The load is the contact forces' resultant along the push,
-    ``μ Σ cᵢ λᵢ`` with ``cᵢ`` each candidate's ``resultant`` weight (the
-    cosine of its normal's tilt; None when every normal points along the
-    push, ``cᵢ = 1``).
+    The load is the contact resultant along the push, ``μ Σ cᵢ λᵢ`` with ``cᵢ``
+    the cosine of candidate i's normal's tilt (``resultant``; None: all 1).
     """
 
     f1: np.ndarray
@@ -357,12 +355,10 @@ class ContactProblem:
     def inverse_energy(self, r: np.ndarray) -> float:
         """``rᵀ K⁻¹ r``: by the cached factorisation, or by conjugate gradients on big problems.
 
-        The certificate comes here only when the method held no factorisation
-        of K (see :func:`signorini.kkt.primal_dual_gap`). From
-        :data:`ITERATIVE_ENERGY_FROM` dofs, when no factorisation is at hand
-        (a distributed solve never makes one), Jacobi-preconditioned CG to
-        ``ITERATIVE_ENERGY_RTOL`` replaces a serial factorisation (slow on
-        stiff 2D meshes: the last resort); without convergence it factorises.
+        For a certificate whose method held no factorisation of K: from
+        :data:`ITERATIVE_ENERGY_FROM` dofs Jacobi-preconditioned CG to
+        ``ITERATIVE_ENERGY_RTOL`` (the last resort, slow on stiff 2D meshes)
+        instead of a serial factorisation; without convergence it factorises.
         """
         if self._factor is None and self.n >= ITERATIVE_ENERGY_FROM and np.any(r):
             from scipy.sparse.linalg import cg

@@ -291,3 +291,20 @@ def test_the_certificate_page_shows_the_study_json():
     assert {r["nu"] for r in rows} == set(study.NUS)
     near = [r for r in rows if r["nu"] == NEAR_HALF]
     assert near and all(r["status"] != "converged" for r in near)
+
+
+# --- the load asked for is the load applied, on curved obstacles too --------------------------
+
+@pytest.mark.parametrize("scene, params", [
+    ("punch", {"corner_radius": 1, "P": 0.9, "n_contact": 8}),
+    ("reverse-hertz", {"a_over_R": 0.5, "n_contact": 8}),
+])
+def test_the_target_load_is_the_load_applied_on_a_curved_obstacle(scene, params):
+    """Load control matches the contact resultant along the push (each force with its normal's
+    tilt), which the boundary applies: not Σλ, the total normal force, which exceeds it."""
+    result = signorini.solve(scene, params=params)
+    assert result.converged, result.message
+    target = result.problem.push.target * result.problem.scales.force
+    assert result.applied_load == pytest.approx(target, rel=1e-9)
+    assert result.to_dict()["load_resultant"] == pytest.approx(target, rel=1e-9)
+    assert result.total_force > 1.001 * target  # the normal forces' sum is more than the load
