@@ -118,6 +118,10 @@ class SizeModel:
     def estimate(self, p: dict[str, Any]) -> float:
         """The dofs of a mesh with checked parameters ``p``: inf where they overflow a float
         (the size check then refuses them, naming the mesh parameters)."""
+        return self.graded(p) * 2.0 ** (self.dim * p.get("refine", 0))
+
+    def graded(self, p: dict[str, Any]) -> float:
+        """The dofs of the graded mesh, before any uniform refinement."""
         with np.errstate(over="ignore", divide="ignore"):  # an overflow is an infinite estimate
             dofs = (self.dofs - self.far_field) * (np.float64(p["n_contact"]) / self.n_contact) ** self.alpha
             dofs *= (self.grading / np.float64(p["grading"])) ** self.beta
@@ -128,7 +132,63 @@ class SizeModel:
             if self.uniform is not None:  # no finer than uniform at the contact's element size
                 dofs = min(dofs, self.uniform
                            * (np.float64(p["n_contact"]) / p.get("a_over_R", 1.0)) ** self.dim)
-            return float(dofs * 2.0 ** (self.dim * p.get("refine", 0)))
+            return float(dofs)
+
+
+#: the graded octant's dofs ≈ OCTANT_FAR + OCTANT_SCALE · I^OCTANT_POWER, I = ∫ dV / h³ over
+#: the unit octant for the target element size h of :func:`signorini.scenes.hertz_sphere_3d.build`
+#: (the number of tetrahedra the grading asks for): fitted to 18 meshes over grading 0.05..2,
+#: n_contact 3..20 and a/R 0.01..0.2, 1.0 to 1.25 times their dofs
+OCTANT_FAR, OCTANT_SCALE, OCTANT_POWER = 100.0, 64.4, 0.915
+#: a uniform refinement of a tetrahedral mesh of N nodes multiplies them by 1 + edges / nodes,
+#: below OCTANT_REFINE[0] − OCTANT_REFINE[1] · N^(-1/3) (6.63 at 2,428 nodes, 7.10 at 19,168,
+#: the surface's nodes having fewer edges), and never more than 8
+OCTANT_REFINE = (7.6, 12.0)
+
+
+@dataclass(frozen=True)
+class GradedOctant:
+    """The size of :mod:`signorini.scenes.hertz_sphere_3d`'s mesh from its target element size
+    ``h = min(a/n_contact + grading · dist(x, disc of radius 1.25 a), MAX_SIZE)``."""
+
+    dim: int = 3
+
+    def graded(self, p: dict[str, Any]) -> float:
+        """The dofs of the graded mesh, before any uniform refinement."""
+        a, n, g = _sphere_ratio(p), float(p["n_contact"]), float(p["grading"])
+        with np.errstate(over="ignore"):  # an overflow is an infinite estimate
+            return OCTANT_FAR + OCTANT_SCALE * octant_density(a, n, g) ** OCTANT_POWER
+
+    def estimate(self, p: dict[str, Any]) -> float:
+        nodes = self.graded(p) / 3.0
+        for _ in range(p.get("refine", 0)):
+            nodes *= min(8.0, OCTANT_REFINE[0] - OCTANT_REFINE[1] * nodes ** (-1 / 3))
+        return 3.0 * nodes
+
+
+def octant_density(a: float, n_contact: float, grading: float, points: int = 120) -> float:
+    """``∫ dV / h³`` over the octant ``x, y ≥ 0, z ≤ 1`` of the unit ball centred at (0, 0, 1),
+    ``h = min(a/n_contact + grading · d, MAX_SIZE)``, d the distance to the disc ``ρ ≤ 1.25 a``,
+    ``z = 0`` (midpoint rule in (ρ, z), fine near the disc: within 0.5 % of a fine grid's)."""
+    from signorini.scenes.hertz_sphere_3d import MAX_SIZE
+
+    h0 = a / n_contact
+    edges = np.unique(np.concatenate([np.linspace(0.0, 3.0 * a, points),
+                                      np.geomspace(min(h0, a) / 20.0, 1.0, 2 * points), [0.0]]))
+    middle, width = 0.5 * (edges[1:] + edges[:-1]), np.diff(edges)
+    rho, z = middle[:, None], middle[None, :]
+    inside = rho ** 2 + (z - 1.0) ** 2 <= 1.0
+    with np.errstate(over="ignore", divide="ignore"):
+        h = np.minimum(h0 + grading * np.hypot(np.maximum(rho - 1.25 * a, 0.0), z), MAX_SIZE)
+        return float(np.sum(np.where(inside, 0.5 * np.pi * rho * np.outer(width, width) / h ** 3,
+                                     0.0)))
+
+
+def _sphere_ratio(p: dict[str, Any]) -> float:
+    """The a/R a sphere's mesh is graded for: the load's (``P``, ``delta`` or ``a_over_R``)."""
+    from signorini.scenes.hertz_sphere import load_choice
+
+    return load_choice(p, {k for k in ("P", "delta") if p.get(k) is not None})[1]
 
 
 #: measured at each family's defaults (signorini commit 66f74ea: hertz-cylinder 4,866 dofs,
@@ -136,7 +196,7 @@ class SizeModel:
 SIZE_MODELS = {
     "hertz-cylinder": SizeModel(2, 4866, 40, 0.15, 0.05, uniform=5.2),
     "hertz-sphere": SizeModel(2, 6824, 60, 0.15, 0.05, uniform=5.2),
-    "hertz-sphere-3d": SizeModel(3, 7284, 10, 0.5, 0.05),
+    "hertz-sphere-3d": GradedOctant(),
     "punch": SizeModel(2, 7948, 128, 0.2, uniform=6082.0),
     "reverse-hertz": SizeModel(2, 6118, 128, 0.3, uniform=2.66),
 }
@@ -175,15 +235,17 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
         return
     dofs, dim = found
     if dim == 3:  # the mesher's limit first (as the tetrahedra reach it long before memory)
-        _check_graded(family, params, dofs, dim)
+        _check_graded(family, params, dim)
     _check_memory(family, params, dofs, dim, solved_by)
-    _check_graded(family, params, dofs, dim)
+    _check_graded(family, params, dim)
 
 
-def _check_graded(family: str, params: dict[str, Any], dofs: float, dim: int) -> None:
+def _check_graded(family: str, params: dict[str, Any], dim: int) -> None:
     """InputError when the graded mesh, before uniform refinement, exceeds the mesher's limit."""
-    graded = dofs / 2.0 ** (dim * params.get("refine", 0)) * ELEMENTS_PER_DOF[dim]
-    if "grading" in params and graded > GRADED_LIMIT[dim]:
+    if "grading" not in params:
+        return
+    graded = SIZE_MODELS[family].graded(params) * ELEMENTS_PER_DOF[dim]
+    if graded > GRADED_LIMIT[dim]:
         raise InputError(
             f"scene {family!r} with grading={params['grading']:g}, n_contact={params['n_contact']:g} "
             f"would be graded to about {graded:,.0f} {ELEMENT_NAMES[dim]} "
@@ -192,12 +254,22 @@ def _check_graded(family: str, params: dict[str, Any], dofs: float, dim: int) ->
             "and refine (refine=1, 2...) to go finer")
 
 
+def over_limit(dofs: float, dim: int, params: dict[str, Any],
+               solved_by: str | None = None) -> tuple[float, float] | None:
+    """``(bytes needed, limit)`` when building and solving a model of ``dofs`` dofs with the
+    method ``solved_by`` would exceed :func:`memory_limit`; None when it fits. ``params`` needs
+    only ``nu`` and ``volumetric`` (and for 3D ``P`` and ``delta``), as :func:`bytes_per_dof`."""
+    need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
+    return None if need <= limit else (need, limit)
+
+
 def _check_memory(family: str, params: dict[str, Any], dofs: float, dim: int,
                   solved_by: str | None) -> None:
     """InputError when building and solving the scene would exceed :func:`memory_limit`."""
-    need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
-    if need <= limit:
+    over = over_limit(dofs, dim, params, solved_by)
+    if over is None:
         return
+    need, limit = over
     names = [k for k in ("n_contact", "grading", "refine", "nx", "ny") if k in params]
     mesh = ", ".join(f"{k}={params[k]:g}" for k in names)
     raise InputError(
