@@ -328,7 +328,7 @@ def solve_adaptive(scene: str, target_error: float | str, method: str = DEFAULT_
                             **options)
 
     run = adapt(scene, params, parse_target(target_error), solver, max_dofs=max_dofs,
-                quantity=target_on)
+                quantity=target_on, solved_by=method)
     result = Result(run.problem, run.solution, certificate(run.problem, run.solution))
     result._estimate = run.estimate
     return result

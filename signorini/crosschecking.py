@@ -18,9 +18,8 @@ claim of success is what a cross-check is there to test. A judged pair
 ``AGREE_FACTOR × max(tol_a, tol_b)``; that is a bug in one of the two (or a
 tolerance that means less than it says). The factor: the certificate bounds
 residuals, not errors, and W = N K⁻¹ Nᵀ's conditioning turns residuals within
-tol into λ errors of up to 1.6e3 × tol (316 converged runs with the exact active
-set, docs/formulations/runs.json: OSQP's dual at 75k dofs, tol 1e-9); 10⁴ leaves
-room for finer meshes and still catches, at tol 1e-8, a λ off by 1e-4.
+tol into λ errors of up to 1.6e3 × tol in the formulation runs (docs/crosscheck.md);
+10⁴ leaves room for finer meshes and still catches, at tol 1e-8, a λ off by 1e-4.
 
 The methods run one after another in this process (a problem from
 :meth:`ContactProblem.from_qp` cannot be rebuilt in a worker); a method that

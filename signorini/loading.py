@@ -130,16 +130,20 @@ def predicted_zone(problem: ContactProblem, coarse: CoarseModel | None = None) -
 def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
     """The problem at the push whose total contact force is its target load.
 
-    On the predicted ``zone`` by the zone kernel (one factorisation) when
-    given, else (or should the prediction fail) on the full active-set system
-    from the candidates the scene predicts in contact.
+    The load is the contact forces' resultant along the push (on a curved
+    obstacle each force counts with the cosine of its normal's tilt,
+    ``Push.resultant``), the load the body's boundary applies. On the
+    predicted ``zone`` by the zone kernel (one factorisation) when given and
+    the obstacle is flat across the push, else (or should the prediction
+    fail) on the full active-set system from the candidates the scene
+    predicts in contact.
     """
     if not problem.pending:
         raise InputError("the problem has no target load to match: it is solved as it is")
     before = counters()
     pu, disc = problem.push, problem.discretisation
     f0 = pu.load * pu.f_load if pu.f_load is not None else None
-    if zone is not None:
+    if zone is not None and pu.resultant is None:  # the zone kernel sums forces along the push
         try:
             system = ZoneSolver(problem.K, problem.N)
             scale, _, lam, final = system.push_for_load(
@@ -154,7 +158,7 @@ def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
             log.info("load control on the predicted zone failed (%s): full active set", exc)
     scale, lam, u = calibrate_push(problem.K, problem.N, pu.f1, pu.d0, pu.d1, pu.target,
                                    problem.force_multiplicity, f0=f0,
-                                   start=disc.predicted_contact)
+                                   start=disc.predicted_contact, weights=pu.resultant)
     return Matched(problem.pushed(scale), WarmStart(lam=lam, u=u), "full active set",
                    spent(before))
 

@@ -330,8 +330,7 @@ def compare_hertz_sphere(problem: ContactProblem, solution: ContactSolution) -> 
     the 3D model p₀ is the nodal pressure at the first point of contact and a
     the mean edge along the two symmetry planes: the lumped nodal pressures
     of an unstructured surface mesh scatter, and a fit through their squares
-    is biased by it (measured on the default 3D sphere: +3.3 % in p₀ against
-    −1.0 % for the nodal peak).
+    is biased by it more than the nodal peak is (docs/spheres.md).
     ``pressure_l2_rel`` is relative in the L2 norm of the contact plane
     (area-weighted), ``edge_margin`` the outermost candidate's radius over a.
     """

@@ -88,6 +88,8 @@ class Push:
     None; ``pending`` says that no push has been matched to it yet: the
     problem is at a nominal push, and load control
     (:func:`signorini.loading.match`) finds the push whose load is the target.
+    The load is the contact resultant along the push, ``μ Σ cᵢ λᵢ`` with ``cᵢ``
+    the cosine of candidate i's normal's tilt (``resultant``; None: all 1).
     """
 
     f1: np.ndarray
@@ -100,6 +102,7 @@ class Push:
     load: float = 0.0
     target: float | None = None
     pending: bool = False
+    resultant: np.ndarray | None = None
 
     def f(self, scale: float, load: float | None = None) -> np.ndarray:
         """The load vector at push ``scale`` (and target ``load``, default the assembled one)."""
@@ -262,9 +265,7 @@ class ContactProblem:
                    force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
 
     # -- what the discretisation says (neutral values for a QP given as arrays) ---------------
-    @property
-    def scene(self) -> str:
-        return self.name
+    scene = property(lambda self: self.name, doc="The scene's name (``name``).")
 
     @property
     def mesh(self) -> Any:
@@ -344,10 +345,8 @@ class ContactProblem:
             self._factor = factorize(self.K)
         return self._factor
 
-    @property
-    def cached_factor(self):
-        """The factorisation of K :meth:`factor` made, or None when none was asked for yet."""
-        return self._factor
+    cached_factor = property(lambda self: self._factor,
+                             doc="The factorisation of K :meth:`factor` made, or None so far.")
 
     def displacement_for(self, lam: np.ndarray) -> np.ndarray:
         """``u(λ) = K⁻¹ (f − Nᵀλ)``, the minimiser of the Lagrangian."""
@@ -356,12 +355,10 @@ class ContactProblem:
     def inverse_energy(self, r: np.ndarray) -> float:
         """``rᵀ K⁻¹ r``: by the cached factorisation, or by conjugate gradients on big problems.
 
-        The certificate comes here only when the method held no factorisation
-        of K (see :func:`signorini.kkt.primal_dual_gap`). From
-        :data:`ITERATIVE_ENERGY_FROM` dofs, when no factorisation is at hand
-        (a distributed solve never makes one), Jacobi-preconditioned CG to
-        ``ITERATIVE_ENERGY_RTOL`` replaces a serial factorisation (slow on
-        stiff 2D meshes: the last resort); without convergence it factorises.
+        For a certificate whose method held no factorisation of K: from
+        :data:`ITERATIVE_ENERGY_FROM` dofs Jacobi-preconditioned CG to
+        ``ITERATIVE_ENERGY_RTOL`` (the last resort, slow on stiff 2D meshes)
+        instead of a serial factorisation; without convergence it factorises.
         """
         if self._factor is None and self.n >= ITERATIVE_ENERGY_FROM and np.any(r):
             from scipy.sparse.linalg import cg
@@ -482,7 +479,8 @@ class ContactProblem:
                 p = about["push"]
                 push = Push(z["push_f1"], z["push_d0"], z["push_d1"], p["offset1"], p["scale"],
                             z["push_f_load"] if "push_f_load" in z else None, p["offset_load"],
-                            p["load"], p["target"], p["pending"])
+                            p["load"], p["target"], p["pending"],
+                            z["push_resultant"] if "push_resultant" in z else None)
             mesh = None
             if "mesh_p" in z:
                 kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet

@@ -1,11 +1,12 @@
-"""Load targeting left to the method: pdas-amg matches a target load without a factorisation.
+"""Load control (signorini.loading): a target load is matched outside assembly, by one driver.
 
 A scene with a target load P is assembled at a nominal push with the target
-``pending`` when the method that will solve it says it matches the load itself
-(``build_problem(..., solved_by=...)``); pdas-amg then carries the push as one
-more unknown of its CG systems (:class:`signorini.solvers.amg.LoadBorder`). The
-answer must be the one the factorised load targeting gives, for the same load;
-any other method gets the problem matched first. Work is counted, not timed.
+``pending``; building it factorises nothing. Load control matches it: by
+factorisation (the full active-set system, or the zone kernel), or, for
+pdas-amg, with the push as one more unknown of its CG systems
+(:class:`signorini.solvers.amg.LoadBorder`), never factorised. Every route
+must give the same answer for the same load; a method that solves the QP as
+it is refuses a pending problem. Work is counted, not timed.
 """
 
 import dataclasses
@@ -16,6 +17,7 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
+from signorini import loading
 from signorini.kkt import certificate, compare
 from signorini.numerics import factor
 from signorini.numerics.multigrid import Bordered
@@ -36,32 +38,33 @@ def factorisations() -> int:
 
 @pytest.fixture(scope="module", params=[{}, PUSHED], ids=["traction", "pushed-cut"])
 def pair(request):
-    """(pending problem, the same scene load-targeted by factorisation)."""
+    """(pending problem, the same scene matched by factorisation)."""
     before = factorisations()
-    pending = build_problem(SCENE, params=request.param, solved_by="pdas-amg")
-    assert factorisations() == before, "a pending problem is assembled without a factorisation"
-    return pending, build_problem(SCENE, params=request.param)
+    pending = build_problem(SCENE, params=request.param)
+    assert factorisations() == before, "a problem is built without a factorisation"
+    return pending, loading.at_load(pending)
 
 
 def test_the_target_is_pending_until_matched(pair):
     pending, eager = pair
     assert pending.pending and not eager.pending
     assert pending.push.target == pytest.approx(eager.push.target, rel=1e-12)
-    matched = pending.matched()
-    assert not matched.pending and matched.matched() is matched
-    assert matched.push.scale == pytest.approx(eager.push.scale, rel=1e-9)
-    assert np.allclose(matched.f, eager.f, rtol=0, atol=1e-9 * np.abs(eager.f).max())
+    matched = loading.match(pending)
+    assert not matched.problem.pending and matched.work["factorisations"] >= 1
+    assert matched.problem.push.scale == pytest.approx(eager.push.scale, rel=1e-9)
+    assert np.allclose(matched.problem.f, eager.f, rtol=0, atol=1e-9 * np.abs(eager.f).max())
+    with pytest.raises(signorini.InputError, match="no target load to match"):
+        loading.match(matched.problem)
 
 
 def test_pdas_amg_matches_the_load_without_a_factorisation(pair):
     pending, eager = pair
     reference = solve(eager, "pdas")
     before = factorisations()
-    solution = solve(pending, "pdas-amg")
+    settled, solution = loading.solve(pending, "pdas-amg")
     assert solution.status == "converged", solution.message
-    assert "one more unknown" in solution.message
-    settled = solution.problem
-    assert settled is not None and not settled.pending
+    assert "one more unknown" in solution.message and "load control" not in solution.work
+    assert not settled.pending
     # no factorisation of the fine model (its coarse model, if any, is small and counted apart)
     assert factorisations() - before <= 1
     assert certificate(settled, solution).worst()[1] <= 1e-9
@@ -74,11 +77,13 @@ def test_pdas_amg_matches_the_load_without_a_factorisation(pair):
 
 def test_any_other_method_gets_the_problem_matched_first(pair):
     pending, eager = pair
-    solution = solve(pending, "pdas")
-    assert solution.status == "converged"
-    assert solution.problem is not None and not solution.problem.pending
-    assert solution.problem.total_contact_force(solution.lam) == pytest.approx(
-        pending.push.target, rel=1e-9)
+    with pytest.raises(signorini.InputError, match="not matched yet"):
+        solve(pending, "pdas")  # the method alone solves the QP as it is: it refuses
+    settled, solution = loading.solve(pending, "pdas")
+    assert solution.status == "converged" and not settled.pending
+    assert solution.work["load control"]["factorisations"] >= 1
+    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
+                                                                      rel=1e-9)
 
 
 def test_the_api_reports_the_matched_problem(monkeypatch):
@@ -91,10 +96,11 @@ def test_the_api_reports_the_matched_problem(monkeypatch):
 
 
 def test_small_models_keep_the_factorised_targeting():
-    """auto picks pdas for a small 3D model: the assembly targets the load (and nested reuses it)."""
-    problem = build_problem(SCENE, solved_by="auto")
-    assert not problem.pending
-    assert not build_problem(SCENE, solved_by="pdas").pending
+    """auto picks pdas for a small 3D model: load control matches the load by factorisation and
+    pdas confirms what it found in one step."""
+    result = signorini.solve(SCENE)
+    assert result.method == "pdas" and result.iterations == 1
+    assert result.solution.work["load control"]["factorisations"] >= 1
 
 
 def test_a_pending_problem_is_saved_pending(tmp_path, pair):
@@ -103,9 +109,9 @@ def test_a_pending_problem_is_saved_pending(tmp_path, pair):
     pending.save(path)
     loaded = ContactProblem.load(path)
     assert loaded.pending and loaded.push.target == pending.push.target
-    solution = solve(loaded, "pdas")
-    assert solution.problem.total_contact_force(solution.lam) == pytest.approx(
-        pending.push.target, rel=1e-9)
+    settled, solution = loading.solve(loaded, "pdas")
+    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
+                                                                      rel=1e-9)
 
 
 def test_the_bordered_operator_is_the_bordered_matrix():
@@ -123,8 +129,8 @@ def test_the_bordered_operator_is_the_bordered_matrix():
                     reason="the petsc backend of pdas-amg needs petsc4py (extra 'petsc')")
 def test_both_multigrids_match_the_load(pair):
     pending, eager = pair
-    first = solve(pending, "pdas-amg", amg="petsc")
-    second = solve(pending, "pdas-amg", amg="pyamg")
+    first = loading.solve(pending, "pdas-amg", amg="petsc")[1]
+    second = loading.solve(pending, "pdas-amg", amg="pyamg")[1]
     assert first.status == second.status == "converged"
     assert compare(eager, first, second).lam_rel <= 1e-7
 
@@ -134,21 +140,25 @@ def test_the_push_as_an_unknown_costs_few_cg_iterations(pair):
     CG iterations stay close to those of the same problem with the push given (counted, not
     timed; measured at 6.9k dofs: 150 against 120 or so)."""
     pending, _ = pair
-    targeted = solve(pending, "pdas-amg")
-    given = solve(targeted.problem, "pdas-amg")
+    settled, targeted = loading.solve(pending, "pdas-amg")
+    given = solve(settled, "pdas-amg")
     assert targeted.status == given.status == "converged"
     assert targeted.extras["cg_iterations"] <= 1.5 * given.extras["cg_iterations"] + 30
 
 
 def test_a_push_pdas_amg_cannot_carry_is_matched_before_its_bound_form(pair):
-    """When the push also moves contact candidates (d₁ ≠ 0) there is no border: pdas-amg matches
-    the load by factorisation first and then solves that problem, not the nominal one."""
+    """When the push also moves contact candidates (d₁ ≠ 0) there is no border: load control
+    matches the load by factorisation first and pdas-amg solves that problem, not the nominal
+    one; alone, pdas-amg refuses the pending problem."""
     pending, _ = pair
     d1 = np.full(pending.m, 1e-3 * np.abs(pending.push.d0).max())
     moved = pending.with_data(push=dataclasses.replace(pending.push, d1=d1),
                               d=pending.push.d0 + pending.push.scale * d1)
     assert moved.pending
-    ours, reference = solve(moved, "pdas-amg"), solve(moved, "pdas")
+    with pytest.raises(signorini.InputError, match="match the load first"):
+        solve(moved, "pdas-amg")
+    (ours_problem, ours), (their_problem, reference) = (loading.solve(moved, "pdas-amg"),
+                                                        loading.solve(moved, "pdas"))
     assert ours.status == reference.status == "converged"
-    assert ours.problem.push.scale == pytest.approx(reference.problem.push.scale, rel=1e-9)
-    assert compare(reference.problem, ours, reference).lam_rel <= 1e-7
+    assert ours_problem.push.scale == pytest.approx(their_problem.push.scale, rel=1e-9)
+    assert compare(their_problem, ours, reference).lam_rel <= 1e-7

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import signorini
 from signorini.errors import InputError
 from signorini.kkt import active_set, compare
 from signorini.scenes import build_problem
@@ -35,7 +36,7 @@ def references():
     """Each scene at its defaults and its exact answer from the serial active-set method."""
     out = {}
     for name in SCENES + ("reverse-hertz",):
-        problem = build_problem(name)
+        problem = signorini.at_load(build_problem(name))
         out[name] = (problem, solve(problem, "pdas"))
     return out
 

@@ -7,22 +7,23 @@ standard library, never the package.
 
     /usr/bin/python3 benchmarks/peers/getfem_hertz.py '{"scene": "sphere", "h_contact": 0.03125}'
 
-The model: the lower quarter of the disc (x ≥ 0, y ≤ R; the sphere's meridian
-for ``"scene": "sphere"``, then r = x and the weak form carries the weight r
-and the hoop strain u_r/r), a symmetry plane on x = 0 (u_x = 0), a uniform
-downward traction on the cut through the centre y = R whose resultant is
-Hertz's load for ``a_over_R`` (cylinder: P = πE*a²/(4R) per unit thickness;
-sphere: P = 4E*a³/(3R)), a tiny spring ``stabilisation · E/R² · u`` over the
-body that removes the rigid vertical mode, and GetFEM's nodal contact brick
-(``add_nodal_contact_with_rigid_obstacle_brick``, Alart–Curnier augmented
-Lagrangian, Newton) on the arc with x ≤ ``candidates`` · a against the rigid
-flat y ≤ 0. P1 triangles on a gmsh mesh whose size is ``h_contact`` · a within
-``fine_radius`` · a of the first point of contact and grows by ``growth`` per
-unit distance beyond it up to ``h_max`` · R. The model is solved in units of R
-and E (see :func:`solve`) by ``Model.solve`` (MUMPS), Newton starting from a
-rigid push by Hertz's approach a²/R: from zero, the first step (the rigid mode
-held by one node and the tiny spring) sent the sphere's Newton into 100 damped
-steps at 72k dofs.
+The model: the lower quarter of the
+disc (x ≥ 0, y ≤ R; the sphere's meridian for ``"scene": "sphere"``, then
+r = x and the weak form carries the weight r and the hoop strain u_r/r), a
+symmetry plane on x = 0 (u_x = 0), a uniform downward traction on the cut
+through the centre y = R whose resultant is Hertz's load for ``a_over_R``
+(cylinder: P = πE*a²/(4R) per unit thickness; sphere: P = 4E*a³/(3R)), a tiny
+spring ``stabilisation · E/R² · u`` over the body that removes the rigid
+vertical mode, and GetFEM's nodal contact brick (``add_nodal_contact_with_
+rigid_obstacle_brick``, Alart–Curnier augmented Lagrangian, Newton) on the arc
+with x ≤ ``candidates`` · a against the rigid flat y ≤ 0. P1 triangles on a
+gmsh mesh whose size is ``h_contact`` · a within ``fine_radius`` · a of the
+first point of contact and grows by ``growth`` per unit distance beyond it up
+to ``h_max`` · R. The model is solved in units of R and E (see :func:`solve`)
+by ``Model.solve`` (MUMPS), Newton starting from a rigid push by Hertz's
+approach a²/R: from zero, the first step moves the body by its nearly free
+rigid mode (held by one node and the tiny spring) and the line search damps
+Newton for many steps (docs/peer.md).
 
 Output, one JSON line on stdout: dofs (GetFEM's displacement dofs), contact
 nodes, p0 and a from the least-squares fit :func:`fit_hertz` of the nodal

@@ -14,7 +14,7 @@ from signorini.cli.common import input_files, out_folder, pairs, parse_sizes
 
 def _bench_peer(args: argparse.Namespace) -> int:
     # each command loads what it needs (the peer report starts matplotlib)
-    from signorini.files import all_or_none
+    from signorini.files import all_or_none  # as above
     from signorini.output.report import provenance  # as above
     from signorini.studies import peer  # as above
 

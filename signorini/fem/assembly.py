@@ -236,7 +236,8 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
         mesh=mesh, free_dofs=free, prescribed=full, load_row=load_full[free],
         load_offset=load_offset, E=float(model.E), nu=float(model.nu),
         volumetric=model.volumetric, axisymmetric=axisymmetric, params=params,
-        push=_push(lifted, 1.0, None if f_load is None else f_load[free], offset_load, target),
+        push=_push(lifted, 1.0, None if f_load is None else f_load[free], offset_load, target,
+                   _resultant(N_full, np.intersect1d(dof_table[component], free))),
         predicted_contact=model.predicted_contact, watch=boundary_watch(model, dof_table, U))
     problem = ContactProblem(
         K=K_II, f=f, N=N_free, d=d, weights=contact_weights(mesh, model.contact_facets, nodes,
@@ -326,11 +327,20 @@ def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch 
                  remedy=model.candidate_remedy, nodes=watched)
 
 
+def _resultant(N_full: sp.csr_matrix, axis_dofs: np.ndarray) -> np.ndarray | None:
+    """Each candidate's share of the contact resultant along the push axis, ``cᵢ = −nᵢ·e``
+    (the free dofs ``axis_dofs`` of that axis); None when every ``cᵢ`` is exactly 1 (a flat
+    obstacle across the push: the resultant is ``Σλ``)."""
+    weights = -np.asarray(N_full[:, axis_dofs].sum(axis=1)).ravel()
+    return None if np.all(weights == 1.0) else weights
+
+
 def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
-          load: float | None) -> Push:
+          load: float | None, resultant: np.ndarray | None) -> Push:
     """How f, d and the load offset depend on the push and the load (they are affine in both)."""
     f0, d0, offset0, _ = lifted(0.0)
     f1, d_one, offset_one, _ = lifted(1.0)
     return Push(f1=f1 - f0, d0=d0, d1=d_one - d0, offset1=offset_one - offset0, scale=scale,
                 f_load=f_load, offset_load=offset_load if f_load is not None else 0.0,
-                load=load if f_load is not None else 0.0, target=load, pending=load is not None)
+                load=load if f_load is not None else 0.0, target=load, pending=load is not None,
+                resultant=resultant)

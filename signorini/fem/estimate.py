@@ -313,7 +313,7 @@ def pressure_estimate(problem: ContactProblem, solution: ContactSolution, nodal:
     ``p*`` is the traction ``σ* ν`` on the body's curved boundary (outward
     normal ν) along the obstacle's normal — the direction of N's row: on
     Hertz's cylinder at x = 0.7 a, taking ν as the obstacle's normal instead
-    biases p* by about 0.2 % of p₀ for any mesh (measured). ``nodal_trace`` is the
+    biases p* by about 0.2 % of p₀ for any mesh (docs/estimate.md). ``nodal_trace`` is the
     volumetric strain at the nodes when K averages it there (else the recovered strain's trace).
     """
     mesh, dim = problem.mesh, problem.mesh.p.shape[0]

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from signorini.fem.checks import check_model
 from signorini.fem.volumetric import resolve
 
 
@@ -89,8 +90,6 @@ class SceneModel:
     def __post_init__(self) -> None:
         """Refuse a model that cannot be assembled right (:mod:`signorini.fem.checks`): a bad
         mesh, an obstacle that starts inside the body, units beyond double precision."""
-        from signorini.fem.checks import check_model  # it checks models: imported when one is made
-
         check_model(self)
 
     @property

@@ -110,9 +110,8 @@ def solid_stiffness(mesh: Any, Lambda: float, Mu: float) -> sp.csr_matrix:
     transpose: the ten pairs a ≤ b of each element are summed into K's
     node-by-node pattern (:func:`node_pair_slots`) by ``bincount``, in
     element blocks of :data:`TETRA_BLOCK`, and each off-diagonal block then
-    gets its mirror's transpose. At 1,093,568 dofs (2.1M tetrahedra) this took
-    6.3–6.4 s where all sixteen pairs took 7.1–8.3 s (two runs each); of it,
-    the pattern's slots 2.1 s, the gradients 0.9 s, products and sums 2.3 s.
+    gets its mirror's transpose: ten blocks computed per element instead of
+    sixteen (timings in docs/speed.md, "Building large 3D models").
     """
     p, t = mesh.p, mesh.t
     nodes, elements = p.shape[1], t.shape[1]

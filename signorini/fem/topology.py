@@ -3,9 +3,9 @@
 scikit-fem finds a mesh's facets (``facets``, ``t2f``, ``f2t``) on first use
 by ``np.unique(..., axis=1)`` over the sorted node triples, which sorts
 columns lexicographically, and does it again for every new mesh object,
-even one that only moved or scaled the nodes. On the 3D sphere at 350k dofs
-that took 8.6 s of an 18 s build (24 meshes: the grading passes, snapping,
-scaling). Here each facet's sorted nodes are packed into one int64 (node
+even one that only moved or scaled the nodes: a large part of building a
+large 3D scene, which makes many meshes (docs/speed.md, "Building large 3D
+models"). Here each facet's sorted nodes are packed into one int64 (node
 indices below 2²¹ per component in 3D), so one stable ``argsort`` of a flat
 array gives the same arrays in the same order: ``facets`` sorted
 lexicographically, ``t2f`` its inverse, ``f2t`` the first and last element

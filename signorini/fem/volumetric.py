@@ -25,7 +25,7 @@ Commun. Numer. Meth. Engng 14 (1998) 437–449. A uniform strain gives θₙ =
 tr ε at every node, so the patch test still passes; K stays symmetric and,
 with μ > 0 and the rigid modes held, positive definite. Its stencil reaches
 the neighbours' neighbours, so K has 2.7 times the nonzeros of plain P1 on triangles
-and 5.2 times on tetrahedra (measured on the Hertz scenes).
+and 5.2 times on tetrahedra (on the Hertz scenes: docs/accuracy.md, §4).
 """
 
 from __future__ import annotations

@@ -9,11 +9,8 @@ Backends for the SPD stiffness (one interface, ``factorize(K).solve(b)``):
 ``auto`` (the default) takes the first installed of pardiso, cholmod, superlu
 (leaving PARDISO, 0.2 s to import, the small matrices where it does not pay:
 :data:`PARDISO_OVER_CHOLMOD_FROM`); the environment variable ``SIGNORINI_FACTOR``
-overrides it. Measured here
-(2 cores) on the Hertz cylinder by examples/factorisations.py, factorisation +
-one solve, PARDISO vs CHOLMOD vs SuperLU: 0.037/0.056/0.091 s at 17k dofs,
-0.18/0.28/0.73 s at 66k, 1.0/1.9/24.5 s at 261k, 5.4/11.3 s at 1.04M (where the
-whole end-to-end run peaked at 4.1 GB with PARDISO; see docs/speed.md).
+overrides it. docs/speed.md (§1) compares the three backends' times and
+holds the measurements this module's thresholds were chosen from.
 
 Every factorisation knows the matrix it factorised (``matrix``) and the dofs it
 pinned (``fixed``; none for a plain one), so that the certificate can reuse a
@@ -53,19 +50,16 @@ def available_backends() -> list[str]:
 
 
 #: ``auto`` leaves matrices below this many dofs to CHOLMOD or SuperLU: time does not matter
-#: there, and on the 6-dof bogie of the tutorials PARDISO's solve left a 1.0e-12 primal
-#: residual where CHOLMOD's and SuperLU's met 1e-12
+#: there, and on the tutorials' smallest problem PARDISO's solve missed the 1e-12 residual the
+#: other two met (docs/speed.md, §1)
 PARDISO_FROM = 5_000
-#: with CHOLMOD installed, ``auto`` leaves it the matrices below this many dofs. Measured whole
-#: process here (2 cores shared with other work, 3 runs each), ``signorini solve hertz-cylinder``
-#: at 8k, 20k, 31k, 42k and 59k dofs took 0.3-0.9 s less with CHOLMOD (median 0.60 s against
-#: 0.90 s at the default 8k; importing pypardiso and MKL alone takes 0.2 s) in 45-80 % of the
-#: memory; at 125k both took 10.3 s (PARDISO in 4x the memory). Only a solve of many
-#: factorisations on an idle machine went the other way (31k dofs, nine: 1.95 s against 2.3 s).
+#: with CHOLMOD installed, ``auto`` leaves it the matrices below this many dofs: there a whole
+#: solve is faster with CHOLMOD, in less memory, than with PARDISO and the cost of importing it
+#: (chosen from measurements, docs/speed.md §1)
 PARDISO_OVER_CHOLMOD_FROM = 50_000
 #: ... counted in nonzeros of K when they are known (a 2D K has about 14 per row, a 3D one 35-80):
-#: in 3D CHOLMOD was 3-4 times slower than PARDISO from 12k dofs on (0.22 s against 0.05 s at
-#: 12k, 4.1 s against 1.0 s at 47k on the 3D sphere), where 2D reached that ratio only at 75k
+#: a 3D K fills in sooner, and PARDISO pays there from far fewer dofs than in 2D (chosen from
+#: measurements, docs/speed.md §1)
 PARDISO_OVER_CHOLMOD_FROM_NNZ = 750_000
 
 
@@ -115,9 +109,9 @@ class Factor:
         return self._lu.solve(_count_solve(np.asarray(b, dtype=float)))
 
 
-#: from this many dofs CHOLMOD orders by nested dissection (METIS) instead of AMD: measured on
-#: the Hertz cylinder (2 cores) AMD + factorisation took 0.33 s vs 0.42 s at 49k dofs, 2.4 s vs
-#: 2.2 s at 193k and 17.2 s vs 12.0 s at 673k (nnz(L) 78.6M vs 59.4M)
+#: from this many dofs CHOLMOD orders by nested dissection (METIS) instead of AMD: below it AMD
+#: is faster, above it nested dissection's smaller factor wins (chosen from measurements,
+#: docs/speed.md §1)
 NESTED_DISSECTION_FROM = 100_000
 
 
@@ -160,9 +154,8 @@ class CholmodFactor(Factor):
 
 #: PARDISO's settings (iparm, counted from 1 as its manual does): 1 — these, not its defaults;
 #: 2 — METIS's nested dissection (its default ordering); 8 — no iterative refinement. By default it
-#: refines every solve twice (a product with K and a back-solve each), which tripled every solve
-#: (Hertz cylinder, 2 cores: 0.67 s → 0.20 s a right-hand side at 1M dofs, 0.11 → 0.055 s at
-#: 261k) while the residual of K u = f moved from 1.2e-12 to 1.7e-12 of ‖f‖ (5.6e-13 → 7.5e-13):
+#: refines every solve twice (a product with K and a back-solve each), which costs two to three
+#: times the solve and leaves the residual of K u = f at round-off either way (docs/speed.md, §4):
 #: a Cholesky factor needs no refinement, and every certificate still checks the answer.
 PARDISO_IPARM = {1: 1, 2: 2, 8: 0}
 #: the environment variable that caps a factorisation's memory, in GB (default: MemAvailable)
@@ -260,7 +253,7 @@ class PardisoFactor(Factor):
 
     def __del__(self) -> None:
         # MKL keeps a factorisation until told to drop it: without this every PARDISO factor
-        # leaked its memory (measured: +16 MB per factorisation at 19k dofs, +260 MB at 261k)
+        # leaked its memory (docs/speed.md, §1)
         solver = getattr(self, "_solver", None)
         if solver is not None:
             try:
@@ -358,8 +351,7 @@ class Pinning:
     once (K's upper triangle in CSR for PARDISO, all of K in CSC otherwise) and
     each pinning only rewrites its values; CHOLMOD's symbolic analysis (the
     ordering, most of a large factorisation's cost beyond the numeric work)
-    is computed once too. At 1M 2D dofs this took the pinned PARDISO factor from
-    0.74 s of copying and cutting to 0.1 s (docs/bench-nested).
+    is computed once too: a pinning costs no copy of K (docs/speed.md, §4).
     """
 
     def __init__(self, K: sp.spmatrix, backend: str = "cholmod"):

@@ -17,8 +17,8 @@ import scipy.sparse as sp
 
 
 #: the dense right-hand sides of one block of back-solves are kept to about this many bytes: the
-#: backends copy them several times (PARDISO: ~4), and 128 columns at 66k dofs cost 5× the
-#: memory of the factorisation itself (measured: 488 MB against 99 MB)
+#: backends copy them several times (PARDISO: ~4), so a wide block can cost several times the
+#: memory of the factorisation itself (chosen from measurements, docs/calibration.md)
 BLOCK_BYTES = 8e6
 
 

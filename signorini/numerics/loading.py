@@ -34,9 +34,12 @@ PairSolve = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 LoadPair = Callable[[np.ndarray], np.ndarray]
 
 
-def summed(multiplicity: float) -> LoadPair:
-    """The load of a model's contact forces: ``μ Σλ`` (μ copies of the model make the body)."""
-    return lambda lam: multiplicity * lam.sum(axis=0)
+def summed(multiplicity: float, weights: np.ndarray | None = None) -> LoadPair:
+    """The load of a model's contact forces: ``μ Σλ`` (μ copies of the model make the body), or
+    their resultant along the push ``μ Σ cᵢλᵢ`` with the candidates' ``weights`` cᵢ."""
+    if weights is None:
+        return lambda lam: multiplicity * lam.sum(axis=0)
+    return lambda lam: multiplicity * (weights @ lam)
 
 
 def first_contact(d0: np.ndarray) -> np.ndarray:
@@ -99,14 +102,15 @@ def condensed_pair(W: np.ndarray, b_pair: np.ndarray) -> PairSolve:
 
 def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.ndarray,
                    d1: np.ndarray, target: float, multiplicity: float = 1.0,
-                   f0: np.ndarray | None = None,
-                   start: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray]:
+                   f0: np.ndarray | None = None, start: np.ndarray | None = None,
+                   weights: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray]:
     """The push on the full sparse system (one factorisation per active set); λ and u then.
 
     The load is ``s f1 + f0`` (``f0``, e.g. a traction, does not change with the
     push). The iteration starts from the active set ``start`` (e.g. the zone an
     analytic estimate predicts: a good guess leaves one or two steps) or from
-    the first point(s) of contact.
+    the first point(s) of contact. The load is the forces' resultant along the
+    push (:func:`summed` with the candidates' ``weights``).
     """
     system = ActiveSetSolver(K, N)
     f_pair = np.column_stack([f1, np.zeros_like(f1) if f0 is None else f0])
@@ -118,7 +122,7 @@ def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.nd
         return lam, N @ last["u"] - d_pair
 
     first = first_contact(d0) if start is None or not start.any() else start
-    s, lam = push_for_load(solve_pair, first, target, summed(multiplicity))
+    s, lam = push_for_load(solve_pair, first, target, summed(multiplicity, weights))
     return s, lam, last["u"] @ [s, 1.0]
 
 

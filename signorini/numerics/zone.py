@@ -45,9 +45,8 @@ ROUND_OFF = 1e-10
 BLOCK = 32
 #: band columns ``K̃⁻¹N_jᵀ`` are kept whole while they fit in this many bytes; beyond, only what
 #: the band's LCP reads of them (``N z_j`` and the core's reactions) is kept, and the displacement
-#: costs one back-solve more. At 1,093,024 3D dofs (a pushed sphere) the band had 1,894 nodes:
-#: 8.7 MB a column, 16.6 GB kept whole, more with the matrix stacked from them, and ``nested``
-#: was killed by the kernel at 23 GB; with the budget it peaked at 15.4 GB (docs/amg/bench.json).
+#: costs one back-solve more: kept whole, the columns of a large 3D band do not fit in memory
+#: (chosen from measurements, docs/calibration.md)
 COLUMN_BYTES = 512 * 2 ** 20
 
 
@@ -126,9 +125,8 @@ def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | No
     ``a`` centred at the origin: by :func:`radial_distance`; in 3D ``h`` is the candidates'
     median distance to their nearest neighbour within a quarter of a from the edge (their
     radial distances crowd together, so the gap between sorted ones says nothing), and the band
-    stops at ``a + margin·a``: a ring of candidates costs a back-solve each (30 ms at 351k dofs)
-    and a node beyond it that touches joins it for one back-solve more (measured on the 3D sphere:
-    the band fell from 300 to 200 nodes at 351k dofs)."""
+    stops at ``a + margin·a``: a ring of candidates costs a back-solve each, and a node beyond it
+    that touches joins it for one back-solve more (docs/calibration.md)."""
     points = np.atleast_2d(np.asarray(points, dtype=float))
     rho = radial_distance(points)
     if points.shape[1] == 2:

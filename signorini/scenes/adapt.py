@@ -25,7 +25,13 @@ Each step (:func:`solve_adaptive`):
    Hertz's cylinder while the estimate fell: docs/estimate.md) —
    refine them conformingly (scikit-fem's red-green-blue
    ``MeshTri.refined(marked)``), move new boundary nodes onto the curved
-   boundary, and stop instead when the refined mesh would exceed ``max_dofs``.
+   boundary, and stop instead when the refined mesh would exceed ``max_dofs``
+   or, before its model is assembled, the memory the size guard allows
+   (:func:`signorini.scenes.size.over_limit`: its dofs times the bytes per
+   dof of the method that solves it, under ``SIGNORINI_MAX_MEMORY_GB``); the
+   last step's answer is returned, its message saying the target was not met.
+
+The first mesh is sized before it is made (:func:`signorini.scenes.size.check_size`).
 
 Every 2D and axisymmetric scene and scene file takes part. A family whose
 ``build`` accepts ``mesh=`` and that :data:`CURVED` names (the Hertz scenes)
@@ -58,6 +64,7 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes.families import get_scene, scene_reference
 from signorini.scenes.meshing import snap_to_circle
 from signorini.scenes.scenefile import build_scene_model, family_scene_values
+from signorini.scenes.size import MEMORY_VARIABLE, check_size, over_limit
 
 log = logging.getLogger(__name__)
 
@@ -207,8 +214,9 @@ class _Scene:
         return refined_model(model, mesh, solution.lam > 0, self.snap)
 
 
-def _scene(name: str, values: dict[str, Any]) -> _Scene:
-    """The scene ``name`` (a family or a ``.toml`` scene file) ready for the loop."""
+def _scene(name: str, values: dict[str, Any], solved_by: str | None = None) -> _Scene:
+    """The scene ``name`` (a family or a ``.toml`` scene file) ready for the loop; a family's
+    mesh too big for the memory limit is refused before it is made."""
     if name.lower().endswith(".toml"):
         found = family_scene_values(name, values)
         if found is None:  # a mesh scene
@@ -217,6 +225,7 @@ def _scene(name: str, values: dict[str, Any]) -> _Scene:
         name, values = found
     family = get_scene(name)
     params = family.parse(values)
+    check_size(name, params, solved_by)
     model = family.build(params, set(values))
     snap = CURVED[name](params) if name in CURVED else None
     builds_on_mesh = name in CURVED and "mesh" in inspect.signature(family.build).parameters
@@ -285,10 +294,12 @@ Solver = Callable[[ContactProblem], "tuple[ContactProblem, ContactSolution]"]
 
 def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Solver, *,
                    max_dofs: int | None = None, theta: float = THETA, quantity: str | None = None,
+                   solved_by: str | None = None,
                    on_step: Callable[[ContactProblem, ContactSolution, ErrorEstimate | None], None]
                    | None = None) -> AdaptiveRun:
     """Refine scene ``name`` (a family, or the path of a ``.toml`` scene file) adaptively until
-    the estimate of ``quantity`` meets ``target`` or the next mesh would exceed ``max_dofs``.
+    the estimate of ``quantity`` meets ``target`` or the next mesh would exceed ``max_dofs`` or
+    the memory limit for the method ``solved_by`` (:func:`signorini.scenes.size.over_limit`).
 
     ``solver`` solves each step's problem (matching its target load) and
     returns the problem solved and the judged solution
@@ -297,8 +308,8 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Sol
     ``quantity`` is ``"pressure"`` (the default where the scene has contact
     pressures) or ``"energy"``.
     Returns the last step's problem, solution and estimate; ``reason`` says
-    why the loop stopped (the target met, the dof limit, or a solve that did
-    not converge) and is appended to the solution's message. ``on_step`` is
+    why the loop stopped (the target met, the dof or memory limit, or a solve
+    that did not converge) and is appended to the solution's message. ``on_step`` is
     called with every step's problem, solution and estimate (studies use it).
     """
     if quantity is not None and quantity not in QUANTITIES:
@@ -306,8 +317,9 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Sol
     max_dofs = DEFAULT_MAX_DOFS if max_dofs is None else int(max_dofs)
     if max_dofs <= 0:
         raise InputError(f"max dofs {max_dofs} must be positive")
-    scene = _scene(name, values)
+    scene = _scene(name, values, solved_by)
     model = scene.model
+    _check_first(scene, solved_by)
     run = None
     steps: list[dict[str, Any]] = []
     growths = 0
@@ -348,11 +360,13 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Sol
             break
         marked = mark(model.mesh, found, quantity, theta)
         mesh = model.mesh.refined(marked)
-        dofs = mesh.p.size
-        if dofs > max_dofs:
-            run.reason = (f"max dofs {max_dofs} reached: {what} estimate {100 * value:.3g} % > target "
-                          f"{100 * target:.3g} % at {problem.n} dofs (the next mesh has {dofs})")
-            steps.append(_row(step, problem, solution, found, 0, seconds, "max dofs"))
+        limit = _limit_reached(mesh.p.size, max_dofs, model, solved_by)
+        if limit is not None:
+            action, reached, next_mesh = limit
+            run.reason = (f"{reached} reached: {what} estimate {100 * value:.3g} % > target "
+                          f"{100 * target:.3g} % at {problem.n} dofs "
+                          f"(the next mesh has {next_mesh})")
+            steps.append(_row(step, problem, solution, found, 0, seconds, action))
             break
         steps.append(_row(step, problem, solution, found, len(marked), seconds, "refined"))
         model = scene.on(model, mesh, problem, solution)
@@ -363,6 +377,34 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Sol
     run.solution.extras["adaptive"] = steps
     log.info("%s", run.reason)
     return run
+
+
+def _memory_params(model: SceneModel) -> dict[str, Any]:
+    """What :func:`signorini.scenes.size.bytes_per_dof` reads of a model."""
+    return {**model.params, "nu": model.nu, "volumetric": model.volumetric}
+
+
+def _check_first(scene: _Scene, solved_by: str | None) -> None:
+    """InputError when the first model (a mesh scene file's, say) is already over the memory limit."""
+    over = over_limit(scene.model.mesh.p.size, 2, _memory_params(scene.model), solved_by)
+    if over is not None:
+        raise InputError(f"scene {scene.name!r} has {scene.model.mesh.p.size:,} dofs, about "
+                         f"{over[0] / 1e9:,.1f} GB to build and solve, over the limit of "
+                         f"{over[1] / 1e9:,.1f} GB ({MEMORY_VARIABLE}): start from a coarser mesh")
+
+
+def _limit_reached(dofs: int, max_dofs: int, model: SceneModel,
+                   solved_by: str | None) -> tuple[str, str, str] | None:
+    """``(action, what was reached, the next mesh)`` when a refined mesh of ``dofs`` dofs
+    exceeds ``max_dofs`` or the memory limit (before its model is assembled); None when it fits."""
+    if dofs > max_dofs:
+        return "max dofs", f"max dofs {max_dofs}", str(dofs)
+    over = over_limit(dofs, 2, _memory_params(model), solved_by)
+    if over is None:
+        return None
+    need, limit = over
+    return ("memory limit", f"memory limit of {limit / 1e9:,.1f} GB ({MEMORY_VARIABLE}, else ¾ of "
+            "this machine's memory)", f"{dofs} dofs, about {need / 1e9:,.1f} GB to build and solve")
 
 
 def _row(step: int, problem: ContactProblem, solution: ContactSolution,

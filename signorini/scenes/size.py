@@ -1,33 +1,31 @@
 """A scene's size before it is meshed: estimated dofs and memory, refused above what the machine holds.
 
-Each family's dofs are estimated from its parameters by a model calibrated on
-its own default mesh (tests/test_scene_size.py holds every estimate within a
-factor 1.5 of the mesh actually built, over the mesh parameters' ranges):
+Each family's dofs are estimated from its parameters, bounding the mesh it
+builds from above (tests/test_size_guard.py holds each estimate between 1 and
+1.3 times the dofs built over grading 0.05..2, n_contact and refine;
+tests/test_scene_size.py within a factor 1.5 over the parameters' ranges). A 2D family's model,
+calibrated on its own default mesh (:class:`SizeModel`):
 
-    dofs ≈ [b + (dofs₀ − b) · (n_contact / n₀)^α · (grading₀ / grading)^β
-            · (1 + ¼ ln(a₀ / a))] · 2^(d · refine)
+    dofs ≈ m · [b + (dofs₀ − b) · (n_contact / n₀)^α · (grading₀ / grading)^β
+            · (1 + ¼ ln(a₀ / a))] · 4^refine
 
-(α = 0.75, β = 1.35, b = 300 for the graded 2D meshes, α = 1.35, β = 1.5,
-b = 1000 for the 3D octant: b is the coarse far field that every mesh has;
-the last factor counts the uniform refinements, the one before it the longer
-grading from a smaller contact), but never more than the uniform mesh at the
+(α, β, the far field b that every mesh has and the margin m fitted per
+family: :data:`SIZE_MODELS`; a the contact ratio the mesh is graded for, from
+the load; n_contact rounded up to a power of two and doubled with ``half=0``
+for the half-block meshes), but never more than the uniform mesh at the
 contact's element size, ``c · (n_contact / (a/R))^d · 2^(d · refine)`` (c
-measured at grading 1e-6: 5.2 for the discs, 2.66 reverse-hertz, 6,082 for
-the punch, whose size is not scaled by a). The block's dofs are exact. Memory is
-the peak resident size per dof of building the scene and solving it with
-``pdas``, measured here (Python's own ~0.3 GB included): 4.2 kB per dof for
-hertz-cylinder refine=3 (298k dofs), 22 kB for hertz-sphere-3d refine=1 (47k
-dofs); taken as 4 kB (2D) and 20 kB (3D). A 3D factorisation grows faster
-than the dofs (``pdas`` at 350k 3D dofs was killed at 21 GB), which a
-factorising method has to weigh on its own. Two 3D paths are measured apart
-(docs/amg/): a prescribed push (``delta``) goes to ``pdas-amg`` by default,
-no factorisation — 1.3 GB at 350,532 dofs, 3.85 GB at 1,093,024, taken as
-5 kB per dof; so does a target load that ``pdas-amg`` matches itself (the
-method ``auto`` picks from :data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D
-dofs, see :mod:`signorini.loading`: 1.0 GB at
-351,076 dofs, 3.0 GB at 1,093,568, docs/amg/bench.md); a target load met by load targeting on one factorisation of
-K (any other method: 4.7 GB at 351,076 dofs, 13.4 kB per dof) has a fill
-that grows like n^⅓ per dof: 20 kB × (dofs / 350k)^⅓ from 350k dofs on.
+per family, in :data:`SIZE_MODELS`); the 3D octant from the number of tetrahedra its target
+element size asks for (:class:`GradedOctant`). The block's dofs are exact.
+
+Memory is the peak resident size of building the scene and solving it, in
+bytes per dof: :data:`BYTES_PER_DOF` with a factorising method;
+:data:`BYTES_PER_DOF_3D_PUSHED` in 3D without one (a prescribed push, or a
+target load that ``pdas-amg`` matches itself: the method ``auto`` picks from
+:data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D dofs, see
+:mod:`signorini.loading`); a 3D factorisation's fill grows like n^⅓ per dof
+from :data:`FILL_GROWS_FROM` dofs on; :data:`NODAL_MEMORY` scales it all when
+the volumetric strain is averaged at the nodes. The constants were chosen
+from measurements (docs/calibration.md).
 
 A scene whose estimate exceeds :func:`memory_limit` — by default three
 quarters of this machine's physical memory, or ``SIGNORINI_MAX_MEMORY_GB`` —
@@ -39,7 +37,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -57,7 +55,7 @@ BYTES_PER_DOF = {2: 4_000, 3: 20_000}
 BYTES_PER_DOF_3D_PUSHED = 5_000
 #: from this many 3D dofs a factorisation's bytes per dof grow like (dofs / this)^⅓
 FILL_GROWS_FROM = 350_000
-#: tetrahedra per dof of the 3D octant's meshes (664,768 at 351,076 dofs, hertz-sphere-3d refine=2)
+#: tetrahedra per dof of the 3D octant's meshes (chosen from measurements, docs/calibration.md)
 TETRAHEDRA_PER_DOF = 1.9
 #: elements per dof of the graded meshes: a triangle mesh has about twice as many triangles as
 #: nodes, one per dof
@@ -67,8 +65,7 @@ ELEMENTS_PER_DOF = {2: 1.0, 3: TETRAHEDRA_PER_DOF}
 GRADED_LIMIT = {2: 2 * MAX_TRIANGLES, 3: MAX_ELEMENTS}
 ELEMENT_NAMES = {2: "triangles", 3: "tetrahedra"}
 #: peak memory with the volumetric strain averaged at the nodes over plain P1, same scene and
-#: default method, measured here at ν = 0.45: 1.75 GB against 0.79 GB for hertz-cylinder
-#: refine=3 (297,984 dofs), 1.41 GB against 0.54 GB for hertz-sphere-3d refine=1 (46,964 dofs)
+#: default method (chosen from measurements at ν = 0.45, docs/calibration.md)
 NODAL_MEMORY = {2: 2.2, 3: 2.6}
 
 
@@ -92,53 +89,135 @@ def _plain_bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
     return BYTES_PER_DOF[3] * max(1.0, dofs / FILL_GROWS_FROM) ** (1 / 3)
 
 
+#: a half-block's far field per unit of ln(size / 20): punch size=200 built 11,732 dofs, 7,948 at 20
+BLOCK_FAR_GROWTH = 1.4
+
+
 @dataclass(frozen=True)
 class SizeModel:
-    """A family's default mesh and how its dofs grow with the mesh parameters."""
+    """A 2D family's default mesh and how its dofs grow with the mesh parameters: the far field
+    ``far_field``, the exponents ``alpha`` (n_contact) and ``beta`` (grading), and ``margin``
+    that lifts the estimate over every mesh measured (see :data:`SIZE_MODELS`)."""
 
-    dim: int
     dofs: float
     n_contact: float
     grading: float
     a_over_R: float | None = None
     uniform: float | None = None
-
-    @property
-    def alpha(self) -> float:
-        return 0.75 if self.dim == 2 else 1.35
-
-    @property
-    def beta(self) -> float:
-        return 1.35 if self.dim == 2 else 1.5
-
-    @property
-    def far_field(self) -> float:
-        return 300.0 if self.dim == 2 else 1000.0
+    alpha: float = 0.75
+    beta: float = 1.35
+    far_field: float = 300.0
+    margin: float = 1.0
+    #: n_contact is rounded up to a power of two (the half-block meshes), and ``half=0`` mirrors
+    block: bool = False
+    #: the a/R the mesh is graded for, from the parameters (None: ``a_over_R``)
+    ratio: Callable[[dict[str, Any]], float] | None = None
+    dim: int = 2
 
     def estimate(self, p: dict[str, Any]) -> float:
         """The dofs of a mesh with checked parameters ``p``: inf where they overflow a float
         (the size check then refuses them, naming the mesh parameters)."""
+        return self.graded(p) * 2.0 ** (self.dim * p.get("refine", 0))
+
+    def graded(self, p: dict[str, Any]) -> float:
+        """The dofs of the graded mesh, before any uniform refinement."""
+        n = np.float64(p["n_contact"])
+        if self.block:  # the bottom's edges are 1/n_contact rounded down to a power of two
+            n = 2.0 ** np.ceil(np.log2(n))
+        a = self.ratio(p) if self.ratio is not None else p.get("a_over_R")
         with np.errstate(over="ignore", divide="ignore"):  # an overflow is an infinite estimate
-            dofs = (self.dofs - self.far_field) * (np.float64(p["n_contact"]) / self.n_contact) ** self.alpha
+            dofs = (self.dofs - self.far_field) * (n / self.n_contact) ** self.alpha
             dofs *= (self.grading / np.float64(p["grading"])) ** self.beta
-            if self.a_over_R is not None and p.get("a_over_R") is not None \
-                    and p["a_over_R"] < self.a_over_R:
-                dofs *= 1.0 + 0.25 * math.log(self.a_over_R / p["a_over_R"])
-            dofs += self.far_field
+            if self.a_over_R is not None and a is not None and a < self.a_over_R:
+                dofs *= 1.0 + 0.25 * math.log(self.a_over_R / a)
+            far = self.far_field
+            if self.block:  # the far field grows with the log of the block's size (20 a: 1)
+                far *= 1.0 + BLOCK_FAR_GROWTH * math.log(max(p.get("size", 20.0) / 20.0, 1.0))
+                far *= min(1.0, n / self.n_contact) ** 0.25  # and shrinks with a coarser contact
+            dofs = self.margin * (dofs + far)
             if self.uniform is not None:  # no finer than uniform at the contact's element size
-                dofs = min(dofs, self.uniform
-                           * (np.float64(p["n_contact"]) / p.get("a_over_R", 1.0)) ** self.dim)
-            return float(dofs * 2.0 ** (self.dim * p.get("refine", 0)))
+                dofs = min(dofs, self.uniform * (n / (a or 1.0)) ** self.dim)
+            return float(dofs * (2.0 if self.block and p.get("half", 1) == 0 else 1.0))
 
 
-#: measured at each family's defaults (signorini commit 66f74ea: hertz-cylinder 4,866 dofs,
-#: hertz-sphere 6,824, hertz-sphere-3d 7,284, punch 7,948, reverse-hertz 6,118)
+def _cylinder_ratio(p: dict[str, Any]) -> float:
+    """The a/R hertz-cylinder's mesh is graded for: the target load's, else ``a_over_R``."""
+    from signorini.analytic import contact_modulus, hertz_cylinder_half_width
+
+    if p.get("P") is None or p.get("delta") is not None:
+        return p["a_over_R"]
+    return hertz_cylinder_half_width(p["P"], p["R"], contact_modulus(p["E"], p["nu"])) / p["R"]
+
+
+#: the graded octant's dofs ≈ OCTANT_FAR + OCTANT_SCALE · I^OCTANT_POWER, I = ∫ dV / h³ over
+#: the unit octant for the target element size h of :func:`signorini.scenes.hertz_sphere_3d.build`
+#: (the number of tetrahedra the grading asks for): fitted to 18 meshes over grading 0.05..2,
+#: n_contact 3..20 and a/R 0.01..0.2, 1.0 to 1.25 times their dofs
+OCTANT_FAR, OCTANT_SCALE, OCTANT_POWER = 100.0, 64.4, 0.915
+#: a uniform refinement of a tetrahedral mesh of N nodes multiplies them by 1 + edges / nodes,
+#: below OCTANT_REFINE[0] − OCTANT_REFINE[1] · N^(-1/3) (6.35 at 647 nodes, 6.63 at 2,428, 7.10
+#: at 19,168: the surface's nodes have fewer edges), and never more than 8
+OCTANT_REFINE = (7.7, 10.0)
+
+
+@dataclass(frozen=True)
+class GradedOctant:
+    """The size of :mod:`signorini.scenes.hertz_sphere_3d`'s mesh from its target element size
+    ``h = min(a/n_contact + grading · dist(x, disc of radius 1.25 a), MAX_SIZE)``."""
+
+    dim: int = 3
+
+    def graded(self, p: dict[str, Any]) -> float:
+        """The dofs of the graded mesh, before any uniform refinement."""
+        a, n, g = _sphere_ratio(p), float(p["n_contact"]), float(p["grading"])
+        with np.errstate(over="ignore"):  # an overflow is an infinite estimate
+            return OCTANT_FAR + OCTANT_SCALE * octant_density(a, n, g) ** OCTANT_POWER
+
+    def estimate(self, p: dict[str, Any]) -> float:
+        nodes = self.graded(p) / 3.0
+        for _ in range(p.get("refine", 0)):
+            nodes *= min(8.0, OCTANT_REFINE[0] - OCTANT_REFINE[1] * nodes ** (-1 / 3))
+        return 3.0 * nodes
+
+
+def octant_density(a: float, n_contact: float, grading: float, points: int = 120) -> float:
+    """``∫ dV / h³`` over the octant ``x, y ≥ 0, z ≤ 1`` of the unit ball centred at (0, 0, 1),
+    ``h = min(a/n_contact + grading · d, MAX_SIZE)``, d the distance to the disc ``ρ ≤ 1.25 a``,
+    ``z = 0`` (midpoint rule in (ρ, z), fine near the disc: within 0.5 % of a fine grid's)."""
+    from signorini.scenes.hertz_sphere_3d import MAX_SIZE
+
+    h0 = a / n_contact
+    edges = np.unique(np.concatenate([np.linspace(0.0, 3.0 * a, points),
+                                      np.geomspace(min(h0, a) / 20.0, 1.0, 2 * points), [0.0]]))
+    middle, width = 0.5 * (edges[1:] + edges[:-1]), np.diff(edges)
+    rho, z = middle[:, None], middle[None, :]
+    inside = rho ** 2 + (z - 1.0) ** 2 <= 1.0
+    with np.errstate(over="ignore", divide="ignore"):
+        h = np.minimum(h0 + grading * np.hypot(np.maximum(rho - 1.25 * a, 0.0), z), MAX_SIZE)
+        return float(np.sum(np.where(inside, 0.5 * np.pi * rho * np.outer(width, width) / h ** 3,
+                                     0.0)))
+
+
+def _sphere_ratio(p: dict[str, Any]) -> float:
+    """The a/R a sphere's mesh is graded for: the load's (``P``, ``delta`` or ``a_over_R``)."""
+    from signorini.scenes.hertz_sphere import load_choice
+
+    return load_choice(p, {k for k in ("P", "delta") if p.get(k) is not None})[1]
+
+
+#: each family's default mesh (dofs, n_contact, grading, a/R), the uniform bound's c and the 2D
+#: exponents, far fields and margins, fitted to the meshes built (docs/calibration.md): every
+#: estimate at or above the dofs built (tests/test_size_guard.py)
 SIZE_MODELS = {
-    "hertz-cylinder": SizeModel(2, 4866, 40, 0.15, 0.05, uniform=5.2),
-    "hertz-sphere": SizeModel(2, 6824, 60, 0.15, 0.05, uniform=5.2),
-    "hertz-sphere-3d": SizeModel(3, 7284, 10, 0.5, 0.05),
-    "punch": SizeModel(2, 7948, 128, 0.2, uniform=6082.0),
-    "reverse-hertz": SizeModel(2, 6118, 128, 0.3, uniform=2.66),
+    "hertz-cylinder": SizeModel(4866, 40, 0.15, 0.05, uniform=5.2, alpha=0.6, beta=1.15,
+                                far_field=100.0, margin=1.18, ratio=_cylinder_ratio),
+    "hertz-sphere": SizeModel(6824, 60, 0.15, 0.05, uniform=5.2, alpha=0.65, beta=1.15,
+                              far_field=100.0, margin=1.13, ratio=_sphere_ratio),
+    "hertz-sphere-3d": GradedOctant(),
+    "punch": SizeModel(7948, 128, 0.2, uniform=6082.0, alpha=0.55, beta=1.5, far_field=1200.0,
+                       margin=1.13, block=True),
+    "reverse-hertz": SizeModel(6118, 128, 0.3, uniform=2.66, alpha=0.55, beta=1.4,
+                               far_field=1300.0, margin=1.16, block=True),
 }
 
 
@@ -175,15 +254,17 @@ def check_size(family: str, params: dict[str, Any], solved_by: str | None = None
         return
     dofs, dim = found
     if dim == 3:  # the mesher's limit first (as the tetrahedra reach it long before memory)
-        _check_graded(family, params, dofs, dim)
+        _check_graded(family, params, dim)
     _check_memory(family, params, dofs, dim, solved_by)
-    _check_graded(family, params, dofs, dim)
+    _check_graded(family, params, dim)
 
 
-def _check_graded(family: str, params: dict[str, Any], dofs: float, dim: int) -> None:
+def _check_graded(family: str, params: dict[str, Any], dim: int) -> None:
     """InputError when the graded mesh, before uniform refinement, exceeds the mesher's limit."""
-    graded = dofs / 2.0 ** (dim * params.get("refine", 0)) * ELEMENTS_PER_DOF[dim]
-    if "grading" in params and graded > GRADED_LIMIT[dim]:
+    if "grading" not in params:
+        return
+    graded = SIZE_MODELS[family].graded(params) * ELEMENTS_PER_DOF[dim]
+    if graded > GRADED_LIMIT[dim]:
         raise InputError(
             f"scene {family!r} with grading={params['grading']:g}, n_contact={params['n_contact']:g} "
             f"would be graded to about {graded:,.0f} {ELEMENT_NAMES[dim]} "
@@ -192,12 +273,22 @@ def _check_graded(family: str, params: dict[str, Any], dofs: float, dim: int) ->
             "and refine (refine=1, 2...) to go finer")
 
 
+def over_limit(dofs: float, dim: int, params: dict[str, Any],
+               solved_by: str | None = None) -> tuple[float, float] | None:
+    """``(bytes needed, limit)`` when building and solving a model of ``dofs`` dofs with the
+    method ``solved_by`` would exceed :func:`memory_limit`; None when it fits. ``params`` needs
+    only ``nu`` and ``volumetric`` (and for 3D ``P`` and ``delta``), as :func:`bytes_per_dof`."""
+    need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
+    return None if need <= limit else (need, limit)
+
+
 def _check_memory(family: str, params: dict[str, Any], dofs: float, dim: int,
                   solved_by: str | None) -> None:
     """InputError when building and solving the scene would exceed :func:`memory_limit`."""
-    need, limit = dofs * bytes_per_dof(dim, dofs, params, solved_by), memory_limit()
-    if need <= limit:
+    over = over_limit(dofs, dim, params, solved_by)
+    if over is None:
         return
+    need, limit = over
     names = [k for k in ("n_contact", "grading", "refine", "nx", "ny") if k in params]
     mesh = ", ".join(f"{k}={params[k]:g}" for k in names)
     raise InputError(

@@ -82,21 +82,16 @@ MAX_CYCLES = 2
 CG_MAX_ITER = 3000
 #: relative residual of the certificate's solve ``e = K̃⁻¹r`` (r: the final stationarity residual).
 #: The gap is ``λ̂ᵀ(d − Nu) + ½eᵀKe``: a relative error ε of e in the energy norm moves the
-#: quadratic term by about 2ε of itself, so a few digits do. At 1e-6 this solve cost a third
-#: of the method's time at 350k dofs (≈ 90 V-cycles). On the default hertz-sphere-3d at
-#: refine=2 (351,076 dofs, by hand, idle): 1e-3 took 30 CG iterations, 1.39 s (14 % of the
-#: method's 10.1 s), 1e-2 20 iterations, 0.84 s (9 %), and the gap moved by 7e-5 of itself
+#: quadratic term by about 2ε of itself, so a few digits do; a tighter solve costs a large part
+#: of the method's time at scale (chosen from measurements, docs/amg.md)
 CERTIFICATE_RTOL = 1e-2
 
 
 #: PETSc options of the GAMG hierarchy (prefix ``signorini_amg_``; PETSC_OPTIONS overrides):
 #: plain aggregation, a coarsest level of up to 10,000 equations solved directly and one
-#: smoothing step per level. Chosen by one set-up + CG to 1e-10 of the pushed hertz-sphere-3d's
-#: K (by hand, idle 2-core machine): at 350,532 dofs PETSc's defaults took 1.3 s + 5.1 s
-#: (77 iterations, 7 levels), these 1.2 s + 3.3 s (52, 3 levels); at 1,093,024 dofs 4.7 s + 24.0 s
-#: (93, 8 levels) against 4.1 s + 12.6 s (62, 4 levels); a 40,000-equation coarsest level cost
-#: 0.36 s per iteration at 350k, smoothed aggregation 7 s of set-up. The committed comparison
-#: at 350k is docs/amg/bench.md's first table.
+#: smoothing step per level: fewer levels and CG iterations than PETSc's defaults on 3D
+#: elasticity, for a cheaper set-up than smoothed aggregation (chosen from measurements,
+#: docs/amg.md)
 GAMG_OPTIONS = {"pc_gamg_agg_nsmooths": "0", "pc_gamg_coarse_eq_limit": "10000",
                 "mg_levels_ksp_max_it": "1"}
 
@@ -125,7 +120,7 @@ class GamgHierarchy:
                 vectors.append(vector)
             self._A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=comm))
         options = PETSc.Options("signorini_amg_")
-        for name, value in GAMG_OPTIONS.items():  # measured (see GAMG_OPTIONS); a user's wins
+        for name, value in GAMG_OPTIONS.items():  # see GAMG_OPTIONS; a user's wins
             if not options.hasName(name):
                 options.setValue(name, value)
         self._pc = PETSc.PC().create(comm)

@@ -13,8 +13,8 @@
 
 The chosen method's name is the solution's ``method``; ``extras["auto"]``
 and the message say what was picked and why. Options and the warm start
-are passed on to the chosen method. The thresholds were measured on the
-Hertz sphere (docs/amg.md).
+are passed on to the chosen method. The thresholds were chosen from
+measurements on the Hertz sphere (docs/amg.md).
 """
 
 from __future__ import annotations

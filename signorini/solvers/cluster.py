@@ -44,7 +44,8 @@ def launched_size() -> int:
 def mpirun_command(ranks: int, argv: list[str]) -> tuple[list[str], dict[str, str]]:
     """``mpirun -n ranks argv…`` and its environment; refuses more ranks than cores.
 
-    Oversubscribed runs were 20–40× slower here, so they are never started.
+    Oversubscribed runs (more ranks than cores) are many times slower (docs/petsc.md), so
+    they are never started.
     Open MPI refuses to run as root unless told to (containers and CI run as root).
     """
     import shutil

@@ -210,8 +210,8 @@ def _kkt_on(problem: ContactProblem, form: Formulation, active: np.ndarray):
 
     The dual holds W: ``W_AA λ_A = b_A`` and one back-solve. The other forms
     factorise K once with the active dofs pinned (the saddle-point matrix when
-    a row of N bounds more than one dof): measured at 75k dofs, cheaper than
-    the |A| ≈ 260 back-solves of a Schur complement on the shifted form's factor.
+    a row of N bounds more than one dof): cheaper than the |A| back-solves of a
+    Schur complement on the shifted form's factor (docs/calibration.md).
     """
     if form.W is None:
         solver = ActiveSetSolver(problem.K, problem.N)
@@ -244,7 +244,9 @@ def polish(problem: ContactProblem, form: Formulation, raw: ContactSolution,
     raw.factor = factor
     raw_cert, new_cert = certificate(problem, raw), certificate(problem, polished)
     raw_worst, new_worst = raw_cert.worst()[1], new_cert.worst()[1]
-    kept = bool(new_worst < raw_worst)
+    # a polished point that pulls a node (tension) is a wrong active set, whatever else it fixes
+    pulls = new_cert.as_dict()["dual_sign"] > max(tol or 0.0, raw_cert.as_dict()["dual_sign"])
+    kept = bool(new_worst < raw_worst and not pulls)
     record = {"kept": kept, "active": int(active.sum()), "raw_status": raw.status,
               "raw": raw_cert.as_dict(), "polished": new_cert.as_dict(),
               "seconds": time.perf_counter() - start}

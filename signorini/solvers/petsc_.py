@@ -20,7 +20,7 @@ The linear solves are MUMPS's parallel LU (``ksp=mumps``) or CG
 preconditioned by PETSc's algebraic multigrid GAMG given the rigid-body
 modes as near-null space (``ksp=gamg``); ``ksp=auto`` (the default) takes
 GAMG for 3D problems from :data:`GAMG_FROM_DOFS` dofs and MUMPS otherwise
-(62,757-dof sphere, 2 ranks: MUMPS 53 s, GAMG 6.5 s; docs/petsc.md). Under ``mpirun -n N`` rank 0
+(chosen from measurements, docs/petsc.md). Under ``mpirun -n N`` rank 0
 assembles, rotates and splits the rows by whole nodes
 (:mod:`signorini.solvers.cluster`); each rank builds its block of a parallel AIJ
 matrix, and rank 0 gathers the answer, recovers the contact forces as the
@@ -295,12 +295,12 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
     if job["ksp"] == "gamg":
         options = PETSc.Options(PREFIX + "mg_")
         if not options.hasName("pc_gamg_agg_nsmooths"):
-            # plain aggregation: with six rigid modes, smoothing the prolongator made each
-            # set-up 15x dearer (64k dofs: 9.7 s vs 0.6 s) for 3x fewer CG iterations
+            # plain aggregation: with six rigid modes, smoothing the prolongator makes each
+            # set-up many times dearer for fewer CG iterations (docs/petsc.md)
             options.setValue("pc_gamg_agg_nsmooths", "0")
         if kind == "snes" and not PETSc.Options(PREFIX).hasName("snes_ksp_ew"):
-            # Eisenstat-Walker: loose CG solves while the active set still moves (64k dofs:
-            # 65 CG iterations instead of 384, the same final residuals)
+            # Eisenstat-Walker: loose CG solves while the active set still moves, a fraction of
+            # the CG iterations for the same final residuals (docs/petsc.md)
             PETSc.Options(PREFIX).setValue("snes_ksp_ew", "")
         free_set = (lambda: solver.getVIInactiveSet().getIndices()) if kind == "snes" else None
         multigrid = FreshMultigrid(PETSc, n, piece["modes"], piece["first"], free_set)

@@ -150,10 +150,10 @@ def _each(*names: str, bounds: tuple[float, float] = (0.0, np.inf),
     return translate
 
 
-#: Clarabel's gap tolerance is never asked below this, near double precision: at 1e-12 its
-#: primal left a node on the wrong side of the zone at 66k dofs and tol 1e-8, at 1e-14 not
-#: (docs/bench-forms.md); where it cannot get there (a 3001-dof test problem) it says
-#: ``AlmostSolved``, which is ``inaccurate``, and polish finishes the job
+#: Clarabel's gap tolerance is never asked below this, near double precision: a floor of 1e-12
+#: still left a node on the wrong side of the zone (chosen from measurements, docs/crosscheck.md);
+#: where it cannot get there it says ``AlmostSolved``, which is ``inaccurate``, and polish
+#: finishes the job
 CLARABEL_GAP_FLOOR = 1e-14
 
 
@@ -162,9 +162,9 @@ def _clarabel_tolerance(tol: float) -> dict[str, Any]:
 
     An interior point's gap is the complementarity product ``Σ sᵢzᵢ``: a gap
     of ``tol`` leaves a node with both a force and a gap of order ``√tol``,
-    which is what the certificate's (linear) natural residual measured on
-    Clarabel's answers (1.5e-4 at tol 1e-8, one node on the wrong side of the
-    zone's edge). With the gap at ``tol²``, floored at :data:`CLARABEL_GAP_FLOOR`,
+    which is what the certificate's (linear) natural residual saw in
+    Clarabel's answers, with a node on the wrong side of the zone's edge
+    (docs/crosscheck.md). With the gap at ``tol²``, floored at :data:`CLARABEL_GAP_FLOOR`,
     the active set came out right on every validation case, in every form
     (docs/crosscheck.md), and in the primal at 66k and 261k dofs (docs/bench-forms.md).
     """

@@ -58,7 +58,7 @@ OUR_LADDER = {
     "hertz-sphere": ({"n_contact": 12}, {"n_contact": 25}, {"n_contact": 50},
                      {"n_contact": 100}, {"n_contact": 100, "refine": 1}),
 }
-#: accuracies at which the report compares the codes' fastest runs (issue 16: 0.3 % and 0.1 %)
+#: accuracies at which the report compares the codes' fastest runs: p₀ and a within 0.3 % and 0.1 %
 TARGETS = (0.003, 0.001)
 
 
