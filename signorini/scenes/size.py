@@ -44,7 +44,10 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.fem.volumetric import resolve
 from signorini.numerics.factor import gigabytes_from
+from signorini.analytic import contact_modulus, hertz_cylinder_half_width
 from signorini.numerics.multigrid import AMG_FROM_DOFS
+from signorini.scenes.hertz_sphere import load_choice
+from signorini.scenes.hertz_sphere_3d import MAX_SIZE
 from signorini.scenes.meshing import MAX_ELEMENTS, MAX_TRIANGLES
 
 #: the environment variable that raises (or lowers) the memory a scene may take, in GB
@@ -142,8 +145,6 @@ class SizeModel:
 
 def _cylinder_ratio(p: dict[str, Any]) -> float:
     """The a/R hertz-cylinder's mesh is graded for: the target load's, else ``a_over_R``."""
-    from signorini.analytic import contact_modulus, hertz_cylinder_half_width
-
     if p.get("P") is None or p.get("delta") is not None:
         return p["a_over_R"]
     return hertz_cylinder_half_width(p["P"], p["R"], contact_modulus(p["E"], p["nu"])) / p["R"]
@@ -184,7 +185,6 @@ def octant_density(a: float, n_contact: float, grading: float, points: int = 120
     """``∫ dV / h³`` over the octant ``x, y ≥ 0, z ≤ 1`` of the unit ball centred at (0, 0, 1),
     ``h = min(a/n_contact + grading · d, MAX_SIZE)``, d the distance to the disc ``ρ ≤ 1.25 a``,
     ``z = 0`` (midpoint rule in (ρ, z), fine near the disc: within 0.5 % of a fine grid's)."""
-    from signorini.scenes.hertz_sphere_3d import MAX_SIZE
 
     h0 = a / n_contact
     edges = np.unique(np.concatenate([np.linspace(0.0, 3.0 * a, points),
@@ -200,7 +200,6 @@ def octant_density(a: float, n_contact: float, grading: float, points: int = 120
 
 def _sphere_ratio(p: dict[str, Any]) -> float:
     """The a/R a sphere's mesh is graded for: the load's (``P``, ``delta`` or ``a_over_R``)."""
-    from signorini.scenes.hertz_sphere import load_choice
 
     return load_choice(p, {k for k in ("P", "delta") if p.get(k) is not None})[1]
 
