@@ -153,10 +153,12 @@ def step_finding(rows: Rows) -> str:
     stalled = {case: [r["value"] for r in pick(nesterov, case=case, status="max_iter")]
                for case in ("hertz-cylinder", "block")}
     grown = pick(nesterov, status="diverged")
+    early = [r for r in nesterov if r["value"] <= 0.5]
+    uncertified = [r for r in early if r["status"] == "inaccurate"]
     claim(all("cycle" not in r["message"] for r in grown) and min(r["value"] for r in grown) > 1
-          and all(r["outcome"] == "right" for r in nesterov if r["value"] <= 0.5)
+          and all(r["outcome"] in ("right", "caught", "conservative") for r in early)
           and all(v < 1 for vs in stalled.values() for v in vs),
-          "uzawa-nesterov is right to 0.5×, stalls below 1× and grows past it")
+          "uzawa-nesterov is never wrong to 0.5×, stalls below 1× and grows past it")
     return (f"**Uzawa's step** (axis 1): plain Uzawa is right for ρ up to the bound 2/λ_max(W) on "
             f"a {uz_cyl[0]['dofs']:,}-dof cylinder ({iterations[0.1]:,} iterations at 0.1×, "
             f"{iterations[0.95]:,} at 0.95×) and the {uz_block[0]['dofs']:,}-dof block, except at "
@@ -165,7 +167,10 @@ def step_finding(rows: Rows) -> str:
             "returns every other step; growth is never seen): from "
             f"{times(first_cycle['block'])} on the block, from "
             f"{times(first_cycle['hertz-cylinder'])} on the cylinder, whose active block W_AA "
-            f"allows {bound:.2f}×. `uzawa-nesterov` needs ρ ≤ 1/λ_max: at "
+            f"allows {bound:.2f}×. `uzawa-nesterov` needs ρ ≤ 1/λ_max: up to 0.5× it meets the "
+            "KKT residuals, but its stopping rule stops short of the forces: the certificate's "
+            f"forward error leaves {len(uncertified)} of its {len(early)} runs there "
+            "`inaccurate` (docs/certificate.md); at "
             f"{span(stalled['hertz-cylinder'])} of 2/λ_max ({span(stalled['block'])} on the "
             "block) it stops at `max_iter`, past 1× it diverges by growth.")
 
@@ -253,9 +258,9 @@ def nodal_finding(nodal: Rows, plain: Rows, order: list[str], dofs: dict[str, in
     def p0(mesh: str, nu: float, rows: Rows = nodal) -> float:
         return one(rows, case=f"{mesh}, nodal" if rows is nodal else mesh, value=nu)["p0_rel"]
 
-    nus = sorted({r["value"] for r in nodal})
+    nus = sorted({r["value"] for r in nodal})[:-1]  # the extreme ν is not certified (below)
     claim(all(p0(m, nu) < 0.01 for m in order for nu in nus),
-          "with the nodal average PDAS's p₀ is within 1 % for every ν on every mesh")
+          "with the nodal average PDAS's p₀ is within 1 % for every ν up to 0.4999 on every mesh")
     claim(all(p0(m, nu) < 0.1 * p0(m, nu, plain) for m in order for nu in (0.499, 0.4999)),
           "with the nodal average p₀ is at least ten times closer than plain P1's at ν ≥ 0.499")
     return ("With the volumetric strain averaged at the nodes (`volumetric=nodal`, the default "
@@ -281,9 +286,15 @@ def poisson_finding(rows: Rows) -> str:
     claim(all(p0(a, 0.499) > p0(b, 0.499) for a, b in zip(order, order[1:])),
           "refinement lowers the p₀ error at ν = 0.499")
     exact = [m for m in ("pdas", "nested", "condensed") if m in methods_of(rows)]
-    claim(all(r["outcome"] == "right" for r in pick(rows, case=coarsest) if r["method"] in exact),
-          "the exact methods solve every ν")
-    worst = [r for r in pick(rows, case=coarsest, value=max(r["value"] for r in rows))
+    extreme = max(r["value"] for r in rows)
+    usual = sorted({r["value"] for r in rows} - {extreme})
+    claim(all(r["outcome"] == "right" for r in pick(rows, case=coarsest)
+              if r["method"] in exact and r["value"] != extreme),
+          "the exact methods solve every ν short of the extreme one")
+    at_extreme = [r for r in rows if r["value"] == extreme]
+    claim(all(r["status"] != "converged" and r["outcome"] != "wrong" for r in at_extreme),
+          "no method is converged at the extreme ν, and none is wrong there")
+    worst = [r for r in pick(rows, case=coarsest, value=usual[-1])
              if r["method"] in ("uzawa", "petsc-vi") and r["outcome"] != "right"]
     return (f"**ν → 0.5** (axis 5): plain P1 locks, the solvers do not fail: PDAS's p₀ error on the finest "
             f"mesh ({dofs[finest]:,} dofs) is {pct(p0(finest, 0.3))} at ν = 0.3, "
@@ -291,9 +302,13 @@ def poisson_finding(rows: Rows) -> str:
             f"{pct(p0(finest, 0.4999), 0)} at 0.4999; at 0.499 each refinement cuts it ("
             + " → ".join(pct(p0(m, 0.499)) for m in order) + "), at 0.4999 it stays large ("
             + " → ".join(pct(p0(m, 0.4999), 0) for m in order) + "). "
-            + nodal_finding(nodal, pdas, order, dofs) + " The exact methods solve every ν; at 0.4999 "
+            + nodal_finding(nodal, pdas, order, dofs) + " The exact methods solve every ν up to "
+            f"{usual[-1]:g}; at {usual[-1]:g} "
             + " and ".join(f"{name(r['method'])} {VERBS.get(r['status'], r['status'])}"
-                           for r in worst) + f" on the {dofs[coarsest]:,}-dof mesh.")
+                           for r in worst) + f" on the {dofs[coarsest]:,}-dof mesh. At ν = {extreme!r} "
+            "double precision cannot certify the contact forces (the certificate's forward error, "
+            f"docs/certificate.md): all {len(at_extreme)} runs there, the exact methods' too, end "
+            "`inaccurate` or worse, none `converged`.")
 
 
 def force_finding(rows: Rows) -> str:
@@ -334,12 +349,15 @@ def degenerate_finding(rows: Rows) -> str:
     claim(all(r["misclassified"] == 0 for r in pick(rows, status="converged")),
           "no converged method shows a misclassified node")
     strict = [r for r in converged if r["misclassified_strict"] > 0]
-    claim(max(r["misclassified_strict"] for r in strict) == 1, "a strict count flags one node")
+    claim(max((r["misclassified_strict"] for r in strict), default=0) <= 1,
+          "a strict count flags at most one node")
+    flagged = (f"a comparison without the weak label would flag one for {len(strict)} of the "
+               f"{len(converged)} converged methods" if strict else
+               f"even a comparison without the weak label flags none of the {len(converged)} "
+               "converged methods")
     return ("**Degenerate contact** (axis 7, `signorini solve block --set "
             f"{case}`): nodes that touch with zero force are labelled weakly "
-            "active and left out; no converged method shows a misclassified node, where a "
-            f"comparison without the weak label would flag one for {len(strict)} of the "
-            f"{len(converged)} converged methods.")
+            f"active and left out; no converged method shows a misclassified node, and {flagged}.")
 
 
 def ill_posed_finding(rows: Rows) -> str:
