@@ -1,24 +1,15 @@
-"""The scene families by name, and the analytic reference each declares."""
+"""The built-in scene families, registered by name, and the registry's look-ups.
+
+A new family is one module with a ``FAMILY`` and one line below (or a call
+to :func:`~signorini.scenes.registry.register` from anywhere).
+"""
 
 from __future__ import annotations
 
-from signorini.errors import InputError
 from signorini.scenes import block, hertz_cylinder, hertz_sphere, hertz_sphere_3d, punch, reverse_hertz
-from signorini.scenes.base import SceneFamily
+from signorini.scenes.registry import SCENES, get_scene, register, scene_reference, unregister
 
-SCENES: dict[str, SceneFamily] = {f.name: f for f in (hertz_cylinder.FAMILY, block.FAMILY,
-                                                     hertz_sphere.FAMILY, hertz_sphere_3d.FAMILY,
-                                                     punch.FAMILY, reverse_hertz.FAMILY)}
+for _module in (hertz_cylinder, block, hertz_sphere, hertz_sphere_3d, punch, reverse_hertz):
+    register(_module.FAMILY)
 
-
-def get_scene(name: str) -> SceneFamily:
-    """Look a scene family up by name; unknown names list the known ones."""
-    if name not in SCENES:
-        raise InputError(f"unknown scene {name!r}: choose one of {', '.join(sorted(SCENES))} "
-                         "(or give the path of a .toml scene file)")
-    return SCENES[name]
-
-
-def scene_reference(name: str) -> str:
-    """The analytic reference of scene ``name`` ("" for scenes read from mesh files)."""
-    return SCENES[name].reference if name in SCENES else ""
+__all__ = ["SCENES", "get_scene", "register", "scene_reference", "unregister"]

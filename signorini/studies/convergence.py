@@ -37,6 +37,7 @@ from signorini.pressure import compare_punch, contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import REFERENCES
 from signorini.scenes import SCENES, get_scene, scene_reference
+from signorini.scenes.registry import FamilyField
 from signorini.scenes.size import check_size
 from signorini.solvers.registry import get_method
 from signorini.solvers.registry import methods as registered_methods
@@ -50,13 +51,9 @@ LABELS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressu
           "estimate": "estimate η / ‖u_h‖ (energy norm)", "pressure_estimate": "pressure estimate"}
 #: the a posteriori estimates a study records next to the errors (signorini.fem.estimate)
 ESTIMATES = ("estimate", "pressure_estimate")
-#: the coarse mesh each study starts from unless ``--set`` says otherwise
-COARSE_START = {
-    "hertz-cylinder": {"n_contact": 15, "grading": 0.6},
-    "reverse-hertz": {"n_contact": 16, "grading": 0.6},
-    "punch": {"n_contact": 16, "grading": 0.6},
-    "hertz-sphere": {"n_contact": 12, "grading": 0.6},
-}
+#: the coarse mesh each study starts from unless ``--set`` says otherwise, by scene (a live
+#: view of each family's ``convergence_start``, :class:`signorini.scenes.base.SceneFamily`)
+COARSE_START = FamilyField("convergence_start")
 #: grading that makes a graded scene uniform: the contact's element size everywhere
 UNIFORM_GRADING = 1e-6
 #: seconds one run (assembly of its level included) may take before it is stopped
@@ -136,7 +133,7 @@ def _study_params(scene: str, params: dict[str, Any]) -> dict[str, Any]:
                          f"that have one ({', '.join(_refinable())})")
     if "refine" in params:
         raise InputError("converge sets 'refine' itself: give --levels instead of --set refine=")
-    start = {k: v for k, v in COARSE_START.get(scene, {}).items() if k in names}
+    start = {k: v for k, v in family.convergence_start.items() if k in names}
     start.update(params)
     return start
 

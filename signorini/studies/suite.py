@@ -1,9 +1,10 @@
 """The validation suite: default scenes × every installed method → tidy runs and checks.
 
-Each case is one scene; each run is one method at one tolerance. Runs record
-what the method said (status, iterations, times) and what the package
-measured independently (the KKT certificate, the distance from the exact
-``pdas`` answer, the error against the analytic reference). Checks are the
+Each case is one scene, declared by its family (``SceneFamily.validation``);
+each run is one method at one tolerance. Runs record what the method said
+(status, iterations, times) and what the package measured independently
+(the KKT certificate, the distance from the exact ``pdas`` answer, the error
+against the analytic reference). Checks are the
 claims the suite stands behind; any failed check fails the suite.
 
 Every run goes through the study runner (:mod:`signorini.studies.runner`):
@@ -17,7 +18,8 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -27,6 +29,8 @@ from signorini.errors import InputError
 from signorini.pressure import contact_profile, radial_distance
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics
+from signorini.scenes.base import Case
+from signorini.scenes.registry import ValidationCases
 from signorini.solvers.registry import BACKENDS, Method, get_method, methods
 from signorini.studies.measures import answer_from
 from signorini.studies.problems import build_spec
@@ -91,36 +95,9 @@ LIMITS = {
 }
 
 
-@dataclass(frozen=True)
-class Case:
-    """One scene of the suite with its parameters."""
-
-    name: str
-    scene: str
-    params: dict[str, Any] = field(default_factory=dict)
-    same_as: str | None = None  # a case whose dimensionless answer this one must reproduce
-    check_reference: bool = True  # hold the answer to the analytic reference's limits
-    agrees_with: str | None = None  # a case modelling the same body otherwise: same a and p0
-
-    @property
-    def spec(self) -> dict[str, Any]:
-        """The case's problem as a spec a worker rebuilds (:func:`signorini.studies.problems.build_spec`)."""
-        return {"kind": "scene", "scene": self.scene, "params": dict(self.params)}
-
-
-DEFAULT_CASES = (
-    Case("block", "block"),
-    Case("hertz-cylinder", "hertz-cylinder", {"a_over_R": 0.05}),
-    # coarse enough for the dense backends (≤ 3000 dofs); its Hertz errors are not checked
-    Case("hertz-cylinder-coarse", "hertz-cylinder",
-         {"a_over_R": 0.05, "n_contact": 16, "grading": 0.4}, check_reference=False),
-    Case("hertz-cylinder-SI", "hertz-cylinder", {"E": 2.1e11, "R": 0.01, "a_over_R": 0.05},
-         same_as="hertz-cylinder"),
-    Case("hertz-sphere", "hertz-sphere", {"a_over_R": 0.05}),
-    Case("hertz-sphere-3d", "hertz-sphere-3d", {"a_over_R": 0.05}, agrees_with="hertz-sphere"),
-    Case("punch", "punch"),
-    Case("reverse-hertz", "reverse-hertz"),
-)
+#: every registered family's validation cases, in the order of registration (a live view of
+#: :attr:`SceneFamily.validation <signorini.scenes.base.SceneFamily>`)
+DEFAULT_CASES = ValidationCases()
 
 
 @dataclass
@@ -340,7 +317,7 @@ class SuiteResult:
 def select_cases(names: list[str] | None) -> tuple[Case, ...]:
     """The default cases named in ``names`` (all when empty); unknown names list the known."""
     if not names:
-        return DEFAULT_CASES
+        return tuple(DEFAULT_CASES)
     known = {case.name: case for case in DEFAULT_CASES}
     unknown = [n for n in names if n not in known]
     if unknown:
@@ -363,7 +340,7 @@ def portable(method: Method) -> bool:
     return ":" in method.name or any(method.name == m.name for b in BACKENDS for m in b.METHODS)
 
 
-def run_suite(cases: tuple[Case, ...] = DEFAULT_CASES, method_names: list[str] | None = None,
+def run_suite(cases: Sequence[Case] = DEFAULT_CASES, method_names: list[str] | None = None,
               progress: Callable[[str], None] | None = None, *, isolate: bool | None = None,
               time_limit: float = TIME_LIMIT) -> SuiteResult:
     """Run every case with every installed method (or ``method_names``) and check it.
