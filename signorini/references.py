@@ -46,7 +46,8 @@ class Reference:
     load is the vertical resultant of tilted normals (curved or cornered
     obstacles), reported beside it; ``convergence`` lists the errors a
     refinement study fits rates to; ``figure`` says the validation report
-    draws every method's pressure against this reference's profile.
+    draws every method's pressure against this reference's profile;
+    ``summary_line`` says the comparison in a solve's summary.
     """
 
     name: str
@@ -58,6 +59,8 @@ class Reference:
     figure: bool = False
     extent: Callable[[dict[str, Any]], float | None] | None = None
     extent_margin: float = 0.0
+    #: the line a solve's summary shows of the comparison (its ``as_dict()``); None: no line
+    summary_line: Callable[[dict[str, Any]], str] | None = None
 
     def metrics(self, problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:
         """The comparison as a flat dictionary; empty when the answer has no finite forces."""
@@ -67,6 +70,19 @@ class Reference:
 
 
 _PRESSURE_ERRORS = ("p0_rel", "a_rel", "pressure_l2_rel")
+
+
+def _hertz_line(h: dict[str, Any]) -> str:
+    return (f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "
+            f"p0 = {h['p0']:.6g} (ref {h['p0_ref']:.6g}, {100 * h['p0_rel']:.2f} %), "
+            f"pressure L2 {100 * h['pressure_l2_rel']:.2f} %")
+
+
+def _punch_line(q: dict[str, Any]) -> str:
+    return (f"  punch: load {q['load']:.6g}; pressure vs P/(π√(a² − x²)) on |x| ≤ "
+            f"{q['inner']:g}a: max {100 * q['pressure_max_rel']:.2f} %, "
+            f"L2 {100 * q['pressure_l2_rel']:.2f} %; edge node p = {q['edge_pressure']:.4g} "
+            f"(element {q['edge_h']:.3g} next to the edge)")
 
 
 def _hertz_extent(half_width: Callable[[float, float, float], float]):
@@ -81,17 +97,25 @@ def _hertz_extent(half_width: Callable[[float, float, float], float]):
 REFERENCES: dict[str, Reference] = {r.name: r for r in (
     Reference("hertz-2d", "Hertz's cylinder on a flat, plane strain", compare_hertz, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_cylinder_half_width),
-              extent_margin=0.001),
+              extent_margin=0.001, summary_line=_hertz_line),
     Reference("hertz-3d", "Hertz's sphere on a flat", compare_hertz_sphere, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_sphere_radius),
-              extent_margin=0.006),
+              extent_margin=0.006, summary_line=_hertz_line),
     Reference("reverse-hertz", "a block pressed by a rigid cylinder (Hertz 2D)",
-              compare_reverse_hertz, "hertz", _PRESSURE_ERRORS, resultant=True),
+              compare_reverse_hertz, "hertz", _PRESSURE_ERRORS, resultant=True,
+              summary_line=_hertz_line),
     Reference("punch", "a rigid flat punch on a half-plane", compare_punch, "punch",
-              ("pressure_max_rel", "pressure_l2_rel", "edge_over_centre"), resultant=True),
+              ("pressure_max_rel", "pressure_l2_rel", "edge_over_centre"), resultant=True,
+              summary_line=_punch_line),
     Reference("uniform", "uniform pressure under a block pressed onto a flat", compare_uniform,
               "uniform"),
 )}
+
+
+def summary_lines(record: dict[str, Any]) -> list[str]:
+    """The lines a solve record's comparisons (each under its reference's ``key``) show."""
+    lines = {r.key: r.summary_line for r in REFERENCES.values() if r.summary_line is not None}
+    return [line(record[key]) for key, line in lines.items() if record.get(key)]
 
 
 def reference_of(problem: ContactProblem) -> Reference | None:
