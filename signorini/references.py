@@ -15,6 +15,10 @@ punch          a rigid flat punch, P/(π√(a² − x²))          ``punch``
 uniform        uniform pressure E*δ/H (the block patch test) ``uniform``
 ============== ============================================ ===================
 
+A reference also says its comparison in a solve's summary
+(:func:`summary_lines`) and the claims the validation suite holds an exact
+answer to (:class:`Claim`, with the suite's limits by name).
+
 Formulas: :mod:`signorini.analytic`; comparisons: :mod:`signorini.pressure`.
 """
 
@@ -33,8 +37,21 @@ from signorini.pressure import (
     compare_punch,
     compare_reverse_hertz,
     compare_uniform,
+    contact_profile,
+    radial_distance,
 )
 from signorini.problem import ContactProblem, ContactSolution
+
+
+@dataclass(frozen=True)
+class Claim:
+    """One claim about an answer against its reference: ``value`` at most the suite's limit
+    named ``limit`` (:data:`signorini.studies.suite.LIMITS`), or, with ``limit`` None, true."""
+
+    name: str
+    value: float | bool
+    limit: str | None = None
+    detail: str = ""
 
 
 @dataclass(frozen=True)
@@ -47,7 +64,8 @@ class Reference:
     obstacles), reported beside it; ``convergence`` lists the errors a
     refinement study fits rates to; ``figure`` says the validation report
     draws every method's pressure against this reference's profile;
-    ``summary_line`` says the comparison in a solve's summary.
+    ``summary_line`` says the comparison in a solve's summary; ``claims``
+    are what the validation suite holds the exact answer to (:class:`Claim`).
     """
 
     name: str
@@ -61,6 +79,8 @@ class Reference:
     extent_margin: float = 0.0
     #: the line a solve's summary shows of the comparison (its ``as_dict()``); None: no line
     summary_line: Callable[[dict[str, Any]], str] | None = None
+    #: ``claims(problem, exact, metrics)``: what the validation suite checks of the exact answer
+    claims: Callable[[ContactProblem, ContactSolution, dict[str, float]], list[Claim]] | None = None
 
     def metrics(self, problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:
         """The comparison as a flat dictionary; empty when the answer has no finite forces."""
@@ -85,6 +105,59 @@ def _punch_line(q: dict[str, Any]) -> str:
             f"(element {q['edge_h']:.3g} next to the edge)")
 
 
+def _pressure_claims(metrics: dict[str, float], prefix: str) -> list[Claim]:
+    return [Claim("Hertz p0 relative error (pdas)", metrics["p0_rel"], prefix + "p0_rel"),
+            Claim("Hertz a relative error (pdas)", metrics["a_rel"], prefix + "a_rel"),
+            Claim("Hertz pressure L2 relative error (pdas)", metrics["pressure_l2_rel"],
+                  prefix + "pressure_l2_rel"),
+            _force_balance(metrics)]
+
+
+def _force_balance(metrics: dict[str, float]) -> Claim:
+    return Claim("force balance: contact force vs applied load (pdas)", metrics["force_balance"],
+                 "force_balance")
+
+
+_RAISE_CANDIDATES = "contact reached the end of the candidates: raise 'candidates'"
+
+
+def _hertz_2d_claims(problem: ContactProblem, exact: ContactSolution,
+                     metrics: dict[str, float]) -> list[Claim]:
+    """Hertz's a, p₀ and pressure, force balance, and the last candidate out of contact."""
+    outside = not bool(contact_profile(problem, exact).active[-1])
+    return _pressure_claims(metrics, "hertz_") + [
+        Claim("outermost candidate is not in contact", outside, None, _RAISE_CANDIDATES)]
+
+
+def _hertz_3d_claims(problem: ContactProblem, exact: ContactSolution,
+                     metrics: dict[str, float]) -> list[Claim]:
+    """As in 2D (the 3D model to its own limits), the outermost ring out of contact."""
+    prefix = "hertz_3d_" if problem.contact_points.shape[1] == 3 else "hertz_"
+    rho = radial_distance(problem.contact_points)
+    outside = not bool(np.any(contact_profile(problem, exact).active[rho >= 0.95 * rho.max()]))
+    return _pressure_claims(metrics, prefix) + [
+        Claim("outermost candidates are not in contact", outside, None, _RAISE_CANDIDATES)]
+
+
+def _punch_claims(problem: ContactProblem, exact: ContactSolution,
+                  metrics: dict[str, float]) -> list[Claim]:
+    """The pressure away from the edges, force balance, the load (sharp corners), full contact."""
+    claims = [Claim("punch pressure max relative error on |x| <= a/2 (pdas)",
+                    metrics["pressure_max_rel"], "punch_pressure_rel"), _force_balance(metrics)]
+    if np.isfinite(metrics["target_rel"]) and problem.params.get("corner_radius", 0) == 0:
+        claims.append(Claim("total contact force equals the load P (pdas)", metrics["target_rel"],
+                            "load_target_rel"))
+    touching = metrics["active_fraction"] == 1.0
+    return claims + [Claim("every node under the punch face is in contact", touching, None,
+                           f"only {100 * metrics['active_fraction']:.1f} % are")]
+
+
+def _uniform_claims(problem: ContactProblem, exact: ContactSolution,
+                    metrics: dict[str, float]) -> list[Claim]:
+    return [Claim("uniform pressure max relative error (pdas)", metrics["pressure_max_rel"],
+                  "uniform_pressure_rel"), _force_balance(metrics)]
+
+
 def _hertz_extent(half_width: Callable[[float, float, float], float]):
     def extent(params: dict[str, Any]) -> float | None:
         if not all(isinstance(params.get(k), (int, float)) for k in ("P", "R", "E", "nu")):
@@ -97,18 +170,18 @@ def _hertz_extent(half_width: Callable[[float, float, float], float]):
 REFERENCES: dict[str, Reference] = {r.name: r for r in (
     Reference("hertz-2d", "Hertz's cylinder on a flat, plane strain", compare_hertz, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_cylinder_half_width),
-              extent_margin=0.001, summary_line=_hertz_line),
+              extent_margin=0.001, summary_line=_hertz_line, claims=_hertz_2d_claims),
     Reference("hertz-3d", "Hertz's sphere on a flat", compare_hertz_sphere, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_sphere_radius),
-              extent_margin=0.006, summary_line=_hertz_line),
+              extent_margin=0.006, summary_line=_hertz_line, claims=_hertz_3d_claims),
     Reference("reverse-hertz", "a block pressed by a rigid cylinder (Hertz 2D)",
               compare_reverse_hertz, "hertz", _PRESSURE_ERRORS, resultant=True,
-              summary_line=_hertz_line),
+              summary_line=_hertz_line, claims=_hertz_2d_claims),
     Reference("punch", "a rigid flat punch on a half-plane", compare_punch, "punch",
               ("pressure_max_rel", "pressure_l2_rel", "edge_over_centre"), resultant=True,
-              summary_line=_punch_line),
+              summary_line=_punch_line, claims=_punch_claims),
     Reference("uniform", "uniform pressure under a block pressed onto a flat", compare_uniform,
-              "uniform"),
+              "uniform", claims=_uniform_claims),
 )}
 
 
