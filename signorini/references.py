@@ -79,6 +79,8 @@ class Reference:
     extent_margin: float = 0.0
     #: the line a solve's summary shows of the comparison (its ``as_dict()``); None: no line
     summary_line: Callable[[dict[str, Any]], str] | None = None
+    #: the errors a study runner's row records of every answer against it (the atlas's columns)
+    row_errors: tuple[str, ...] = ()
     #: ``claims(problem, exact, metrics)``: what the validation suite checks of the exact answer
     claims: Callable[[ContactProblem, ContactSolution, dict[str, float]], list[Claim]] | None = None
 
@@ -170,7 +172,8 @@ def _hertz_extent(half_width: Callable[[float, float, float], float]):
 REFERENCES: dict[str, Reference] = {r.name: r for r in (
     Reference("hertz-2d", "Hertz's cylinder on a flat, plane strain", compare_hertz, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_cylinder_half_width),
-              extent_margin=0.001, summary_line=_hertz_line, claims=_hertz_2d_claims),
+              extent_margin=0.001, summary_line=_hertz_line, claims=_hertz_2d_claims,
+              row_errors=("a_rel", "p0_rel", "pressure_l2_rel")),
     Reference("hertz-3d", "Hertz's sphere on a flat", compare_hertz_sphere, "hertz",
               _PRESSURE_ERRORS, figure=True, extent=_hertz_extent(hertz_sphere_radius),
               extent_margin=0.006, summary_line=_hertz_line, claims=_hertz_3d_claims),
