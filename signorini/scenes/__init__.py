@@ -8,7 +8,8 @@ validation cases) and one :func:`register` call.
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.scenes.base import Case, Param, SceneFamily
 from signorini.scenes.build import build_problem, coarse_problem, coarse_values
-from signorini.scenes.families import SCENES, get_scene, register, scene_reference, unregister
+from signorini.scenes.families import SCENES, get_scene, portable_scene, register, scene_reference, unregister
 
 __all__ = ["SCENES", "Case", "FlatObstacle", "Param", "SceneFamily", "SceneModel", "build_problem",
-           "coarse_problem", "coarse_values", "get_scene", "register", "scene_reference", "unregister"]
+           "coarse_problem", "coarse_values", "get_scene", "portable_scene", "register", "scene_reference",
+           "unregister"]

@@ -12,4 +12,15 @@ from signorini.scenes.registry import SCENES, get_scene, register, scene_referen
 for _module in (hertz_cylinder, block, hertz_sphere, hertz_sphere_3d, punch, reverse_hertz):
     register(_module.FAMILY)
 
-__all__ = ["SCENES", "get_scene", "register", "scene_reference", "unregister"]
+#: the families every process knows (registered on import of the package)
+BUILT_IN = frozenset(SCENES)
+
+
+def portable_scene(name: str) -> bool:
+    """A worker process (:mod:`signorini.studies.runner`) can build this scene: a built-in
+    family, or a scene file. A family registered in this process only is not."""
+    return name in BUILT_IN or name.lower().endswith(".toml")
+
+
+__all__ = ["BUILT_IN", "SCENES", "get_scene", "portable_scene", "register", "scene_reference",
+           "unregister"]

@@ -28,6 +28,7 @@ from signorini.crosschecking import agreement
 from signorini.errors import InputError
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics, reference_of
+from signorini.scenes import portable_scene
 from signorini.scenes.base import Case
 from signorini.scenes.registry import ValidationCases
 from signorini.solvers.registry import BACKENDS, Method, get_method, methods
@@ -318,16 +319,18 @@ def run_suite(cases: Sequence[Case] = DEFAULT_CASES, method_names: list[str] | N
     every case: a user's method that only claims success fails the suite.
     The runs go to one worker process, each within ``time_limit`` seconds;
     ``isolate=False`` runs them in this process without a limit, as happens
-    by default when a method was registered in this process only (:func:`portable`).
+    by default when a method or a case's scene family was registered in this
+    process only (:func:`portable`, :func:`signorini.scenes.portable_scene`).
     """
     start = time.perf_counter()
     say = progress or (lambda message: None)
     chosen = [get_method(name) for name in method_names] if method_names else \
         [m for m in methods(installed_only=True) if m.family != "user"]
     if isolate is None:
-        isolate = all(portable(m) for m in chosen)
+        isolate = all(portable(m) for m in chosen) and all(portable_scene(c.scene) for c in cases)
         if not isolate:
-            log.info("a method registered in this process only: the suite runs here, no time limit")
+            log.info("a method or scene family registered in this process only: the suite runs "
+                     "here, no time limit")
     tasks = [task for case in cases for task in case_tasks(case, chosen)]
 
     def report(index: int, count: int, task: Task, row: Row) -> None:
