@@ -25,8 +25,8 @@ for backend in backends:
 print("| dofs | " + " | ".join(backends) + " |")
 print("|---:|" + "---:|" * len(backends))
 for level in levels:
-    problem = build_problem("hertz-cylinder", refine=level, n_contact=110, grading=0.1,
-                            delta=0.0025)
+    problem = build_problem("hertz-cylinder", params={"refine": level, "n_contact": 110, "grading": 0.1,
+                                                      "delta": 0.0025})
     cells = []
     for backend in backends:
         if backend == "superlu" and problem.n > 300_000:

@@ -32,12 +32,13 @@ from signorini.errors import BackendNotInstalled, InputError, SignoriniError, So
 from signorini.kkt import Certificate
 from signorini.problem import ContactProblem, ContactSolution, Discretisation, Scales
 from signorini.solution import WarmStart
+from signorini.solvers.base import DEFAULT_TOL
 
 __version__ = "0.1.0"
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
-__all__ = ["DEFAULT_METHOD", "BackendNotInstalled", "Certificate", "ContactProblem", "ContactSolution",
-           "CrossCheck", "Discretisation", "InputError", "Result", "Scales", "SignoriniError",
-           "SolverError", "WarmStart", "__version__", "at_load", "build_problem", "certificate", "crosscheck",
-           "methods", "scene_families", "solve", "solve_adaptive"]
+__all__ = ["DEFAULT_METHOD", "DEFAULT_TOL", "BackendNotInstalled", "Certificate", "ContactProblem",
+           "ContactSolution", "CrossCheck", "Discretisation", "InputError", "Result", "Scales",
+           "SignoriniError", "SolverError", "WarmStart", "__version__", "at_load", "build_problem",
+           "certificate", "crosscheck", "methods", "scene_families", "solve", "solve_adaptive"]

@@ -30,6 +30,7 @@ from signorini import loading
 from signorini.loading import solve as load_control
 from signorini.scenes import SCENES, SceneFamily, build_problem
 from signorini.scenes.adapt import parse_target
+from signorini.scenes.base import scene_params
 from signorini.scenes.adapt import solve_adaptive as adapt
 from signorini.scenes.build import coarse_problem
 from signorini.solvers.registry import Method, check_request
@@ -258,20 +259,20 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     :class:`Result`), and the iterations it reports are its own;
     ``result.solution.work`` lists the work of every stage. ``tol`` is the
     relative KKT tolerance the answer must meet to be ``converged`` (None:
-    the method's default); other keyword arguments are the method's options.
+    the method's default; a QP backend then runs at its own settings and its
+    answer is held to :data:`signorini.DEFAULT_TOL`); other keyword arguments
+    are the method's options.
     Bad input raises :class:`signorini.InputError`; a method that fails
     returns a result whose ``status`` says so.
     """
-    if params is not None and not isinstance(params, dict):
-        raise InputError(f"params must be a dict of scene parameters, got {type(params).__name__}: "
-                         "e.g. params={'E': 2.1e11}")
+    params = scene_params(params)
     adaptive = sorted(set(options) & {"target_error", "max_dofs", "target_on"})
     if adaptive:
         raise InputError(f"{', '.join(adaptive)} steer{'s' * (len(adaptive) == 1)} adaptive "
                          "refinement: call signorini.solve_adaptive(scene, target_error, ...)")
     if isinstance(problem, str):
         check_request(method, tol, max_iter, options)  # bad options fail before the scene is built
-        problem = build_problem(problem, solved_by=method, **(params or {}))
+        problem = build_problem(problem, params=params, solved_by=method)
     elif params:
         raise InputError("params= builds a scene by name: give solve('hertz-cylinder', params=...) "
                          "or build the problem with those parameters first")
@@ -309,15 +310,14 @@ def solve_adaptive(scene: str, target_error: float | str, method: str = DEFAULT_
     if not isinstance(scene, str):
         raise InputError("adaptive refinement refines a scene's mesh: give the scene by name, "
                          "solve_adaptive('hertz-cylinder', 0.01)")
-    if params is not None and not isinstance(params, dict):
-        raise InputError(f"params must be a dict of scene parameters, got {type(params).__name__}")
+    params = scene_params(params)
     check_request(method, tol, max_iter, options)
 
     def solver(problem: ContactProblem):
         return load_control(problem, method, tol=tol, max_iter=max_iter, coarse=coarse_problem,
                             **options)
 
-    run = adapt(scene, params or {}, parse_target(target_error), solver, max_dofs=max_dofs,
+    run = adapt(scene, params, parse_target(target_error), solver, max_dofs=max_dofs,
                 quantity=target_on, solved_by=method)
     result = Result(run.problem, run.solution, certificate(run.problem, run.solution))
     result._estimate = run.estimate

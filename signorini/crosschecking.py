@@ -40,14 +40,12 @@ from signorini.errors import BackendNotInstalled, InputError
 from signorini.kkt import WEAK_TOL, compare
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics, reference_of
-from signorini.solvers.base import DEFAULT_ACCEPT, check_tol
+from signorini.solvers.base import DEFAULT_TOL, check_tol
 from signorini.solvers.registry import get_method
 
 #: the methods compared when none are named: the paper's, the two named QP backends,
 #: the modelling layer and the exact reference
 DEFAULT_METHODS = ("uzawa", "qp-osqp", "qp-clarabel", "cvxpy", "pdas")
-#: the tolerance every method is asked for when none is given (docs/crosscheck.md runs at it)
-DEFAULT_TOL = 1e-8
 #: two converged answers agree when λ and u differ by at most this × the larger tolerance
 AGREE_FACTOR = 1e4
 #: a row's status when the method refused the problem or its backend is missing
@@ -200,8 +198,8 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     ----------
     problem : a :class:`ContactProblem`, or a scene name or ``.toml`` file built with ``params``.
     methods : method names (default :data:`DEFAULT_METHODS`); ``module:function`` for your own.
-    tol : the relative KKT tolerance every method is asked for (default 1e-8; ``None``
-        leaves each method its own default, judged at ``DEFAULT_ACCEPT``).
+    tol : the relative KKT tolerance every method is asked for (default
+        :data:`signorini.DEFAULT_TOL`; ``None`` leaves each method its own default).
     options : per-method options, ``{"qp-osqp": {"polish": False}}``.
 
     Returns
@@ -235,14 +233,14 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
                          f"({', '.join(names)}): add it with --method {stray[0]}")
     tol = check_tol(tol)
     if isinstance(problem, str):
-        problem = build_problem(problem, **(params or {}))
+        problem = build_problem(problem, params=params)
     elif params:
         raise InputError("params= builds a scene by name: give crosscheck('hertz-cylinder', "
                          "params=...) or build the problem with those parameters first")
     elif not isinstance(problem, ContactProblem):
         raise InputError(f"problem must be a ContactProblem or a scene name, got "
                          f"{type(problem).__name__}")
-    judged_tol = tol if tol is not None else DEFAULT_ACCEPT
+    judged_tol = tol if tol is not None else DEFAULT_TOL
     runs: list[MethodRun] = []
     results: dict[str, Result] = {}
     for name in names:
@@ -349,5 +347,5 @@ def render_markdown(record: dict[str, Any]) -> str:
                       "", _verdict_line(record), ""])
 
 
-__all__ = ["AGREE_FACTOR", "DEFAULT_METHODS", "DEFAULT_TOL", "CrossCheck", "MethodRun", "Pair",
+__all__ = ["AGREE_FACTOR", "DEFAULT_METHODS", "CrossCheck", "MethodRun", "Pair",
            "agreement", "crosscheck", "render", "render_markdown"]

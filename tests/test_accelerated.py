@@ -11,7 +11,7 @@ from signorini.solvers.registry import solve
 
 @pytest.fixture(scope="module")
 def hertz():
-    return signorini.at_load(build_problem("hertz-cylinder", n_contact=24, grading=0.3))
+    return signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 24, "grading": 0.3}))
 
 
 def test_nesterov_reaches_the_exact_answer_in_fewer_iterations(hertz):

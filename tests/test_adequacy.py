@@ -56,7 +56,7 @@ def test_the_cli_exits_1_on_an_inadequate_model(tmp_path):
 
 
 def test_a_watched_node_through_the_obstacle_is_found():
-    problem = signorini.build_problem("hertz-cylinder", **SMALL)
+    problem = signorini.build_problem("hertz-cylinder", params=SMALL)
     solution = signorini.solve(problem).solution
     watch = problem.discretisation.watch
     assert adequacy(problem, solution, 1e-9).penetrating_nodes == 0
@@ -78,7 +78,7 @@ def test_warnings_keep_the_status():
     # by default (auto) ν = 0.49 averages the volumetric strain at the nodes: nothing locks
     result = signorini.solve("hertz-cylinder", params={"nu": 0.49, **SMALL})
     assert result.converged and "lock" not in result.message
-    problem = signorini.build_problem("hertz-cylinder", **SMALL)
+    problem = signorini.build_problem("hertz-cylinder", params=SMALL)
     watch = problem.discretisation.watch
     push = np.max(np.abs(problem.discretisation.prescribed))
     problem.discretisation.watch = Watch(watch.rows, watch.gaps, watch.edge, watch.candidate_gaps - 2 * push,

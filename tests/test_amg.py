@@ -35,7 +35,7 @@ SCENES = [
 
 @pytest.fixture(scope="module")
 def problems():
-    return {name: signorini.at_load(build_problem(name, **values)) for name, values in SCENES}
+    return {name: signorini.at_load(build_problem(name, params=values)) for name, values in SCENES}
 
 
 def assert_agrees(problem, first, second, lam_tol=1e-8):
@@ -60,7 +60,7 @@ def test_agrees_with_pdas(problems, name, backend):
 
 def test_no_factorisation_and_the_certificate_uses_the_multigrid(problems):
     """Without a coarse model nothing is factorised: not the method, not its certificate."""
-    problem = signorini.at_load(build_problem("hertz-sphere-3d", delta=0.0025))
+    problem = signorini.at_load(build_problem("hertz-sphere-3d", params={"delta": 0.0025}))
     before = dict(factor.COUNTS)
     solution = solve(problem, "pdas-amg", amg="pyamg")
     assert solution.status == "converged"
@@ -96,7 +96,7 @@ def test_a_predicted_active_set_saves_steps(problems):
 @pytest.mark.slow
 def test_a_coarse_model_predicts_the_first_active_set():
     """signorini.solve hands pdas-amg the first active set a coarser model of the scene predicts."""
-    problem = build_problem("hertz-sphere-3d", refine=1, n_contact=8, delta=0.0025)
+    problem = build_problem("hertz-sphere-3d", params={"refine": 1, "n_contact": 8, "delta": 0.0025})
     solution = signorini.solve(problem, "pdas-amg", amg="pyamg").solution
     assert solution.status == "converged", solution.message
     assert solution.extras["first_active"] == "given"
@@ -154,7 +154,7 @@ def test_auto_is_the_default_and_picks_pdas_in_2d():
 
 
 def test_auto_picks_pdas_for_axisymmetric_and_small_3d(problems):
-    axisymmetric = signorini.at_load(build_problem("hertz-sphere", n_contact=16, grading=0.4))
+    axisymmetric = signorini.at_load(build_problem("hertz-sphere", params={"n_contact": 16, "grading": 0.4}))
     assert auto.choose(axisymmetric)[0] == "pdas"
     assert "axisymmetric" in auto.choose(axisymmetric)[1]
     small = problems["hertz-sphere-3d"]
@@ -166,7 +166,7 @@ def test_auto_leaves_a_pushed_3d_model_to_pdas_amg_sooner_than_a_load_targeted_o
     """Between the two thresholds a push goes to pdas-amg, a target load (matched by
     factorisation) to the method that reuses what load control found."""
     monkeypatch.setattr(auto, "PUSHED_AMG_FROM_DOFS", 1_000)
-    pushed = build_problem("hertz-sphere-3d", delta=0.0025)
+    pushed = build_problem("hertz-sphere-3d", params={"delta": 0.0025})
     loaded = build_problem("hertz-sphere-3d")
     assert pushed.n < auto.AMG_FROM_DOFS and loaded.pending
     assert auto.choose(pushed)[0] == "pdas-amg"
@@ -198,7 +198,7 @@ def test_nodes_touching_with_no_force_end_converged_not_cycling(touching):
     """The atlas's degenerate block: PDAS's active set cycles over nodes that touch with no force.
     pdas-amg solves the cycling set tightly and lets the certificate judge it (either set is the
     answer there), and its duality gap survives pinned dofs that must be released."""
-    problem = signorini.at_load(build_problem("block", nx=8, ny=8, touching=touching))
+    problem = signorini.at_load(build_problem("block", params={"nx": 8, "ny": 8, "touching": touching}))
     solution = solve(problem, "pdas-amg", tol=1e-8)
     assert solution.status == "converged", solution.message
     assert_agrees(problem, solution, solve(problem, "pdas", tol=1e-8), lam_tol=1e-7)

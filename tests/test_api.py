@@ -67,7 +67,7 @@ def test_forces_are_in_the_scene_units_and_equal_the_cli_json(tmp_path):
 
 def test_the_result_does_not_depend_on_the_solver_units():
     scaled = signorini.solve("hertz-cylinder", params=SI, tol=1e-10)
-    raw = signorini.solve(signorini.build_problem("hertz-cylinder", nondimensionalise=False, **SI),
+    raw = signorini.solve(signorini.build_problem("hertz-cylinder", params=SI, nondimensionalise=False),
                           tol=1e-10)
     assert raw.problem.scales.force == 1.0
     np.testing.assert_allclose(raw.force, scaled.force, rtol=1e-6, atol=1e-9 * scaled.force.max())
@@ -141,3 +141,26 @@ def test_a_tolerance_double_precision_cannot_certify_is_refused(tol, capsys):
         signorini.solve("block", tol=tol)
     assert main(["solve", "block", "--tol", f"{tol:g}"]) == 2
     assert "--tol" in capsys.readouterr().err
+
+
+def test_one_default_tolerance():
+    """crosscheck asks for signorini.DEFAULT_TOL, and an answer nobody named a tolerance for
+    (a QP backend at its own settings) is held to it: λ off by 1e-7 is not converged."""
+    import dataclasses
+    import inspect
+
+    from signorini.solvers.base import judge
+    from signorini.solvers.registry import get_method
+
+    assert inspect.signature(signorini.crosscheck).parameters["tol"].default == signorini.DEFAULT_TOL
+    assert get_method("uzawa").default_tol == signorini.DEFAULT_TOL
+    assert get_method("qp-osqp").default_tol is None  # its backend's own settings
+    problem = signorini.at_load(signorini.build_problem("block", params={"nx": 4, "ny": 4}))
+    exact = signorini.solve(problem, "pdas", tol=1e-12).solution
+
+    def off_by(relative):
+        lam = exact.lam * (1 + relative)
+        return judge(problem, dataclasses.replace(exact, lam=lam, status="converged"), None)
+
+    assert off_by(1e-10).status == "converged"
+    assert off_by(1e-7).status == "inaccurate"  # within the 1e-6 accepted before DEFAULT_TOL

@@ -25,17 +25,17 @@ STEEL = {"E": 2.1e11, "R": 0.01}
 
 @pytest.fixture(scope="module")
 def block():
-    return signorini.at_load(build_problem("block", **BLOCK))
+    return signorini.at_load(build_problem("block", params=BLOCK))
 
 
 @pytest.fixture(scope="module")
 def hertz():
-    return signorini.at_load(build_problem("hertz-cylinder", **HERTZ))
+    return signorini.at_load(build_problem("hertz-cylinder", params=HERTZ))
 
 
 @pytest.fixture(scope="module")
 def hertz_steel():
-    return signorini.at_load(build_problem("hertz-cylinder", **HERTZ, **STEEL))
+    return signorini.at_load(build_problem("hertz-cylinder", params={**HERTZ, **STEEL}))
 
 
 @pytest.fixture(scope="module", params=["block", "hertz"])
@@ -254,8 +254,9 @@ def test_physical_pressure_scales_with_E(hertz, hertz_steel):
 ])
 @pytest.mark.slow
 def test_nondimensionalise_false_gives_the_same_physical_answer(units):
-    scaled = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, **units))
-    raw = signorini.at_load(build_problem("hertz-cylinder", nondimensionalise=False, **HERTZ, **units))
+    scaled = signorini.at_load(build_problem("hertz-cylinder", params={**HERTZ, **units}))
+    raw = signorini.at_load(build_problem("hertz-cylinder", params={**HERTZ, **units},
+                                          nondimensionalise=False))
     assert raw.scales.force == raw.scales.length == raw.scales.displacement == 1.0
     s_scaled, s_raw = exact(scaled), exact(raw)
     assert certificate(raw, s_raw).worst()[1] < 1e-9
@@ -270,8 +271,8 @@ def test_nondimensionalise_false_gives_the_same_physical_answer(units):
 
 
 def test_nondimensionalise_false_block_in_SI_units():
-    scaled = signorini.at_load(build_problem("block", **BLOCK))
-    raw = signorini.at_load(build_problem("block", nondimensionalise=False, **BLOCK))
+    scaled = signorini.at_load(build_problem("block", params=BLOCK))
+    raw = signorini.at_load(build_problem("block", params=BLOCK, nondimensionalise=False))
     s_scaled, s_raw = exact(scaled), exact(raw)
     E_star = contact_modulus(BLOCK["E"], BLOCK["nu"])
     p_raw = s_raw.lam / raw.weights
@@ -287,7 +288,7 @@ def test_nondimensionalise_false_block_in_SI_units():
     pytest.param({"P": 3.0e6, **STEEL}, id="steel-SI"),
 ])
 def test_target_load_is_reached(values):
-    problem = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, **values))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={**HERTZ, **values}))
     solution = exact(problem)
     total = problem.total_contact_force(solution.lam) * problem.scales.force
     assert total == pytest.approx(values["P"], rel=1e-8)
@@ -306,8 +307,8 @@ def test_default_load_is_hertz_load_for_default_a_over_R(hertz):
 def test_consistent_a_over_R_and_P_give_the_same_problem():
     a_over_R, nu = 0.1, 0.3
     P = hertz_cylinder_load(a_over_R, 1.0, contact_modulus(1.0, nu))
-    by_width = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, a_over_R=a_over_R))
-    by_load = signorini.at_load(build_problem("hertz-cylinder", **HERTZ, P=P))
+    by_width = signorini.at_load(build_problem("hertz-cylinder", params={**HERTZ, "a_over_R": a_over_R}))
+    by_load = signorini.at_load(build_problem("hertz-cylinder", params={**HERTZ, "P": P}))
     assert (by_width.n, by_width.m) == (by_load.n, by_load.m)
     assert rel_diff(by_width.K.toarray(), by_load.K.toarray()) < 1e-12
     assert rel_diff(by_width.N.toarray(), by_load.N.toarray()) < 1e-12
@@ -319,7 +320,7 @@ def test_consistent_a_over_R_and_P_give_the_same_problem():
 
 def test_P_and_a_over_R_together_raise():
     with pytest.raises(InputError, match="P") as info:
-        signorini.at_load(build_problem("hertz-cylinder", **HERTZ, P=0.004, a_over_R=0.05))
+        signorini.at_load(build_problem("hertz-cylinder", params={**HERTZ, "P": 0.004, "a_over_R": 0.05}))
     assert "a_over_R" in str(info.value)
 
 

@@ -27,7 +27,7 @@ def runs(*methods):
 
 
 def test_problem_cache_round_trip(tmp_path):
-    problem = build_problem("hertz-cylinder", **SMALL)
+    problem = build_problem("hertz-cylinder", params=SMALL)
     problem.save(tmp_path / "p.npz")
     again = ContactProblem.load(tmp_path / "p.npz")
     assert (again.K != problem.K).nnz == 0 and np.array_equal(again.f, problem.f)
@@ -118,7 +118,7 @@ def test_a_stored_problem_keeps_nested_s_coarse_model(tmp_path):
     from signorini.studies.problems import PROBLEM_KINDS
 
     path = tmp_path / "p.npz"
-    build_problem("hertz-cylinder", refine=1, n_contact=16, grading=0.3).save(path)
+    build_problem("hertz-cylinder", params={"refine": 1, "n_contact": 16, "grading": 0.3}).save(path)
     problem = PROBLEM_KINDS["stored"]({"path": str(path)})
     from signorini.solvers.registry import solve
 

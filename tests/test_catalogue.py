@@ -16,6 +16,7 @@ import signorini
 from signorini import ContactProblem
 from signorini.cli import main
 from signorini.errors import InputError
+from signorini.scenes.block import force_controlled_problem
 
 LOAD = "0.001:0.002:3"
 SCENE_TOML = """[mesh]
@@ -241,11 +242,17 @@ API = [
     ("build_problem with a number for the scene", lambda: signorini.build_problem(3), ["scene", "int"]),
     ("build_problem with None", lambda: signorini.build_problem(None), ["scene", "NoneType"]),
     ("build_problem unknown scene", lambda: signorini.build_problem("nowhere"), ["'nowhere'"]),
-    ("build_problem bad parameter", lambda: signorini.build_problem("block", nx="a"), ["nx="]),
-    ("build_problem unknown parameter", lambda: signorini.build_problem("block", colour=1),
+    ("build_problem bad parameter", lambda: signorini.build_problem("block", params={"nx": "a"}), ["nx="]),
+    ("build_problem unknown parameter", lambda: signorini.build_problem("block", params={"colour": 1}),
      ["'colour'"]),
-    ("build_problem too big", lambda: signorini.build_problem("hertz-cylinder", refine=6),
+    ("build_problem too big", lambda: signorini.build_problem("hertz-cylinder", params={"refine": 6}),
      ["dofs", "GB"]),
+    ("build_problem params a number", lambda: signorini.build_problem("block", 4),
+     ["params", "int", "params={"]),
+    ("build_problem params keyed by number", lambda: signorini.build_problem("block", {1: 2.0}),
+     ["params", "1", "strings"]),
+    ("force-controlled block params a list",
+     lambda: force_controlled_problem(0.01, ["nx", 4]), ["params", "list"]),
     ("solve method a number", lambda: signorini.solve(_problem(), 3), ["method", "int"]),
     ("solve unknown method", lambda: signorini.solve(_problem(), "simplex"), ["'simplex'"]),
     ("solve a list", lambda: signorini.solve([1, 2]), ["problem", "list"]),
@@ -280,7 +287,7 @@ API = [
     ("certificate of a Result", lambda: signorini.certificate(_problem(), signorini.solve("block")),
      ["result.solution"]),
     ("certificate of another problem's answer",
-     lambda: signorini.certificate(signorini.build_problem("block", nx=8), _solution()),
+     lambda: signorini.certificate(signorini.build_problem("block", params={"nx": 8}), _solution()),
      ["solution.u", "entries"]),
     ("from_qp K text", lambda: ContactProblem.from_qp("K", F3, N3, D1), ["K", "str"]),
     ("from_qp K not square", lambda: ContactProblem.from_qp(sp.eye(3, 4), F3, N3, D1), ["K", "square"]),

@@ -15,7 +15,7 @@ from signorini.teaching.synthetic import random_problem
 
 @pytest.mark.parametrize("params", [{"n_contact": 20, "grading": 0.4}, {"candidates": 3.0, "n_contact": 12}])
 def test_condensed_equals_pdas_on_hertz(params):
-    problem = signorini.at_load(build_problem("hertz-cylinder", **params))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params=params))
     exact, condensed = solve(problem, "pdas"), solve(problem, "condensed")
     assert condensed.status == "converged"
     agreement = compare(problem, exact, condensed)

@@ -106,7 +106,7 @@ def test_write_study_writes_markdown_json_and_figures(hertz_study, tmp_path, sav
 def test_punch_figures_take_and_return_axes():
     from matplotlib.figure import Figure
 
-    problem = signorini.at_load(build_problem("punch", n_contact=8, grading=0.8, size=6))
+    problem = signorini.at_load(build_problem("punch", params={"n_contact": 8, "grading": 0.8, "size": 6}))
     solution = solve(problem, "pdas", tol=1e-10)
     ax = Figure().add_subplot()
     assert plot_punch_pressure(problem, solution, ax=ax) is ax

@@ -40,7 +40,7 @@ def hanging():
 
 @pytest.fixture(scope="module")
 def hertz():
-    return signorini.at_load(build_problem("hertz-cylinder", n_contact=16, grading=0.4))
+    return signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 16, "grading": 0.4}))
 
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,8 @@ CELL_DATA = {"von_mises", "sigma_xx", "sigma_yy", "sigma_zz", "sigma_xy"}
 
 @pytest.fixture(scope="module")
 def block():
-    problem = build_problem("block", nx=4, ny=4, E=70e9, nu=0.3, delta=1e-3, H=2.0, W=1.5)
+    problem = build_problem("block", params={"nx": 4, "ny": 4, "E": 70e9, "nu": 0.3, "delta": 1e-3,
+                                             "H": 2.0, "W": 1.5})
     return problem, solve(problem, "pdas", tol=1e-10)
 
 

@@ -19,7 +19,7 @@ def test_a_factorisation_over_the_limit_is_refused_before_its_numeric_phase(monk
     import signorini
     from signorini.numerics.factor import PardisoFactor
 
-    problem = signorini.build_problem("hertz-cylinder", refine=2, delta=0.001)
+    problem = signorini.build_problem("hertz-cylinder", params={"refine": 2, "delta": 0.001})
     factor = PardisoFactor(problem.K)
     assert factor.memory > 8 * problem.K.nnz  # at least K's own values
     monkeypatch.setenv(FACTOR_MEMORY_VARIABLE, f"{0.5 * factor.memory / 1e9}")

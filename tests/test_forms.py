@@ -31,7 +31,7 @@ def require(method: str) -> None:
 
 @pytest.fixture(scope="module", params=sorted(SCENES))
 def scene(request):
-    problem = signorini.at_load(signorini.build_problem(request.param, **SCENES[request.param]))
+    problem = signorini.at_load(signorini.build_problem(request.param, params=SCENES[request.param]))
     return problem, solve(problem, "pdas", tol=1e-10)
 
 
@@ -105,7 +105,7 @@ def test_work_of_each_form(method):
     reuses that factorisation: judging adds back-solves, no factorisation. (Unpolished:
     polish, the default of qp-clarabel and cvxpy, solves one more KKT system.)"""
     require(method)
-    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", **SCENES["hertz-cylinder"]))
+    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", params=SCENES["hertz-cylinder"]))
     m = problem.m
     expected = {"primal": (0, 0), "shifted": (1, 1), "dual": (1, m + 2)}
     for form, (factorisations, back_solves) in expected.items():
@@ -152,7 +152,7 @@ def test_api_and_every_qp_method_take_the_options():
 def test_dense_backends_solve_the_dual_beyond_their_dof_limit():
     """The dual's unknowns are the m candidates: a dense backend takes n > max_dense_dofs."""
     require("qp-daqp")
-    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", **SCENES["hertz-cylinder"]))
+    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", params=SCENES["hertz-cylinder"]))
     exact = solve(problem, "pdas", tol=1e-10)
     with pytest.raises(InputError, match="max_dense_dofs"):
         solve(problem, "qp-daqp", tol=1e-9, form="primal", max_dense_dofs=500)
@@ -163,7 +163,7 @@ def test_dense_backends_solve_the_dual_beyond_their_dof_limit():
 
 def test_polish_keeps_the_better_answer_and_records_both():
     require("qp-osqp")
-    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", **SCENES["hertz-cylinder"]))
+    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", params=SCENES["hertz-cylinder"]))
     exact = solve(problem, "pdas", tol=1e-10)
     # OSQP at its loose defaults: a rough answer that the polish repairs
     sol = solve(problem, "qp-osqp", polish=True)
@@ -177,7 +177,7 @@ def test_polish_keeps_the_better_answer_and_records_both():
 def test_polish_on_a_wrong_active_set_is_not_kept():
     """An answer one node off the exact one: polishing on its active set (that node closed)
     pulls the node with a tensile force, and the raw answer is kept and said to be."""
-    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", **SCENES["hertz-cylinder"]))
+    problem = signorini.at_load(signorini.build_problem("hertz-cylinder", params=SCENES["hertz-cylinder"]))
     exact = solve(problem, "pdas", tol=1e-10)
     gap = problem.gap(exact.u)
     node = int(np.argmin(np.where(exact.lam > 0, np.inf, gap)))  # the nearest open node

@@ -26,6 +26,7 @@ from signorini.kkt import ACTIVE, FORCE_FLOOR, active_set, certificate, classify
 from signorini.numerics.factor import COUNTS, factorize
 from signorini.pressure import compare_hertz
 from signorini.problem import ContactSolution
+from signorini import at_load
 from signorini.scenes import build_problem
 from signorini.solvers import registry
 from signorini.studies.atlas import poisson
@@ -58,12 +59,12 @@ def spent(step):
 
 @pytest.fixture(scope="module")
 def hertz():
-    return signorini.at_load(build_problem("hertz-cylinder", n_contact=20))
+    return signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
 
 
 @pytest.fixture(scope="module")
 def near_half():
-    return signorini.at_load(build_problem("hertz-cylinder", n_contact=20, nu=NEAR_HALF))
+    return signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 20, "nu": NEAR_HALF}))
 
 
 # --- the forward error of λ -------------------------------------------------------------------
@@ -111,7 +112,7 @@ def test_the_contact_is_found_near_half(near_half):
 
 def test_no_contact_forces_are_still_judged_against_the_load():
     """A body that does not reach the obstacle: round-off forces count as zero."""
-    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=20))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
     lifted = problem.with_data(d=problem.d + 10.0)  # the obstacle moved far away
     exact = registry.solve(lifted, "pdas")
     assert not np.any(exact.lam)
@@ -131,11 +132,11 @@ def test_well_conditioned_answers_stay_converged(hertz, method, tol):
 
 def test_qpalm_at_its_defaults_is_caught():
     pytest.importorskip("qpalm")
-    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=20))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
     solution = registry.solve(problem, "qp-qpalm")
     assert solution.claimed_status == "converged" and solution.status == "inaccurate"
     error = lam_error(solution, reference_lam(problem))
-    assert error > 10 * registry.DEFAULT_ACCEPT
+    assert error > 1000 * registry.DEFAULT_TOL  # 1e-5: far beyond any tolerance it could claim
     assert certificate(problem, solution).force_error == pytest.approx(error, rel=0.1)
     assert "contact force is not certified" in solution.message
 
@@ -154,7 +155,7 @@ def test_the_forward_error_on_a_plain_factorisation_adds_no_factorisation(hertz)
 
 
 def test_the_sweep_judges_every_level_without_factorising(hertz):
-    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=24, grading=0.3))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 24, "grading": 0.3}))
     problem.factor()
     loads = np.array([0.6, 1.0]) * problem.params["P"]
     cost, levels = spent(lambda: sweep_loads(problem, loads))
@@ -226,7 +227,7 @@ def hostile(tmp_path, monkeypatch):
     ("scales_the_stiffness", "changed the problem it was given: K (the stiffness)"),
 ])
 def test_a_method_that_changes_the_problem_fails(hostile, function, words):
-    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=8))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 8}))
     solution = registry.solve(problem, f"hostile:{function}")
     assert solution.status == "failed" and words in solution.message, solution.message
     assert not np.isfinite(solution.lam).any()
@@ -234,14 +235,14 @@ def test_a_method_that_changes_the_problem_fails(hostile, function, words):
 
 @pytest.mark.parametrize("function", ["answers_another_problem", "answers_a_pushed_problem"])
 def test_an_answer_to_another_problem_is_judged_on_the_problem_given(hostile, function):
-    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=8))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 8}))
     solution = registry.solve(problem, f"hostile:{function}")
     assert solution.claimed_status == "converged" and solution.status == "inaccurate", \
         solution.message
 
 
 def test_an_honest_user_method_converges(hostile):
-    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=8))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 8}))
     assert registry.solve(problem, "hostile:honest").status == "converged"
 
 

@@ -176,10 +176,12 @@ API = [
      lambda: signorini.build_problem("block", nondimensionalise="no"), ["nondimensionalise='no'"]),
     ("build_problem nondimensionalise a number",
      lambda: signorini.build_problem("block", nondimensionalise=0), ["nondimensionalise=0"]),
-    ("build_problem a subnormal modulus", lambda: signorini.build_problem("block", E=1e-320), ["E="]),
-    ("build_problem a length beyond range", lambda: signorini.build_problem("block", W=1e101), ["W="]),
+    ("build_problem a subnormal modulus",
+     lambda: signorini.build_problem("block", params={"E": 1e-320}), ["E="]),
+    ("build_problem a length beyond range",
+     lambda: signorini.build_problem("block", params={"W": 1e101}), ["W="]),
     ("build_problem a huge count",
-     lambda: signorini.build_problem("block", nx=10 ** 20), ["nx=", "2^53"]),
+     lambda: signorini.build_problem("block", params={"nx": 10 ** 20}), ["nx=", "2^53"]),
 ]
 
 

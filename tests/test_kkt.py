@@ -32,7 +32,7 @@ RESIDUALS = ("primal", "stationarity", "dual_sign", "complementarity", "natural"
 
 @pytest.fixture(scope="module")
 def hertz():
-    return signorini.at_load(build_problem("hertz-cylinder", n_contact=20))
+    return signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
 
 
 @pytest.fixture(scope="module")
@@ -134,8 +134,9 @@ def test_non_finite_input_gives_inf(hertz, exact, field, value):
 
 
 def test_certificate_is_unit_free():
-    scaled = signorini.at_load(build_problem("block", nx=4, ny=4))
-    raw = signorini.at_load(build_problem("block", nx=4, ny=4, E=2.1e11, delta=1e-3, nondimensionalise=False))
+    scaled = signorini.at_load(build_problem("block", params={"nx": 4, "ny": 4}))
+    raw = signorini.at_load(build_problem("block", params={"nx": 4, "ny": 4, "E": 2.1e11, "delta": 1e-3},
+                                          nondimensionalise=False))
     s_scaled = registry.solve(scaled, "pdas", tol=1e-9)
     s_raw = registry.solve(raw, "pdas", tol=1e-9)
     assert s_scaled.status == s_raw.status == "converged"
@@ -319,7 +320,8 @@ def zoned():
     """A cylinder load-targeted on a predicted zone (nested then reuses that factorisation)."""
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(loading, "ZONE_FROM_DOFS", 0)
-        return signorini.at_load(build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4))
+        return signorini.at_load(build_problem("hertz-cylinder",
+                                               params={"refine": 1, "n_contact": 24, "grading": 0.4}))
 
 
 def refuse_the_fallback(monkeypatch):

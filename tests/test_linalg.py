@@ -19,7 +19,7 @@ MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "sc
 
 @pytest.fixture(scope="module")
 def hertz():
-    return build_problem("hertz-cylinder", n_contact=16, grading=0.4)
+    return build_problem("hertz-cylinder", params={"n_contact": 16, "grading": 0.4})
 
 
 @pytest.mark.parametrize("backend", sorted(MODULES))

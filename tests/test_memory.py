@@ -22,7 +22,7 @@ def resident_mb() -> float:
 @pytest.mark.slow
 @pytest.mark.parametrize("backend", available_backends())
 def test_repeated_factorisations_do_not_grow_resident_memory(backend):
-    K = signorini.build_problem("hertz-cylinder", refine=1).K  # ~19k dofs
+    K = signorini.build_problem("hertz-cylinder", params={"refine": 1}).K  # ~19k dofs
     b = np.ones(K.shape[0])
     for _ in range(2):  # the first ones load the library and size its pools
         factorize(K, backend).solve(b)
@@ -40,7 +40,7 @@ def test_repeated_factorisations_do_not_grow_resident_memory(backend):
 
 @pytest.mark.slow
 def test_a_freed_factorisation_leaves_the_others_intact():
-    K = signorini.build_problem("hertz-cylinder", refine=1).K
+    K = signorini.build_problem("hertz-cylinder", params={"refine": 1}).K
     b = np.ones(K.shape[0])
     for backend in available_backends():
         first, second = factorize(K, backend), factorize(K, backend)

@@ -40,7 +40,7 @@ def zoned_build(name, **values):
     """build_problem with load targeting on a predicted zone even for a small model."""
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(loading, "ZONE_FROM_DOFS", 0)
-        return signorini.at_load(build_problem(name, **values))
+        return signorini.at_load(build_problem(name, params=values))
 
 
 @pytest.fixture(scope="module")
@@ -63,7 +63,7 @@ def test_nested_equals_pdas_on_the_cylinder(cylinder):
                                        ("hertz-sphere", 0.45)])
 def test_the_analytic_zone_predicts_on_one_factorisation(scene, nu):
     """Hertz's a for the target load predicts the zone (the sphere at ν = 0 is 0.5 % off it)."""
-    problem = signorini.at_load(build_problem(scene, refine=1, nu=nu))
+    problem = signorini.at_load(build_problem(scene, params={"refine": 1, "nu": nu}))
     reference = solve(problem, "pdas")
     nested = solve(problem, "nested", zone=analytic_zone(problem))
     assert nested.status == "converged" and "the given zone" in nested.message
@@ -93,7 +93,7 @@ def test_auto_reuses_the_load_targeting_factorisation_of_a_large_3d_model():
     K); auto then picks nested, which solves on that factorisation by back-solves only."""
     from signorini.numerics.factor import COUNTS
 
-    problem = build_problem("hertz-sphere-3d", refine=1)
+    problem = build_problem("hertz-sphere-3d", params={"refine": 1})
     answer = signorini.solve(problem)
     assert answer.method == "nested" and answer.status == "converged"
     assert answer.solution.work["load control"]["factorisations"] == 1
@@ -104,7 +104,7 @@ def test_auto_reuses_the_load_targeting_factorisation_of_a_large_3d_model():
 
 def test_a_wrong_analytic_zone_is_amended_not_trusted():
     """A zone predicted for a load 10 % lower (a 5 % too small): the answer stays exact."""
-    problem = signorini.at_load(build_problem("hertz-cylinder", refine=1))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"refine": 1}))
     zone = analytic_zone(problem)
     shifted = analytic_zone(problem.with_data(params={**problem.params, "P": problem.params["P"] * 0.9}))
     assert shifted is not None and shifted.core.sum() < zone.core.sum()
@@ -115,7 +115,7 @@ def test_a_wrong_analytic_zone_is_amended_not_trusted():
 
 
 def test_nested_reuses_the_factorisation_load_control_hands_it():
-    problem = build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4)
+    problem = build_problem("hertz-cylinder", params={"refine": 1, "n_contact": 24, "grading": 0.4})
     matched = loading.match(problem, analytic_zone(problem))
     assert matched.how == "zone kernel" and matched.work["factorisations"] == 1
     system = matched.warm_start.zone_solver
@@ -130,7 +130,7 @@ def test_nested_reuses_the_factorisation_load_control_hands_it():
     ("punch", {"refine": 1, "n_contact": 16}),
 ])
 def test_nested_equals_pdas_on_other_scenes(scene, params):
-    problem = signorini.at_load(build_problem(scene, **params)).with_data()
+    problem = signorini.at_load(build_problem(scene, params=params)).with_data()
     assert_same_answer(problem, solve(problem, "pdas"), solve(problem, "nested"))
 
 
@@ -193,7 +193,7 @@ def test_coarse_values_drop_two_refinements_and_keep_the_load():
 
 
 def test_without_a_coarse_model_nested_says_it_used_pdas():
-    problem = signorini.at_load(build_problem("block", nx=6, ny=6))
+    problem = signorini.at_load(build_problem("block", params={"nx": 6, "ny": 6}))
     nested = solve(problem, "nested")
     assert nested.status == "converged" and "pdas" in nested.message
     assert nested.extras["fallback"] == "pdas"
@@ -208,7 +208,7 @@ def test_zone_solver_refuses_rows_that_couple_dofs():
 @pytest.mark.parametrize("backend", sorted(MODULES))
 def test_pinned_factor_matches_superlu_on_the_free_block(backend):
     pytest.importorskip(MODULES[backend], reason=f"the {backend} backend is not installed")
-    problem = signorini.at_load(build_problem("hertz-cylinder", n_contact=16, grading=0.4))
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 16, "grading": 0.4}))
     fixed = np.arange(0, problem.n, 7)
     rhs = np.column_stack([problem.f, problem.N.T @ np.ones(problem.m)])
     rhs[fixed] = np.linspace(-1, 1, len(fixed))[:, None]
@@ -223,7 +223,8 @@ def test_pinned_factor_matches_superlu_on_the_free_block(backend):
 
 def test_a_coarse_model_out_of_range_means_no_prediction(monkeypatch):
     """Coarser parameters a scene refuses give no coarse model (pdas), never an input error."""
-    problem = signorini.at_load(build_problem("hertz-cylinder", refine=1, n_contact=24, grading=0.4)).with_data()
+    params = {"refine": 1, "n_contact": 24, "grading": 0.4}
+    problem = signorini.at_load(build_problem("hertz-cylinder", params=params)).with_data()
     monkeypatch.setattr(scenes, "coarse_values", lambda name, params: {"n_contact": 1})
     nested = solve(problem, "nested", analytic=False)
     assert nested.status == "converged" and nested.extras["fallback"] == "pdas"

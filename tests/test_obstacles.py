@@ -143,7 +143,7 @@ SMALL = {"n_contact": 32, "grading": 0.5}
 
 @pytest.fixture(scope="module")
 def reverse():
-    problem = signorini.at_load(build_problem("reverse-hertz", **SMALL))
+    problem = signorini.at_load(build_problem("reverse-hertz", params=SMALL))
     return problem, solve(problem, "pdas", tol=1e-10)
 
 
@@ -183,7 +183,7 @@ def test_reverse_hertz_matches_hertz_at_the_default_mesh():
 
 def test_reverse_hertz_whole_block_is_symmetric_and_equals_the_half(reverse):
     half_problem, half = reverse
-    problem = signorini.at_load(build_problem("reverse-hertz", half=0, **SMALL))
+    problem = signorini.at_load(build_problem("reverse-hertz", params={"half": 0, **SMALL}))
     whole = solve(problem, "pdas", tol=1e-10)
     profile = contact_profile(problem, whole)
     x, p = problem.contact_points[:, 0] * problem.scales.length, profile.pressure

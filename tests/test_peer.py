@@ -3,17 +3,29 @@
 from __future__ import annotations
 
 import csv
-import importlib
+import importlib.util
 import json
 import subprocess
+
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import signorini
 from signorini.cli import main
 from signorini.studies import peer
 
-script = importlib.import_module("signorini.studies.peer_getfem")  # getfem is imported lazily
+
+
+def load_script():
+    """The GetFEM script of the checkout as a module (it imports getfem only when it solves)."""
+    if not peer.SCRIPT.is_file():
+        pytest.skip(f"{peer.SCRIPT} is not here: the package is installed without its repository")
+    spec = importlib.util.spec_from_file_location("getfem_hertz", peer.SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 
@@ -59,7 +71,14 @@ def test_the_fit_leaves_out_the_outermost_active_node():
     assert np.isnan(peer.fit_hertz(x[:2], p[:2])[0])  # too few nodes: no fit
 
 
+def test_the_getfem_script_lives_in_the_checkout_not_in_the_package():
+    assert peer.SCRIPT.is_file() and peer.SCRIPT.parent.name == "peers"
+    assert peer.SCRIPT.parents[2] == Path(signorini.__file__).parents[1]
+    assert not (Path(signorini.__file__).parent / "studies" / "peer_getfem.py").exists()
+
+
 def test_the_getfem_script_fits_with_the_same_formula():
+    script = load_script()
     x, p = hertz_nodes()
     noisy = p * (1 + 0.01 * np.random.default_rng(1).standard_normal(p.size))
     assert script.fit_hertz(x, noisy) == pytest.approx(peer.fit_hertz(x, noisy), rel=1e-12)
@@ -119,6 +138,17 @@ def test_without_getfem_the_command_says_so_and_writes_nothing(tmp_path, capsys,
     printed = capsys.readouterr().out
     assert code == 0 and not out.exists()
     assert len(printed.strip().splitlines()) == 1 and "apt-get install python3-getfem" in printed
+
+
+def test_without_the_checkout_the_command_says_so_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    """An installed package has no benchmarks/ beside it: one line, nothing written, GetFEM not run."""
+    monkeypatch.setattr(peer, "SCRIPT", tmp_path / "benchmarks" / "peers" / "getfem_hertz.py")
+    monkeypatch.setattr(peer.subprocess, "run", lambda *a, **k: pytest.fail("GetFEM was started"))
+    out = tmp_path / "peer"
+    code = main(["bench", "--peer", "getfem", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert code == 0 and not out.exists()
+    assert len(printed.strip().splitlines()) == 1 and "needs a checkout of the repository" in printed
 
 
 @pytest.mark.parametrize("argv, word", [

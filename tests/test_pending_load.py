@@ -40,7 +40,7 @@ def factorisations() -> int:
 def pair(request):
     """(pending problem, the same scene matched by factorisation)."""
     before = factorisations()
-    pending = build_problem(SCENE, **request.param)
+    pending = build_problem(SCENE, params=request.param)
     assert factorisations() == before, "a problem is built without a factorisation"
     return pending, loading.at_load(pending)
 

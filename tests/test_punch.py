@@ -17,7 +17,7 @@ SMALL = {"n_contact": 16, "grading": 0.5}
 
 @pytest.fixture(scope="module")
 def punch():
-    problem = signorini.at_load(build_problem("punch", **SMALL))
+    problem = signorini.at_load(build_problem("punch", params=SMALL))
     return problem, solve(problem, "pdas", tol=1e-10)
 
 
@@ -57,7 +57,7 @@ def test_edge_pressure_grows_like_one_over_root_h():
     """The singularity in the discrete answer: halving h multiplies the edge pressure by √2."""
     ratios = []
     for level in (0, 1, 2):
-        problem = signorini.at_load(build_problem("punch", refine=level, **SMALL))
+        problem = signorini.at_load(build_problem("punch", params={"refine": level, **SMALL}))
         result = compare_punch(problem, solve(problem, "pdas", tol=1e-10))
         ratios.append((result.edge_h, result.edge_over_centre, result.pressure_max_rel))
     h, edge, inner = map(np.array, zip(*ratios))
@@ -68,7 +68,7 @@ def test_edge_pressure_grows_like_one_over_root_h():
 
 def test_whole_block_is_symmetric_and_equals_the_half(punch):
     half_problem, half = punch
-    problem = signorini.at_load(build_problem("punch", half=0, **SMALL))
+    problem = signorini.at_load(build_problem("punch", params={"half": 0, **SMALL}))
     whole = solve(problem, "pdas", tol=1e-10)
     x = problem.contact_points[:, 0] * problem.scales.length
     p = contact_profile(problem, whole).pressure
@@ -92,8 +92,8 @@ def test_rounded_corners_spread_the_contact_and_bound_the_pressure():
     def peaks(radius):
         out = []
         for level in (1, 2):
-            problem = signorini.at_load(build_problem("punch", corner_radius=radius, load_ratio=0.02, refine=level,
-                                    **SMALL))
+            params = {"corner_radius": radius, "load_ratio": 0.02, "refine": level, **SMALL}
+            problem = signorini.at_load(build_problem("punch", params=params))
             solution = solve(problem, "pdas", tol=1e-10)
             out.append((problem, solution, contact_profile(problem, solution).pressure.max()))
         return out
@@ -123,16 +123,16 @@ def test_rounded_corners_spread_the_contact_and_bound_the_pressure():
 ])
 def test_bad_punch_parameters_name_themselves(values, name):
     with pytest.raises(InputError, match=rf"\b{name}="):
-        signorini.at_load(build_problem("punch", **values))
+        signorini.at_load(build_problem("punch", params=values))
 
 
 def test_two_load_parameters_raise():
     with pytest.raises(InputError, match="P and delta"):
-        signorini.at_load(build_problem("punch", P=0.01, delta=0.001))
+        signorini.at_load(build_problem("punch", params={"P": 0.01, "delta": 0.001}))
 
 
 def test_prescribed_delta_without_target():
-    problem = signorini.at_load(build_problem("punch", delta=1e-3, **SMALL))
+    problem = signorini.at_load(build_problem("punch", params={"delta": 1e-3, **SMALL}))
     solution = solve(problem, "pdas", tol=1e-10)
     assert problem.params["P"] is None
     assert compare_punch(problem, solution).force_balance < 1e-9

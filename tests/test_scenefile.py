@@ -41,12 +41,12 @@ def write(tmp_path, text, name="scene.toml"):
 def test_family_file_builds_what_the_parameters_build(tmp_path):
     path = write(tmp_path, FAMILY)
     from_file = signorini.at_load(build_problem(str(path)))
-    direct = signorini.at_load(build_problem("block", E=2.0, nu=0.25, nx=4, ny=3))
+    direct = signorini.at_load(build_problem("block", params={"E": 2.0, "nu": 0.25, "nx": 4, "ny": 3}))
     assert from_file.scene == "block"
     assert from_file.params == direct.params
     assert abs(from_file.K - direct.K).max() == 0.0
     # --set overrides a value of the file
-    finer = signorini.at_load(build_problem(str(path), nx="8"))
+    finer = signorini.at_load(build_problem(str(path), params={"nx": "8"}))
     assert finer.params["nx"] == 8
 
 
@@ -244,5 +244,5 @@ def test_cli_solves_a_scene_file_and_reports_errors_in_one_line(tmp_path, capsys
     ("block-mesh.toml", {}),
 ])
 def test_examples_build_and_solve(example, overrides):
-    problem = signorini.at_load(build_problem(str(EXAMPLES / example), **overrides))
+    problem = signorini.at_load(build_problem(str(EXAMPLES / example), params=overrides))
     assert solve(problem, "pdas", tol=1e-9).status == "converged"

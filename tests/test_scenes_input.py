@@ -11,7 +11,7 @@ SMALL = {"block": {"nx": 2, "ny": 2}, "hertz-cylinder": {"n_contact": 4}}
 
 
 def build(scene, **values):
-    return build_problem(scene, **{**SMALL.get(scene, {}), **values})
+    return build_problem(scene, params={**SMALL.get(scene, {}), **values})
 
 
 def test_unknown_scene_lists_the_known_ones():
@@ -81,7 +81,7 @@ def test_non_number_for_a_float_names_the_parameter(scene, name, value):
 @pytest.mark.parametrize("value", [20.5, "20.5", "abc", "", "inf", float("nan")])
 def test_non_integer_n_contact_names_the_parameter(value):
     with pytest.raises(InputError, match=r"\bn_contact=") as info:
-        build_problem("hertz-cylinder", n_contact=value)
+        build_problem("hertz-cylinder", params={"n_contact": value})
     assert "int" in str(info.value)
 
 
@@ -89,12 +89,12 @@ def test_non_integer_n_contact_names_the_parameter(value):
 @pytest.mark.parametrize("value", [2.5, "3.0", "x"])
 def test_non_integer_block_resolution_names_the_parameter(name, value):
     with pytest.raises(InputError, match=rf"\b{name}="):
-        build_problem("block", **{name: value})
+        build_problem("block", params={name: value})
 
 
 def test_numbers_given_as_strings_are_accepted():
-    from_strings = build_problem("block", nx="2", ny=" 2 ", E="70e9", nu="0.33")
-    from_numbers = build_problem("block", nx=2, ny=2, E=70e9, nu=0.33)
+    from_strings = build_problem("block", params={"nx": "2", "ny": " 2 ", "E": "70e9", "nu": "0.33"})
+    from_numbers = build_problem("block", params={"nx": 2, "ny": 2, "E": 70e9, "nu": 0.33})
     assert from_strings.params == from_numbers.params
     assert abs(from_strings.K - from_numbers.K).max() == 0.0
 
@@ -128,7 +128,7 @@ def test_good_input_builds():
 ])
 def test_overflowing_value_names_the_parameter(scene, name, value):
     with pytest.raises(InputError, match=rf"\b{name}="):
-        build_problem(scene, **{name: value})
+        build_problem(scene, params={name: value})
 
 
 def test_none_for_a_required_parameter_names_it():

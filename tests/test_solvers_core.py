@@ -15,12 +15,12 @@ from signorini.solvers import pdas, registry
 
 @pytest.fixture(scope="module")
 def block():
-    return signorini.at_load(build_problem("block", nx=6, ny=6))
+    return signorini.at_load(build_problem("block", params={"nx": 6, "ny": 6}))
 
 
 @pytest.fixture(scope="module")
 def hertz():
-    return signorini.at_load(build_problem("hertz-cylinder", n_contact=20))
+    return signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 20}))
 
 
 @pytest.fixture(scope="module", params=["block", "hertz"])

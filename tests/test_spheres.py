@@ -213,8 +213,8 @@ def test_sphere_formulas_are_consistent():
 
 def test_dimensionless_answer_does_not_depend_on_units():
     coarse = {"n_contact": 12, "a_over_R": 0.05}
-    one = signorini.at_load(build_problem("hertz-sphere", **coarse))
-    steel = signorini.at_load(build_problem("hertz-sphere", **coarse, E=2.1e11, R=0.01))
+    one = signorini.at_load(build_problem("hertz-sphere", params=coarse))
+    steel = signorini.at_load(build_problem("hertz-sphere", params={**coarse, "E": 2.1e11, "R": 0.01}))
     # force = E·U·L with U ∝ R and L = R
     assert steel.scales.force == pytest.approx(2.1e11 * 0.01 ** 2 * one.scales.force, rel=1e-12)
     lam_one, lam_steel = exact(one).lam, exact(steel).lam
@@ -223,7 +223,7 @@ def test_dimensionless_answer_does_not_depend_on_units():
 
 @pytest.mark.parametrize("scene", ["hertz-sphere", "hertz-sphere-3d"])
 def test_a_prescribed_load_is_met(scene):
-    problem = signorini.at_load(build_problem(scene, P=2e-4, n_contact=6))
+    problem = signorini.at_load(build_problem(scene, params={"P": 2e-4, "n_contact": 6}))
     solution = exact(problem)
     assert problem.total_contact_force(solution.lam) * problem.scales.force == pytest.approx(2e-4, rel=1e-9)
 
@@ -231,12 +231,12 @@ def test_a_prescribed_load_is_met(scene):
 @pytest.mark.parametrize("scene", ["hertz-sphere", "hertz-sphere-3d"])
 def test_conflicting_or_excessive_loads_are_refused(scene):
     with pytest.raises(InputError, match="give only one of"):
-        signorini.at_load(build_problem(scene, P=1e-3, delta=1e-3))
+        signorini.at_load(build_problem(scene, params={"P": 1e-3, "delta": 1e-3}))
     with pytest.raises(InputError, match="a/R"):
-        signorini.at_load(build_problem(scene, P=1.0))
+        signorini.at_load(build_problem(scene, params={"P": 1.0}))
 
 
 def test_prescribed_delta_is_recorded():
-    problem = signorini.at_load(build_problem("hertz-sphere", delta=0.002, n_contact=8))
+    problem = signorini.at_load(build_problem("hertz-sphere", params={"delta": 0.002, "n_contact": 8}))
     assert problem.params["delta"] == 0.002 and problem.params["P"] is None
     assert problem.total_contact_force(exact(problem).lam) > 0

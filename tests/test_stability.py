@@ -33,12 +33,12 @@ TINY_BLOCK = {"nx": 4, "ny": 4}
 
 @pytest.fixture(scope="module")
 def hertz():
-    return signorini.at_load(build_problem("hertz-cylinder", **TINY_HERTZ))
+    return signorini.at_load(build_problem("hertz-cylinder", params=TINY_HERTZ))
 
 
 @pytest.fixture(scope="module")
 def block():
-    return signorini.at_load(build_problem("block", **TINY_BLOCK))
+    return signorini.at_load(build_problem("block", params=TINY_BLOCK))
 
 
 # --- Uzawa's step bound -------------------------------------------------------------------------
@@ -107,9 +107,9 @@ def test_verdict_flags_a_converged_status_with_a_wrong_answer():
 
 def test_the_touching_block_has_weakly_active_nodes_and_keeps_its_default(block):
     assert block.params["touching"] == 0.0
-    plain = signorini.at_load(build_problem("block", **TINY_BLOCK, touching=0.0))
+    plain = signorini.at_load(build_problem("block", params={**TINY_BLOCK, "touching": 0.0}))
     assert abs(plain.K - block.K).max() == 0 and np.array_equal(plain.d, block.d)
-    problem = signorini.at_load(build_problem("block", **TINY_BLOCK, touching=0.5))
+    problem = signorini.at_load(build_problem("block", params={**TINY_BLOCK, "touching": 0.5}))
     exact = solve(problem, "pdas", tol=1e-9)
     labels = classify(problem, exact)
     assert np.sum(labels == "weak") >= 2 and np.sum(labels == "active") >= 2
@@ -117,7 +117,7 @@ def test_the_touching_block_has_weakly_active_nodes_and_keeps_its_default(block)
 
 
 def test_a_weakly_active_node_is_not_misclassified():
-    problem = signorini.at_load(build_problem("block", **TINY_BLOCK, touching=0.5))
+    problem = signorini.at_load(build_problem("block", params={**TINY_BLOCK, "touching": 0.5}))
     exact = solve(problem, "pdas", tol=1e-9)
     weak = classify(problem, exact) == "weak"
     lam = exact.lam.copy()
@@ -134,7 +134,7 @@ def test_a_weakly_active_node_is_not_misclassified():
 
 
 def test_a_small_touching_fraction_leaves_the_outer_corner_touching():
-    problem = signorini.at_load(build_problem("block", nx=4, ny=4, touching=0.01))
+    problem = signorini.at_load(build_problem("block", params={"nx": 4, "ny": 4, "touching": 0.01}))
     labels = classify(problem, solve(problem, "pdas", tol=1e-9))
     assert labels[-1] == "weak" and np.sum(labels == "weak") == 1
 
@@ -143,7 +143,7 @@ def test_a_small_touching_fraction_leaves_the_outer_corner_touching():
 
 
 def test_force_controlled_block_is_singular_and_its_patch_solution_is_exact():
-    problem = force_controlled_problem(**TINY_BLOCK)
+    problem = force_controlled_problem(params=TINY_BLOCK)
     exact = force_controlled_exact(problem)
     cert = certificate(problem, exact, duality_gap=False)
     assert cert.worst()[1] < 1e-12
@@ -152,7 +152,7 @@ def test_force_controlled_block_is_singular_and_its_patch_solution_is_exact():
 
 
 def test_regularisation_makes_every_k_inverse_method_work_at_a_small_cost():
-    problem = force_controlled_problem(**TINY_BLOCK)
+    problem = force_controlled_problem(params=TINY_BLOCK)
     exact = force_controlled_exact(problem)
     regularised = regularise(problem, 1e-8)
     assert diagnose(regularised) == []
@@ -169,12 +169,12 @@ def test_regularisation_makes_every_k_inverse_method_work_at_a_small_cost():
 @pytest.mark.parametrize("epsilon", [0.0, -1e-8, float("nan"), float("inf"), "1e-8", True])
 def test_regularise_refuses_a_bad_epsilon(epsilon):
     with pytest.raises(InputError, match="epsilon"):
-        regularise(force_controlled_problem(**TINY_BLOCK), epsilon)
+        regularise(force_controlled_problem(params=TINY_BLOCK), epsilon)
 
 
 @pytest.mark.parametrize("method", ["pdas", "qp-clarabel"])
 def test_a_singular_k_gets_a_status_not_an_exception(method):
-    solution = solve(force_controlled_problem(**TINY_BLOCK), method, tol=1e-8)
+    solution = solve(force_controlled_problem(params=TINY_BLOCK), method, tol=1e-8)
     assert solution.status in ("converged", "inaccurate", "failed")
 
 
@@ -183,14 +183,14 @@ def test_a_singular_k_gets_a_status_not_an_exception(method):
 
 def test_ill_posed_inputs_are_refused_or_diagnosed(block):
     with pytest.raises(InputError, match="no contact candidates"):
-        ill_posed_problem("no-candidates", **TINY_BLOCK)
+        ill_posed_problem("no-candidates", params=TINY_BLOCK)
     with pytest.raises(InputError, match="weight 0"):
-        ill_posed_problem("zero-weight", **TINY_BLOCK)
-    penetrated = ill_posed_problem("penetrated", **TINY_BLOCK)
+        ill_posed_problem("zero-weight", params=TINY_BLOCK)
+    penetrated = ill_posed_problem("penetrated", params=TINY_BLOCK)
     assert any(line.startswith("infeasible") for line in diagnose(penetrated))
     for method in ("pdas", "uzawa", "qp-clarabel"):
         assert solve(penetrated, method, tol=1e-8).status in ("infeasible", "failed")
-    duplicate = ill_posed_problem("duplicate", **TINY_BLOCK)
+    duplicate = ill_posed_problem("duplicate", params=TINY_BLOCK)
     assert any("not unique" in line for line in diagnose(duplicate))
     assert diagnose(block) == []
     with pytest.raises(InputError, match="unknown ill-posed case"):

@@ -17,9 +17,10 @@ SMALL = {"n_contact": 24, "grading": 0.3}
 
 
 def test_a_sweep_level_equals_a_full_solve_at_that_load():
-    base = signorini.at_load(build_problem("hertz-cylinder", delta=0.003, **SMALL))  # pushed, not load-targeted
+    # pushed, not load-targeted
+    base = signorini.at_load(build_problem("hertz-cylinder", params={"delta": 0.003, **SMALL}))
     # the same mesh and model (the cut pushed flat), its P found by assembly
-    targeted = signorini.at_load(build_problem("hertz-cylinder", loading="displacement", **SMALL))
+    targeted = signorini.at_load(build_problem("hertz-cylinder", params={"loading": "displacement", **SMALL}))
     loads = np.array([0.5, 2.0, 1.0]) * targeted.params["P"]
     levels = sweep_loads(base, loads)
     assert [lv.total_force for lv in levels] == pytest.approx(list(loads), rel=1e-9)
@@ -31,7 +32,8 @@ def test_a_sweep_level_equals_a_full_solve_at_that_load():
 
 
 def test_a_traction_loaded_sweep_level_equals_a_full_solve_at_that_load():
-    targeted = signorini.at_load(build_problem("hertz-cylinder", **SMALL))  # a traction on the cut, the centre pinned
+    # a traction on the cut, the centre pinned
+    targeted = signorini.at_load(build_problem("hertz-cylinder", params=SMALL))
     assert targeted.push.f_load is not None
     loads = np.array([2.0, 0.5, 1.0]) * targeted.params["P"]
     levels = sweep_loads(targeted, loads)
@@ -44,7 +46,7 @@ def test_a_traction_loaded_sweep_level_equals_a_full_solve_at_that_load():
 
 
 def test_half_width_grows_like_the_square_root_of_the_load():
-    base = signorini.at_load(build_problem("hertz-cylinder", **SMALL))
+    base = signorini.at_load(build_problem("hertz-cylinder", params=SMALL))
     loads = np.array([0.6, 1.0, 1.4]) * base.params["P"]
     levels = sweep_loads(base, loads)
     slope = np.polyfit(np.log(loads), np.log([lv.a for lv in levels]), 1)[0]

@@ -63,10 +63,10 @@ def test_auto_averages_from_nu_0_4():
     assert resolve("auto", 0.49, dim=3) == "element" and resolve("nodal", 0.3, dim=3) == "nodal"
     small = {"n_contact": 12, "grading": 0.4}
     for nu, used in ((0.3, "element"), (0.45, "nodal")):
-        problem = signorini.build_problem("hertz-cylinder", nu=nu, **small)
+        problem = signorini.build_problem("hertz-cylinder", params={"nu": nu, **small})
         assert problem.params["volumetric"] == used  # what K integrates, recorded in the result
     with pytest.raises(InputError, match="volumetric"):
-        signorini.build_problem("hertz-cylinder", volumetric="mixed")
+        signorini.build_problem("hertz-cylinder", params={"volumetric": "mixed"})
 
 
 def test_the_block_patch_test_holds_with_the_average():

@@ -155,7 +155,7 @@ def backends() -> dict:
     from signorini.solvers import amg
     from signorini.solvers.bounds import bound_form
 
-    problem = build_problem("hertz-sphere-3d", **SPHERE_350K)
+    problem = build_problem("hertz-sphere-3d", params=SPHERE_350K)
     form = bound_form(problem)
     pinned = form.lower == form.upper
     A = pinned_matrix(form.K, pinned)
@@ -191,7 +191,7 @@ def crossover() -> dict:
     rows = []
     for params in ({"delta": 0.0025}, {"n_contact": 16, "delta": 0.0025},
                    {"refine": 1, "delta": 0.0025}):
-        problem = build_problem("hertz-sphere-3d", **params)
+        problem = build_problem("hertz-sphere-3d", params=params)
         row = {"params": params, "dofs": problem.n, "load_before": load()}
         for method in ("pdas", "pdas-amg"):
             solve(problem, method)  # warm: imports, the coarse model's first build
@@ -208,7 +208,7 @@ def petsc_350k(params: dict = SPHERE_350K, method: str = "pdas-amg") -> dict:
     from signorini.scenes import build_problem
     from signorini.solvers.registry import solve
 
-    problem = build_problem("hertz-sphere-3d", solved_by=method, **params)
+    problem = build_problem("hertz-sphere-3d", params=params, solved_by=method)
     before = load()
     problem, ours = load_control(problem, method)  # a target load matched with the answer
     theirs = solve(problem, "petsc-vi")
@@ -229,7 +229,7 @@ def one_amg_solve(params: dict, rtol: float = AMG_RTOL) -> dict:
     from signorini.solvers import amg
     from signorini.solvers.bounds import bound_form
 
-    problem = build_problem("hertz-sphere-3d", **params)
+    problem = build_problem("hertz-sphere-3d", params=params)
     form = bound_form(problem)
     pinned = form.lower == form.upper
     A = pinned_matrix(form.K, pinned)

@@ -49,7 +49,7 @@ def reference(problem) -> np.ndarray:
 def run() -> list[dict]:
     rows = []
     for nu in NUS:
-        problem = build_problem("hertz-cylinder", nu=nu, **SCENE)
+        problem = build_problem("hertz-cylinder", params={"nu": nu, **SCENE})
         lam_ref = reference(problem)
         for method, tol in METHODS:
             module = "qpalm" if method == "qp-qpalm" else None

@@ -56,7 +56,7 @@ def run() -> dict:
             "load_before": list(os.getloadavg()), "variants": {}}
     start = time.perf_counter()
     for case in DEFAULT_CASES:
-        problem = signorini.build_problem(case.scene, **case.params)
+        problem = signorini.build_problem(case.scene, params=case.params)
         for variant, options in VARIANTS.items():
             check = signorini.crosscheck(problem, METHODS, tol=TOL, options=options)
             record = check.to_dict()

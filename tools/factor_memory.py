@@ -37,7 +37,7 @@ def resident() -> float:
 def main() -> int:
     rows = []
     for scene, params in MODELS:
-        problem = signorini.build_problem(scene, **params)
+        problem = signorini.build_problem(scene, params=params)
         before = resident()
         factor = PardisoFactor(problem.K)
         growth = resident() - before

@@ -23,7 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "speed" / "startup.json"
 REPEAT = 7
-GETFEM_SCRIPT = ROOT / "signorini" / "studies" / "peer_getfem.py"
+GETFEM_SCRIPT = ROOT / "benchmarks" / "peers" / "getfem_hertz.py"
 
 #: (label, interpreter: "venv" or "system", argv after the interpreter)
 STEPS = (

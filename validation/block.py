@@ -15,7 +15,7 @@ from signorini.solvers.registry import solve
 
 PARAMS = {"W": 0.5, "H": 0.2, "E": 70e9, "nu": 0.33, "delta": 1e-4, "nx": 10, "ny": 4}
 
-problem = signorini.at_load(build_problem("block", **PARAMS))
+problem = signorini.at_load(build_problem("block", params=PARAMS))
 solution = solve(problem, "pdas", tol=1e-9)
 uniform = compare_uniform(problem, solution)
 profile = contact_profile(problem, solution)

@@ -17,7 +17,7 @@ from signorini.solvers.registry import solve
 
 PARAMS = {"a_over_R": 0.05, "E": 2.1e11, "nu": 0.3, "R": 0.01}
 
-problem = signorini.at_load(build_problem("hertz-cylinder", **PARAMS))
+problem = signorini.at_load(build_problem("hertz-cylinder", params=PARAMS))
 exact = solve(problem, "pdas", tol=1e-9)
 paper = solve(problem, "uzawa", tol=1e-9)
 hertz = compare_hertz(problem, exact)

@@ -50,7 +50,7 @@ SWEEP = (
 
 def _timed_solve(scene: str, mesh: dict[str, Any]):
     start = time.perf_counter()
-    problem = signorini.at_load(build_problem(scene, **PARAMS, **mesh))
+    problem = signorini.at_load(build_problem(scene, params={**PARAMS, **mesh}))
     built = time.perf_counter()
     solution = solve(problem, "pdas", tol=1e-9)
     return problem, solution, built - start, time.perf_counter() - built
@@ -85,7 +85,7 @@ with open("/proc/self/clear_refs", "w") as clear:
     clear.write("5")  # reset the peak resident set (VmHWM) to the current one
 baseline_kb = kilobytes("VmRSS")
 start = time.perf_counter()
-problem = signorini.at_load(build_problem(scene, **params))
+problem = signorini.at_load(build_problem(scene, params=params))
 built = time.perf_counter()
 solution = solve(problem, "pdas", tol=1e-9)
 done = time.perf_counter()

@@ -40,7 +40,7 @@ def main() -> int:
     rows = []
     for scene, extra in CASES:
         for n in SIZES:
-            problem = build_problem(scene, n_contact=n, **extra)
+            problem = build_problem(scene, params={"n_contact": n, **extra})
             _, reference = run_one(problem, get_method("pdas"), TIGHT_TOL, None)
             for method in chosen:
                 row, solution = run_one(problem, method, TIGHT_TOL, reference)

@@ -8,6 +8,7 @@ from signorini.cli.common import (EXIT_FAILED, input_files, option_value, pairs,
                                   stdout_to_stderr, user_methods_in_workers,
                                   write_output)
 from signorini.errors import InputError
+from signorini.solvers.base import DEFAULT_TOL
 
 
 def method_options(items: list[str]) -> dict[str, dict]:
@@ -24,7 +25,7 @@ def method_options(items: list[str]) -> dict[str, dict]:
 
 
 def cmd_crosscheck(args: argparse.Namespace) -> int:
-    from signorini.crosschecking import DEFAULT_METHODS, DEFAULT_TOL, crosscheck  # per command (start-up)
+    from signorini.crosschecking import DEFAULT_METHODS, crosscheck  # per command (start-up)
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # as above
 
     if args.json == args.md == STDOUT:
@@ -60,7 +61,8 @@ def add_parsers(sub) -> None:
     cross.add_argument("--method", action="append", default=[], metavar="M",
                        help="a method to compare (repeat; default uzawa, qp-osqp, qp-clarabel, "
                             "cvxpy, pdas)")
-    cross.add_argument("--tol", help="the relative KKT tolerance asked of every method (default 1e-8)")
+    cross.add_argument("--tol", help="the relative KKT tolerance asked of every method "
+                                     f"(default {DEFAULT_TOL:g})")
     cross.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="scene parameter, e.g. --set a_over_R=0.05")
     cross.add_argument("--opt", action="append", default=[], metavar="METHOD:KEY=VALUE",

@@ -8,6 +8,7 @@ import sys
 from signorini.cli.common import (EXIT_FAILED, input_files, option_value, pairs,
                                   parse_time_limit, parse_tol, stdout_to_stderr, write_output)
 from signorini.errors import InputError
+from signorini.solvers.base import DEFAULT_TOL
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
@@ -55,8 +56,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
                                     target_on=args.target_on, **options)
             problem = result.problem
         else:
-            problem = build_problem(args.scene, nondimensionalise=not args.raw_units,
-                                    solved_by=args.method, **params)
+            problem = build_problem(args.scene, params=params, nondimensionalise=not args.raw_units,
+                                    solved_by=args.method)
             if time_limit is None:
                 result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
                 problem = result.problem
@@ -94,7 +95,8 @@ def add_parsers(sub) -> None:
     solve.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
     solve.add_argument("--method", default="auto",
                        help="method name (see 'signorini methods'; auto: pdas in 2D, pdas-amg for large 3D)")
-    solve.add_argument("--tol", help="the method's tolerance (default: the method's own)")
+    solve.add_argument("--tol", help="the method's tolerance (default: the method's own; a QP "
+                       f"backend runs at its own settings, its answer held to {DEFAULT_TOL:g})")
     solve.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="scene parameter, e.g. --set a_over_R=0.05")
     solve.add_argument("--opt", action="append", default=[], metavar="KEY=VALUE",

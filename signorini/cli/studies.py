@@ -85,7 +85,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     loads = parse_loads(args.load)
     out = out_folder(args.out, input_files(args.scene))
-    problem = build_problem(args.scene, **pairs(args.set, "--set"))
+    problem = build_problem(args.scene, params=pairs(args.set, "--set"))
     levels = sweep_loads(problem, loads, progress=lambda i, n: print(
         f"\r  load level {i}/{n}", end="" if i < n else "\n", file=sys.stderr))
     rows = [vars(level) for level in levels]

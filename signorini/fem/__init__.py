@@ -8,3 +8,13 @@
   recovery and a contact term), per element;
 - :mod:`~signorini.fem.transfer`: P1 fields carried onto a refined mesh (midpoint parents).
 """
+
+from signorini.fem.assembly import assemble
+from signorini.fem.checks import check_model
+from signorini.fem.estimate import ErrorEstimate, PressureEstimate, estimate
+from signorini.fem.model import CutLoad, FlatObstacle, FlatObstacle3D, SceneModel
+from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, Obstacle, SignedDistance
+
+__all__ = ["Circle", "CutLoad", "ErrorEstimate", "FlatObstacle", "FlatObstacle3D", "FlatPunch",
+           "HalfPlane", "Obstacle", "PressureEstimate", "SceneModel", "SignedDistance", "assemble",
+           "check_model", "estimate"]

@@ -10,3 +10,13 @@
 - :mod:`~signorini.numerics.multigrid`: algebraic multigrid (pyamg) and CG with pinned dofs,
   the linear algebra of ``pdas-amg``.
 """
+
+from signorini.numerics.factor import ActiveSetSolver, PinnedFactor, available_backends, factorize
+from signorini.numerics.lcp import delassus, delassus_max_eigenvalue, solve_lcp
+from signorini.numerics.loading import push_for_load
+from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg
+from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
+
+__all__ = ["ActiveSetSolver", "PinnedFactor", "PyamgHierarchy", "Zone", "ZoneSolver",
+           "available_backends", "delassus", "delassus_max_eigenvalue", "factorize", "pinned_cg",
+           "predict_zone", "push_for_load", "solve_lcp"]

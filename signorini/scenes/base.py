@@ -291,3 +291,18 @@ class SceneFamily:
                              "precision cannot hold: choose units in which E and the lengths are "
                              "nearer 1 (e.g. MPa and mm)")
         return parsed
+
+
+def scene_params(params: Any) -> dict[str, Any]:
+    """A copy of ``params``, the scene parameters by name (``{}`` for None); anything but a dict
+    with string keys is refused in one line."""
+    if params is None:
+        return {}
+    if not isinstance(params, dict):
+        raise InputError(f"params must be a dict of scene parameters, got {type(params).__name__}: "
+                         "e.g. params={'E': 2.1e11, 'n_contact': 20}")
+    named = [k for k in params if not isinstance(k, str)]
+    if named:
+        raise InputError(f"params key {named[0]!r} is not a parameter name: give the names as "
+                         "strings, e.g. params={'E': 2.1e11}")
+    return dict(params)

@@ -34,7 +34,8 @@ from signorini.fem.topology import facets_on
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution, Scales
-from signorini.scenes.base import VOLUMETRIC, Case, Param, SceneFamily, at_least, length, poisson_ratio, positive
+from signorini.scenes.base import (VOLUMETRIC, Case, Param, SceneFamily, at_least, length, poisson_ratio,
+                                   positive, scene_params)
 from signorini.scenes.size import CountedSize
 
 PARAMS = (
@@ -145,8 +146,8 @@ FAMILY = SceneFamily(name="block", summary="elastic block pressed onto a rigid f
 # --- force control: a body held only by contact --------------------------------------------------
 
 
-def force_controlled_problem(pressure: float = 0.01, nondimensionalise: bool = True,
-                             **values: Any) -> ContactProblem:
+def force_controlled_problem(pressure: float = 0.01, params: dict[str, Any] | None = None, *,
+                             nondimensionalise: bool = True) -> ContactProblem:
     """The half block under a uniform pressure q on its top: held in y by the contact alone.
 
     Only the symmetry plane is prescribed (``u_x = 0`` at x = 0), so K is
@@ -164,16 +165,17 @@ def force_controlled_problem(pressure: float = 0.01, nondimensionalise: bool = T
     Parameters
     ----------
     pressure : the uniform pressure q on the top (physical units, > 0).
+    params : the block's scene parameters (``W``, ``H``, ``E``, ``nu``, ``nx``, ``ny``) by name;
+        ``delta`` and ``touching`` do not apply.
     nondimensionalise : scale as :func:`signorini.fem.assembly.assemble` does, with the
         displacement unit ``q H / E*`` (the size of the answer).
-    **values : the block's scene parameters (``W``, ``H``, ``E``, ``nu``, ``nx``, ``ny``);
-        ``delta`` and ``touching`` do not apply.
 
     Returns
     -------
     ContactProblem
         with ``params["pressure"] = q``; its ``load_offset`` is the applied load 2Wq.
     """
+    values = scene_params(params)
     for name in ("delta", "touching"):
         if name in values:
             raise InputError(f"scene parameter {name} does not apply to the force-controlled "

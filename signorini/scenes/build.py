@@ -14,6 +14,7 @@ from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.numerics.arrays import flag_argument
 from signorini.problem import ContactProblem, Scales
+from signorini.scenes.base import scene_params
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import check_size
@@ -38,7 +39,7 @@ def _coarse_model(name: str, params: dict[str, Any], nondimensionalise: bool):
     if values is None:
         return None
     try:
-        return build_problem(name, nondimensionalise=nondimensionalise, **values)
+        return build_problem(name, params=values, nondimensionalise=nondimensionalise)
     except InputError:  # the coarser parameters are out of range: no coarse model
         return None
 
@@ -48,16 +49,19 @@ def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
     return _coarse_model(problem.scene, problem.params, problem.scales != Scales())
 
 
-def build_problem(name: str, nondimensionalise: bool = True, *, solved_by: str | None = None,
-                  **values: Any) -> ContactProblem:
-    """Build scene ``name`` with parameter ``values`` and assemble its contact problem.
+def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensionalise: bool = True,
+                  solved_by: str | None = None) -> ContactProblem:
+    """Build scene ``name`` with parameters ``params`` and assemble its contact problem.
 
-    ``name`` may be the path of a TOML scene file (``*.toml``, see
-    :mod:`signorini.scenes.scenefile`); ``values`` then override its parameters.
-    A target load stays pending (load control matches it when the problem
-    is solved). ``solved_by`` names the method that will solve it, for the
-    size guard (a method that never factorises needs less memory).
+    ``params`` maps the scene's parameter names to values in its units (see
+    :func:`signorini.scene_families`; None: the defaults). ``name`` may be the
+    path of a TOML scene file (``*.toml``, see :mod:`signorini.scenes.scenefile`);
+    ``params`` then override its parameters. A target load stays pending (load
+    control matches it when the problem is solved). ``solved_by`` names the
+    method that will solve it, for the size guard (a method that never
+    factorises needs less memory).
     """
+    values = scene_params(params)
     nondimensionalise = flag_argument(nondimensionalise, "nondimensionalise")
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
@@ -66,10 +70,10 @@ def build_problem(name: str, nondimensionalise: bool = True, *, solved_by: str |
         name, model = build_scene_model(name, values)
     else:
         family = get_scene(name)
-        params = family.parse(values)
-        check_size(name, params, solved_by)  # too big for this machine: refused before meshing
+        parsed = family.parse(values)
+        check_size(name, parsed, solved_by)  # too big for this machine: refused before meshing
         try:
-            model = family.build(params, set(values))
+            model = family.build(parsed, set(values))
         except InputError:  # the model's own checks (signorini.fem.checks): said as they are
             raise
         except (RuntimeError, ValueError, ArithmeticError, IndexError, MemoryError) as exc:

@@ -5,3 +5,8 @@ Each backend module (``pdas``, ``nested``, ``condensed``, ``uzawa``, ``qp``, ``c
 :mod:`~signorini.solvers.base` holds :class:`Method` and the judging of a claim of success
 by the KKT certificate.
 """
+
+from signorini.solvers.base import Method
+from signorini.solvers.registry import REGISTRY, get_method, methods, register
+
+__all__ = ["Method", "REGISTRY", "get_method", "methods", "register"]

@@ -24,11 +24,20 @@ from signorini.solvers.options import Option, check_names, guess_value
 
 SolverFunction = Callable[..., ContactSolution]
 
+#: the package's default relative KKT tolerance: what :func:`signorini.crosscheck` asks every
+#: method for, and what an answer is held to when neither the caller nor the method names a
+#: tolerance (a QP backend run at its own settings)
+DEFAULT_TOL = 1e-8
 #: a claim of success is accepted when every relative KKT residual is at most
-#: ``ACCEPT_FACTOR × tol`` (or ``DEFAULT_ACCEPT`` when no tolerance was asked for):
-#: success means what qpbenchmark means by it, the residuals under the tolerance
+#: ``ACCEPT_FACTOR × tol`` (:func:`acceptance`): success means what qpbenchmark means by it,
+#: the residuals under the tolerance
 ACCEPT_FACTOR = 1.0
-DEFAULT_ACCEPT = 1e-6
+
+
+def acceptance(tol: float | None) -> float:
+    """The largest relative KKT residual accepted of an answer asked for ``tol`` (None:
+    :data:`DEFAULT_TOL`)."""
+    return ACCEPT_FACTOR * (DEFAULT_TOL if tol is None else tol)
 
 
 @dataclass(frozen=True)
@@ -39,7 +48,9 @@ class Method:
     pip extra that installs them. ``dense`` methods build dense matrices and
     refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
     answer up to round-off when they converge. ``options`` names the options
-    it takes; ``typed_options`` declares their kinds and ranges
+    it takes; ``default_tol`` is the tolerance it runs at and is held to when none is asked
+    for (None: the backend's own settings, the answer held to :data:`DEFAULT_TOL`);
+    ``typed_options`` declares their kinds and ranges
     (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
     refuses a bad value before any work. ``targets_load`` methods take a
     problem whose target load is pending (``problem.pending``) and match it
@@ -154,7 +165,7 @@ def judge(problem: ContactProblem, solution: ContactSolution,
     """
     if solution.status != "converged":
         return solution
-    accept = ACCEPT_FACTOR * tol if tol is not None else DEFAULT_ACCEPT
+    accept = acceptance(tol)
     try:
         cert = certificate(problem, solution)
     except np.linalg.LinAlgError:  # K singular: no dual function; judge on the other residuals

@@ -43,7 +43,7 @@ from signorini.kkt import ACTIVE, certificate, classify
 from signorini.numerics.factor import COUNTS, ActiveSetSolver, factorize
 from signorini.numerics.lcp import delassus
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.base import ACCEPT_FACTOR, DEFAULT_ACCEPT
+from signorini.solvers.base import acceptance
 
 FORMS = ("primal", "shifted", "dual")
 #: ``‖K K⁻¹f − f‖∞ / ‖f‖∞`` above this means K is singular (SuperLU does not say so itself)
@@ -257,7 +257,7 @@ def polish(problem: ContactProblem, form: Formulation, raw: ContactSolution,
                        f"certificate ({new_worst:.1e} ≥ {raw_worst:.1e}): the backend's answer"
         return raw
     raw.u, raw.lam = u, lam
-    if new_worst <= (ACCEPT_FACTOR * tol if tol is not None else DEFAULT_ACCEPT):
+    if new_worst <= acceptance(tol):
         raw.status = "converged"
     raw.message += f"; polished on {int(active.sum())} active nodes (certificate " \
                    f"{raw_worst:.1e} → {new_worst:.1e}): the polished answer"

@@ -24,7 +24,7 @@ from signorini.numerics.multigrid import COUNTS as MULTIGRID_COUNTS
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
-from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_ACCEPT, Method, check_max_iter, check_tol,
+from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, check_max_iter, check_tol,
                                     hold_to_contract, judge)
 
 log = logging.getLogger(__name__)
@@ -192,5 +192,5 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     return run(problem, method, tol=tol, max_iter=max_iter, warm_start=warm_start, **options)[1]
 
 
-__all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_ACCEPT", "Method", "REGISTRY", "check_request",
+__all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_TOL", "Method", "REGISTRY", "check_request",
            "get_method", "judge", "methods", "register", "run", "solve"]

@@ -43,7 +43,7 @@ from signorini.errors import InputError
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.base import Method
+from signorini.solvers.base import DEFAULT_TOL, Method
 from signorini.solvers.options import Option, declare, take_options
 
 DEFAULTS = declare(
@@ -58,7 +58,6 @@ NESTEROV_DEFAULTS = {**DEFAULTS, "step_fraction": Option("step_fraction", "posit
                                             choices=("none", "nesterov"))}
 DELASSUS_MAX_CANDIDATES = 2000
 RATE_WINDOW = 20
-DEFAULT_TOL = 1e-8
 MAX_ITER = 50_000
 #: stop when the estimated distance to the fixed point is below this fraction of tol ‖λ‖:
 #: at 1 the forward error of λ came out 1.0001–1.0015 × tol on Hertz's cylinder

@@ -5,3 +5,8 @@ The validation suite (:mod:`~signorini.studies.suite`), the benchmark
 refinement studies (:mod:`~signorini.studies.convergence`) and load sweeps
 (:mod:`~signorini.studies.sweep`).
 """
+
+from signorini.studies.runner import run_tasks
+from signorini.studies.task import Task
+
+__all__ = ["Task", "run_tasks"]

@@ -140,7 +140,7 @@ def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any])
     path = directory / "problems" / f"{scene}-{size}.npz"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        build_problem(scene, **params).save(path)
+        build_problem(scene, params=params).save(path)
     return path
 
 

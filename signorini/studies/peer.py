@@ -1,8 +1,9 @@
 """A peer, side by side: Hertz's cylinder and sphere by GetFEM and by this package.
 
-``signorini bench --peer getfem``. GetFEM runs in the system
-Python (Debian's ``python3-getfem`` and ``python3-gmsh``) through our own script
-:mod:`signorini.studies.peer_getfem`; this package runs as ``signorini solve SCENE
+``signorini bench --peer getfem``. GetFEM runs in the system Python (Debian's
+``python3-getfem`` and ``python3-gmsh``) through our own script,
+``benchmarks/peers/getfem_hertz.py`` in a checkout of the repository (:data:`SCRIPT`;
+not part of the installed package); this package runs as ``signorini solve SCENE
 --json -``. Both are separate processes, timed from start to exit (whole-process
 wall time: interpreter, imports, meshing, assembly, solve, output), each point
 run ``repeat`` times and the fastest kept. Both codes' p₀ and a come from the
@@ -28,6 +29,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+import signorini
 from signorini.analytic import (contact_modulus, hertz_cylinder_load, hertz_cylinder_peak,
                                 hertz_sphere_load, hertz_sphere_peak)
 from signorini.errors import InputError
@@ -35,8 +37,9 @@ from signorini.files import atomic_write_text, save_figure, to_json, writable_di
 from signorini.output import plots
 from signorini.pressure import hertz_fit
 
-#: the standalone GetFEM script, run by the system Python
-SCRIPT = Path(__file__).with_name("peer_getfem.py")
+#: the standalone GetFEM script, run by the system Python: in the repository's checkout,
+#: beside the package's source tree (an installed package has none)
+SCRIPT = Path(signorini.__file__).parents[1] / "benchmarks" / "peers" / "getfem_hertz.py"
 #: the interpreter that has GetFEM (override with SIGNORINI_GETFEM_PYTHON)
 SYSTEM_PYTHON = "/usr/bin/python3"
 INSTALL = "apt-get install python3-getfem python3-gmsh"
@@ -66,7 +69,7 @@ def fit_hertz(x, p, rel: float = 1e-9) -> tuple[float, float, int]:
     over the active nodes but the outermost) with the nodes counted active by
     their pressure alone, p > rel · max p, since GetFEM returns no active set.
     Returns (p0, a, active nodes). The GetFEM script carries the same formula
-    (:func:`signorini.studies.peer_getfem.fit_hertz`; a test holds them equal).
+    (``fit_hertz`` in :data:`SCRIPT`; a test holds them equal).
     """
     x, p = np.abs(np.asarray(x, dtype=float)), np.asarray(p, dtype=float)
     active = p > rel * p.max()
@@ -90,7 +93,11 @@ def system_python() -> str:
 
 
 def getfem_missing(python: str | None = None) -> str | None:
-    """None when ``python`` imports getfem and gmsh; otherwise one line saying what to install."""
+    """None when the GetFEM script is here and ``python`` imports getfem and gmsh; otherwise
+    one line saying what is missing (a checkout of the repository, or what to install)."""
+    if not SCRIPT.is_file():
+        return (f"the peer benchmark needs a checkout of the repository ({SCRIPT} is not there: "
+                "this package was installed without benchmarks/)")
     python = python or system_python()
     try:
         done = subprocess.run([python, "-c", "import getfem, gmsh"], capture_output=True,

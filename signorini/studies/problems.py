@@ -38,6 +38,7 @@ from signorini.files import atomic_write_bytes
 from signorini.loading import at_load
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes import block, build_problem, coarse_problem
+from signorini.scenes.base import scene_params
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
 from signorini.solvers.registry import solve
 
@@ -52,18 +53,18 @@ REFERENCE_TOL = 1e-9
 
 def _scene(spec: dict[str, Any]) -> ContactProblem:
     # a study runs every method, cold, on the QP at the scene's load (matched once)
-    return at_load(build_problem(spec["scene"], nondimensionalise=spec.get("nondimensionalise", True),
-                                 **spec.get("params", {})), coarse_problem)
+    return at_load(build_problem(spec["scene"], params=spec.get("params"),
+                                 nondimensionalise=spec.get("nondimensionalise", True)), coarse_problem)
 
 
 def _force_controlled(spec: dict[str, Any]) -> ContactProblem:
-    problem = force_controlled_problem(spec.get("pressure", 0.01), **spec.get("params", {}))
+    problem = force_controlled_problem(spec.get("pressure", 0.01), params=spec.get("params", {}))
     epsilon = spec.get("regularisation", 0.0)
     return regularise(problem, epsilon) if epsilon else problem
 
 
 def _ill_posed(spec: dict[str, Any]) -> ContactProblem:
-    return ill_posed_problem(spec["case"], **spec.get("params", {}))
+    return ill_posed_problem(spec["case"], params=spec.get("params", {}))
 
 
 def _stored(spec: dict[str, Any]) -> ContactProblem:
@@ -110,15 +111,15 @@ ILL_POSED_CASES = {
 }
 
 
-def ill_posed_problem(case: str, **values: Any) -> ContactProblem:
-    """The block (``values`` are its parameters) made infeasible or ill-posed as ``case`` says.
+def ill_posed_problem(case: str, params: dict[str, Any] | None = None) -> ContactProblem:
+    """The block (``params`` are its parameters) made infeasible or ill-posed as ``case`` says.
 
     ``case`` is one of :data:`ILL_POSED_CASES`. Cases the package refuses
     raise :class:`~signorini.errors.InputError` here, from the assembly.
     """
     if case not in ILL_POSED_CASES:
         raise InputError(f"unknown ill-posed case {case!r}: choose {', '.join(ILL_POSED_CASES)}")
-    p = block.FAMILY.parse(values)
+    p = block.FAMILY.parse(scene_params(params))
     model = block.build(p)
     bottom = model.contact_nodes
     if case == "penetrated":

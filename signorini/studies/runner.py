@@ -8,7 +8,7 @@ answer it is held to. :func:`run_task` runs it and measures one :class:`Row`:
 - the method's own word (``claimed_status``) and the package's status;
 - the independent certificate :func:`signorini.kkt.certificate` and whether
   its worst relative residual is within the accepted tolerance ``τ``
-  (``ACCEPT_FACTOR · tol``, or ``DEFAULT_ACCEPT`` without a tolerance);
+  (:func:`signorini.solvers.base.acceptance`: ``tol``, or ``DEFAULT_TOL`` without one);
 - the distance from the trusted exact answer ``(u*, λ*)``:
   ``‖λ − λ*‖∞ / max(‖λ*‖∞, 1e-5 ‖f‖∞)`` and the misclassified contact
   nodes (weakly active nodes left out, :func:`signorini.kkt.compare`, plus
@@ -55,7 +55,8 @@ from signorini.solvers import cluster
 from signorini.loading import solve as load_control
 from signorini.scenes import coarse_problem
 from signorini.solvers.base import Method
-from signorini.solvers.registry import ACCEPT_FACTOR, DEFAULT_ACCEPT, get_method
+from signorini.solvers.base import acceptance
+from signorini.solvers.registry import get_method
 from signorini.studies.measures import (
     answer_from,
     answer_record,
@@ -223,7 +224,7 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
     """The certificate, the distance from the exact answer and what ``task.measure`` asks for."""
     cert = certificate_of(problem, solution)
     worst_name, worst = cert.worst()
-    accept = ACCEPT_FACTOR * task.tol if task.tol is not None else DEFAULT_ACCEPT
+    accept = acceptance(task.tol)
     row.update(kkt_worst=worst, kkt_name=worst_name,
                cert_ok=bool(np.isfinite(worst) and worst <= accept), message=solution.message)
     if "kkt" in task.measure:

@@ -12,12 +12,13 @@ import logging
 from dataclasses import asdict, dataclass, field
 from typing import Any, TypedDict
 
+from signorini.solvers.base import DEFAULT_TOL
 from signorini.studies.problems import REFERENCE_TOL, reference_policy
 
 log = logging.getLogger(__name__)
 
-#: the tolerance of a task unless it says otherwise
-ATLAS_TOL = 1e-8
+#: the tolerance of a task unless it says otherwise: the package's default
+ATLAS_TOL = DEFAULT_TOL
 #: seconds a run may take (problem assembly and the reference included) before it is stopped
 DEFAULT_TIME_LIMIT = 30.0
 #: the "method" of a task that only builds (and diagnoses) its problem

@@ -78,15 +78,16 @@ class Axis:
 # --- tasks ---------------------------------------------------------------------------------------
 
 
-def scene_spec(scene: str, nondimensionalise: bool = True, cold: bool = False,
-               **params: Any) -> dict[str, Any]:
+def scene_spec(scene: str, params: dict[str, Any] | None = None, *, nondimensionalise: bool = True,
+               cold: bool = False) -> dict[str, Any]:
     """The problem spec of a scene of the package (:func:`signorini.studies.problems.build_spec`).
 
-    ``cold`` drops what load targeting learnt (its answer, its zone), so that a method starts
-    from nothing and its own iterations are measured.
+    ``params`` are the scene's parameters by name. ``cold`` drops what load targeting learnt
+    (its answer, its zone), so that a method starts from nothing and its own iterations are
+    measured.
     """
-    return {"kind": "scene", "scene": scene, "params": params, "nondimensionalise": nondimensionalise,
-            "cold": cold}
+    return {"kind": "scene", "scene": scene, "params": dict(params or {}),
+            "nondimensionalise": nondimensionalise, "cold": cold}
 
 
 def capped(method: str, tol: float | None) -> int | None:

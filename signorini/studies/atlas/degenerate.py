@@ -16,7 +16,7 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     out = []
     for touching in TOUCHING[:1] if quick else TOUCHING:
         out += every_method("degenerate", f"touching={touching:g}", touching,
-                            scene_spec("block", **params, touching=touching), methods)
+                            scene_spec("block", params={**params, "touching": touching}), methods)
     return out
 
 

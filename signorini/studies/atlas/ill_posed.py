@@ -25,7 +25,7 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
         out.append(Task("ill-posed", case, case, spec, BUILD_ONLY, expect=flag,
                         measure=("diagnosis",)))
         if case == "duplicate":  # λ is not unique: compare u with that of the block listed once
-            reference = {"kind": "pdas", "problem": scene_spec("block", **params),
+            reference = {"kind": "pdas", "problem": scene_spec("block", params=params),
                          "displacement_only": True}
             out += every_method("ill-posed", case, case, spec, methods, expect=expect,
                                 answer="displacement", reference=reference)

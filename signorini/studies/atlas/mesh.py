@@ -19,7 +19,7 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     out = []
     for level in (MESH_LEVELS[:2] if quick else MESH_LEVELS):
         out += every_method("mesh", f"refine {level}", level,
-                            scene_spec("hertz-cylinder", cold=True, **MESH_BASE, refine=level),
+                            scene_spec("hertz-cylinder", params={**MESH_BASE, "refine": level}, cold=True),
                             methods)
     return out
 

@@ -20,18 +20,20 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     mesh = TINY_HERTZ if quick else POISSON_MESH
     out = []
     for nu in ratios:  # plain P1 (the volumetric strain element by element): where it locks
-        problem = scene_spec("hertz-cylinder", **mesh, nu=nu, volumetric="element")
+        problem = scene_spec("hertz-cylinder", params={**mesh, "nu": nu, "volumetric": "element"})
         for task in every_method("poisson", "mesh A", nu, problem, methods):
             out.append(Task(**{**task.as_dict(), "measure": ("profile",)}) if task.method == "pdas"
                        else task)
     levels = ((0, "mesh A"), (1, "mesh B"), (2, "mesh C"))[: 2 if quick else 3]
     for level, name in levels[1:]:
-        out += [Task("poisson", name, nu, scene_spec("hertz-cylinder", **mesh, nu=nu, refine=level,
-                                                     volumetric="element"),
+        out += [Task("poisson", name, nu,
+                     scene_spec("hertz-cylinder", params={**mesh, "nu": nu, "refine": level,
+                                                          "volumetric": "element"}),
                      "pdas", measure=("profile",)) for nu in ratios]
     for level, name in levels:  # the volumetric strain averaged at the nodes: no locking
         out += [Task("poisson", f"{name}, nodal", nu,
-                     scene_spec("hertz-cylinder", **mesh, nu=nu, refine=level, volumetric="nodal"),
+                     scene_spec("hertz-cylinder", params={**mesh, "nu": nu, "refine": level,
+                                                          "volumetric": "nodal"}),
                      "pdas", measure=("profile",)) for nu in ratios]
     return out
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output.report import provenance
+from signorini.solvers.base import DEFAULT_TOL
 from signorini.studies.atlas.axis import Axis, capped, nodes_text, num
 from signorini.studies.atlas.summary import AtlasResult, method_rows, method_summary, verdicts, wrapper_record
 from signorini.studies.runner import AGREE_CAP, AGREE_FACTOR, NEAR_FACTOR
@@ -106,7 +107,7 @@ def _header(result: AtlasResult, command: str, info: dict[str, Any], runs: int) 
         ("- **own status** (`claimed_status`): what the method said before the package judged "
          "it; **status**: what `signorini.solvers.registry.solve` returned."),
         ("- **certificate**: the worst relative KKT residual of `signorini.kkt.certificate`; it "
-         "passes when ≤ τ (the tolerance asked for; 1e-6 without one)."),
+         f"passes when ≤ τ (the tolerance asked for; {DEFAULT_TOL:g} without one)."),
         ("- **exact answer**: PDAS at 1e-9 on the non-dimensionalised problem (or the patch "
          "solution where K is singular). An answer **agrees** when no contact node is "
          "misclassified (`kkt.compare`, weakly active nodes left out — but a node with zero "

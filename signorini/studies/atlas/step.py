@@ -24,7 +24,7 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     for scene, params in (QUICK_STEP_SCENES if quick else STEP_SCENES).items():
         for method, cap in STEP_CAPS.items():
             if method in methods:
-                out += [Task("uzawa-step", scene, fraction, scene_spec(scene, **params), method,
+                out += [Task("uzawa-step", scene, fraction, scene_spec(scene, params=params), method,
                              options={"step_fraction": fraction}, max_iter=cap, measure=("bound",))
                         for fraction in fractions]
     return out

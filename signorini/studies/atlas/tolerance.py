@@ -19,7 +19,7 @@ NO_TOLERANCE = ("qp-quadprog",)
 
 
 def tasks(quick: bool, methods: list[str]) -> list[Task]:
-    problem = scene_spec("hertz-cylinder", **(TINY_HERTZ if quick else TOLERANCE_SCENE))
+    problem = scene_spec("hertz-cylinder", params=TINY_HERTZ if quick else TOLERANCE_SCENE)
     tolerances = (1e-3, 1e-8, None) if quick else TOLERANCES + (None,)
     out = []
     for method in methods:

@@ -19,9 +19,10 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     mesh = TINY_HERTZ if quick else UNITS_MESH
     out = []
     for label, E, R in systems:
-        scaled = scene_spec("hertz-cylinder", **mesh, E=E, R=R)
+        scaled = scene_spec("hertz-cylinder", params={**mesh, "E": E, "R": R})
         for nondimensionalise in (True, False):
-            problem = scene_spec("hertz-cylinder", nondimensionalise, **mesh, E=E, R=R)
+            problem = scene_spec("hertz-cylinder", params={**mesh, "E": E, "R": R},
+                                 nondimensionalise=nondimensionalise)
             case = f"{label}, {'scaled' if nondimensionalise else 'raw'}"
             out += every_method("units", case, label, problem, methods,
                                 reference={"kind": "pdas", "problem": scaled})

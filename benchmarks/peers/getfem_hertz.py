@@ -1,10 +1,11 @@
 """Hertz's contact solved by GetFEM: the peer that ``signorini bench --peer getfem`` runs.
 
 A standalone script for the *system* Python (Debian's ``python3-getfem`` and
-``python3-gmsh``), started in a subprocess by :mod:`signorini.studies.peer`; it
-imports only getfem, gmsh, numpy and the standard library, never the package.
+``python3-gmsh``), started in a subprocess by :mod:`signorini.studies.peer`
+from a checkout of the repository; it imports only getfem, gmsh, numpy and the
+standard library, never the package.
 
-    /usr/bin/python3 peer_getfem.py '{"scene": "sphere", "h_contact": 0.03125, "nu": 0.45}'
+    /usr/bin/python3 benchmarks/peers/getfem_hertz.py '{"scene": "sphere", "h_contact": 0.03125}'
 
 The model: the lower quarter of the
 disc (x ≥ 0, y ≤ R; the sphere's meridian for ``"scene": "sphere"``, then
@@ -73,10 +74,19 @@ def fit_hertz(x, p, rel=1e-9):
     idx = idx[np.argsort(x[idx])][:-1]
     if idx.size < 2 or np.ptp(x[idx]) == 0:
         return math.nan, math.nan, int(active.sum())
-    slope, intercept = np.polyfit(x[idx] ** 2, p[idx] ** 2, 1)
+    # in units of the largest x and p, so that their squares stay representable
+    xs, ps = (_unit_of(v) for v in (x[idx], p[idx]))
+    slope, intercept = np.polyfit((x[idx] / xs) ** 2, (p[idx] / ps) ** 2, 1)
     if not (intercept > 0 and slope < 0):
         return math.nan, math.nan, int(active.sum())
-    return float(np.sqrt(intercept)), float(np.sqrt(-intercept / slope)), int(active.sum())
+    return float(ps * np.sqrt(intercept)), float(xs * np.sqrt(-intercept / slope)), int(active.sum())
+
+
+def _unit_of(values):
+    """The largest finite magnitude among ``values`` (1 when there is none)."""
+    values = np.abs(values[np.isfinite(values)])
+    largest = float(values.max()) if values.size else 0.0
+    return largest if largest > 0 else 1.0
 
 
 def hertz(scene, R, E_star, a):
@@ -130,7 +140,7 @@ def solve(q):
     times = {"import_s": time.perf_counter() - START}
     tic = time.perf_counter()
     if q["scene"] not in ("cylinder", "sphere"):
-        raise SystemExit(f"peer_getfem: scene {q['scene']!r} is not cylinder or sphere")
+        raise SystemExit(f"getfem_hertz: scene {q['scene']!r} is not cylinder or sphere")
     # GetFEM's Newton test is relative to the first residual, which mixes forces (contact,
     # Dirichlet multipliers) and lengths (their constraints): in SI units (E = 2.1e11 Pa,
     # R = 1 cm) it stalls with tensile contact forces. Solve in units of R and E, then scale.
@@ -216,7 +226,7 @@ def main(argv):
     given = json.loads(argv[1]) if len(argv) > 1 else {}
     unknown = sorted(set(given) - set(DEFAULTS))
     if unknown:
-        raise SystemExit(f"peer_getfem: unknown parameters {unknown}; known: {sorted(DEFAULTS)}")
+        raise SystemExit(f"getfem_hertz: unknown parameters {unknown}; known: {sorted(DEFAULTS)}")
     print(json.dumps(solve({**DEFAULTS, **given})))
 
 
