@@ -25,7 +25,7 @@ from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.kkt import Certificate, certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import Reference, reference_of
+from signorini.references import Reference, reference_of, summary_lines
 from signorini import loading
 from signorini.loading import solve as load_control
 from signorini.scenes import SCENES, SceneFamily, build_problem
@@ -228,17 +228,7 @@ def solve_summary(record: dict[str, Any]) -> str:
                      f"of ‖u_h‖ over {record['estimate']['elements']} elements")
         if record["estimate"].get("pressure") is not None:
             lines[-1] += f"; contact pressure {100 * record['estimate']['pressure']:.2f} % (L2)"
-    if record.get("hertz"):
-        h = record["hertz"]
-        lines.append(f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "
-                     f"p0 = {h['p0']:.6g} (ref {h['p0_ref']:.6g}, {100 * h['p0_rel']:.2f} %), "
-                     f"pressure L2 {100 * h['pressure_l2_rel']:.2f} %")
-    if record.get("punch"):
-        q = record["punch"]
-        lines.append(f"  punch: load {q['load']:.6g}; pressure vs P/(π√(a² − x²)) on |x| ≤ "
-                     f"{q['inner']:g}a: max {100 * q['pressure_max_rel']:.2f} %, "
-                     f"L2 {100 * q['pressure_l2_rel']:.2f} %; edge node p = {q['edge_pressure']:.4g} "
-                     f"(element {q['edge_h']:.3g} next to the edge)")
+    lines += summary_lines(record)  # the comparison with the analytic reference
     steps = record["extras"].get("adaptive", [])
     if steps:
         lines.append(f"  adaptive refinement, {len(steps)} solve{'s' * (len(steps) != 1)} in "

@@ -34,7 +34,7 @@ Each step (:func:`solve_adaptive`):
 The first mesh is sized before it is made (:func:`signorini.scenes.size.check_size`).
 
 Every 2D and axisymmetric scene and scene file takes part. A family whose
-``build`` accepts ``mesh=`` and that :data:`CURVED` names (the Hertz scenes)
+``build`` accepts ``mesh=`` and that has a ``snap`` (:data:`CURVED`: the Hertz scenes)
 is rebuilt on each new mesh, new nodes first moved onto its curved boundary,
 and widens its candidate zone by :data:`GROWTH` when the contact outgrows
 it. Any other model is carried onto the refinement
@@ -61,8 +61,7 @@ from signorini.fem.transfer import refined_model, with_candidates
 from signorini.fem.model import SceneModel
 from signorini.kkt import gap_scale
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.scenes.families import get_scene, scene_reference
-from signorini.scenes.meshing import snap_to_circle
+from signorini.scenes.registry import FamilyField, get_scene, scene_reference
 from signorini.scenes.scenefile import build_scene_model, family_scene_values
 from signorini.scenes.size import MEMORY_VARIABLE, check_size, over_limit
 
@@ -81,16 +80,9 @@ DEFAULT_MAX_DOFS = 100_000
 MAX_STEPS = 30
 
 
-def quarter_disc_snap(params: dict[str, Any]) -> Callable:
-    """New arc nodes of the Hertz scenes' quarter disc moved radially onto the circle."""
-    return snap_to_circle((0.0, params["R"]), params["R"])
-
-
-#: how each adaptive family puts refined boundary nodes back on its curved boundary
-CURVED: dict[str, Callable[[dict[str, Any]], Callable]] = {
-    "hertz-cylinder": quarter_disc_snap,
-    "hertz-sphere": quarter_disc_snap,
-}
+#: how each adaptive family puts refined boundary nodes back on its curved boundary, by name
+#: (a live view of :attr:`SceneFamily.snap <signorini.scenes.base.SceneFamily>`)
+CURVED = FamilyField("snap")
 
 
 @dataclass
@@ -227,8 +219,8 @@ def _scene(name: str, values: dict[str, Any], solved_by: str | None = None) -> _
     params = family.parse(values)
     check_size(name, params, solved_by)
     model = family.build(params, set(values))
-    snap = CURVED[name](params) if name in CURVED else None
-    builds_on_mesh = name in CURVED and "mesh" in inspect.signature(family.build).parameters
+    snap = family.snap(params) if family.snap is not None else None
+    builds_on_mesh = snap is not None and "mesh" in inspect.signature(family.build).parameters
     return _checked(_Scene(name, model, family if builds_on_mesh else None, params, set(values), snap))
 
 

@@ -4,15 +4,18 @@ A scene family declares its parameters (:class:`Param`) and a ``build``
 function that turns checked parameter values into a
 :class:`~signorini.fem.model.SceneModel` in physical units;
 :mod:`signorini.fem.assembly` turns the model into a
-:class:`~signorini.problem.ContactProblem`.
+:class:`~signorini.problem.ContactProblem`. The family also owns what else
+is known of it (:class:`SceneFamily`): its size model, its coarse rule, how
+refined nodes go back onto a curved boundary, its analytic reference (by
+name, :mod:`signorini.references`) and its validation cases (:class:`Case`).
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass
-from typing import Any, Callable
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Protocol
 
 from signorini.errors import InputError
 from signorini.fem.checks import LENGTH_RANGE
@@ -183,19 +186,93 @@ def checked_ratio(a_over_R: float, name: str, value: float) -> float:
     return a_over_R
 
 
+class SizeEstimate(Protocol):
+    """A family's dofs from its checked parameters, before any mesh is made
+    (:mod:`signorini.scenes.size`): ``estimate`` the model's dofs, ``graded`` those of its
+    graded mesh before uniform refinement, ``dim`` the mesh's dimension."""
+
+    dim: int
+
+    def estimate(self, p: dict[str, Any]) -> float: ...
+
+    def graded(self, p: dict[str, Any]) -> float: ...
+
+
+@dataclass(frozen=True)
+class Case:
+    """One scene of the validation suite (:mod:`signorini.studies.suite`) with its parameters."""
+
+    name: str
+    scene: str
+    params: dict[str, Any] = field(default_factory=dict)
+    same_as: str | None = None  # a case whose dimensionless answer this one must reproduce
+    check_reference: bool = True  # hold the answer to the analytic reference's limits
+    agrees_with: str | None = None  # a case modelling the same body otherwise: same a and p0
+
+    @property
+    def spec(self) -> dict[str, Any]:
+        """The case's problem as a spec a worker rebuilds (:func:`signorini.studies.problems.build_spec`)."""
+        return {"kind": "scene", "scene": self.scene, "params": dict(self.params)}
+
+
+#: parameter names that set the load, left out of a coarse model's parameters and set again
+LOAD_NAMES = ("P", "delta", "a_over_R", "load_ratio")
+
+
+def two_refinements_coarser(params: dict[str, Any]) -> dict[str, Any] | None:
+    """Parameters of a model about 16 times coarser than ``params``, or None (a family's ``coarse``).
+
+    Two uniform refinements fewer (or one, and half the elements across the
+    contact); the load is the same target P, or the same push ``delta`` when
+    no target was set; meshed by bisection where the family offers a choice
+    (the coarse model only predicts the contact zone).
+    """
+    values = {k: v for k, v in params.items() if k not in LOAD_NAMES}
+    if params["refine"] >= 2:
+        values["refine"] = params["refine"] - 2
+    elif params["refine"] == 1 and params["n_contact"] >= 8:
+        values.update(refine=0, n_contact=params["n_contact"] // 2)
+    else:
+        return None
+    if "mesher" in params:  # a zone predictor needs no well-shaped triangles: bisection is faster
+        values["mesher"] = "bisection"
+    if params.get("P") is not None:
+        values["P"] = params["P"]
+    elif params.get("delta") is not None:
+        values["delta"] = params["delta"]
+    else:
+        return None
+    return values
+
+
 @dataclass(frozen=True)
 class SceneFamily:
-    """A named family of scenes and how to build one."""
+    """A named family of scenes: how to build one, and what else is known of it.
+
+    ``size_model`` estimates its dofs before meshing (required to register
+    it: :func:`signorini.scenes.registry.register`); ``coarse(params)`` gives
+    the parameters of a coarser model that predicts the contact zone (None:
+    none); ``snap(params)`` gives the function that moves refined boundary
+    nodes onto the family's curved boundary, and makes the family rebuild
+    itself on each adaptive mesh (its ``build`` takes ``mesh=``);
+    ``reference`` names its analytic reference (:data:`signorini.references.REFERENCES`);
+    ``validation`` its cases in the validation suite; ``convergence_start``
+    the coarse mesh a convergence study starts from.
+    """
 
     name: str
     summary: str
     params: tuple[Param, ...]
-    build: Callable[[dict[str, Any], set[str]], SceneModel]
+    build: Callable[..., SceneModel]
     reference: str = ""
     #: ``loads(p, given)``: the load the checked parameters set, target P (None: a push) first;
     #: raises InputError for a load the family cannot model. Run by :meth:`parse`.
     loads: Callable[[dict[str, Any], set[str]], tuple] | None = None
-
+    size_model: SizeEstimate | None = None
+    coarse: Callable[[dict[str, Any]], dict[str, Any] | None] | None = None
+    snap: Callable[[dict[str, Any]], Callable] | None = None
+    validation: tuple[Case, ...] = ()
+    convergence_start: Mapping[str, Any] = field(default_factory=dict)
     def parse(self, values: dict[str, Any]) -> dict[str, Any]:
         """Defaults overridden by ``values``; unknown names, bad values and loads the family
         cannot model raise InputError (before any mesh is made)."""

@@ -34,8 +34,9 @@ from signorini.fem.topology import facets_on
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution, Scales
-from signorini.scenes.base import (VOLUMETRIC, Param, SceneFamily, at_least, length, poisson_ratio, positive,
-                                   scene_params)
+from signorini.scenes.base import (VOLUMETRIC, Case, Param, SceneFamily, at_least, length, poisson_ratio,
+                                   positive, scene_params)
+from signorini.scenes.size import CountedSize
 
 PARAMS = (
     Param("W", 1.0, "half-width of the block", check=length),
@@ -132,8 +133,14 @@ def _touching_model(p: dict[str, Any]) -> SceneModel:
     return _plain_model(p, obstacle=obstacle)
 
 
+def mesh_dofs(p: dict[str, Any]) -> float:
+    """The dofs of the block's structured mesh: two per node of its (nx + 1) × (ny + 1) grid."""
+    return 2.0 * (p["nx"] + 1) * (p["ny"] + 1)
+
+
 FAMILY = SceneFamily(name="block", summary="elastic block pressed onto a rigid flat (uniform pressure)",
-                     params=PARAMS, build=build, reference="uniform")
+                     params=PARAMS, build=build, reference="uniform", size_model=CountedSize(mesh_dofs),
+                     validation=(Case("block", "block"),))
 
 
 # --- force control: a body held only by contact --------------------------------------------------

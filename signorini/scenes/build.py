@@ -19,37 +19,18 @@ from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import check_size
 
-_LOAD_NAMES = ("P", "delta", "a_over_R", "load_ratio")
-
-
 def coarse_values(name: str, params: dict[str, Any]) -> dict[str, Any] | None:
     """Parameters of a model of scene ``name`` about 16 times coarser than ``params``, or None.
 
-    Families with ``refine`` and ``n_contact`` lose two uniform refinements
-    (or one, and half the elements across the contact); the load is the
-    same target P, or the same push ``delta`` when no target was set; meshed
-    by bisection where the family offers a choice (it only predicts the zone).
+    The family's own rule (:attr:`~signorini.scenes.base.SceneFamily.coarse`, e.g.
+    :func:`~signorini.scenes.base.two_refinements_coarser`) on the family's
+    parameters; None for a family without one (or a scene file).
     """
     family = SCENES.get(name)
-    names = {p.name for p in family.params} if family else set()
-    if not {"refine", "n_contact", "P", "delta"} <= names:
+    if family is None or family.coarse is None:
         return None
-    values = {k: v for k, v in params.items() if k in names and k not in _LOAD_NAMES}
-    if params["refine"] >= 2:
-        values["refine"] = params["refine"] - 2
-    elif params["refine"] == 1 and params["n_contact"] >= 8:
-        values.update(refine=0, n_contact=params["n_contact"] // 2)
-    else:
-        return None
-    if "mesher" in names:  # a zone predictor needs no well-shaped triangles: bisection is faster
-        values["mesher"] = "bisection"
-    if params.get("P") is not None:
-        values["P"] = params["P"]
-    elif params.get("delta") is not None:
-        values["delta"] = params["delta"]
-    else:
-        return None
-    return values
+    names = {p.name for p in family.params}
+    return family.coarse({k: v for k, v in params.items() if k in names})
 
 
 def _coarse_model(name: str, params: dict[str, Any], nondimensionalise: bool):

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from signorini.analytic import hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.scenes.base import (
@@ -31,6 +31,7 @@ from signorini.scenes.base import (
     LOADING,
     MESHER,
     VOLUMETRIC,
+    Case,
     Param,
     SceneFamily,
     at_least,
@@ -40,8 +41,10 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
+    two_refinements_coarser,
 )
-from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on
+from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
+from signorini.scenes.size import SizeModel
 
 PARAMS = (
     Param("R", 1.0, "cylinder radius", check=length),
@@ -113,7 +116,29 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
         predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 
 
+def graded_ratio(p: dict[str, Any]) -> float:
+    """The a/R the mesh is graded for: the target load's, else ``a_over_R``."""
+    if p.get("P") is None or p.get("delta") is not None:
+        return p["a_over_R"]
+    return hertz_cylinder_half_width(p["P"], p["R"], contact_modulus(p["E"], p["nu"])) / p["R"]
+
+
+#: the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
+SIZE = SizeModel(4866, 40, 0.15, 0.05, uniform=5.2, alpha=0.6, beta=1.15, far_field=100.0,
+                 margin=1.18, ratio=graded_ratio)
+
+VALIDATION = (
+    Case("hertz-cylinder", "hertz-cylinder", {"a_over_R": 0.05}),
+    # coarse enough for the dense backends (≤ 3000 dofs); its Hertz errors are not checked
+    Case("hertz-cylinder-coarse", "hertz-cylinder",
+         {"a_over_R": 0.05, "n_contact": 16, "grading": 0.4}, check_reference=False),
+    Case("hertz-cylinder-SI", "hertz-cylinder", {"E": 2.1e11, "R": 0.01, "a_over_R": 0.05},
+         same_as="hertz-cylinder"),
+)
+
 FAMILY = SceneFamily(
     name="hertz-cylinder",
     summary="elastic cylinder on a rigid flat, plane strain, quarter model graded to the contact",
-    params=PARAMS, build=build, loads=_load_choice, reference="hertz-2d")
+    params=PARAMS, build=build, loads=_load_choice, reference="hertz-2d", size_model=SIZE,
+    coarse=two_refinements_coarser, snap=quarter_disc_snap, validation=VALIDATION,
+    convergence_start={"n_contact": 15, "grading": 0.6})

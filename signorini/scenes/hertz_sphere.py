@@ -29,6 +29,7 @@ from signorini.scenes.base import (
     LOADING,
     MESHER,
     VOLUMETRIC,
+    Case,
     Param,
     SceneFamily,
     at_least,
@@ -38,8 +39,10 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
+    two_refinements_coarser,
 )
-from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on
+from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
+from signorini.scenes.size import SizeModel
 
 COMMON_PARAMS = (
     Param("R", 1.0, "sphere radius", check=length),
@@ -117,7 +120,19 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
         predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 
 
+def graded_ratio(p: dict[str, Any]) -> float:
+    """The a/R a sphere's mesh is graded for: the load's (``P``, ``delta`` or ``a_over_R``)."""
+    return load_choice(p, {k for k in ("P", "delta") if p.get(k) is not None})[1]
+
+
+#: the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
+SIZE = SizeModel(6824, 60, 0.15, 0.05, uniform=5.2, alpha=0.65, beta=1.15, far_field=100.0,
+                 margin=1.13, ratio=graded_ratio)
+
 FAMILY = SceneFamily(
     name="hertz-sphere",
     summary="elastic sphere on a rigid flat, axisymmetric (r, z) model graded to the contact",
-    params=PARAMS, build=build, loads=load_choice, reference="hertz-3d")
+    params=PARAMS, build=build, loads=load_choice, reference="hertz-3d", size_model=SIZE,
+    coarse=two_refinements_coarser, snap=quarter_disc_snap,
+    validation=(Case("hertz-sphere", "hertz-sphere", {"a_over_R": 0.05}),),
+    convergence_start={"n_contact": 12, "grading": 0.6})

@@ -13,7 +13,7 @@ import logging
 from contextlib import contextmanager
 from dataclasses import dataclass
 from itertools import combinations
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 from scipy.spatial import Delaunay
@@ -104,6 +104,12 @@ def snap_to_circle(centre: tuple[float, float], radius: float) -> Callable[[Mesh
         return MeshTri(p, mesh.t)
 
     return snap
+
+
+def quarter_disc_snap(params: dict[str, Any]) -> Callable[[MeshTri], MeshTri]:
+    """New arc nodes of the Hertz scenes' quarter disc of radius ``params["R"]`` moved radially
+    onto the circle (a family's ``snap``)."""
+    return snap_to_circle((0.0, params["R"]), params["R"])
 
 
 # --- tetrahedra: the lower octant of a ball -------------------------------------------------

@@ -36,6 +36,7 @@ from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
 from signorini.fem.topology import facets_on
 from signorini.scenes.base import (
     VOLUMETRIC,
+    Case,
     Param,
     SceneFamily,
     at_least,
@@ -44,8 +45,10 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
+    two_refinements_coarser,
 )
 from signorini.scenes.meshing import distance_to_segment, refine_to_size
+from signorini.scenes.size import SizeModel
 
 
 def _non_negative(x: float) -> str | None:
@@ -216,4 +219,9 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
 FAMILY = SceneFamily(
     name="punch",
     summary="rigid flat punch (sharp or rounded corners) pressed into an elastic block, plane strain",
-    params=PARAMS, build=build, loads=checked_load, reference="punch")
+    params=PARAMS, build=build, loads=checked_load, reference="punch",
+    # the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
+    size_model=SizeModel(7948, 128, 0.2, uniform=6082.0, alpha=0.55, beta=1.5, far_field=1200.0,
+                         margin=1.13, block=True),
+    coarse=two_refinements_coarser, validation=(Case("punch", "punch"),),
+    convergence_start={"n_contact": 16, "grading": 0.6})

@@ -26,6 +26,7 @@ from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle
 from signorini.scenes.base import (
     VOLUMETRIC,
+    Case,
     Param,
     SceneFamily,
     at_least,
@@ -36,8 +37,10 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
+    two_refinements_coarser,
 )
 from signorini.scenes.punch import bottom_contact_model, graded_half_block, mirrored_about_x0
+from signorini.scenes.size import SizeModel
 
 #: the mesh is uniformly fine on the bottom up to this multiple of the half-width
 FINE_END = 1.25
@@ -107,4 +110,9 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
 FAMILY = SceneFamily(
     name="reverse-hertz",
     summary="elastic block pressed onto a rigid cylinder (a curved obstacle), plane strain",
-    params=PARAMS, build=build, loads=load_choice, reference="reverse-hertz")
+    params=PARAMS, build=build, loads=load_choice, reference="reverse-hertz",
+    # the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
+    size_model=SizeModel(6118, 128, 0.3, uniform=2.66, alpha=0.55, beta=1.4, far_field=1300.0,
+                         margin=1.16, block=True),
+    coarse=two_refinements_coarser, validation=(Case("reverse-hertz", "reverse-hertz"),),
+    convergence_start={"n_contact": 16, "grading": 0.6})

@@ -10,12 +10,14 @@ calibrated on its own default mesh (:class:`SizeModel`):
             · (1 + ¼ ln(a₀ / a))] · 4^refine
 
 (α, β, the far field b that every mesh has and the margin m fitted per
-family: :data:`SIZE_MODELS`; a the contact ratio the mesh is graded for, from
+family: each family's ``size_model``, :data:`SIZE_MODELS` by name; a the
+contact ratio the mesh is graded for, from
 the load; n_contact rounded up to a power of two and doubled with ``half=0``
 for the half-block meshes), but never more than the uniform mesh at the
 contact's element size, ``c · (n_contact / (a/R))^d · 2^(d · refine)`` (c
-per family, in :data:`SIZE_MODELS`); the 3D octant from the number of tetrahedra its target
-element size asks for (:class:`GradedOctant`). The block's dofs are exact.
+per family); the 3D octant from the number of tetrahedra its target element size asks
+for (:class:`signorini.scenes.hertz_sphere_3d.GradedOctant`). The block's dofs are counted
+exactly (:class:`CountedSize`).
 
 Memory is the peak resident size of building the scene and solving it, in
 bytes per dof: :data:`BYTES_PER_DOF` with a factorising method;
@@ -44,11 +46,9 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.fem.volumetric import resolve
 from signorini.numerics.factor import gigabytes_from
-from signorini.analytic import contact_modulus, hertz_cylinder_half_width
 from signorini.numerics.multigrid import AMG_FROM_DOFS
-from signorini.scenes.hertz_sphere import load_choice
-from signorini.scenes.hertz_sphere_3d import MAX_SIZE
 from signorini.scenes.meshing import MAX_ELEMENTS, MAX_TRIANGLES
+from signorini.scenes.registry import SCENES, FamilyField
 
 #: the environment variable that raises (or lowers) the memory a scene may take, in GB
 MEMORY_VARIABLE = "SIGNORINI_MAX_MEMORY_GB"
@@ -143,91 +143,29 @@ class SizeModel:
             return float(dofs * (2.0 if self.block and p.get("half", 1) == 0 else 1.0))
 
 
-def _cylinder_ratio(p: dict[str, Any]) -> float:
-    """The a/R hertz-cylinder's mesh is graded for: the target load's, else ``a_over_R``."""
-    if p.get("P") is None or p.get("delta") is not None:
-        return p["a_over_R"]
-    return hertz_cylinder_half_width(p["P"], p["R"], contact_modulus(p["E"], p["nu"])) / p["R"]
-
-
-#: the graded octant's dofs ≈ OCTANT_FAR + OCTANT_SCALE · I^OCTANT_POWER, I = ∫ dV / h³ over
-#: the unit octant for the target element size h of :func:`signorini.scenes.hertz_sphere_3d.build`
-#: (the number of tetrahedra the grading asks for): fitted to 18 meshes over grading 0.05..2,
-#: n_contact 3..20 and a/R 0.01..0.2, 1.0 to 1.25 times their dofs
-OCTANT_FAR, OCTANT_SCALE, OCTANT_POWER = 100.0, 64.4, 0.915
-#: a uniform refinement of a tetrahedral mesh of N nodes multiplies them by 1 + edges / nodes,
-#: below OCTANT_REFINE[0] − OCTANT_REFINE[1] · N^(-1/3) (6.35 at 647 nodes, 6.63 at 2,428, 7.10
-#: at 19,168: the surface's nodes have fewer edges), and never more than 8
-OCTANT_REFINE = (7.7, 10.0)
-
-
 @dataclass(frozen=True)
-class GradedOctant:
-    """The size of :mod:`signorini.scenes.hertz_sphere_3d`'s mesh from its target element size
-    ``h = min(a/n_contact + grading · dist(x, disc of radius 1.25 a), MAX_SIZE)``."""
+class CountedSize:
+    """A mesh whose dofs are counted from its parameters, ``dofs(p)`` (e.g. a structured
+    block's ``2 (nx + 1)(ny + 1)``): the estimate is exact, and nothing is graded."""
 
-    dim: int = 3
-
-    def graded(self, p: dict[str, Any]) -> float:
-        """The dofs of the graded mesh, before any uniform refinement."""
-        a, n, g = _sphere_ratio(p), float(p["n_contact"]), float(p["grading"])
-        with np.errstate(over="ignore"):  # an overflow is an infinite estimate
-            return OCTANT_FAR + OCTANT_SCALE * octant_density(a, n, g) ** OCTANT_POWER
+    dofs: Callable[[dict[str, Any]], float]
+    dim: int = 2
 
     def estimate(self, p: dict[str, Any]) -> float:
-        nodes = self.graded(p) / 3.0
-        for _ in range(p.get("refine", 0)):
-            nodes *= min(8.0, OCTANT_REFINE[0] - OCTANT_REFINE[1] * nodes ** (-1 / 3))
-        return 3.0 * nodes
+        return float(self.dofs(p))
+
+    def graded(self, p: dict[str, Any]) -> float:
+        return self.estimate(p)
 
 
-def octant_density(a: float, n_contact: float, grading: float, points: int = 120) -> float:
-    """``∫ dV / h³`` over the octant ``x, y ≥ 0, z ≤ 1`` of the unit ball centred at (0, 0, 1),
-    ``h = min(a/n_contact + grading · d, MAX_SIZE)``, d the distance to the disc ``ρ ≤ 1.25 a``,
-    ``z = 0`` (midpoint rule in (ρ, z), fine near the disc: within 0.5 % of a fine grid's)."""
-
-    h0 = a / n_contact
-    edges = np.unique(np.concatenate([np.linspace(0.0, 3.0 * a, points),
-                                      np.geomspace(min(h0, a) / 20.0, 1.0, 2 * points), [0.0]]))
-    middle, width = 0.5 * (edges[1:] + edges[:-1]), np.diff(edges)
-    rho, z = middle[:, None], middle[None, :]
-    inside = rho ** 2 + (z - 1.0) ** 2 <= 1.0
-    with np.errstate(over="ignore", divide="ignore"):
-        h = np.minimum(h0 + grading * np.hypot(np.maximum(rho - 1.25 * a, 0.0), z), MAX_SIZE)
-        return float(np.sum(np.where(inside, 0.5 * np.pi * rho * np.outer(width, width) / h ** 3,
-                                     0.0)))
-
-
-def _sphere_ratio(p: dict[str, Any]) -> float:
-    """The a/R a sphere's mesh is graded for: the load's (``P``, ``delta`` or ``a_over_R``)."""
-
-    return load_choice(p, {k for k in ("P", "delta") if p.get(k) is not None})[1]
-
-
-#: each family's default mesh (dofs, n_contact, grading, a/R), the uniform bound's c and the 2D
-#: exponents, far fields and margins, fitted to the meshes built (docs/calibration.md): every
-#: estimate at or above the dofs built (tests/test_size_guard.py)
-SIZE_MODELS = {
-    "hertz-cylinder": SizeModel(4866, 40, 0.15, 0.05, uniform=5.2, alpha=0.6, beta=1.15,
-                                far_field=100.0, margin=1.18, ratio=_cylinder_ratio),
-    "hertz-sphere": SizeModel(6824, 60, 0.15, 0.05, uniform=5.2, alpha=0.65, beta=1.15,
-                              far_field=100.0, margin=1.13, ratio=_sphere_ratio),
-    "hertz-sphere-3d": GradedOctant(),
-    "punch": SizeModel(7948, 128, 0.2, uniform=6082.0, alpha=0.55, beta=1.5, far_field=1200.0,
-                       margin=1.13, block=True),
-    "reverse-hertz": SizeModel(6118, 128, 0.3, uniform=2.66, alpha=0.55, beta=1.4,
-                               far_field=1300.0, margin=1.16, block=True),
-}
+#: each family's size model by name (a live view of :attr:`SceneFamily.size_model`)
+SIZE_MODELS = FamilyField("size_model")
 
 
 def estimate_dofs(family: str, params: dict[str, Any]) -> tuple[float, int] | None:
     """``(dofs, dimension)`` of scene ``family`` with checked ``params``; None when unknown."""
-    if family == "block":
-        return 2.0 * (params["nx"] + 1) * (params["ny"] + 1), 2
-    model = SIZE_MODELS.get(family)
+    model = SCENES[family].size_model if family in SCENES else None
     return None if model is None else (model.estimate(params), model.dim)
-
-
 def physical_memory() -> float:
     """This machine's physical memory in bytes (NaN when the system does not say)."""
     try:
@@ -262,7 +200,7 @@ def _check_graded(family: str, params: dict[str, Any], dim: int) -> None:
     """InputError when the graded mesh, before uniform refinement, exceeds the mesher's limit."""
     if "grading" not in params:
         return
-    graded = SIZE_MODELS[family].graded(params) * ELEMENTS_PER_DOF[dim]
+    graded = SCENES[family].size_model.graded(params) * ELEMENTS_PER_DOF[dim]
     if graded > GRADED_LIMIT[dim]:
         raise InputError(
             f"scene {family!r} with grading={params['grading']:g}, n_contact={params['n_contact']:g} "

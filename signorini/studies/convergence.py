@@ -36,7 +36,8 @@ from signorini.files import atomic_write_text, save_figure, to_json, writable_di
 from signorini.pressure import compare_punch, contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import REFERENCES
-from signorini.scenes import SCENES, get_scene, scene_reference
+from signorini.scenes import SCENES, get_scene, portable_scene, scene_reference
+from signorini.scenes.registry import FamilyField
 from signorini.scenes.size import check_size
 from signorini.solvers.registry import get_method
 from signorini.solvers.registry import methods as registered_methods
@@ -50,13 +51,9 @@ LABELS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressu
           "estimate": "estimate η / ‖u_h‖ (energy norm)", "pressure_estimate": "pressure estimate"}
 #: the a posteriori estimates a study records next to the errors (signorini.fem.estimate)
 ESTIMATES = ("estimate", "pressure_estimate")
-#: the coarse mesh each study starts from unless ``--set`` says otherwise
-COARSE_START = {
-    "hertz-cylinder": {"n_contact": 15, "grading": 0.6},
-    "reverse-hertz": {"n_contact": 16, "grading": 0.6},
-    "punch": {"n_contact": 16, "grading": 0.6},
-    "hertz-sphere": {"n_contact": 12, "grading": 0.6},
-}
+#: the coarse mesh each study starts from unless ``--set`` says otherwise, by scene (a live
+#: view of each family's ``convergence_start``, :class:`signorini.scenes.base.SceneFamily`)
+COARSE_START = FamilyField("convergence_start")
 #: grading that makes a graded scene uniform: the contact's element size everywhere
 UNIFORM_GRADING = 1e-6
 #: seconds one run (assembly of its level included) may take before it is stopped
@@ -136,7 +133,7 @@ def _study_params(scene: str, params: dict[str, Any]) -> dict[str, Any]:
                          f"that have one ({', '.join(_refinable())})")
     if "refine" in params:
         raise InputError("converge sets 'refine' itself: give --levels instead of --set refine=")
-    start = {k: v for k, v in COARSE_START.get(scene, {}).items() if k in names}
+    start = {k: v for k, v in family.convergence_start.items() if k in names}
     start.update(params)
     return start
 
@@ -206,7 +203,7 @@ def check_study(scene: str, levels: int, params: dict[str, Any] | None = None,
 
 def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
               methods: list[str] | None = None, tol: float = 1e-10, fit_from: int = 0,
-              progress: Callable[[str], None] | None = None, *, isolate: bool = True,
+              progress: Callable[[str], None] | None = None, *, isolate: bool | None = None,
               time_limit: float = TIME_LIMIT) -> ConvergenceStudy:
     """Solve ``scene`` at refinement levels 0..``levels`` with every exact method and fit rates.
 
@@ -214,7 +211,8 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     :data:`COARSE_START`); ``fit_from`` leaves the first levels out of the
     rate fits (pre-asymptotic). Methods that refuse a level (dense ones on
     large meshes) are recorded as ``skipped``. The runs go through the study
-    runner: one worker process (``isolate``), each run within ``time_limit`` seconds.
+    runner: one worker process (``isolate``; by default unless the family was
+    registered in this process only), each run within ``time_limit`` seconds.
     """
     say = progress or (lambda message: None)
     base, reference = check_study(scene, levels, params, methods, fit_from)
@@ -232,6 +230,8 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
             f"{task.method} {row['status']} in {row.get('time_s', float('nan')):.2f} s: "
             + ", ".join(f"{k} {v:.3e}" for k, v in errors.items()))
 
+    if isolate is None:  # a family registered in this process only is built here
+        isolate = portable_scene(scene)
     done = run_tasks(tasks, isolate=isolate, time_limit=time_limit, progress=report)
     rows: list[LevelResult] = []
     for level in range(levels + 1):

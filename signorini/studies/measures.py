@@ -15,7 +15,7 @@ import scipy.sparse as sp
 from signorini.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
 from signorini.numerics.factor import factorize, resolve_backend
 from signorini.numerics.lcp import delassus
-from signorini.pressure import compare_hertz, contact_profile
+from signorini.pressure import contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_of
 
@@ -30,15 +30,16 @@ def certificate_of(problem: ContactProblem, solution: ContactSolution):
 
 def hertz_errors(problem: ContactProblem, solution: ContactSolution,
                  prefix: str = "") -> dict[str, float]:
-    """Errors of a and p₀ (and the pressure's L2 error) against Hertz's cylinder; {} elsewhere."""
-    if problem.reference != "hertz-2d" or not np.all(np.isfinite(solution.lam)):
+    """The errors a row records against the problem's reference (its ``row_errors``: Hertz's
+    cylinder's a, p₀ and pressure L2), each name after ``prefix``; {} for none."""
+    reference = reference_of(problem)
+    if reference is None or not reference.row_errors or not np.all(np.isfinite(solution.lam)):
         return {}
     try:
-        h = compare_hertz(problem, solution)
+        comparison = reference.compare(problem, solution)
     except Exception:  # an answer too wrong to measure (no contact at all)
         return {}
-    return {f"{prefix}a_rel": h.a_rel, f"{prefix}p0_rel": h.p0_rel,
-            f"{prefix}pressure_l2_rel": h.pressure_l2_rel}
+    return {f"{prefix}{name}": getattr(comparison, name) for name in reference.row_errors}
 
 
 def bound_at_solution(problem: ContactProblem, reference: ContactSolution) -> float:

@@ -1,9 +1,10 @@
 """The validation suite: default scenes × every installed method → tidy runs and checks.
 
-Each case is one scene; each run is one method at one tolerance. Runs record
-what the method said (status, iterations, times) and what the package
-measured independently (the KKT certificate, the distance from the exact
-``pdas`` answer, the error against the analytic reference). Checks are the
+Each case is one scene, declared by its family (``SceneFamily.validation``);
+each run is one method at one tolerance. Runs record what the method said
+(status, iterations, times) and what the package measured independently
+(the KKT certificate, the distance from the exact ``pdas`` answer, the error
+against the analytic reference). Checks are the
 claims the suite stands behind; any failed check fails the suite.
 
 Every run goes through the study runner (:mod:`signorini.studies.runner`):
@@ -17,16 +18,19 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
 
 from signorini.crosschecking import agreement
 from signorini.errors import InputError
-from signorini.pressure import contact_profile, radial_distance
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import reference_metrics
+from signorini.references import reference_metrics, reference_of
+from signorini.scenes import portable_scene
+from signorini.scenes.base import Case
+from signorini.scenes.registry import ValidationCases
 from signorini.solvers.registry import BACKENDS, Method, get_method, methods
 from signorini.studies.measures import answer_from
 from signorini.studies.problems import build_spec
@@ -91,36 +95,9 @@ LIMITS = {
 }
 
 
-@dataclass(frozen=True)
-class Case:
-    """One scene of the suite with its parameters."""
-
-    name: str
-    scene: str
-    params: dict[str, Any] = field(default_factory=dict)
-    same_as: str | None = None  # a case whose dimensionless answer this one must reproduce
-    check_reference: bool = True  # hold the answer to the analytic reference's limits
-    agrees_with: str | None = None  # a case modelling the same body otherwise: same a and p0
-
-    @property
-    def spec(self) -> dict[str, Any]:
-        """The case's problem as a spec a worker rebuilds (:func:`signorini.studies.problems.build_spec`)."""
-        return {"kind": "scene", "scene": self.scene, "params": dict(self.params)}
-
-
-DEFAULT_CASES = (
-    Case("block", "block"),
-    Case("hertz-cylinder", "hertz-cylinder", {"a_over_R": 0.05}),
-    # coarse enough for the dense backends (≤ 3000 dofs); its Hertz errors are not checked
-    Case("hertz-cylinder-coarse", "hertz-cylinder",
-         {"a_over_R": 0.05, "n_contact": 16, "grading": 0.4}, check_reference=False),
-    Case("hertz-cylinder-SI", "hertz-cylinder", {"E": 2.1e11, "R": 0.01, "a_over_R": 0.05},
-         same_as="hertz-cylinder"),
-    Case("hertz-sphere", "hertz-sphere", {"a_over_R": 0.05}),
-    Case("hertz-sphere-3d", "hertz-sphere-3d", {"a_over_R": 0.05}, agrees_with="hertz-sphere"),
-    Case("punch", "punch"),
-    Case("reverse-hertz", "reverse-hertz"),
-)
+#: every registered family's validation cases, in the order of registration (a live view of
+#: :attr:`SceneFamily.validation <signorini.scenes.base.SceneFamily>`)
+DEFAULT_CASES = ValidationCases()
 
 
 @dataclass
@@ -219,30 +196,14 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
                             bool(np.isfinite(value) and value <= LIMITS[key]), detail))
 
     metrics = reference_metrics(problem, ref) if case.check_reference else {}
-    kind = problem.reference
-    if kind in ("hertz-2d", "reverse-hertz") and metrics:
-        limit("Hertz p0 relative error (pdas)", metrics["p0_rel"], "hertz_p0_rel")
-        limit("Hertz a relative error (pdas)", metrics["a_rel"], "hertz_a_rel")
-        limit("Hertz pressure L2 relative error (pdas)", metrics["pressure_l2_rel"],
-              "hertz_pressure_l2_rel")
-        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
-        profile = contact_profile(problem, ref)
-        checks.append(Check(case.name, "outermost candidate is not in contact",
-                            not bool(profile.active[-1]), None, not bool(profile.active[-1]),
-                            "contact reached the end of the candidates: raise 'candidates'"))
-    if kind == "hertz-3d" and metrics:
-        prefix = "hertz_3d_" if problem.contact_points.shape[1] == 3 else "hertz_"
-        limit("Hertz p0 relative error (pdas)", metrics["p0_rel"], prefix + "p0_rel")
-        limit("Hertz a relative error (pdas)", metrics["a_rel"], prefix + "a_rel")
-        limit("Hertz pressure L2 relative error (pdas)", metrics["pressure_l2_rel"],
-              prefix + "pressure_l2_rel")
-        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
-        profile = contact_profile(problem, ref)
-        rho = radial_distance(problem.contact_points)
-        outer = rho >= 0.95 * rho.max()
-        inside = not bool(np.any(profile.active[outer]))
-        checks.append(Check(case.name, "outermost candidates are not in contact", inside, None, inside,
-                            "contact reached the end of the candidates: raise 'candidates'"))
+    reference = reference_of(problem)
+    if metrics and reference is not None and reference.claims is not None:
+        for claim in reference.claims(problem, ref, metrics):  # the reference's own claims
+            if claim.limit is not None:
+                limit(claim.name, claim.value, claim.limit, claim.detail)
+            else:
+                checks.append(Check(case.name, claim.name, bool(claim.value), None,
+                                    bool(claim.value), claim.detail))
     if case.agrees_with and case.agrees_with in by_name and metrics:
         other = by_name[case.agrees_with]
         theirs = reference_metrics(other.problem, other.reference)
@@ -250,20 +211,6 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
             if theirs:
                 diff = abs(metrics[key] / theirs[key] - 1.0)
                 limit(f"{key} agrees with that of {case.agrees_with} (pdas)", diff, "models_agree_rel")
-    if kind == "punch" and metrics:
-        limit("punch pressure max relative error on |x| <= a/2 (pdas)", metrics["pressure_max_rel"],
-              "punch_pressure_rel")
-        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
-        if np.isfinite(metrics["target_rel"]) and problem.params.get("corner_radius", 0) == 0:
-            limit("total contact force equals the load P (pdas)", metrics["target_rel"],
-                  "load_target_rel")
-        touching = metrics["active_fraction"] == 1.0
-        checks.append(Check(case.name, "every node under the punch face is in contact", touching, None,
-                            touching, f"only {100 * metrics['active_fraction']:.1f} % are"))
-    if kind == "uniform" and metrics:
-        limit("uniform pressure max relative error (pdas)", metrics["pressure_max_rel"],
-              "uniform_pressure_rel")
-        limit("force balance: contact force vs applied load (pdas)", metrics["force_balance"], "force_balance")
     for row in result.runs:
         # the reference's own method at the reference's tolerance would be compared with itself
         if row["label"] == REFERENCE_LABEL:
@@ -340,7 +287,7 @@ class SuiteResult:
 def select_cases(names: list[str] | None) -> tuple[Case, ...]:
     """The default cases named in ``names`` (all when empty); unknown names list the known."""
     if not names:
-        return DEFAULT_CASES
+        return tuple(DEFAULT_CASES)
     known = {case.name: case for case in DEFAULT_CASES}
     unknown = [n for n in names if n not in known]
     if unknown:
@@ -363,7 +310,7 @@ def portable(method: Method) -> bool:
     return ":" in method.name or any(method.name == m.name for b in BACKENDS for m in b.METHODS)
 
 
-def run_suite(cases: tuple[Case, ...] = DEFAULT_CASES, method_names: list[str] | None = None,
+def run_suite(cases: Sequence[Case] = DEFAULT_CASES, method_names: list[str] | None = None,
               progress: Callable[[str], None] | None = None, *, isolate: bool | None = None,
               time_limit: float = TIME_LIMIT) -> SuiteResult:
     """Run every case with every installed method (or ``method_names``) and check it.
@@ -372,16 +319,18 @@ def run_suite(cases: tuple[Case, ...] = DEFAULT_CASES, method_names: list[str] |
     every case: a user's method that only claims success fails the suite.
     The runs go to one worker process, each within ``time_limit`` seconds;
     ``isolate=False`` runs them in this process without a limit, as happens
-    by default when a method was registered in this process only (:func:`portable`).
+    by default when a method or a case's scene family was registered in this
+    process only (:func:`portable`, :func:`signorini.scenes.portable_scene`).
     """
     start = time.perf_counter()
     say = progress or (lambda message: None)
     chosen = [get_method(name) for name in method_names] if method_names else \
         [m for m in methods(installed_only=True) if m.family != "user"]
     if isolate is None:
-        isolate = all(portable(m) for m in chosen)
+        isolate = all(portable(m) for m in chosen) and all(portable_scene(c.scene) for c in cases)
         if not isolate:
-            log.info("a method registered in this process only: the suite runs here, no time limit")
+            log.info("a method or scene family registered in this process only: the suite runs "
+                     "here, no time limit")
     tasks = [task for case in cases for task in case_tasks(case, chosen)]
 
     def report(index: int, count: int, task: Task, row: Row) -> None:
