@@ -219,8 +219,8 @@ def test_each_axis_is_one_module_with_everything_about_it():
     assert [a.number for a in AXES] == list(range(1, len(AXES) + 1))
     # one module per axis, holding its tasks and its report together
     assert len({a.tasks.__module__ for a in AXES}) == len(AXES)
-    assert all({f.__module__ for f in (a.findings, a.table, a.figure)} == {a.tasks.__module__}
-               for a in AXES)
+    assert all({f.__module__ for f in (a.findings, a.headline, a.table, a.figure)}
+               == {a.tasks.__module__} for a in AXES)
     methods = atlas_methods(quick=True)
     for axis in AXES:
         assert axis.setup and axis.advice and axis.legend.startswith(("Cells", "Mesh A"))

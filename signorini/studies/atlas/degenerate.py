@@ -5,6 +5,7 @@ from __future__ import annotations
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
+from signorini.studies.atlas.findings import claim, pick
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, num, pivot, plural, scene_spec
 from signorini.studies.task import Task
 
@@ -56,6 +57,24 @@ def figure(rows: Rows) -> Figure:
     return ax.figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis\'s finding in a paragraph, as the README states it."""
+    case = max({r["case"] for r in rows}, key=lambda c: max(r["weak"] for r in pick(rows, case=c)))
+    converged = pick(rows, case=case, status="converged")
+    claim(all(r["misclassified"] == 0 for r in pick(rows, status="converged")),
+          "no converged method shows a misclassified node")
+    strict = [r for r in converged if r["misclassified_strict"] > 0]
+    claim(max((r["misclassified_strict"] for r in strict), default=0) <= 1,
+          "a strict count flags at most one node")
+    flagged = (f"a comparison without the weak label would flag one for {len(strict)} of the "
+               f"{len(converged)} converged methods" if strict else
+               f"even a comparison without the weak label flags none of the {len(converged)} "
+               "converged methods")
+    return ("**Degenerate contact** (axis 7, `signorini solve block --set "
+            f"{case}`): nodes that touch with zero force are labelled weakly "
+            f"active and left out; no converged method shows a misclassified node, and {flagged}.")
+
+
 AXIS = Axis(
     7, "degenerate", "Degenerate contact",
     "Nodes that touch with zero force: does the comparison classify them and stay quiet?",
@@ -67,4 +86,4 @@ AXIS = Axis(
            "Look at their count (`weak`) when two answers seem to disagree.",
     legend="Cells: status, misclassified nodes (weak left out) / counted strictly / "
            "weakly active nodes.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

@@ -7,6 +7,7 @@ from typing import Any
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
+from signorini.studies.atlas.findings import claim, methods_of, names, one, pick, power, right
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, num, pivot
 from signorini.studies.task import Task
 
@@ -98,6 +99,39 @@ def figure(rows: Rows) -> Figure:
     return figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis\'s finding in a paragraph, as the README states it."""
+    singular = pick(rows, case="singular K")
+    eps = [r for r in rows if r["case"].startswith("regularised")]
+    claim(len({r["value"] for r in eps}) == 1, "one regularisation is run with every method")
+    fine = right(singular)
+    worst = max(r["patch_lam_rel"] for r in fine)
+    qp = [m for m in methods_of(singular) if m.startswith("qp-")]
+    lost = [m for m in qp if m not in {r["method"] for r in fine}]
+    claim({r["method"] for r in fine} == (set(qp) - set(lost)) | {"cvxpy"}
+          | {m for m in methods_of(singular) if m.startswith("petsc-")},
+          "the QP backends but a few, cvxpy and the PETSc methods are right on the singular K")
+    claim({r["method"] for r in singular if r["outcome"] != "right"} - set(lost)
+          == {"pdas", "pdas-amg", "auto", "nested", "condensed", "uzawa", "uzawa-nesterov"},
+          "PDAS (and pdas-amg, auto's picks), nested, the condensed dual and both Uzawas fail on "
+          "the singular K")
+    moved = one(eps, method="pdas")["patch_lam_rel"]
+    not_helped = [r for r in eps if r["outcome"] != "right"]
+    claim(all(r["status"] == "max_iter" for r in not_helped if r["method"].startswith("uzawa")),
+          "both Uzawas stop at max_iter on the regularised problem")
+    return (f"**Force control** (axis 6): K is singular; {len(fine)} of {len(singular)} methods are "
+            "right on it (every QP backend but " + names(lost) + ", cvxpy and the PETSc methods; "
+            f"λ within {power(worst)} of the exact patch solution), while PDAS (also `pdas-amg`, and "
+            "`auto`, which picks one of them), `nested`, the condensed dual and both Uzawas need K⁻¹ "
+            "and fail. The handling: "
+            f"`signorini.diagnose.regularise(problem, {power(eps[0]['value'])})` adds "
+            f"{power(eps[0]['value'])} · mean(diag K) to the diagonal; then {len(right(eps))} of "
+            f"{len(eps)} methods are right and λ moves by {power(moved, 1)} "
+            f"({moved / eps[0]['value']:.0f} ε); Uzawa is not helped (both variants stop at "
+            "`max_iter`: W gains an eigenvalue of order 1/ε). The scene: "
+            "`signorini.scenes.block.force_controlled_problem(pressure=…)`.")
+
+
 AXIS = Axis(
     6, "force-control", "A body held only by contact",
     "K is singular under force control: which methods still work, and what does a small "
@@ -115,4 +149,4 @@ AXIS = Axis(
            "Uzawa does not (its W gains an eigenvalue of order 1/ε). Run "
            "`signorini.diagnose.diagnose(problem)` to see whether K is singular.",
     legend="Cells: status, λ error against the exact patch solution.",
-    tasks=tasks, findings=findings, table=table, figure=figure, counts=counts)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline, counts=counts)

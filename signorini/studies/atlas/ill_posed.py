@@ -7,6 +7,7 @@ from typing import Any, Iterable
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
+from signorini.studies.atlas.findings import claim, pick
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, pivot, scene_spec
 from signorini.studies.problems import ILL_POSED_CASES
 from signorini.studies.task import BUILD_ONLY, Task
@@ -80,6 +81,21 @@ def figure(rows: Rows) -> Figure:
     return ax.figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis\'s finding in a paragraph, as the README states it."""
+    penetrated = [r for r in pick(rows, case="penetrated") if r["method"] != "(build)"]
+    statuses = {s: len(pick(penetrated, status=s)) for s in ("infeasible", "failed")}
+    claim(sum(statuses.values()) == len(penetrated), "every method says infeasible or failed")
+    unclear = "float division by zero"
+    claim(any(unclear in str(r["message"]) for r in penetrated), f"a message says '{unclear}'")
+    return ("**Ill-posed input** (axis 8): an empty contact set and a zero-weight candidate are "
+            "refused when the problem is built; `signorini.diagnose.diagnose(problem)` names an "
+            "obstacle the Dirichlet data already penetrate (infeasible), a candidate listed twice "
+            "(λ not unique) and a singular K. On the penetrated obstacle "
+            f"{statuses['infeasible']} methods say `infeasible` and {statuses['failed']} "
+            f"`failed`, some with unclear messages (\"{unclear}\").")
+
+
 AXIS = Axis(
     8, "ill-posed", "Infeasible and ill-posed input",
     "Does every infeasible or ill-posed input end in a clear error or status?",
@@ -90,4 +106,4 @@ AXIS = Axis(
            "names infeasible candidates, duplicated candidates and a singular K in words. "
            "The package refuses an empty contact set and zero-weight candidates outright.",
     legend="Cells: status.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

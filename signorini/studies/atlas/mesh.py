@@ -6,6 +6,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
+from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, power, right
 from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot, scene_spec
 from signorini.studies.task import Task
 
@@ -82,6 +83,36 @@ def figure(rows: Rows) -> Figure:
     return figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis\'s finding in a paragraph, as the README states it."""
+    levels = sorted({r["value"] for r in rows})
+
+    def series(method: str, key: str) -> list[Any]:
+        return [one(rows, method=method, value=v)[key] for v in levels]
+
+    dofs = series("pdas", "dofs")
+    pdas, uzawa, nesterov = (series(m, "iterations") for m in ("pdas", "uzawa", "uzawa-nesterov"))
+    nested = series("nested", "iterations")
+    claim(all(n <= p for n, p in zip(nested, pdas)), "`nested` takes no more steps than PDAS")
+    growth = (uzawa[-1] / uzawa[0]) ** (1 / (len(levels) - 1))
+    qp = [m for m in methods_of(rows) if m.startswith("qp-") or m == "cvxpy"]
+    sparse = [m for m in qp if not pick(rows, method=m, status="refused")]
+    every = [m for m in sparse if len(right(pick(rows, method=m))) == len(levels)]
+    some = {m: len(right(pick(rows, method=m))) for m in sparse if m not in every}
+    partly = [f"{name(m)} at {k}" for m, k in sorted(some.items(), key=lambda i: -i[1]) if k]
+    claim(len(every) >= 1, "a sparse QP backend is right at every level")
+    at_all = ", ".join(name(m) for m in every)
+    return (f"**Mesh** (axis 2, {dofs[0]:,} → {dofs[-1]:,} dofs, h halving): PDAS takes "
+            + " → ".join(str(i) for i in pdas) + " steps from a cold start and `nested` "
+            + " → ".join(str(i) for i in nested) + " (the zone from Hertz's width for the load, "
+            "one factorisation at every level); Uzawa "
+            f"{uzawa[0]:,} → {uzawa[-1]:,} iterations (×{growth:.2f} per halving of h), "
+            f"`uzawa-nesterov` {nesterov[0]:,} → {nesterov[-1]:,}. Of the sparse QP backends "
+            f"{at_all} {'is' if len(every) == 1 else 'are'} right at all {len(levels)} levels at "
+            f"tol {power(rows[0]['tol'])}"
+            + (" (" + ", ".join(partly) + "; the others at none)." if partly else "."))
+
+
 AXIS = Axis(
     2, "mesh", "Mesh refinement",
     "How do iterations and time grow as h halves, and does PDAS stay mesh-independent?",
@@ -91,4 +122,4 @@ AXIS = Axis(
            "iterations barely grow, while Uzawa's double with every halving of h. Of the QP "
            "backends only those shown right here reach tol 1e-8 honestly; check the status.",
     legend="Cells: status, iterations, time.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
+from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, right
 from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot, scene_spec
 from signorini.studies.task import Task
 
@@ -67,6 +68,35 @@ def figure(rows: Rows) -> Figure:
     return figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis\'s finding in a paragraph, as the README states it."""
+    systems = list(dict.fromkeys(r["value"] for r in rows))
+    scaled = pick(rows, case=lambda c: c.endswith(", scaled"))
+    raw = pick(rows, case=lambda c: c.endswith(", raw"))
+    methods = methods_of(rows)
+    for m in methods:
+        claim(len({one(scaled, method=m, value=s)["outcome"] for s in systems}) == 1,
+              f"{m} behaves the same in every scaled unit system")
+    right_scaled = len(right(pick(scaled, value=systems[0])))
+    changed = {m: (len(right(pick(scaled, method=m))), len(right(pick(raw, method=m))))
+               for m in methods}
+    changed = {m: c for m, c in changed.items() if c[0] != c[1]}
+    claim(all(s > r for s, r in changed.values()), "raw units never help a method")
+    infeasible = [r for r in pick(raw, method="qp-quadprog") if r["status"] == "infeasible"]
+    if infeasible:
+        claim(all("E=2.1e11" in r["value"] for r in infeasible)
+              and len(infeasible) == sum("E=2.1e11" in s for s in systems),
+              "quadprog calls exactly the raw problems with E = 2.1e11 infeasible")
+    moves = [f"{name(m)} is right in {r} of {len(systems)} (scaled: {s})"
+             for m, (s, r) in changed.items() if m != "qp-quadprog" or not infeasible]
+    quadprog = (f", and quadprog calls the {len(infeasible)} feasible problems with E = 2.1e11 "
+                "`infeasible`" if infeasible else "")
+    return (f"**Units** (axis 4): with the default non-dimensionalisation every method behaves the "
+            f"same in all {len(systems)} unit systems (E = 1 … 2.1e11, lengths in m or mm; "
+            f"{right_scaled} of {len(methods)} methods right in each); in raw units "
+            + (", ".join(moves) if moves else "no method changes") + quadprog + ".")
+
+
 AXIS = Axis(
     4, "units", "Units and scaling",
     "What do raw units (E up to 2.1e11, lengths in m or mm) do to each method, with and "
@@ -79,4 +109,4 @@ AXIS = Axis(
            "`nondimensionalise=False`) leave the exact methods unharmed but put the QP "
            "backends' absolute tolerances at the mercy of E and the length unit.",
     legend="Cells: status, λ error.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
