@@ -5,8 +5,8 @@ from __future__ import annotations
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
-from signorini.studies.atlas.findings import claim, pick
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, num, pivot, plural, scene_spec
+from signorini.studies.atlas.findings import claim, pick
 from signorini.studies.task import Task
 
 TOUCHING = (0.25, 0.5)
@@ -25,6 +25,11 @@ def _most_strict(rows: Rows) -> float:
     return max((r.get("misclassified_strict") or 0 for r in rows), default=0)
 
 
+def _flagged_strictly(converged: Rows) -> Rows:
+    """The runs a comparison without the weak label (weak tolerance 0) would flag."""
+    return [r for r in converged if (r.get("misclassified_strict") or 0) > 0]
+
+
 def findings(rows: Rows) -> list[str]:
     out = []
     for case in dict.fromkeys(r["case"] for r in rows):
@@ -32,7 +37,7 @@ def findings(rows: Rows) -> list[str]:
         pdas = next((r for r in mine if r["method"] == "pdas"), mine[0])
         converged = [r for r in mine if r["status"] == "converged"]
         wolves = [r for r in converged if (r.get("misclassified") or 0) > 0]
-        strict = [r for r in converged if (r.get("misclassified_strict") or 0) > 0]
+        strict = _flagged_strictly(converged)
         out.append(
             f"**{case}** ({pdas.get('candidates', 0):.0f} candidates, {num(pdas.get('weak'), 0)} "
             f"weakly active in the exact answer): {len(converged)} methods converged; with weakly "
@@ -58,13 +63,13 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis\'s finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as the README states it."""
     case = max({r["case"] for r in rows}, key=lambda c: max(r["weak"] for r in pick(rows, case=c)))
     converged = pick(rows, case=case, status="converged")
     claim(all(r["misclassified"] == 0 for r in pick(rows, status="converged")),
           "no converged method shows a misclassified node")
-    strict = [r for r in converged if r["misclassified_strict"] > 0]
-    claim(max((r["misclassified_strict"] for r in strict), default=0) <= 1,
+    strict = _flagged_strictly(converged)
+    claim(_most_strict(strict) <= 1,
           "a strict count flags at most one node")
     flagged = (f"a comparison without the weak label would flag one for {len(strict)} of the "
                f"{len(converged)} converged methods" if strict else

@@ -14,7 +14,7 @@ import math
 from typing import Any, Callable, Iterable, Sequence
 
 from signorini.studies.atlas.axis import Axis, Rows
-from signorini.studies.atlas.summary import method_rows, method_summary, wrapper_record
+from signorini.studies.atlas.summary import method_rows, method_summary, share, wrapper_record
 from signorini.studies.task import DEFAULT_TIME_LIMIT
 
 #: how the findings name the methods
@@ -152,9 +152,8 @@ def status_finding(data: dict[str, Any]) -> str:
           "DAQP's fault is a converged answer with nodes penetrating at zero force")
     loosest = min(r["tol"] for r in false_claims)
     claim(all(r["tol"] == loosest for r in false_claims), "false claims got through only at one tolerance")
-    return (f"**The package's status was right in {ok} of {runs} runs ({100 * ok / runs:.1f} %)"
-            + (", not 100 %.** " if faults else ".** ")
-            + f"The {len(faults)} exceptions, each with a line that repeats it in the report: in "
+    return (f"**The package's status was right in {share(ok, runs)}, not 100 %.** "
+            f"The {len(faults)} exceptions, each with a line that repeats it in the report: in "
             f"raw units with E = 2.1e11 quadprog's silent failure is reported as `infeasible` "
             f"({len(quadprog)}); DAQP at `--tol {power(d['tol'])}` is `converged` with λ "
             f"{pct(d['lam_rel'], 0)} off, {d['weak_penetrating']} nodes carrying no force while "

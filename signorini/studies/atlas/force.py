@@ -7,8 +7,8 @@ from typing import Any
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
-from signorini.studies.atlas.findings import claim, methods_of, names, one, pick, power, right
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, num, pivot
+from signorini.studies.atlas.findings import claim, methods_of, names, one, pick, power, right
 from signorini.studies.task import Task
 
 FORCE_BLOCK = {"nx": 8, "ny": 8}
@@ -16,6 +16,8 @@ REGULARISATION = 1e-8
 EPSILONS = (1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2)
 #: the methods of the sweep over ε
 SWEPT = ("pdas", "qp-clarabel")
+#: the two problems every method runs: K singular, and K regularised by REGULARISATION
+SINGULAR, REGULARISED = "singular K", f"regularised ε={REGULARISATION:g}"
 
 
 def _force_spec(params: dict[str, Any], epsilon: float = 0.0) -> dict[str, Any]:
@@ -36,9 +38,9 @@ def counts(row: dict[str, Any]) -> bool:
 def tasks(quick: bool, methods: list[str]) -> list[Task]:
     params = {"nx": 4, "ny": 4} if quick else FORCE_BLOCK
     exact = {"kind": "force-controlled-exact"}
-    out = every_method("force-control", "singular K", 0.0, _force_spec(params), methods,
+    out = every_method("force-control", SINGULAR, 0.0, _force_spec(params), methods,
                        reference=exact, measure=("diagnosis", "patch"))
-    out += every_method("force-control", f"regularised ε={REGULARISATION:g}", REGULARISATION,
+    out += every_method("force-control", REGULARISED, REGULARISATION,
                         _force_spec(params, REGULARISATION), methods, measure=("patch",))
     for epsilon in ((1e-8, 1e-2) if quick else EPSILONS):
         for method in SWEPT:
@@ -70,7 +72,7 @@ def _case_text(case: str, mine: Rows) -> str:
 
 def findings(rows: Rows) -> list[str]:
     out = []
-    for case in ("singular K", f"regularised ε={REGULARISATION:g}"):
+    for case in (SINGULAR, REGULARISED):
         mine = [r for r in rows if r["case"] == case]
         if mine:
             out.append(_case_text(case, mine))
@@ -100,9 +102,8 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis\'s finding in a paragraph, as the README states it."""
-    singular = pick(rows, case="singular K")
-    eps = [r for r in rows if r["case"].startswith("regularised")]
+    """The axis's finding in a paragraph, as the README states it."""
+    singular, eps = pick(rows, case=SINGULAR), pick(rows, case=REGULARISED)
     claim(len({r["value"] for r in eps}) == 1, "one regularisation is run with every method")
     fine = right(singular)
     worst = max(r["patch_lam_rel"] for r in fine)

@@ -6,8 +6,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
-from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, power, right
 from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot, scene_spec
+from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, power, right
 from signorini.studies.task import Task
 
 MESH_BASE = TINY_HERTZ
@@ -25,14 +25,19 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     return out
 
 
+def per_halving(iterations: list[float]) -> str:
+    """``×g per halving of h``: the mean growth of ``iterations`` from one level to the next."""
+    growth = (iterations[-1] / iterations[0]) ** (1.0 / (len(iterations) - 1))
+    return f"×{growth:.2f} per halving of h"
+
+
 def _growth_text(method: str, mine: Rows) -> str:
     """Iterations and times from level to level, and how fast the iterations grow."""
     its = [r.get("iterations", float("nan")) for r in mine]
     text = (f"**{method}**: iterations " + " → ".join(num(i, 0) for i in its)
             + ", time " + " → ".join(f"{r.get('time_s', float('nan')):.2f}" for r in mine) + " s")
     if len(its) >= 2 and all(np.isfinite(its)) and min(its) > 0:
-        growth = (its[-1] / its[0]) ** (1.0 / (len(its) - 1))
-        text += f" (×{growth:.2f} per halving of h"
+        text += f" ({per_halving(its)}"
         if method == "pdas":
             step = (its[-1] - its[0]) / (len(its) - 1)
             text += (f": about {step:.1f} more steps per halving — nearly, not exactly, "
@@ -84,7 +89,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis\'s finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as the README states it."""
     levels = sorted({r["value"] for r in rows})
 
     def series(method: str, key: str) -> list[Any]:
@@ -94,7 +99,6 @@ def headline(rows: Rows) -> str:
     pdas, uzawa, nesterov = (series(m, "iterations") for m in ("pdas", "uzawa", "uzawa-nesterov"))
     nested = series("nested", "iterations")
     claim(all(n <= p for n, p in zip(nested, pdas)), "`nested` takes no more steps than PDAS")
-    growth = (uzawa[-1] / uzawa[0]) ** (1 / (len(levels) - 1))
     qp = [m for m in methods_of(rows) if m.startswith("qp-") or m == "cvxpy"]
     sparse = [m for m in qp if not pick(rows, method=m, status="refused")]
     every = [m for m in sparse if len(right(pick(rows, method=m))) == len(levels)]
@@ -106,7 +110,7 @@ def headline(rows: Rows) -> str:
             + " → ".join(str(i) for i in pdas) + " steps from a cold start and `nested` "
             + " → ".join(str(i) for i in nested) + " (the zone from Hertz's width for the load, "
             "one factorisation at every level); Uzawa "
-            f"{uzawa[0]:,} → {uzawa[-1]:,} iterations (×{growth:.2f} per halving of h), "
+            f"{uzawa[0]:,} → {uzawa[-1]:,} iterations ({per_halving(uzawa)}), "
             f"`uzawa-nesterov` {nesterov[0]:,} → {nesterov[-1]:,}. Of the sparse QP backends "
             f"{at_all} {'is' if len(every) == 1 else 'are'} right at all {len(levels)} levels at "
             f"tol {power(rows[0]['tol'])}"

@@ -7,9 +7,9 @@ from matplotlib.figure import Figure
 
 from signorini.output import plots
 from signorini.studies.atlas import figures
-from signorini.studies.atlas.findings import claim, methods_of, name, one, pct, pick, VERBS
 from signorini.studies.atlas.axis import (SHORT, TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot,
                                           scene_spec)
+from signorini.studies.atlas.findings import VERBS, claim, methods_of, name, one, pct, pick
 from signorini.studies.task import Task
 
 POISSON = (0.3, 0.4, 0.45, 0.49, 0.499, 0.4999, 0.49999999999)
@@ -118,7 +118,7 @@ def _nodal_text(nodal: Rows, plain: Rows, order: list[str], dofs: dict[str, int]
 
 
 def headline(rows: Rows) -> str:
-    """The axis\'s finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as the README states it."""
     every = pick(rows, method="pdas")
     pdas = [r for r in every if not r["case"].endswith(", nodal")]
     nodal = [r for r in every if r["case"].endswith(", nodal")]

@@ -8,8 +8,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
-from signorini.studies.atlas.findings import claim, one, pick, span, times
 from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, pivot, scene_spec
+from signorini.studies.atlas.findings import claim, one, pick, span, times
 from signorini.studies.task import Task
 
 STEP_FRACTIONS = (0.05, 0.1, 0.25, 0.5, 0.75, 0.9, 0.95, 0.99, 1.01, 1.05, 1.1, 1.15, 1.2, 1.25,
@@ -40,13 +40,19 @@ def _fraction_text(value: float) -> str:
     return f"{value:g}×"
 
 
+def cycles(row: dict[str, Any]) -> bool:
+    """Whether a divergence the package named is a two-step cycle (λ returns every other step)
+    rather than growth."""
+    return "cycle" in str(row["message"])
+
+
 def _beyond_text(beyond: Rows) -> str:
     """The statuses past the last right step, a divergence told as a two-step cycle or growth."""
     kinds: dict[str, list[float]] = {}
     for r in beyond:
         kind = r["status"]
         if r["status"] == "diverged":
-            kind = "diverged: two-step cycle" if "cycle" in str(r["message"]) else "diverged: growth"
+            kind = "diverged: two-step cycle" if cycles(r) else "diverged: growth"
         kinds.setdefault(kind, []).append(r["value"])
     return "; beyond: " + "; ".join(f"{kind} at {', '.join(_fraction_text(v) for v in values)}"
                                     for kind, values in kinds.items())
@@ -102,11 +108,11 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis\'s finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as the README states it."""
     cyl, block = (pick(rows, case=c) for c in ("hertz-cylinder", "block"))
     uz_cyl, uz_block = pick(cyl, method="uzawa"), pick(block, method="uzawa")
     diverged = pick(rows, method="uzawa", status="diverged")
-    claim(all("cycle" in r["message"] for r in diverged), "Uzawa diverges only in a two-step cycle")
+    claim(all(cycles(r) for r in diverged), "Uzawa diverges only in a two-step cycle")
     first_cycle = {case: min(r["value"] for r in pick(diverged, case=case))
                    for case in ("hertz-cylinder", "block")}
     for mine in (uz_cyl, uz_block):  # right from just past the first wrong step up to the cycle
@@ -126,7 +132,7 @@ def headline(rows: Rows) -> str:
     grown = pick(nesterov, status="diverged")
     early = [r for r in nesterov if r["value"] <= 0.5]
     uncertified = [r for r in early if r["status"] == "inaccurate"]
-    claim(all("cycle" not in r["message"] for r in grown) and min(r["value"] for r in grown) > 1
+    claim(not any(cycles(r) for r in grown) and min(r["value"] for r in grown) > 1
           and all(r["outcome"] in ("right", "caught", "conservative") for r in early)
           and all(v < 1 for vs in stalled.values() for v in vs),
           "uzawa-nesterov is never wrong to 0.5×, stalls below 1× and grows past it")

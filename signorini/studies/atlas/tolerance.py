@@ -8,9 +8,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
-from signorini.studies.atlas.findings import claim, methods_of, names, one, pct, pick, power, right
 from signorini.studies.atlas.axis import (TINY_HERTZ, Axis, Rows, capped, cell, nodes_text, num, pivot,
                                           plural, scene_spec, wrong_nodes)
+from signorini.studies.atlas.findings import claim, methods_of, names, one, pct, pick, power, right
 from signorini.studies.task import Task
 
 TOLERANCES = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
@@ -108,7 +108,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis\'s finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as the README states it."""
     osqp = one(rows, method="qp-osqp", tol=None)
     prox = one(rows, method="qp-proxqp", tol=None)
     claim(osqp["claimed_status"] == prox["claimed_status"] == "converged" and osqp["misclassified"] == 0

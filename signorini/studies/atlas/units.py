@@ -5,8 +5,8 @@ from __future__ import annotations
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
-from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, right
 from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot, scene_spec
+from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, right
 from signorini.studies.task import Task
 
 UNIT_SYSTEMS = (("E=1, R=1", 1.0, 1.0), ("E=1, R=0.01", 1.0, 0.01),
@@ -30,19 +30,22 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     return out
 
 
+def assembled(rows: Rows, scaling: str) -> Rows:
+    """The runs on problems assembled ``"scaled"`` (non-dimensionalised) or ``"raw"``."""
+    return [r for r in rows if r["case"].endswith(f", {scaling}")]
+
+
 def findings(rows: Rows) -> list[str]:
     out = []
     for scaling in ("scaled", "raw"):
-        mine = [r for r in rows if r["case"].endswith(scaling)]
+        mine = assembled(rows, scaling)
         systems = list(dict.fromkeys(r["value"] for r in mine))
         counts = [f"{s}: {sum(r['outcome'] == 'right' for r in mine if r['value'] == s)}/"
                   f"{sum(r['value'] == s for r in mine)}" for s in systems]
         out.append(f"**{scaling}** — methods right per unit system: " + "; ".join(counts) + ".")
     for method in dict.fromkeys(r["method"] for r in rows):
-        scaled = [r for r in rows if r["method"] == method and r["case"].endswith("scaled")]
-        raw = [r for r in rows if r["method"] == method and r["case"].endswith("raw")]
-        s_ok = sum(r["outcome"] == "right" for r in scaled)
-        r_ok = sum(r["outcome"] == "right" for r in raw)
+        scaled, raw = (pick(assembled(rows, s), method=method) for s in ("scaled", "raw"))
+        s_ok, r_ok = len(right(scaled)), len(right(raw))
         if s_ok != r_ok or s_ok < len(scaled):
             bad = [f"{r['value']} ({cell(r)}, λ off {num(r.get('lam_rel'))})"
                    for r in raw if r["outcome"] != "right"]
@@ -61,7 +64,7 @@ def figure(rows: Rows) -> Figure:
     figure = Figure(figsize=(11, 5.0), layout="constrained")
     left, right = figure.subplots(1, 2, sharey=True)
     for ax, scaling in ((left, "scaled"), (right, "raw")):
-        figures.atlas_outcomes([r for r in rows if r["case"].endswith(scaling)], column="value", ax=ax,
+        figures.atlas_outcomes(assembled(rows, scaling), column="value", ax=ax,
                                title=f"{'non-dimensionalised' if scaling == 'scaled' else 'raw units'}")
     figure.suptitle("Axis 4: units (green: right; orange: false 'solved' caught; grey: no claim; "
                     "red: the package's status was wrong)", fontsize=9)
@@ -69,10 +72,9 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis\'s finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as the README states it."""
     systems = list(dict.fromkeys(r["value"] for r in rows))
-    scaled = pick(rows, case=lambda c: c.endswith(", scaled"))
-    raw = pick(rows, case=lambda c: c.endswith(", raw"))
+    scaled, raw = assembled(rows, "scaled"), assembled(rows, "raw")
     methods = methods_of(rows)
     for m in methods:
         claim(len({one(scaled, method=m, value=s)["outcome"] for s in systems}) == 1,
