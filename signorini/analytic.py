@@ -68,11 +68,6 @@ def hertz_sphere_peak(P: float, a: float) -> float:
     return float(3.0 * P / (2.0 * np.pi * a ** 2))
 
 
-def hertz_sphere_approach(a: float, R: float) -> float:
-    """Approach of distant points of the sphere and the flat: ``δ = a² / R``."""
-    return float(a ** 2 / R)
-
-
 # --- rigid flat punch on a half-plane (Johnson 1985, ch. 2: the flat punch) ----------------
 
 

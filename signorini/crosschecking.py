@@ -77,10 +77,6 @@ class MethodRun:
     kkt_worst_name: str = ""
     reference: dict[str, float] = field(default_factory=dict)
 
-    @property
-    def says_converged(self) -> bool:
-        return self.claimed_status == "converged"
-
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
 

@@ -219,8 +219,8 @@ def test_each_axis_is_one_module_with_everything_about_it():
     assert [a.number for a in AXES] == list(range(1, len(AXES) + 1))
     # one module per axis, holding its tasks and its report together
     assert len({a.tasks.__module__ for a in AXES}) == len(AXES)
-    assert all({f.__module__ for f in (a.findings, a.table, a.figure)} == {a.tasks.__module__}
-               for a in AXES)
+    assert all({f.__module__ for f in (a.findings, a.headline, a.table, a.figure)}
+               == {a.tasks.__module__} for a in AXES)
     methods = atlas_methods(quick=True)
     for axis in AXES:
         assert axis.setup and axis.advice and axis.legend.startswith(("Cells", "Mesh A"))
@@ -275,3 +275,17 @@ def test_the_stability_command_runs_one_quick_axis(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert code == 0 and "right in" in out and "axis 1" in err
     assert (tmp_path / "stability.md").exists()
+
+
+def test_the_committed_report_is_what_its_runs_give():
+    # docs/stability.md is written from the rows alone: the committed runs.json gives it back
+    from pathlib import Path
+
+    from signorini.studies.atlas import AtlasResult, report_markdown
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    data = json.loads((docs / "stability" / "runs.json").read_text(encoding="utf-8"))
+    result = AtlasResult(data["rows"], tuple(a for a in AXES if a.name in data["axes"]),
+                         data["elapsed_s"], data["axis_seconds"], data["quick"])
+    text = report_markdown(result, data["command"], data["provenance"])
+    assert text == (docs / "stability.md").read_text(encoding="utf-8")

@@ -30,20 +30,6 @@ def pairs(items: Sequence[str], flag: str) -> dict[str, Any]:
     return out
 
 
-def option_value(text: str) -> Any:
-    lowered = text.lower()
-    if lowered in ("true", "false"):
-        return lowered == "true"
-    if lowered in ("none", "null"):
-        return None
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
-
-
 def parse_tol(text: str) -> float:
     from signorini.solvers.base import check_tol  # per command (start-up)
 

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from signorini.cli.common import (EXIT_FAILED, input_files, option_value, pairs, parse_tol,
+from signorini.cli.common import (EXIT_FAILED, input_files, pairs, parse_tol,
                                   stdout_to_stderr, user_methods_in_workers,
                                   write_output)
 from signorini.errors import InputError
 from signorini.solvers.base import DEFAULT_TOL
+from signorini.solvers.options import guess_value
 
 
 def method_options(items: list[str]) -> dict[str, dict]:
@@ -20,7 +21,7 @@ def method_options(items: list[str]) -> dict[str, dict]:
             raise InputError(f"--opt {item!r} is not METHOD:key=value: write e.g. "
                              "--opt qp-osqp:polish=false")
         for key, value in pairs([setting], "--opt").items():
-            out.setdefault(method, {})[key] = option_value(value)
+            out.setdefault(method, {})[key] = guess_value(value)
     return out
 
 

@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from signorini.cli.common import (EXIT_FAILED, input_files, option_value, pairs,
-                                  parse_time_limit, parse_tol, stdout_to_stderr, write_output)
+from signorini.cli.common import (EXIT_FAILED, input_files, pairs, parse_time_limit,
+                                  parse_tol, stdout_to_stderr, write_output)
 from signorini.errors import InputError
 from signorini.solvers.base import DEFAULT_TOL
+from signorini.solvers.options import guess_value
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
@@ -19,7 +20,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
     params = pairs(args.set, "--set")
     texts = pairs(args.opt, "--opt")
-    max_iter = option_value(texts.pop("max_iter")) if "max_iter" in texts else None
+    max_iter = guess_value(texts.pop("max_iter")) if "max_iter" in texts else None
     tol = parse_tol(args.tol) if args.tol is not None else None
     inputs = input_files(args.scene, [args.method])  # before the method's file is imported
     # every option read as its declared kind and checked before the scene is built

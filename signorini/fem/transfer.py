@@ -34,20 +34,6 @@ def uniform_parents(t: np.ndarray, n: int) -> np.ndarray:
     return np.array([edges // n, edges % n])
 
 
-def midpoint_parents(mesh: Any, points: np.ndarray) -> np.ndarray:
-    """(2, k) the old edge of ``mesh`` whose midpoint each of ``points`` (dim, k) is.
-
-    Raises ValueError when a point is not the midpoint of an edge (up to round-off).
-    """
-    facets = mesh.edges if hasattr(mesh, "edges") and mesh.p.shape[0] == 3 else mesh.facets
-    middles = 0.5 * (mesh.p[:, facets[0]] + mesh.p[:, facets[1]])
-    distance, index = cKDTree(middles.T).query(points.T)
-    size = float(np.max(np.abs(mesh.p))) if mesh.p.size else 1.0
-    if len(distance) and np.max(distance) > 1e-9 * max(size, 1.0):
-        raise ValueError("a new node is not the midpoint of an edge of the old mesh")
-    return facets[:, index]
-
-
 def prolongation(n_old: int, parents: np.ndarray) -> sp.csr_matrix:
     """The (n_old + k) × n_old matrix that keeps old nodal values and averages each new node's
     two ``parents`` (2, k)."""

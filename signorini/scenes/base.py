@@ -186,6 +186,16 @@ def checked_ratio(a_over_R: float, name: str, value: float) -> float:
     return a_over_R
 
 
+def recorded_params(p: dict[str, Any], target: float | None, a_over_R: float,
+                    delta_nominal: float) -> dict[str, Any]:
+    """A Hertz scene's parameters as its problem records them: the load that ruled, the
+    others None."""
+    params = dict(p)
+    params.update(P=target, delta=delta_nominal if target is None else None,
+                  a_over_R=a_over_R if target is not None else None)
+    return params
+
+
 class SizeEstimate(Protocol):
     """A family's dofs from its checked parameters, before any mesh is made
     (:mod:`signorini.scenes.size`): ``estimate`` the model's dofs, ``graded`` those of its

@@ -41,6 +41,7 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
+    recorded_params,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
@@ -101,9 +102,6 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
         disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
                                    p["candidates"], relaxed=p["mesher"] == "relaxed")
     delta_nominal = delta if delta is not None else a_est ** 2 * R
-    params = dict(p)
-    params.update(P=target, delta=delta_nominal if target is None else None,
-                  a_over_R=a_est if target is not None else None)
     pushed, cut_load = disc_loading(disc, p["loading"], target)
     return SceneModel(
         mesh=disc.mesh, E=E, nu=nu,
@@ -111,7 +109,8 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
         contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),
         load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0,
-        target_load=target, params=params, cut_load=cut_load,
+        target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
+        cut_load=cut_load,
         candidate_remedy=CANDIDATE_REMEDY.format(**p),
         predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 

@@ -39,6 +39,7 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
+    recorded_params,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
@@ -86,15 +87,6 @@ def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float
     if "P" in chosen:
         return p["P"], checked_ratio(hertz_sphere_radius(p["P"], R, E_star) / R, "P", p["P"])
     return hertz_sphere_load(p["a_over_R"] * R, R, E_star), p["a_over_R"]
-
-
-def recorded_params(p: dict[str, Any], target: float | None, a_over_R: float,
-                    delta_nominal: float) -> dict[str, Any]:
-    """The parameters as the problem records them: the load that ruled, the others None."""
-    params = dict(p)
-    params.update(P=target, delta=delta_nominal if target is None else None,
-                  a_over_R=a_over_R if target is not None else None)
-    return params
 
 
 def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:

@@ -34,9 +34,10 @@ from signorini.scenes.base import (
     SceneFamily,
     at_least,
     between,
+    recorded_params,
     two_refinements_coarser,
 )
-from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice, recorded_params
+from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice
 from signorini.scenes.meshing import (
     coarse_ball_octant,
     curved_boundary_facets,

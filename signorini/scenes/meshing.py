@@ -30,29 +30,12 @@ MAX_PASSES = 40
 MAX_TRIANGLES = 400_000
 
 
-def longest_edges(mesh: MeshTri) -> np.ndarray:
-    """Longest edge of each triangle."""
-    p, t = mesh.p, mesh.t
-    lengths = [np.linalg.norm(p[:, t[i]] - p[:, t[(i + 1) % 3]], axis=0) for i in range(3)]
-    return np.max(lengths, axis=0)
-
-
 def refine_to_size(mesh: MeshTri, target: Callable[[np.ndarray], np.ndarray],
                    snap: Callable[[MeshTri], MeshTri] | None = None,
                    max_elements: int = MAX_TRIANGLES) -> MeshTri:
-    """Refine ``mesh`` until every element's longest edge is ≤ ``target(centroid)``."""
-    for _ in range(MAX_PASSES):
-        centroids = mesh.p[:, mesh.t].mean(axis=1)
-        marked = np.nonzero(longest_edges(mesh) > target(centroids))[0]
-        if marked.size == 0:
-            return mesh
-        if mesh.t.shape[1] > max_elements:
-            raise RuntimeError(f"mesh grading exceeded {max_elements} elements")
-        mesh = mesh.refined(marked)
-        if snap is not None:
-            mesh = snap(mesh)
-    log.warning("mesh grading stopped after %d passes", MAX_PASSES)
-    return mesh
+    """Refine the triangles of ``mesh`` until every longest edge is ≤ ``target(centroid)``
+    (:func:`refine_simplices_to_size` with at most :data:`MAX_PASSES` passes)."""
+    return refine_simplices_to_size(mesh, target, snap, max_elements, max_passes=MAX_PASSES)
 
 
 def distance_to_segment(points: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:

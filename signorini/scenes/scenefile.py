@@ -88,11 +88,6 @@ MESH_SCENE_OVERRIDES = {"E": ("material", "E"), "nu": ("material", "nu"), "P": (
 COMPONENTS = {"x": 0, "y": 1}
 
 
-def is_scene_file(name: str) -> bool:
-    """Whether a scene argument is a path to a TOML scene file (ends in .toml)."""
-    return str(name).lower().endswith(".toml")
-
-
 class _Locator:
     """Finds the line of ``key`` inside ``[table]`` (or the k-th ``[[table]]``) of a TOML text."""
 

@@ -193,11 +193,6 @@ class IterationHistory:
         """``J(u_k) − D(λ_k) = λ_kᵀ(d − Nu_k)``: negative while u_k penetrates where λ_k pushes."""
         return self.primal - self.dual
 
-    @property
-    def active_count(self) -> np.ndarray:
-        """Number of nodes carrying a force at each iteration."""
-        return self.active.sum(axis=1)
-
     def misclassified(self, final_active: np.ndarray) -> np.ndarray:
         """Per iteration, how many nodes differ from ``final_active`` (a boolean mask)."""
         return np.sum(self.active != np.asarray(final_active, dtype=bool), axis=1)

@@ -44,6 +44,8 @@ class Axis:
     table : ``rows → Markdown lines``.
     figure : ``rows → Figure``.
     counts : ``row → bool``: whether a run counts for the method × axis verdict.
+    headline : ``rows → paragraph``: the axis's finding as the README states it
+        (:func:`signorini.studies.atlas.findings.findings`).
     caps : iteration caps the axis's tasks use instead of :data:`ITERATION_CAPS`.
     """
 
@@ -60,6 +62,7 @@ class Axis:
     figure: Callable[[Rows], Figure]
     counts: Callable[[dict[str, Any]], bool] = _every_run
     caps: dict[str, int] | None = field(default=None, compare=False)
+    headline: Callable[[Rows], str] | None = None
 
     @property
     def figure_name(self) -> str:

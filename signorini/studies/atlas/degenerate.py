@@ -6,6 +6,7 @@ from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, num, pivot, plural, scene_spec
+from signorini.studies.atlas.findings import claim, pick
 from signorini.studies.task import Task
 
 TOUCHING = (0.25, 0.5)
@@ -24,6 +25,11 @@ def _most_strict(rows: Rows) -> float:
     return max((r.get("misclassified_strict") or 0 for r in rows), default=0)
 
 
+def _flagged_strictly(converged: Rows) -> Rows:
+    """The runs a comparison without the weak label (weak tolerance 0) would flag."""
+    return [r for r in converged if (r.get("misclassified_strict") or 0) > 0]
+
+
 def findings(rows: Rows) -> list[str]:
     out = []
     for case in dict.fromkeys(r["case"] for r in rows):
@@ -31,7 +37,7 @@ def findings(rows: Rows) -> list[str]:
         pdas = next((r for r in mine if r["method"] == "pdas"), mine[0])
         converged = [r for r in mine if r["status"] == "converged"]
         wolves = [r for r in converged if (r.get("misclassified") or 0) > 0]
-        strict = [r for r in converged if (r.get("misclassified_strict") or 0) > 0]
+        strict = _flagged_strictly(converged)
         out.append(
             f"**{case}** ({pdas.get('candidates', 0):.0f} candidates, {num(pdas.get('weak'), 0)} "
             f"weakly active in the exact answer): {len(converged)} methods converged; with weakly "
@@ -56,6 +62,24 @@ def figure(rows: Rows) -> Figure:
     return ax.figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis's finding in a paragraph, as the README states it."""
+    case = max({r["case"] for r in rows}, key=lambda c: max(r["weak"] for r in pick(rows, case=c)))
+    converged = pick(rows, case=case, status="converged")
+    claim(all(r["misclassified"] == 0 for r in pick(rows, status="converged")),
+          "no converged method shows a misclassified node")
+    strict = _flagged_strictly(converged)
+    claim(_most_strict(strict) <= 1,
+          "a strict count flags at most one node")
+    flagged = (f"a comparison without the weak label would flag one for {len(strict)} of the "
+               f"{len(converged)} converged methods" if strict else
+               f"even a comparison without the weak label flags none of the {len(converged)} "
+               "converged methods")
+    return ("**Degenerate contact** (axis 7, `signorini solve block --set "
+            f"{case}`): nodes that touch with zero force are labelled weakly "
+            f"active and left out; no converged method shows a misclassified node, and {flagged}.")
+
+
 AXIS = Axis(
     7, "degenerate", "Degenerate contact",
     "Nodes that touch with zero force: does the comparison classify them and stay quiet?",
@@ -67,4 +91,4 @@ AXIS = Axis(
            "Look at their count (`weak`) when two answers seem to disagree.",
     legend="Cells: status, misclassified nodes (weak left out) / counted strictly / "
            "weakly active nodes.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

@@ -8,6 +8,7 @@ from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, num, pivot
+from signorini.studies.atlas.findings import claim, methods_of, names, one, pick, power, right
 from signorini.studies.task import Task
 
 FORCE_BLOCK = {"nx": 8, "ny": 8}
@@ -15,6 +16,8 @@ REGULARISATION = 1e-8
 EPSILONS = (1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2)
 #: the methods of the sweep over ε
 SWEPT = ("pdas", "qp-clarabel")
+#: the two problems every method runs: K singular, and K regularised by REGULARISATION
+SINGULAR, REGULARISED = "singular K", f"regularised ε={REGULARISATION:g}"
 
 
 def _force_spec(params: dict[str, Any], epsilon: float = 0.0) -> dict[str, Any]:
@@ -35,9 +38,9 @@ def counts(row: dict[str, Any]) -> bool:
 def tasks(quick: bool, methods: list[str]) -> list[Task]:
     params = {"nx": 4, "ny": 4} if quick else FORCE_BLOCK
     exact = {"kind": "force-controlled-exact"}
-    out = every_method("force-control", "singular K", 0.0, _force_spec(params), methods,
+    out = every_method("force-control", SINGULAR, 0.0, _force_spec(params), methods,
                        reference=exact, measure=("diagnosis", "patch"))
-    out += every_method("force-control", f"regularised ε={REGULARISATION:g}", REGULARISATION,
+    out += every_method("force-control", REGULARISED, REGULARISATION,
                         _force_spec(params, REGULARISATION), methods, measure=("patch",))
     for epsilon in ((1e-8, 1e-2) if quick else EPSILONS):
         for method in SWEPT:
@@ -69,7 +72,7 @@ def _case_text(case: str, mine: Rows) -> str:
 
 def findings(rows: Rows) -> list[str]:
     out = []
-    for case in ("singular K", f"regularised ε={REGULARISATION:g}"):
+    for case in (SINGULAR, REGULARISED):
         mine = [r for r in rows if r["case"] == case]
         if mine:
             out.append(_case_text(case, mine))
@@ -98,6 +101,38 @@ def figure(rows: Rows) -> Figure:
     return figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis's finding in a paragraph, as the README states it."""
+    singular, eps = pick(rows, case=SINGULAR), pick(rows, case=REGULARISED)
+    claim(len({r["value"] for r in eps}) == 1, "one regularisation is run with every method")
+    fine = right(singular)
+    worst = max(r["patch_lam_rel"] for r in fine)
+    qp = [m for m in methods_of(singular) if m.startswith("qp-")]
+    lost = [m for m in qp if m not in {r["method"] for r in fine}]
+    claim({r["method"] for r in fine} == (set(qp) - set(lost)) | {"cvxpy"}
+          | {m for m in methods_of(singular) if m.startswith("petsc-")},
+          "the QP backends but a few, cvxpy and the PETSc methods are right on the singular K")
+    claim({r["method"] for r in singular if r["outcome"] != "right"} - set(lost)
+          == {"pdas", "pdas-amg", "auto", "nested", "condensed", "uzawa", "uzawa-nesterov"},
+          "PDAS (and pdas-amg, auto's picks), nested, the condensed dual and both Uzawas fail on "
+          "the singular K")
+    moved = one(eps, method="pdas")["patch_lam_rel"]
+    not_helped = [r for r in eps if r["outcome"] != "right"]
+    claim(all(r["status"] == "max_iter" for r in not_helped if r["method"].startswith("uzawa")),
+          "both Uzawas stop at max_iter on the regularised problem")
+    return (f"**Force control** (axis 6): K is singular; {len(fine)} of {len(singular)} methods are "
+            "right on it (every QP backend but " + names(lost) + ", cvxpy and the PETSc methods; "
+            f"λ within {power(worst)} of the exact patch solution), while PDAS (also `pdas-amg`, and "
+            "`auto`, which picks one of them), `nested`, the condensed dual and both Uzawas need K⁻¹ "
+            "and fail. The handling: "
+            f"`signorini.diagnose.regularise(problem, {power(eps[0]['value'])})` adds "
+            f"{power(eps[0]['value'])} · mean(diag K) to the diagonal; then {len(right(eps))} of "
+            f"{len(eps)} methods are right and λ moves by {power(moved, 1)} "
+            f"({moved / eps[0]['value']:.0f} ε); Uzawa is not helped (both variants stop at "
+            "`max_iter`: W gains an eigenvalue of order 1/ε). The scene: "
+            "`signorini.scenes.block.force_controlled_problem(pressure=…)`.")
+
+
 AXIS = Axis(
     6, "force-control", "A body held only by contact",
     "K is singular under force control: which methods still work, and what does a small "
@@ -115,4 +150,4 @@ AXIS = Axis(
            "Uzawa does not (its W gains an eigenvalue of order 1/ε). Run "
            "`signorini.diagnose.diagnose(problem)` to see whether K is singular.",
     legend="Cells: status, λ error against the exact patch solution.",
-    tasks=tasks, findings=findings, table=table, figure=figure, counts=counts)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline, counts=counts)

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any
 
 from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
 from signorini.studies.atlas.axis import Axis, Rows, cell, every_method, pivot, scene_spec
+from signorini.studies.atlas.findings import claim, pick
+from signorini.studies.atlas.summary import method_rows
 from signorini.studies.problems import ILL_POSED_CASES
 from signorini.studies.task import BUILD_ONLY, Task
 
@@ -34,11 +36,6 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     return out
 
 
-def _solved(rows: Iterable[dict[str, Any]]) -> Rows:
-    """The runs of methods (not the rows that only build the problem)."""
-    return [r for r in rows if r["method"] != BUILD_ONLY]
-
-
 def _build_text(build: dict[str, Any]) -> str:
     """What building the problem did: refused it, or built it and diagnosed what."""
     if build["status"] == "input-error":
@@ -51,7 +48,7 @@ def findings(rows: Rows) -> list[str]:
     out = []
     for case in dict.fromkeys(r["case"] for r in rows):
         build = next((r for r in rows if r["case"] == case and r["method"] == BUILD_ONLY), None)
-        mine = _solved(r for r in rows if r["case"] == case)
+        mine = method_rows(r for r in rows if r["case"] == case)
         text = f"**{case}** — {ILL_POSED_CASES.get(case, case)}: "
         if build is not None:
             text += _build_text(build)
@@ -69,15 +66,30 @@ def findings(rows: Rows) -> list[str]:
 
 
 def table(rows: Rows) -> list[str]:
-    return pivot(_solved(rows), "method", "case", lambda r: cell(r), corner="method")
+    return pivot(method_rows(rows), "method", "case", lambda r: cell(r), corner="method")
 
 
 def figure(rows: Rows) -> Figure:
-    ax = figures.atlas_outcomes(_solved(rows), column="case",
+    ax = figures.atlas_outcomes(method_rows(rows), column="case",
                                 title="Axis 8: infeasible and ill-posed input (green: the right "
                                       "status or answer)")
     ax.figure.set_size_inches(7, 5)
     return ax.figure
+
+
+def headline(rows: Rows) -> str:
+    """The axis's finding in a paragraph, as the README states it."""
+    penetrated = method_rows(pick(rows, case="penetrated"))
+    statuses = {s: len(pick(penetrated, status=s)) for s in ("infeasible", "failed")}
+    claim(sum(statuses.values()) == len(penetrated), "every method says infeasible or failed")
+    unclear = "float division by zero"
+    claim(any(unclear in str(r["message"]) for r in penetrated), f"a message says '{unclear}'")
+    return ("**Ill-posed input** (axis 8): an empty contact set and a zero-weight candidate are "
+            "refused when the problem is built; `signorini.diagnose.diagnose(problem)` names an "
+            "obstacle the Dirichlet data already penetrate (infeasible), a candidate listed twice "
+            "(λ not unique) and a singular K. On the penetrated obstacle "
+            f"{statuses['infeasible']} methods say `infeasible` and {statuses['failed']} "
+            f"`failed`, some with unclear messages (\"{unclear}\").")
 
 
 AXIS = Axis(
@@ -90,4 +102,4 @@ AXIS = Axis(
            "names infeasible candidates, duplicated candidates and a singular K in words. "
            "The package refuses an empty contact set and zero-weight candidates outright.",
     legend="Cells: status.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

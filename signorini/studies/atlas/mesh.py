@@ -7,6 +7,7 @@ from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
 from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot, scene_spec
+from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, power, right
 from signorini.studies.task import Task
 
 MESH_BASE = TINY_HERTZ
@@ -24,14 +25,19 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     return out
 
 
+def per_halving(iterations: list[float]) -> str:
+    """``×g per halving of h``: the mean growth of ``iterations`` from one level to the next."""
+    growth = (iterations[-1] / iterations[0]) ** (1.0 / (len(iterations) - 1))
+    return f"×{growth:.2f} per halving of h"
+
+
 def _growth_text(method: str, mine: Rows) -> str:
     """Iterations and times from level to level, and how fast the iterations grow."""
     its = [r.get("iterations", float("nan")) for r in mine]
     text = (f"**{method}**: iterations " + " → ".join(num(i, 0) for i in its)
             + ", time " + " → ".join(f"{r.get('time_s', float('nan')):.2f}" for r in mine) + " s")
     if len(its) >= 2 and all(np.isfinite(its)) and min(its) > 0:
-        growth = (its[-1] / its[0]) ** (1.0 / (len(its) - 1))
-        text += f" (×{growth:.2f} per halving of h"
+        text += f" ({per_halving(its)}"
         if method == "pdas":
             step = (its[-1] - its[0]) / (len(its) - 1)
             text += (f": about {step:.1f} more steps per halving — nearly, not exactly, "
@@ -82,6 +88,35 @@ def figure(rows: Rows) -> Figure:
     return figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis's finding in a paragraph, as the README states it."""
+    levels = sorted({r["value"] for r in rows})
+
+    def series(method: str, key: str) -> list[Any]:
+        return [one(rows, method=method, value=v)[key] for v in levels]
+
+    dofs = series("pdas", "dofs")
+    pdas, uzawa, nesterov = (series(m, "iterations") for m in ("pdas", "uzawa", "uzawa-nesterov"))
+    nested = series("nested", "iterations")
+    claim(all(n <= p for n, p in zip(nested, pdas)), "`nested` takes no more steps than PDAS")
+    qp = [m for m in methods_of(rows) if m.startswith("qp-") or m == "cvxpy"]
+    sparse = [m for m in qp if not pick(rows, method=m, status="refused")]
+    every = [m for m in sparse if len(right(pick(rows, method=m))) == len(levels)]
+    some = {m: len(right(pick(rows, method=m))) for m in sparse if m not in every}
+    partly = [f"{name(m)} at {k}" for m, k in sorted(some.items(), key=lambda i: -i[1]) if k]
+    claim(len(every) >= 1, "a sparse QP backend is right at every level")
+    at_all = ", ".join(name(m) for m in every)
+    return (f"**Mesh** (axis 2, {dofs[0]:,} → {dofs[-1]:,} dofs, h halving): PDAS takes "
+            + " → ".join(str(i) for i in pdas) + " steps from a cold start and `nested` "
+            + " → ".join(str(i) for i in nested) + " (the zone from Hertz's width for the load, "
+            "one factorisation at every level); Uzawa "
+            f"{uzawa[0]:,} → {uzawa[-1]:,} iterations ({per_halving(uzawa)}), "
+            f"`uzawa-nesterov` {nesterov[0]:,} → {nesterov[-1]:,}. Of the sparse QP backends "
+            f"{at_all} {'is' if len(every) == 1 else 'are'} right at all {len(levels)} levels at "
+            f"tol {power(rows[0]['tol'])}"
+            + (" (" + ", ".join(partly) + "; the others at none)." if partly else "."))
+
+
 AXIS = Axis(
     2, "mesh", "Mesh refinement",
     "How do iterations and time grow as h halves, and does PDAS stay mesh-independent?",
@@ -91,4 +126,4 @@ AXIS = Axis(
            "iterations barely grow, while Uzawa's double with every halving of h. Of the QP "
            "backends only those shown right here reach tol 1e-8 honestly; check the status.",
     legend="Cells: status, iterations, time.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

@@ -9,6 +9,7 @@ from signorini.output import plots
 from signorini.studies.atlas import figures
 from signorini.studies.atlas.axis import (SHORT, TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot,
                                           scene_spec)
+from signorini.studies.atlas.findings import VERBS, claim, methods_of, name, one, pct, pick
 from signorini.studies.task import Task
 
 POISSON = (0.3, 0.4, 0.45, 0.49, 0.499, 0.4999, 0.49999999999)
@@ -100,6 +101,65 @@ def figure(rows: Rows) -> Figure:
     return figure
 
 
+def _nodal_text(nodal: Rows, plain: Rows, order: list[str], dofs: dict[str, int]) -> str:
+    """What averaging the volumetric strain at the nodes does on the same meshes (axis 5)."""
+    def p0(mesh: str, nu: float, rows: Rows = nodal) -> float:
+        return one(rows, case=f"{mesh}, nodal" if rows is nodal else mesh, value=nu)["p0_rel"]
+
+    nus = sorted({r["value"] for r in nodal})[:-1]  # the extreme ν is not certified (below)
+    claim(all(p0(m, nu) < 0.01 for m in order for nu in nus),
+          "with the nodal average PDAS's p₀ is within 1 % for every ν up to 0.4999 on every mesh")
+    claim(all(p0(m, nu) < 0.1 * p0(m, nu, plain) for m in order for nu in (0.499, 0.4999)),
+          "with the nodal average p₀ is at least ten times closer than plain P1's at ν ≥ 0.499")
+    return ("With the volumetric strain averaged at the nodes (`volumetric=nodal`, the default "
+            "from ν = 0.4) nothing locks: p₀'s error at ν = 0.3, 0.49, 0.499, 0.4999 is "
+            + "; ".join(", ".join(pct(p0(m, nu), 2) for nu in (0.3, 0.49, 0.499, 0.4999))
+                        + f" on {dofs[m]:,} dofs" for m in order) + ".")
+
+
+def headline(rows: Rows) -> str:
+    """The axis's finding in a paragraph, as the README states it."""
+    every = pick(rows, method="pdas")
+    pdas = [r for r in every if not r["case"].endswith(", nodal")]
+    nodal = [r for r in every if r["case"].endswith(", nodal")]
+    meshes = sorted({r["case"] for r in pdas})
+    dofs = {m: pick(pdas, case=m)[0]["dofs"] for m in meshes}
+    finest, coarsest = max(meshes, key=dofs.get), min(meshes, key=dofs.get)
+
+    def p0(mesh: str, nu: float) -> float:
+        return one(pdas, case=mesh, value=nu)["p0_rel"]
+
+    order = sorted(meshes, key=dofs.get)
+    claim(all(p0(m, nu) < 0.01 for m in meshes for nu in (0.3, 0.4, 0.45)),
+          "PDAS's p₀ is within 1 % for ν ≤ 0.45 on every mesh")
+    claim(all(p0(a, 0.499) > p0(b, 0.499) for a, b in zip(order, order[1:])),
+          "refinement lowers the p₀ error at ν = 0.499")
+    exact = [m for m in ("pdas", "nested", "condensed") if m in methods_of(rows)]
+    extreme = max(r["value"] for r in rows)
+    usual = sorted({r["value"] for r in rows} - {extreme})
+    claim(all(r["outcome"] == "right" for r in pick(rows, case=coarsest)
+              if r["method"] in exact and r["value"] != extreme),
+          "the exact methods solve every ν short of the extreme one")
+    at_extreme = [r for r in rows if r["value"] == extreme]
+    claim(all(r["status"] != "converged" and r["outcome"] != "wrong" for r in at_extreme),
+          "no method is converged at the extreme ν, and none is wrong there")
+    worst = [r for r in pick(rows, case=coarsest, value=usual[-1])
+             if r["method"] in ("uzawa", "petsc-vi") and r["outcome"] != "right"]
+    return ("**ν → 0.5** (axis 5): plain P1 locks, the solvers do not fail: PDAS's p₀ error on the "
+            f"finest mesh ({dofs[finest]:,} dofs) is {pct(p0(finest, 0.3))} at ν = 0.3, "
+            f"{pct(p0(finest, 0.49))} at 0.49, {pct(p0(finest, 0.499))} at 0.499 and "
+            f"{pct(p0(finest, 0.4999), 0)} at 0.4999; at 0.499 each refinement cuts it ("
+            + " → ".join(pct(p0(m, 0.499)) for m in order) + "), at 0.4999 it stays large ("
+            + " → ".join(pct(p0(m, 0.4999), 0) for m in order) + "). "
+            + _nodal_text(nodal, pdas, order, dofs) + " The exact methods solve every ν up to "
+            f"{usual[-1]:g}; at {usual[-1]:g} "
+            + " and ".join(f"{name(r['method'])} {VERBS.get(r['status'], r['status'])}"
+                           for r in worst) + f" on the {dofs[coarsest]:,}-dof mesh. At ν = {extreme!r} "
+            "double precision cannot certify the contact forces (the certificate's forward error, "
+            f"docs/certificate.md): all {len(at_extreme)} runs there, the exact methods' too, end "
+            "`inaccurate` or worse, none `converged`.")
+
+
 AXIS = Axis(
     5, "poisson", "Near-incompressibility",
     "How does P1 locking show in the pressure as ν → 0.5, and do the solvers cope?",
@@ -118,4 +178,4 @@ AXIS = Axis(
            "force to 1e-8 on any method (the certificate's force_error_floor is about 1e-4, "
            "docs/certificate.md): no method is converged there.",
     legend="Mesh A; cells: status, λ error against PDAS on the same mesh.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

@@ -16,7 +16,8 @@ from signorini.files import atomic_write_text, save_figure, to_json, writable_di
 from signorini.output.report import provenance
 from signorini.solvers.base import DEFAULT_TOL
 from signorini.studies.atlas.axis import Axis, capped, nodes_text, num
-from signorini.studies.atlas.summary import AtlasResult, method_rows, method_summary, verdicts, wrapper_record
+from signorini.studies.atlas.summary import (AtlasResult, method_rows, method_summary, share, verdicts,
+                                             wrapper_record)
 from signorini.studies.runner import AGREE_CAP, AGREE_FACTOR, NEAR_FACTOR
 
 #: the columns of ``runs.csv``
@@ -148,7 +149,7 @@ def _package_status(result: AtlasResult) -> list[str]:
     right, runs, faults = wrapper_record(rows)
     by_name = {a.name: a for a in result.axes}
     md = ["", "## The package's status", "",
-          f"**Right in {right} of {runs} runs ({100 * right / max(runs, 1):.1f} %).**", ""]
+          f"**Right in {share(right, runs)}.**", ""]
     if faults:
         md += ["Where it was not (each line repeats the run):", ""]
         for r in faults:

@@ -59,6 +59,11 @@ def wrapper_record(rows: Rows) -> tuple[int, int, Rows]:
     return len(runs) - len(faults), len(runs), faults
 
 
+def share(right: int, runs: int) -> str:
+    """``right of runs runs (p %)``: how the package's record is stated."""
+    return f"{right} of {runs} runs ({100 * right / max(runs, 1):.1f} %)"
+
+
 def verdicts(rows: Rows, axes: Sequence[Axis]) -> dict[tuple[str, str], str]:
     """``(method, axis) → "works n/n" | "degrades k/n" | "fails 0/n"``: right runs among those that count.
 

@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 from signorini.studies.atlas import figures
 from signorini.studies.atlas.axis import (TINY_HERTZ, Axis, Rows, capped, cell, nodes_text, num, pivot,
                                           plural, scene_spec, wrong_nodes)
+from signorini.studies.atlas.findings import claim, methods_of, names, one, pct, pick, power, right
 from signorini.studies.task import Task
 
 TOLERANCES = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
@@ -106,6 +107,28 @@ def figure(rows: Rows) -> Figure:
     return figure
 
 
+def headline(rows: Rows) -> str:
+    """The axis's finding in a paragraph, as the README states it."""
+    osqp = one(rows, method="qp-osqp", tol=None)
+    prox = one(rows, method="qp-proxqp", tol=None)
+    claim(osqp["claimed_status"] == prox["claimed_status"] == "converged" and osqp["misclassified"] == 0
+          and prox["misclassified"] > 0, "OSQP and ProxQP claim success at their defaults")
+    tolerances = sorted({r["tol"] for r in rows if r["tol"] is not None})
+    never = [m for m in methods_of(rows) if m != "qp-quadprog"
+             and not right(pick(rows, method=m, tol=lambda t: t is not None))]
+    daqp_false = [r for r in pick(rows, method="qp-daqp") if r["claimed_status"] == "converged"
+                  and not r["claim_correct"]]
+    claim(len(daqp_false) == 1, "DAQP makes one false claim")
+    return (f"**Tolerance** (axis 3, a {osqp['dofs']:,}-dof cylinder): at its defaults OSQP says "
+            f"\"solved\" with λ {pct(osqp['lam_rel'])} off and no node misclassified, ProxQP with "
+            f"λ off by {prox['lam_rel']:.1f} times its size, {prox['misclassified']} nodes misclassified "
+            f"and Hertz's a and p₀ {pct(prox['a_rel'])} and {pct(prox['p0_rel'])} off (the exact "
+            f"answer: {pct(prox['ref_a_rel'], 2)} and {pct(prox['ref_p0_rel'], 2)}); "
+            f"{names(never)} are right at no tolerance from {power(tolerances[-1])} to "
+            f"{power(tolerances[0])}; DAQP's one false claim is at {power(daqp_false[0]['tol'])} "
+            "(below).")
+
+
 AXIS = Axis(
     3, "tolerance", "Solver tolerance",
     "At which tolerance does each QP backend find the right contact, and where is its own "
@@ -118,4 +141,4 @@ AXIS = Axis(
            "quadprog (the last two on small problems).",
     legend="Cells: status, λ error / misclassified nodes (`+kp`: k more nodes with zero "
            "force that penetrate, which `kkt.classify` labels weakly active).",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)

@@ -6,6 +6,7 @@ from matplotlib.figure import Figure
 
 from signorini.studies.atlas import figures
 from signorini.studies.atlas.axis import TINY_HERTZ, Axis, Rows, cell, every_method, num, pivot, scene_spec
+from signorini.studies.atlas.findings import claim, methods_of, name, one, pick, right
 from signorini.studies.task import Task
 
 UNIT_SYSTEMS = (("E=1, R=1", 1.0, 1.0), ("E=1, R=0.01", 1.0, 0.01),
@@ -29,19 +30,22 @@ def tasks(quick: bool, methods: list[str]) -> list[Task]:
     return out
 
 
+def assembled(rows: Rows, scaling: str) -> Rows:
+    """The runs on problems assembled ``"scaled"`` (non-dimensionalised) or ``"raw"``."""
+    return [r for r in rows if r["case"].endswith(f", {scaling}")]
+
+
 def findings(rows: Rows) -> list[str]:
     out = []
     for scaling in ("scaled", "raw"):
-        mine = [r for r in rows if r["case"].endswith(scaling)]
+        mine = assembled(rows, scaling)
         systems = list(dict.fromkeys(r["value"] for r in mine))
         counts = [f"{s}: {sum(r['outcome'] == 'right' for r in mine if r['value'] == s)}/"
                   f"{sum(r['value'] == s for r in mine)}" for s in systems]
         out.append(f"**{scaling}** — methods right per unit system: " + "; ".join(counts) + ".")
     for method in dict.fromkeys(r["method"] for r in rows):
-        scaled = [r for r in rows if r["method"] == method and r["case"].endswith("scaled")]
-        raw = [r for r in rows if r["method"] == method and r["case"].endswith("raw")]
-        s_ok = sum(r["outcome"] == "right" for r in scaled)
-        r_ok = sum(r["outcome"] == "right" for r in raw)
+        scaled, raw = (pick(assembled(rows, s), method=method) for s in ("scaled", "raw"))
+        s_ok, r_ok = len(right(scaled)), len(right(raw))
         if s_ok != r_ok or s_ok < len(scaled):
             bad = [f"{r['value']} ({cell(r)}, λ off {num(r.get('lam_rel'))})"
                    for r in raw if r["outcome"] != "right"]
@@ -60,11 +64,39 @@ def figure(rows: Rows) -> Figure:
     figure = Figure(figsize=(11, 5.0), layout="constrained")
     left, right = figure.subplots(1, 2, sharey=True)
     for ax, scaling in ((left, "scaled"), (right, "raw")):
-        figures.atlas_outcomes([r for r in rows if r["case"].endswith(scaling)], column="value", ax=ax,
+        figures.atlas_outcomes(assembled(rows, scaling), column="value", ax=ax,
                                title=f"{'non-dimensionalised' if scaling == 'scaled' else 'raw units'}")
     figure.suptitle("Axis 4: units (green: right; orange: false 'solved' caught; grey: no claim; "
                     "red: the package's status was wrong)", fontsize=9)
     return figure
+
+
+def headline(rows: Rows) -> str:
+    """The axis's finding in a paragraph, as the README states it."""
+    systems = list(dict.fromkeys(r["value"] for r in rows))
+    scaled, raw = assembled(rows, "scaled"), assembled(rows, "raw")
+    methods = methods_of(rows)
+    for m in methods:
+        claim(len({one(scaled, method=m, value=s)["outcome"] for s in systems}) == 1,
+              f"{m} behaves the same in every scaled unit system")
+    right_scaled = len(right(pick(scaled, value=systems[0])))
+    changed = {m: (len(right(pick(scaled, method=m))), len(right(pick(raw, method=m))))
+               for m in methods}
+    changed = {m: c for m, c in changed.items() if c[0] != c[1]}
+    claim(all(s > r for s, r in changed.values()), "raw units never help a method")
+    infeasible = [r for r in pick(raw, method="qp-quadprog") if r["status"] == "infeasible"]
+    if infeasible:
+        claim(all("E=2.1e11" in r["value"] for r in infeasible)
+              and len(infeasible) == sum("E=2.1e11" in s for s in systems),
+              "quadprog calls exactly the raw problems with E = 2.1e11 infeasible")
+    moves = [f"{name(m)} is right in {r} of {len(systems)} (scaled: {s})"
+             for m, (s, r) in changed.items() if m != "qp-quadprog" or not infeasible]
+    quadprog = (f", and quadprog calls the {len(infeasible)} feasible problems with E = 2.1e11 "
+                "`infeasible`" if infeasible else "")
+    return (f"**Units** (axis 4): with the default non-dimensionalisation every method behaves the "
+            f"same in all {len(systems)} unit systems (E = 1 … 2.1e11, lengths in m or mm; "
+            f"{right_scaled} of {len(methods)} methods right in each); in raw units "
+            + (", ".join(moves) if moves else "no method changes") + quadprog + ".")
 
 
 AXIS = Axis(
@@ -79,4 +111,4 @@ AXIS = Axis(
            "`nondimensionalise=False`) leave the exact methods unharmed but put the QP "
            "backends' absolute tolerances at the mercy of E and the length unit.",
     legend="Cells: status, λ error.",
-    tasks=tasks, findings=findings, table=table, figure=figure)
+    tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
