@@ -99,3 +99,11 @@ def test_the_first_adaptive_mesh_is_sized_before_it_is_made(monkeypatch):
     monkeypatch.setenv(MEMORY_VARIABLE, "0.1")
     with pytest.raises(InputError, match="over the limit of 0.1 GB"):
         signorini.solve_adaptive("hertz-cylinder", "1%", params={"refine": 2})
+
+
+def test_a_family_scene_file_is_sized_before_it_is_meshed(tmp_path):
+    """A scene file naming a family goes through the family's size guard, as the name does."""
+    path = tmp_path / "big.toml"
+    path.write_text('scene = "hertz-cylinder"\n[mesh]\nrefine = 6\n')
+    with pytest.raises(InputError, match=r"refine=6.*dofs"):
+        signorini.build_problem(str(path))

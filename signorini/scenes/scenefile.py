@@ -62,6 +62,7 @@ from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery
 from signorini.fem.volumetric import CHOICES
 from signorini.scenes.base import length, poisson_ratio
 from signorini.scenes.families import SCENES
+from signorini.scenes.size import check_size
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -178,7 +179,9 @@ def _family_scene(data: dict[str, Any], ctx: _Context,
                   overrides: dict[str, Any]) -> tuple[str, "SceneModel"]:
     name, values = _family_values(data, ctx, overrides)
     family = SCENES[name]
-    return name, family.build(family.parse(values), set(values))
+    params = family.parse(values)
+    check_size(name, params)  # too big for this machine: refused before meshing, as by name
+    return name, family.build(params, set(values))
 
 
 def _family_values(data: dict[str, Any], ctx: _Context,
