@@ -76,9 +76,18 @@ def adequacy(problem: ContactProblem, solution: ContactSolution, accept: float) 
                     edge_active=edge_active, remedy=watch.remedy)
 
 
-def warnings(problem: ContactProblem) -> list[str]:
+#: a contact on fewer candidates than this resolves no pressure profile
+FEWEST_IN_CONTACT = 3
+
+
+def warnings(problem: ContactProblem, solution: ContactSolution | None = None) -> list[str]:
     """What may make an exact answer a poor model (the status stays)."""
     said = []
+    touching = None if solution is None else int(np.sum(solution.lam > 0))
+    if problem.reference and touching is not None and 0 < touching < FEWEST_IN_CONTACT:
+        said.append(f"the contact covers {touching} candidate(s), too few to resolve it (its "
+                    "width and peak pressure cannot be fitted): refine the mesh at the contact "
+                    "or raise the load")
     disc = problem.discretisation
     nu = None if disc is None else disc.nu
     if nu is not None and nu > LOCKING_NU and disc.volumetric == "element":

@@ -95,6 +95,10 @@ _PRESSURE_ERRORS = ("p0_rel", "a_rel", "pressure_l2_rel")
 
 
 def _hertz_line(h: dict[str, Any]) -> str:
+    if not all(isinstance(h.get(k), float) and np.isfinite(h[k]) for k in ("a", "p0")):
+        return (f"  Hertz: the contact covers too few candidates to fit a and p0 (ref a = "
+                f"{h['a_ref']:.6g}, p0 = {h['p0_ref']:.6g}): refine the mesh at the contact or "
+                "raise the load")
     return (f"  Hertz: a = {h['a']:.6g} (ref {h['a_ref']:.6g}, {100 * h['a_rel']:.2f} %), "
             f"p0 = {h['p0']:.6g} (ref {h['p0_ref']:.6g}, {100 * h['p0_rel']:.2f} %), "
             f"pressure L2 {100 * h['pressure_l2_rel']:.2f} %")

@@ -183,6 +183,6 @@ def judge(problem: ContactProblem, solution: ContactSolution,
             solution.claimed_status = "converged"
             solution.status = "model_inadequate"
             solution.message = f"{solution.message}; {found.message()}".lstrip("; ")
-    for warning in warnings(problem):
+    for warning in warnings(problem, solution):
         solution.message = f"{solution.message}; warning: {warning}".lstrip("; ")
     return solution
