@@ -23,7 +23,9 @@ driver that finds it, with one of three strategies:
 Then the method solves the QP at that push. A method named by the caller
 starts cold and the iterations it reports are its own; ``auto`` takes the
 fastest route and is handed what load control learnt as an explicit warm
-start. Every stage's work is in ``solution.work``.
+start. Every stage's work is in ``solution.work``: ``load control``, the
+``prediction`` (a coarser model solved to predict the contact) and the
+``method``.
 """
 
 from __future__ import annotations
@@ -210,19 +212,24 @@ def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = 
     start = None if warm_start is None else WarmStart.of(warm_start)
     name = auto.choose(problem, options, start)[0] if method == "auto" else method
     bordered = problem.pending and name == "pdas-amg" and amg.border_factor(problem) is not None
-    if not problem.pending or bordered:  # the method solves it as it is (bordered: with the push)
-        options = {**_predictions(problem, name, options, coarse), **options}
-        return registry.run(problem, method, tol=tol, max_iter=max_iter, warm_start=start,
-                            **options)
-    matched = match(problem, predicted_zone(problem, coarse))
-    if method == "auto" and start is None:
+    stages: dict[str, dict[str, int]] = {}
+    if problem.pending and not bordered:
+        matched = match(problem, predicted_zone(problem, coarse))
+        stages["load control"] = matched.work
+        problem = matched.problem
+    if method == "auto" and start is None and "load control" in stages:
         start = matched.warm_start  # the fastest route: confirm what load control found
     else:  # a method named by the caller starts cold, from the scene's predictions only
-        options = {**_predictions(matched.problem, name, options, coarse), **options}
-    settled, solution = registry.run(matched.problem, method, tol=tol, max_iter=max_iter,
+        before = counters()
+        options = {**_predictions(problem, name, options, coarse), **options}
+        work = spent(before)
+        if work:  # a coarser model solved for its prediction
+            stages["prediction"] = work
+    settled, solution = registry.run(problem, method, tol=tol, max_iter=max_iter,
                                      warm_start=start, **options)
-    solution.work = {"load control": matched.work, **solution.work}
-    solution.message += f"; load matched by {matched.how} ({_said(matched.work)})"
+    solution.work = {**stages, **solution.work}
+    if "load control" in stages:
+        solution.message += f"; load matched by {matched.how} ({_said(matched.work)})"
     return settled, solution
 
 
@@ -231,5 +238,4 @@ def _said(work: dict[str, int]) -> str:
 
 
 __all__ = ["CoarseModel", "Matched", "ZONE_FROM_DOFS", "analytic_zone", "at_load", "coarse_zone",
-           "counters",
-           "match", "predicted_zone", "solve", "spent"]
+           "counters", "match", "predicted_zone", "solve", "spent"]

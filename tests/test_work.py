@@ -38,3 +38,14 @@ def test_a_warm_start_is_refused_by_a_method_that_cannot_use_one():
     result = signorini.solve("block", "pdas")
     with pytest.raises(signorini.InputError, match="takes no warm start"):
         signorini.solve(result.problem, "uzawa", warm_start=result)
+
+
+def test_a_prediction_from_a_coarser_model_reports_its_work():
+    """pdas-amg's first active set comes from a coarser model of the scene, solved for it: that
+    stage's factorisations are the result's too."""
+    pytest.importorskip("pyamg", reason="pdas-amg needs pyamg")
+    result = signorini.solve("hertz-sphere-3d", "pdas-amg",
+                             params={"delta": 0.0025, "refine": 1, "n_contact": 8})
+    assert result.converged and result.solution.extras["first_active"] == "given"
+    assert result.solution.work["prediction"]["factorisations"] >= 1
+    assert "factorisations" not in result.solution.work["method"]
