@@ -174,13 +174,17 @@ def at_load(problem: ContactProblem, coarse: CoarseModel | None = None) -> Conta
 
 
 def _predictions(problem: ContactProblem, method: str, options: dict[str, Any],
-                 coarse: CoarseModel | None) -> dict[str, Any]:
+                 coarse: CoarseModel | None, zone: Zone | None = None) -> dict[str, Any]:
     """What the scene predicts, as the options of a method that takes a prediction (its own
-    options win): ``nested`` a contact zone, ``pdas-amg`` a first active set."""
+    options win): ``nested`` a contact zone (``zone`` when load control already predicted it),
+    ``pdas-amg`` a first active set."""
     given = set(options)
     if method == "nested" and not given & {"zone", "coarse"} \
             and selection_dofs(problem.N) is not None:
-        zone = analytic_zone(problem) if options.get("analytic", True) else None
+        if not options.get("analytic", True):
+            zone = None  # the caller asked for no analytic zone: the coarse model's only
+        elif zone is None:
+            zone = analytic_zone(problem)
         if zone is None and coarse is not None:
             zone = coarse_zone(problem, coarse(problem))[0]
         return {"zone": zone} if zone is not None else {}
@@ -213,15 +217,17 @@ def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = 
     name = auto.choose(problem, options, start)[0] if method == "auto" else method
     bordered = problem.pending and name == "pdas-amg" and amg.border_factor(problem) is not None
     stages: dict[str, dict[str, int]] = {}
+    zone = None
     if problem.pending and not bordered:
-        matched = match(problem, predicted_zone(problem, coarse))
+        zone = predicted_zone(problem, coarse)  # predicted once: load control's, and nested's
+        matched = match(problem, zone)
         stages["load control"] = matched.work
         problem = matched.problem
     if method == "auto" and start is None and "load control" in stages:
         start = matched.warm_start  # the fastest route: confirm what load control found
     else:  # a method named by the caller starts cold, from the scene's predictions only
         before = counters()
-        options = {**_predictions(problem, name, options, coarse), **options}
+        options = {**_predictions(problem, name, options, coarse, zone), **options}
         work = spent(before)
         if work:  # a coarser model solved for its prediction
             stages["prediction"] = work
