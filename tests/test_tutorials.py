@@ -28,6 +28,7 @@ NOTEBOOKS = {
     "02-lagrangian-kkt-gap": 3,
     "03-multipliers-to-pressure": 2,
     "04-write-your-own-solver": 1,
+    "05-multipliers-are-prices": 5,
 }
 USER_SOLVER = TUTORIALS / "one_shot_solver.py"
 #: matplotlib-inline renders every figure to PNG at the end of a cell and never opens a window
@@ -41,7 +42,7 @@ def _path(name: str) -> Path:
     return TUTORIALS / f"{name}.ipynb"
 
 
-def test_the_tutorials_are_the_four_notebooks():
+def test_the_tutorials_are_the_five_notebooks():
     assert sorted(p.stem for p in TUTORIALS.glob("*.ipynb")) == sorted(NOTEBOOKS)
 
 
@@ -72,7 +73,7 @@ def test_notebook_runs_headless(name, monkeypatch):
 
 
 #: the notebooks rewritten on the public API alone (``import signorini``), with worked exercises
-PUBLIC_API_ONLY = ("01-two-contact-points",)
+PUBLIC_API_ONLY = ("01-two-contact-points", "05-multipliers-are-prices")
 
 
 @pytest.mark.parametrize("name", PUBLIC_API_ONLY)

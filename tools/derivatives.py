@@ -1,9 +1,13 @@
 """The cost of a derivative against the solve, and the discrete contact width against the fitted a.
 
-    python tools/derivatives.py [--refine 2 3] [--out docs/derivatives]
+    python tools/derivatives.py --set refine=3 --set n_contact=110 --set grading=0.1  # one mesh
+    python tools/derivatives.py --width     # width.json + width.png
+    python tools/derivatives.py --doc       # docs/derivatives.md's table from cost.json
 
-Writes ``cost.json`` (per mesh: dofs, solve and derivative seconds and work) and
-``width.json`` + ``width.png`` (the cylinder's discrete width and fitted a against P).
+``--set`` runs hertz-cylinder with those parameters once and puts its row (dofs, solve and
+derivative seconds and work) into ``cost.json``, replacing a row with the same parameters, so
+that each mesh is run once; ``--width`` writes the cylinder's discrete width and fitted a
+against P. Both then write the page's table (``tests/test_readme_numbers.py`` holds it to the JSON).
 """
 
 from __future__ import annotations
@@ -11,23 +15,22 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import sys
 import time
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import signorini
+from signorini.loading import counters, spent
 
-import signorini  # noqa: E402
-from signorini.loading import counters, spent  # noqa: E402
-
-FINE = {"n_contact": 110, "grading": 0.1}
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs" / "derivatives"
+PAGE = ROOT / "docs" / "derivatives.md"
 
 
-def cost(refine: int) -> dict:
-    problem = signorini.build_problem("hertz-cylinder", params={"refine": refine, **FINE})
+def cost(params: dict) -> dict:
+    problem = signorini.build_problem("hertz-cylinder", params=params)
     start, before = time.perf_counter(), counters()
     result = signorini.solve(problem)
     solve_s, solve_work = time.perf_counter() - start, spent(before)
@@ -37,7 +40,7 @@ def cost(refine: int) -> dict:
     start, before = time.perf_counter(), counters()
     again = signorini.derivative(result, "a", "P")
     again_s, again_work = time.perf_counter() - start, spent(before)
-    return {"refine": refine, "dofs": problem.n, "method": result.method, "solve_s": solve_s,
+    return {"params": params, "dofs": problem.n, "method": result.method, "solve_s": solve_s,
             "solve_work": solve_work, "first_derivative_s": first_s, "first_work": first_work,
             "next_derivative_s": again_s, "next_work": again_work,
             "d_total_force_dP": first.derivative, "d_ln_a_d_ln_P":
@@ -61,6 +64,11 @@ def widths(count: int = 41) -> dict:
 
 
 def figure(data: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     rows = data["rows"]
     P = np.array([r["P"] for r in rows])
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -78,20 +86,58 @@ def figure(data: dict, path: Path) -> None:
     fig.savefig(path, dpi=120)
 
 
+def _seconds(seconds: float, work: dict) -> str:
+    said = ", ".join(f"{count} {name.replace('_', '-')[:-1] if count == 1 else name.replace('_', '-')}"
+                     for name, count in work.items() if name in ("factorisations", "back_solves"))
+    return f"{seconds:.1f} s ({said})"
+
+
+def cost_table(data: dict) -> str:
+    """docs/derivatives.md's table: one row per mesh of ``cost.json``, by dofs."""
+    lines = ["| mesh | dofs | solve (auto → method) | first derivative | next derivative "
+             "| first / solve | d ln a / d ln P |", "|---|---:|---|---|---|---:|---:|"]
+    for r in sorted(data["rows"], key=lambda row: row["dofs"]):
+        mesh = ", ".join(f"{name}={value}" for name, value in r["params"].items())
+        lines.append(f"| {mesh} | {r['dofs']:,} | {_seconds(r['solve_s'], r['solve_work'])} → {r['method']} "
+                     f"| {_seconds(r['first_derivative_s'], r['first_work'])} "
+                     f"| {_seconds(r['next_derivative_s'], r['next_work'])} "
+                     f"| {r['first_derivative_s'] / r['solve_s']:.2f} | {r['d_ln_a_d_ln_P']:.4f} |")
+    return "\n".join(lines)
+
+
+def load() -> dict:
+    return json.loads((OUT / "cost.json").read_text())
+
+
+def _value(text: str):
+    try:
+        return int(text)
+    except ValueError:
+        return float(text)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--refine", type=int, nargs="*", default=[2, 3])
-    parser.add_argument("--out", default="docs/derivatives")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="a hertz-cylinder parameter of the mesh to time (repeat)")
+    parser.add_argument("--width", action="store_true", help="write width.json and width.png")
+    parser.add_argument("--doc", action="store_true", help="only write the page's table")
     args = parser.parse_args()
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    data = widths()
-    (out / "width.json").write_text(json.dumps(data, indent=1))
-    figure(data, out / "width.png")
-    if args.refine:
-        rows = [cost(refine) for refine in args.refine]
-        (out / "cost.json").write_text(json.dumps({"scene": "hertz-cylinder", "params": FINE,
-                                                   "rows": rows}, indent=1))
+    OUT.mkdir(parents=True, exist_ok=True)
+    if args.width:
+        data = widths()
+        (OUT / "width.json").write_text(json.dumps(data, indent=1))
+        figure(data, OUT / "width.png")
+    if args.set:
+        params = {name: _value(value) for name, value in (item.split("=", 1) for item in args.set)}
+        data = load() if (OUT / "cost.json").exists() else {"scene": "hertz-cylinder", "rows": []}
+        rows = [row for row in data["rows"] if row["params"] != params] + [cost(params)]
+        data["rows"] = sorted(rows, key=lambda row: row["dofs"])
+        (OUT / "cost.json").write_text(json.dumps(data, indent=1))
+    sys.path.insert(0, str(ROOT / "tools"))
+    import readme  # noqa: E402  (tools/readme.py: the generated blocks of the docs pages)
+
+    readme.fill_blocks(PAGE, {"derivative-cost": cost_table(load())})
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
 import amg_bench  # noqa: E402  (tools/amg_bench.py: 3D at scale, docs/amg)
+import derivatives as derivative_cost  # noqa: E402  (tools/derivatives.py: a derivative against the solve)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 import startup  # noqa: E402  (tools/startup.py: whole-process time before the contact)
@@ -33,7 +34,8 @@ ACCURACY = ROOT / "docs" / "accuracy.md"
 ESTIMATE = ROOT / "docs" / "estimate.md"
 PEER = ROOT / "docs" / "peer.md"
 CONVERGENCE = ROOT / "docs" / "convergence.md"
-DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE)
+DERIVATIVES = ROOT / "docs" / "derivatives.md"
+DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE, DERIVATIVES)
 #: the contact half-width of each convergence study's scene at its defaults (h / a in the tables)
 STUDY_A = {"hertz-cylinder": 0.05, "hertz-sphere": 0.05, "reverse-hertz": 0.02, "punch": 1.0}
 STUDY_COLUMNS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
@@ -142,6 +144,8 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
     if document == ESTIMATE:
         return estimate_study.tables(estimate_study.load(), estimate_study.load("adaptive"),
                                     estimate_study.load("punch"), estimate_study.load("start"))
+    if document == DERIVATIVES:
+        return {"derivative-cost": derivative_cost.cost_table(derivative_cost.load())}
     raise ValueError(f"no generated blocks for {document}")
 
 
