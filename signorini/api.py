@@ -152,8 +152,10 @@ class Result:
     @property
     def sensitivity(self) -> derivatives.Sensitivity:
         """The KKT system on the active set, factorised at the first derivative asked for."""
-        if not hasattr(self, "_sensitivity"):
-            self._sensitivity = derivatives.Sensitivity(self.problem, self.solution)
+        if not hasattr(self, "_sensitivity"):  # handed the method's factor, if it was kept
+            self._sensitivity = derivatives.Sensitivity(self.problem, self.solution,
+                                                        self.solution.factor)
+            self.solution.factor = None
         return self._sensitivity
 
     def jvp(self, df: Any = None, dd: Any = None, side: str = "auto") -> derivatives.Tangent:
@@ -281,7 +283,7 @@ def solve_summary(record: dict[str, Any]) -> str:
 
 def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: float | None = None,
           max_iter: int | None = None, warm_start: Any = None, params: dict[str, Any] | None = None,
-          **options: Any) -> Result:
+          keep_factor: bool = False, **options: Any) -> Result:
     """Solve a problem (or a scene by name) and judge the answer with the KKT certificate.
 
     ``problem`` is a :class:`ContactProblem` (from :func:`build_problem`,
@@ -296,7 +298,10 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     relative KKT tolerance the answer must meet to be ``converged`` (None:
     the method's default; a QP backend then runs at its own settings and its
     answer is held to :data:`signorini.DEFAULT_TOL`); other keyword arguments
-    are the method's options.
+    are the method's options. ``keep_factor=True`` keeps the method's last
+    factorisation on the result (in memory) for the answer's first derivative
+    (:meth:`Result.jvp`, :func:`signorini.derivative`), which reuses it when it
+    pins the final active set (``pdas``): back-solves only.
     Bad input raises :class:`signorini.InputError`; a method that fails
     returns a result whose ``status`` says so.
     """
@@ -316,7 +321,8 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
                          f"{type(problem).__name__}: build one with signorini.build_problem(...) "
                          "or ContactProblem.from_qp(K, f, N, d)")
     problem, solution = load_control(problem, method, tol=tol, max_iter=max_iter,
-                                     warm_start=warm_start, coarse=coarse_problem, **options)
+                                     warm_start=warm_start, coarse=coarse_problem,
+                                     keep_factor=keep_factor, **options)
     return Result(problem, solution, certificate(problem, solution))
 
 

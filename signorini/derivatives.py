@@ -95,7 +95,8 @@ class Sensitivity:
     """The KKT system of one answer on its active set, factorised once, in the problem's units.
 
     ``factor`` is a factorisation the method holds (reused when it pins this
-    very active set); otherwise the first solve makes one and later ones reuse it.
+    very active set, else let go before another is made); otherwise the first
+    solve makes one and later ones reuse it.
     """
 
     def __init__(self, problem: ContactProblem, solution: ContactSolution, factor: Any = None):
@@ -110,6 +111,8 @@ class Sensitivity:
 
     def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(du, dλ)`` on ``active`` (f: n or n × k, d: m or m × k), reusing the factorisation."""
+        if not self._system.pins(active, self._factor):
+            self._factor = None  # not this system's: let go before the solve makes another
         du, dlam = self._system.solve(active, f, d, factor=self._factor)
         if self._system.factor is not None:
             self._factor = self._system.factor
@@ -350,8 +353,9 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
     load), ``delta`` (a push-controlled scene's push) and ``obstacle`` (the
     obstacle's position along the load axis, towards the body). A parameter
     that moves the mesh is refused: shape derivatives are not provided.
-    Cost: the solve, then one factorisation of the active-set system (K with
-    the active dofs pinned) and two back-solves.
+    Cost: the solve, then two back-solves, with the method's factorisation
+    when it pins the final active set (``pdas``), else one factorisation of
+    the active-set system (K with the active dofs pinned) first.
     """
     if output not in OUTPUTS:
         raise InputError(f"output must be one of {', '.join(OUTPUTS)}, got {output!r}")
@@ -362,7 +366,7 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
                          "derivatives are not provided")
     if isinstance(scene, str):
         problem = build_problem(scene, params=scene_params(params), solved_by=method)
-        problem, solution = load_control(problem, method, coarse=coarse_problem)
+        problem, solution = load_control(problem, method, coarse=coarse_problem, keep_factor=True)
         result = None
     else:
         if params:
@@ -372,7 +376,7 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
         raise SolverError(f"the answer is {solution.status} ({solution.message}): only an exact "
                           "answer has a derivative")
     delta = change(problem, solution, wrt)
-    sensitivity = Sensitivity(problem, solution) if result is None else result.sensitivity
+    sensitivity = Sensitivity(problem, solution, solution.factor) if result is None else result.sensitivity
     tangent = scene_tangent(sensitivity, delta)
     value, slope = outputs(problem, solution, output, at, tangent, delta)
     return SceneDerivative(output, wrt, value, slope, sensitivity.weak, result)

@@ -187,7 +187,8 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
         forward = _forward(problem, solution, lam_norm)
         energy = float(0.5 * u @ Ku - problem.f @ u)
         absolute = primal_dual_gap(problem, u, lam, (solution.factor, problem.cached_factor), Ku)
-        solution.factor = None  # used: a kept solution no longer keeps a factorisation alive
+        if not solution.keep_factor:  # used: a kept solution no longer keeps a factorisation alive
+            solution.factor = None
         gap = abs(absolute) / _positive(max(abs(energy), abs(energy - absolute)))
     return Certificate(primal, stationarity, dual_sign, complementarity, natural, gap,
                        forward.force, forward.displacement, forward.floor, forward.back_solves)

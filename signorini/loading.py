@@ -205,13 +205,14 @@ def _predictions(problem: ContactProblem, method: str, options: dict[str, Any],
 
 def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = None,
           max_iter: int | None = None, warm_start: Any = None, coarse: CoarseModel | None = None,
-          **options: Any) -> tuple[ContactProblem, ContactSolution]:
+          keep_factor: bool = False, **options: Any) -> tuple[ContactProblem, ContactSolution]:
     """Solve ``problem`` with ``method``, matching its target load first when it has one.
 
     Returns the problem the answer solves (``problem`` itself, or it at the
     matched push) and the judged solution. ``coarse`` (from the scene: a
     coarser model of the same scene) feeds the predictions of the zone kernel,
-    ``nested`` and ``pdas-amg``.
+    ``nested`` and ``pdas-amg``; ``keep_factor`` keeps the method's last
+    factorisation on the solution (see :func:`signorini.solvers.registry.run`).
     """
     start = None if warm_start is None else WarmStart.of(warm_start)
     name = auto.choose(problem, options, start)[0] if method == "auto" else method
@@ -232,7 +233,7 @@ def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = 
         if work:  # a coarser model solved for its prediction
             stages["prediction"] = work
     settled, solution = registry.run(problem, method, tol=tol, max_iter=max_iter,
-                                     warm_start=start, **options)
+                                     warm_start=start, keep_factor=keep_factor, **options)
     solution.work = {**stages, **solution.work}
     if "load control" in stages:
         solution.message += f"; load matched by {matched.how} ({_said(matched.work)})"

@@ -69,8 +69,11 @@ class ContactSolution:
     #: the method's own status when the package's certificate disagreed with it ("" otherwise)
     claimed_status: str = ""
     #: a factorisation of the problem's K the method holds (a PinnedFactor, possibly with
-    #: contact dofs pinned), which the certificate reuses for its duality gap and then lets go
+    #: contact dofs pinned), which the certificate reuses for its duality gap and then lets go,
+    #: unless ``keep_factor`` (asked for by ``signorini.solve(..., keep_factor=True)``: the
+    #: first derivative of the answer then reuses it when it pins the final active set)
     factor: Any = field(default=None, repr=False, compare=False)
+    keep_factor: bool = field(default=False, repr=False, compare=False)
     #: the work of every stage that ran, by stage ("method", "load control"): active-set or
     #: load-control steps, factorisations, back-solves, CG iterations
     work: dict[str, dict[str, int]] = field(default_factory=dict)

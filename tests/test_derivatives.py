@@ -147,6 +147,20 @@ def test_a_derivative_costs_back_solves_once_factorised(results):
     assert after == {"factorisations": 0, "back_solves": 3}
 
 
+def test_a_kept_factorisation_makes_the_first_derivative_back_solves_only():
+    """``keep_factor=True``: pdas's last factorisation pins the final active set, and is reused."""
+    kept = signorini.solve("hertz-cylinder", "pdas", keep_factor=True)
+    assert kept.solution.factor is not None
+    df, dd = _directions(kept)
+    before = dict(COUNTS)
+    tangent = kept.jvp(df, dd)
+    assert {key: COUNTS[key] - before[key] for key in COUNTS} == {"factorisations": 0, "back_solves": 1}
+    assert kept.solution.factor is None  # handed over to the derivatives, not kept twice
+    fresh = signorini.solve("hertz-cylinder", "pdas")
+    assert fresh.solution.factor is None  # let go after judging, by default
+    assert _rel(tangent.du, fresh.jvp(df, dd).du) < 1e-10
+
+
 def test_a_parameter_that_moves_the_mesh_is_refused():
     with pytest.raises(signorini.InputError, match="shape derivatives are not provided"):
         signorini.derivative("hertz-cylinder", "total_force", "R")

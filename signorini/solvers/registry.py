@@ -119,7 +119,7 @@ def check_request(method: str, tol: Any = None, max_iter: Any = None,
 
 
 def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
-        max_iter: int | None = None, warm_start: WarmStart | None = None,
+        max_iter: int | None = None, warm_start: WarmStart | None = None, keep_factor: bool = False,
         **options: Any) -> tuple[ContactProblem, ContactSolution]:
     """Run ``method`` on ``problem`` and judge its answer: ``(problem solved, solution)``.
 
@@ -127,7 +127,9 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
     a pending target load with the answer (``targets_load``), ``problem``
     at the push it reports (``solution.extras["push"]``). The method's work
     (factorisations, back-solves, CG iterations) is counted into
-    ``solution.work["method"]``. See :func:`solve`.
+    ``solution.work["method"]``. ``keep_factor`` keeps the method's last
+    factorisation on the solution after judging (for the answer's derivatives).
+    See :func:`solve`.
     """
     spec, tol, max_iter, options = check_request(method, tol, max_iter, options)
     if problem.pending and not spec.targets_load:
@@ -163,6 +165,7 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
     solution.work["method"] = {"steps": int(solution.iterations), **{
         key: now[key] - before[key] for key in ("factorisations", "back_solves", "cg_iterations",
                                                 "hierarchies") if now[key] != before[key]}}
+    solution.keep_factor = keep_factor
     if "auto" not in solution.extras:  # auto names the method it picked
         solution.method = method
     if problem.pending:
