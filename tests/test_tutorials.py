@@ -72,7 +72,8 @@ def test_notebook_runs_headless(name, monkeypatch):
 
 
 #: the notebooks rewritten on the public API alone (``import signorini``), with worked exercises
-PUBLIC_API_ONLY = ("01-two-contact-points", "02-lagrangian-kkt-gap")
+PUBLIC_API_ONLY = ("01-two-contact-points", "02-lagrangian-kkt-gap",
+                   "03-multipliers-to-pressure")
 
 
 @pytest.mark.parametrize("name", PUBLIC_API_ONLY)
