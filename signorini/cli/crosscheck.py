@@ -1,4 +1,4 @@
-"""``signorini crosscheck``: one scene, several methods, every pair of answers compared."""
+"""``signorini crosscheck``: one scene or problem file, several methods, every pair compared."""
 
 from __future__ import annotations
 
@@ -58,7 +58,8 @@ def add_parsers(sub) -> None:
                     "of answers: λ and u (relative), nodes classified differently, each method's "
                     "status and KKT certificate, Hertz's errors. Exit 1 when two methods that say "
                     "converged disagree.")
-    cross.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
+    cross.add_argument("scene", help="scene name (see 'signorini scenes'), a .toml scene file, or "
+                       "a problem file: .npz (save's or plain) or Matrix Market (docs/problem-files.md)")
     cross.add_argument("--method", action="append", default=[], metavar="M",
                        help="a method to compare (repeat; default uzawa, qp-osqp, qp-clarabel, "
                             "cvxpy, pdas)")

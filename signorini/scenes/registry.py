@@ -48,7 +48,8 @@ def get_scene(name: str) -> SceneFamily:
     """Look a scene family up by name; unknown names list the known ones."""
     if name not in SCENES:
         raise InputError(f"unknown scene {name!r}: choose one of {', '.join(sorted(SCENES))} "
-                         "(or give the path of a .toml scene file)")
+                         "(or give the path of a .toml scene file, or of a problem file: .npz or "
+                         "Matrix Market, see docs/problem-files.md)")
     return SCENES[name]
 
 
