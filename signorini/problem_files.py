@@ -85,6 +85,9 @@ def read_problem(name: str | os.PathLike) -> ContactProblem:
             return _from_arrays(path, _matrix_market(folder), folder.name)
         if not path.is_file():
             raise InputError(f"problem file {str(path)!r} is not a regular file: give a .npz file")
+        if path.suffix.lower() != ".npz":
+            raise InputError(f"{str(path)!r} is not a problem file: give a .npz file or a folder "
+                             f"of Matrix Market files ({FORMATS})")
         arrays = _npz(path)
         if "meta" in arrays:  # written by ContactProblem.save
             return _saved(path)

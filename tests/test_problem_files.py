@@ -232,3 +232,30 @@ def test_an_output_onto_the_problem_file_is_refused(tmp_path, capsys):
     assert main(["solve", str(path), "--json", str(path)]) == 2
     assert "problem file" in capsys.readouterr().err
     assert path.read_bytes() == before
+
+
+def test_bench_takes_a_problem_file_as_one_size(block, tmp_path, capsys):
+    import csv
+
+    path = write_matrix_market(block, tmp_path)
+    out = tmp_path / "bench"
+    assert main(["bench", "--problem", str(path), "--method", "pdas", "--method", "uzawa",
+                 "--tolerance", "mid", "--out", str(out)]) == 0
+    with open(out / "bench.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert {(r["scene"], r["size"], r["method"]) for r in rows} == {
+        ("market", "file", "pdas"), ("market", "file", "uzawa")}
+    assert all(int(r["dofs"]) == block.n and int(r["candidates"]) == block.m for r in rows)
+    exact = next(r for r in rows if r["method"] == "pdas")
+    assert exact["status"] == "converged" and float(exact["lam_rel"]) < 1e-8
+    assert (out / "bench.md").is_file()
+
+
+@pytest.mark.parametrize("flags", [["--sizes", "0,1"], ["--scene", "block"], ["--set", "E=2"],
+                                   ["--peer", "getfem"]])
+def test_bench_refuses_scene_options_with_a_problem_file(tmp_path, capsys, flags):
+    path = write_bad(tmp_path, "small.npz", SMALL)
+    assert main(["bench", "--problem", str(path), *flags, "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err
+    assert flags[0] in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "b").exists()

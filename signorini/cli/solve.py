@@ -6,7 +6,7 @@ import argparse
 import os
 import sys
 
-from signorini.cli.common import (EXIT_FAILED, input_files, pairs, parse_time_limit,
+from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, parse_time_limit,
                                   parse_tol, stdout_to_stderr, write_output)
 from signorini.errors import InputError
 from signorini.solvers.base import DEFAULT_TOL
@@ -106,8 +106,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 def add_parsers(sub) -> None:
     """Register ``solve``."""
     solve = sub.add_parser("solve", help="solve one scene with one method")
-    solve.add_argument("scene", help="scene name (see 'signorini scenes'), a .toml scene file, or "
-                       "a problem file: .npz (save's or plain) or Matrix Market (docs/problem-files.md)")
+    solve.add_argument("scene", help=SCENE_HELP)
     solve.add_argument("--method", default="auto",
                        help="method name (see 'signorini methods'; auto: pdas in 2D, pdas-amg for large 3D)")
     solve.add_argument("--tol", help="the method's tolerance (default: the method's own; a QP "

@@ -97,7 +97,7 @@ def build_spec(spec: dict[str, Any]) -> ContactProblem:
 def candidate_spacing(problem: ContactProblem) -> float:
     """Median distance from each contact candidate to its nearest neighbour (physical units)."""
     points = problem.contact_points * problem.scales.length
-    if len(points) < 2:
+    if len(points) < 2 or not np.all(np.isfinite(points)):  # no positions: a QP given as arrays
         return float("nan")
     distance, _ = cKDTree(points).query(points, k=2)
     return float(np.median(distance[:, 1]))
