@@ -259,3 +259,13 @@ def test_bench_refuses_scene_options_with_a_problem_file(tmp_path, capsys, flags
     err = capsys.readouterr().err
     assert flags[0] in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "b").exists()
+
+
+@pytest.mark.parametrize("argv", [["converge", "{path}", "--out", "{tmp}/c"],
+                                  ["bench", "--scene", "{path}", "--out", "{tmp}/c"]])
+def test_a_command_that_needs_a_scene_says_so_of_a_problem_file(tmp_path, capsys, argv):
+    path = write_bad(tmp_path, "small.npz", SMALL)
+    assert main([a.format(path=path, tmp=tmp_path) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert "is a problem file, and this needs a scene" in err and "small.npz" in err
+    assert not (tmp_path / "c").exists()
