@@ -28,7 +28,7 @@ import numpy as np
 
 from signorini.errors import BackendNotInstalled, InputError, SolverError
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers import forms
+from signorini.solvers import clarabel_, forms
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare
 from signorini.solvers.backend_output import c_output_discarded, silence_highs_banner
@@ -68,7 +68,8 @@ class Backend:
     falls back to primal when it cannot be built (K singular, m > max_dense_dofs);
     ``polish`` is the default of the option ``polish`` (docs/crosscheck.md);
     ``prints`` says the backend writes to stdout from C whatever its verbosity
-    (its calls then run with the process's output sent nowhere).
+    (its calls then run with the process's output sent nowhere); ``call``
+    solves the qpsolvers problem instead of :func:`qpsolvers.solve_problem`.
     """
 
     name: str
@@ -87,6 +88,7 @@ class Backend:
     form: str = "primal"
     polish: bool = False
     prints: bool = False
+    call: Callable[..., Any] | None = None
 
     @property
     def method_name(self) -> str:
@@ -224,6 +226,7 @@ BACKENDS: tuple[Backend, ...] = (
                  "iterative_refinement_max_iter", "iterative_refinement_stop_ratio",
                  "presolve_enable"),
         tolerance=_clarabel_tolerance, max_iter_option="max_iter", extra="",
+        call=clarabel_.solve_problem,  # qpsolvers drops the iteration count
         polish=True),  # polished, every validation case ends converged and exact at 1e-8
     Backend(
         "proxqp", "ProxQP", "ProxQP (proximal augmented Lagrangian) through qpsolvers",
@@ -421,7 +424,8 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
     try:
         with warnings.catch_warnings(record=True) as record, quiet:
             warnings.simplefilter("always")
-            result = qpsolvers.solve_problem(qp, spec.name, verbose=False, **settings)
+            result = (qpsolvers.solve_problem(qp, spec.name, verbose=False, **settings)
+                      if spec.call is None else spec.call(qp, **settings))
     except qpsolvers.ParamError as exc:
         raise InputError(f"{spec.label}: bad option: {exc}") from exc
     except Exception as exc:
