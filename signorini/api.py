@@ -335,12 +335,12 @@ def solve_adaptive(scene: str, target_error: float | str, method: str = DEFAULT_
     return result
 
 
-def certificate(problem: ContactProblem, solution: ContactSolution | Result | None = None, *,
+def certificate(problem: ContactProblem, solution: ContactSolution | None = None, *,
                 u: Any = None, force: Any = None, duality_gap: bool = True) -> Certificate:
     """The relative KKT residuals of an answer ``(u, λ)`` of ``problem`` (:class:`Certificate`).
 
     Give the answer as a ``solution`` (a :class:`ContactSolution` in the
-    problem's own, dimensionless arrays, or a :class:`Result`), or as arrays in
+    problem's own, dimensionless arrays: ``result.solution``), or as arrays in
     your units: ``u`` the QP's unknown (n entries, as ``Result.u``) and
     ``force`` the contact forces λ (m entries, as ``Result.force``); they are
     scaled by ``problem.scales`` as every method's answer is.
@@ -363,11 +363,6 @@ def certificate(problem: ContactProblem, solution: ContactSolution | Result | No
         scales = problem.scales
         solution = ContactSolution(method="given", u=u / scales.displacement,
                                    lam=force / scales.force, status="converged")
-    elif isinstance(solution, Result):
-        solution = solution.solution
-    elif solution is None:
-        raise InputError("certificate: give the answer, as a solution (result.solution) or as "
-                         "u= and force= in the problem's units")
     return kkt.certificate(problem, solution, duality_gap)
 
 

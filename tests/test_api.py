@@ -94,7 +94,7 @@ def test_a_qp_with_weights_has_pressures_and_survives_save_and_load(tmp_path):
     assert signorini.solve(problem).pressure == pytest.approx([5.0])
     problem.save(tmp_path / "p.npz")
     again = signorini.ContactProblem.load(tmp_path / "p.npz")
-    assert again.weights == pytest.approx([0.1])
+    assert again.weights * again.scales.weight == pytest.approx([0.1])  # kept scaled, with its scale
     bare = signorini.ContactProblem.from_qp(np.eye(1), [1.0], [[1.0]], [0.5])
     bare.save(tmp_path / "q.npz")
     assert signorini.ContactProblem.load(tmp_path / "q.npz").weights is None

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import functools
 import os
 import sys
@@ -12,8 +13,9 @@ __all__ = ["c_output_discarded", "silence_highs_banner"]
 
 @contextlib.contextmanager
 def c_output_discarded():
-    """The process's stdout and stderr sent nowhere, at the file descriptors: for backends that
-    print from C whatever their verbosity (HiGHS's banner; OSQP's "Polishing not needed")."""
+    """The process's stdout and stderr sent nowhere, at the file descriptors and in Python: for
+    backends that print whatever their verbosity, from C or through Python's ``sys.stdout``
+    (HiGHS's banner; OSQP's "Polishing not needed")."""
     sys.stdout.flush()
     sys.stderr.flush()
     saved = [os.dup(1), os.dup(2)]
@@ -21,8 +23,11 @@ def c_output_discarded():
     try:
         os.dup2(sink, 1)
         os.dup2(sink, 2)
-        yield
+        with open(os.devnull, "w") as nowhere, contextlib.redirect_stdout(nowhere), \
+                contextlib.redirect_stderr(nowhere):
+            yield
     finally:
+        ctypes.CDLL(None).fflush(None)  # what C buffered goes where it was meant to: nowhere
         os.dup2(saved[0], 1)
         os.dup2(saved[1], 2)
         for fd in saved + [sink]:
