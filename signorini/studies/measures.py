@@ -6,6 +6,7 @@ it compares) and returns numbers for a row of :mod:`signorini.studies.runner`.
 
 from __future__ import annotations
 
+import os
 import time
 from typing import Any
 
@@ -13,7 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
-from signorini.numerics.factor import factorize, resolve_backend
+from signorini.numerics.factor import PardisoFactor, factorize, resolve_backend
 from signorini.numerics.lcp import delassus
 from signorini.pressure import contact_profile
 from signorini.problem import ContactProblem, ContactSolution
@@ -124,3 +125,29 @@ def answer_from(record: dict[str, Any]) -> ContactSolution:
                            message=record["message"], iterations=record["iterations"],
                            build_time=record["build_time"], solve_time=record["solve_time"],
                            claimed_status=record["claimed_status"])
+
+
+def forward_error(problem: ContactProblem, reference: ContactSolution,
+                  solution: ContactSolution) -> dict[str, float]:
+    """The true force error ``‖λ − λ*‖∞ / ‖λ*‖∞`` beside what the certificate estimates of it:
+    its forward error, that estimate's floor and the back-solves it took."""
+    cert = certificate(problem, solution)
+    lam_error = float(np.max(np.abs(solution.lam - reference.lam)) / np.max(np.abs(reference.lam)))
+    return {"lam_error": lam_error, "force_error": cert.force_error,
+            "force_error_floor": cert.force_error_floor, "back_solves": cert.back_solves}
+
+
+def resident() -> float:
+    """This process's resident set size in bytes (Linux)."""
+    with open("/proc/self/statm", encoding="ascii") as statm:
+        return float(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def factor_memory(problem: ContactProblem) -> dict[str, float]:
+    """PARDISO's analysis-phase estimate of its factorisation of K (the package refuses one by
+    it) against the growth of this process's resident memory that factorisation took."""
+    before = resident()
+    factor = PardisoFactor(problem.K)
+    growth = resident() - before
+    return {"estimate_bytes": factor.memory, "resident_growth_bytes": growth,
+            "ratio": factor.memory / growth}

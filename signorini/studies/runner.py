@@ -43,6 +43,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from signorini.crosschecking import crosscheck
 from signorini.diagnose import diagnose
 from signorini.errors import InputError
 from signorini.fem.estimate import estimate
@@ -62,8 +63,10 @@ from signorini.studies.measures import (
     answer_record,
     bound_at_solution,
     certificate_of,
+    factor_memory,
     factorisation_time,
     force_error,
+    forward_error,
     hertz_errors,
     pressure_profile,
     weak_but_penetrating,
@@ -72,6 +75,7 @@ from signorini.studies.problems import build_spec, candidate_spacing, exact_atte
 from signorini.studies.task import (
     ATLAS_TOL,
     BUILD_ONLY,
+    CROSSCHECK,
     DEFAULT_TIME_LIMIT,
     MEASURES,
     Row,
@@ -98,9 +102,9 @@ NUMERIC = ("dofs", "candidates", "iterations", "time_s", "kkt_worst", "lam_rel",
            "pressure_l2_rel", "ref_a_rel", "ref_p0_rel", "ref_pressure_l2_rel", "rho_over_bound",
            "lambda_max", "bound_at_solution", "patch_lam_rel")
 #: the statuses a run can end with besides :data:`signorini.problem.STATUSES`
-EXTRA_STATUSES = ("built", "refused", "input-error", "raised", "timeout", "crashed")
+EXTRA_STATUSES = ("built", "checked", "refused", "input-error", "raised", "timeout", "crashed")
 
-__all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "DEFAULT_TIME_LIMIT",
+__all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "CROSSCHECK", "DEFAULT_TIME_LIMIT",
            "EXTRA_STATUSES", "ITERATION_CAPS", "MEASURES", "NEAR_FACTOR", "NUMERIC", "Row", "Task",
            "Worker", "in_worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "task_row"]
 #: the verdicts on a row (the name the tests know)
@@ -138,6 +142,10 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
                    message=str(exc), scene=task.problem.get("scene", "block"))
         return verdict(row, task)
     row.update(scene=problem.scene, dofs=problem.n, candidates=problem.m)
+    if "matrix" in task.measure:
+        row["nonzeros"] = int(problem.K.nnz)
+    if "factor_memory" in task.measure:
+        row["factor_memory"] = factor_memory(problem)
     if "mesh" in task.measure:
         row.update(h=candidate_spacing(problem), assemble_s=problem.discretisation.assemble_s)
     if "diagnosis" in task.measure:
@@ -163,6 +171,12 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
                                                      lambda: bound_at_solution(problem, reference))
         return reference
 
+    if task.method == CROSSCHECK:
+        check = crosscheck(problem, task.options["methods"], tol=task.tol,
+                           options=task.options.get("options"))
+        row.update(status="checked", wrapper="returned", claimed_status="", crosscheck=check.to_dict(),
+                   message="every judged pair agrees" if check.passed else "a pair disagrees")
+        return verdict(row, task)
     if task.method == BUILD_ONLY:
         if "exact" in task.measure:
             exact()
@@ -172,23 +186,27 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
     if "factorisation" in task.measure:
         row["factor_s"] = factorisation_time(problem)
     reference = None if task.fresh else exact()
-    solution = run_on(problem, task, row)
-    if solution is None:
+    solved = run_on(problem, task, row)
+    if solved is None:
         return verdict(row, task)
+    problem, solution = solved
     if task.fresh:
         reference = exact(solution if task.is_policy_run else None)
     measure_answer(problem, task, row, solution, reference)
     return verdict(row, task)
 
 
-def run_on(problem: ContactProblem, task: Task, row: Row) -> ContactSolution | None:
-    """Solve ``problem`` as ``task`` says and record what the method said (None when refused)."""
+def run_on(problem: ContactProblem, task: Task,
+           row: Row) -> tuple[ContactProblem, ContactSolution] | None:
+    """Solve ``problem`` as ``task`` says and record what the method said: the problem solved (at
+    the load matched, for a target load left to the method) and the answer; None when refused."""
     start = time.perf_counter()
     wrapper = "returned"
     try:
         # the scene's predictions reach the methods that take them (nested, pdas-amg)
-        solution = load_control(problem, task.method, tol=task.tol, max_iter=task.max_iter,
-                                coarse=coarse_problem, **task.options)[1]
+        problem, solution = load_control(problem, task.method, tol=task.tol,
+                                         max_iter=task.max_iter, coarse=coarse_problem,
+                                         **task.options)
     except InputError as exc:
         row.update(status="refused", wrapper="input-error", claimed_status="", message=str(exc),
                    time_s=time.perf_counter() - start)
@@ -205,7 +223,7 @@ def run_on(problem: ContactProblem, task: Task, row: Row) -> ContactSolution | N
         row.update(build_s=solution.build_time, solve_s=solution.solve_time, method_s=method_s)
         if "factor_s" in row:
             row["ratio_to_factor"] = method_s / row["factor_s"]
-    return solution
+    return problem, solution
 
 
 def _own_answer(problem: ContactProblem, task: Task) -> ContactSolution:
@@ -262,6 +280,8 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
     finite = bool(np.all(np.isfinite(solution.lam)))
     if "profile" in task.measure and finite:
         row["profile"] = pressure_profile(problem, solution)
+    if reference is not None and "forward_error" in task.measure:
+        row["forward_error"] = forward_error(problem, reference, solution)
     if "lam" in task.measure:
         row["lam"] = solution.lam.tolist()
     if "answer" in task.measure:
