@@ -205,9 +205,13 @@ def _solved_by(method: str) -> Callable[..., ContactSolution]:
 
 def _refined(problem: ContactProblem, spec: dict[str, Any],
              other: ContactProblem | None) -> ContactSolution:
-    """PDAS's answer with (u, λ) refined in long double on its active set (``spec["steps"]``)."""
+    """PDAS's answer with (u, λ) refined in long double on its active set (``spec["steps"]``).
+
+    Its active set is taken whatever the certificate said of its λ (near ν = ½ it cannot
+    certify λ, which is what the refinement is for); an answer with no finite λ is returned as is.
+    """
     start = _solved_by("pdas")(problem, spec, other)
-    if start.status != "converged":
+    if not (np.all(np.isfinite(start.u)) and np.all(np.isfinite(start.lam))):
         return start
     u, lam = refined_on_active_set(problem.K, problem.f, problem.N, problem.d, start.u, start.lam,
                                    active_set(problem, start), factorize(problem.K),
