@@ -91,11 +91,8 @@ def row_of(case: dict, row: dict) -> dict:
 
 def run(chosen: list[dict] | None = None) -> list[dict]:
     chosen = cases() if chosen is None else chosen
-
-    def progress(i: int, count: int, task: Task, row: dict) -> None:
-        print(f"{i}/{count} {task.case} {task.problem['params']}: {row['status']}", file=sys.stderr)
-
-    rows = run_tasks([task(c) for c in chosen], time_limit=TIME_LIMIT, progress=progress)
+    rows = run_tasks([task(c) for c in chosen], time_limit=TIME_LIMIT, progress=lambda i, n, t, r:
+                     print(f"{i}/{n} {t.case} {t.problem['params']}: {r['status']}", file=sys.stderr))
     return [row_of(case, row) for case, row in zip(chosen, rows)]
 
 

@@ -50,10 +50,8 @@ def row_of(row: dict) -> dict:
 
 
 def run(nus: tuple[float, ...] = NUS) -> list[dict]:
-    def progress(i: int, count: int, task: Task, row: dict) -> None:
-        print(f"{i}/{count} ν={task.value:<14.12g} {task.method:15s} {row['status']}", file=sys.stderr)
-
-    return [row_of(row) for row in run_tasks(tasks(nus), progress=progress)]
+    return [row_of(row) for row in run_tasks(tasks(nus), progress=lambda i, n, t, r: print(
+        f"{i}/{n} ν={t.value:<14.12g} {t.method:15s} {r['status']}", file=sys.stderr))]
 
 
 def _method(row: dict) -> str:

@@ -69,13 +69,10 @@ def run(cases=DEFAULT_CASES) -> dict:
             "machine": f"{platform.node()}: {platform.processor() or platform.machine()}, "
                        f"{os.cpu_count()} cores, Python {platform.python_version()}",
             "load_before": list(os.getloadavg()), "variants": {}}
-    start = time.perf_counter()
-
-    def progress(i: int, count: int, task: Task, row: dict) -> None:
-        print(f"{task.case:<22} {task.axis:<8} {row['status']}: {row['message']}", file=sys.stderr)
-
-    chosen = tasks(cases)
-    for task, row in zip(chosen, run_tasks(chosen, time_limit=TIME_LIMIT, progress=progress)):
+    start, chosen = time.perf_counter(), tasks(cases)
+    for task, row in zip(chosen, run_tasks(chosen, time_limit=TIME_LIMIT, progress=lambda i, n, t, r:
+                                           print(f"{t.case:<22} {t.axis:<8} {r['message']}",
+                                                 file=sys.stderr))):
         if "crosscheck" not in row:
             raise RuntimeError(f"{task.case} ({task.axis}): {row['status']}: {row['message']}")
         data["variants"].setdefault(task.axis, {})[task.case] = {**row["crosscheck"],
