@@ -80,3 +80,20 @@ def test_factor_memory_is_measured_in_a_process_of_its_own():
     assert row["dofs"] == problem.n
     assert row["estimate_bytes"] == PardisoFactor(problem.K).memory  # the analysis is deterministic
     assert row["resident_growth_bytes"] > 0 and np.isfinite(row["ratio"])
+
+
+def test_an_effectivity_level_is_measured_against_the_finer_solve():
+    study = tool("estimate")
+    from signorini.studies.measures import energy_error
+
+    task = next(t for t in study.tasks() if t.case == "hertz-cylinder" and t.value == 0)
+    task = type(task)(**{**task.as_dict(), "reference": {
+        "kind": "none", "finer": {**task.reference["finer"], "levels": [2]}}})
+    row = run_tasks([task], isolate=False)[0]
+    params = task.problem["params"]
+    coarse, _ = study.solve("hertz-cylinder", params["n_contact"], params["grading"], 0)
+    fine, _ = study.solve("hertz-cylinder", params["n_contact"], params["grading"], 2)
+    direct = energy_error(coarse.problem, coarse.solution, fine.problem, fine.solution, 2)
+    assert row["finer"]["2"]["dofs"] == fine.problem.n and row["dofs"] == coarse.problem.n
+    assert row["finer"]["2"]["error"] == pytest.approx(direct["error"], rel=1e-8)
+    assert row["estimate"]["eta"] == pytest.approx(coarse.estimate.total, rel=1e-8)

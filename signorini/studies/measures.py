@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from signorini.fem.estimate import element_energies, estimate, material_units
+from signorini.fem.transfer import uniform_prolongation
 from signorini.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
 from signorini.numerics.factor import PardisoFactor, factorize, resolve_backend
 from signorini.numerics.lcp import delassus
@@ -151,3 +153,41 @@ def factor_memory(problem: ContactProblem) -> dict[str, float]:
     growth = resident() - before
     return {"estimate_bytes": factor.memory, "resident_growth_bytes": growth,
             "ratio": factor.memory / growth}
+
+
+def estimate_record(problem: ContactProblem, solution: ContactSolution) -> dict[str, float] | None:
+    """The a posteriori estimate (relative, the pressure's relative, η and its parts in physical
+    units, η without the contact term) and the seconds it took; None where there is none."""
+    start = time.perf_counter()
+    found = estimate(problem, solution)
+    seconds = time.perf_counter() - start
+    if found is None:
+        return None
+    return {"estimate": found.relative, "pressure_estimate":
+            found.pressure.relative if found.pressure is not None else float("nan"),
+            "eta": found.total, "eta_recovery": found.recovery * found.scale,
+            "eta_contact": found.contact * found.scale, "energy_norm": found.energy_norm * found.scale,
+            "eta_without_contact": estimate(problem, solution, contact=False).total,
+            "estimate_s": seconds}
+
+
+def _nodal(problem: ContactProblem, solution: ContactSolution) -> np.ndarray:
+    """The displacement of every node (nodes, dim) in physical units."""
+    return (problem.expand(solution.u) * problem.scales.displacement).reshape(-1, problem.mesh.p.shape[0])
+
+
+def energy_error(coarse: ContactProblem, coarse_solution: ContactSolution, fine: ContactProblem,
+                 fine_solution: ContactSolution, steps: int) -> dict[str, float]:
+    """``‖u_fine − P u_coarse‖_E`` (``error``, physical) with P the prolongation over ``steps``
+    uniform refinements, summed element by element on the finer mesh, and the fine answer's
+    ``λᵀ·gap(P u_coarse)`` (``complementarity``, physical)."""
+    P = uniform_prolongation(coarse.mesh.t, coarse.mesh.p.shape[1], steps)
+    moved = P @ _nodal(coarse, coarse_solution)
+    E, nu = material_units(fine)
+    s = fine.scales
+    difference = (_nodal(fine, fine_solution) - moved) / s.displacement
+    energy = element_energies(fine.mesh, difference, E, nu, fine.axisymmetric).sum()
+    v = (moved.ravel() / s.displacement)[fine.dofs()[1]]
+    return {"error": float(np.sqrt(energy * s.force * s.displacement)),
+            "complementarity": float(fine_solution.lam @ fine.gap(v)) * s.force * s.displacement,
+            "dofs": fine.n}

@@ -46,7 +46,6 @@ import numpy as np
 from signorini.crosschecking import crosscheck
 from signorini.diagnose import diagnose
 from signorini.errors import InputError
-from signorini.fem.estimate import estimate
 from signorini.files import plain
 from signorini.kkt import compare
 from signorini.problem import ContactProblem, ContactSolution
@@ -63,6 +62,8 @@ from signorini.studies.measures import (
     answer_record,
     bound_at_solution,
     certificate_of,
+    energy_error,
+    estimate_record,
     factor_memory,
     factorisation_time,
     force_error,
@@ -119,7 +120,9 @@ class _Cache:
         self.items: dict[str, Any] = {}
 
     def get(self, key: str, make: Callable[[], Any]) -> Any:
-        if key not in self.items:
+        if key in self.items:
+            self.items[key] = self.items.pop(key)  # the most recently used is kept longest
+        else:
             value = make()  # may raise: nothing is stored then
             self.items[key] = value
             while len(self.items) > self.size:
@@ -193,7 +196,27 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
     if task.fresh:
         reference = exact(solution if task.is_policy_run else None)
     measure_answer(problem, task, row, solution, reference)
+    if "finer" in task.measure and solution.success:
+        row["finer"] = {str(level): _against_finer(problem, solution, task, level, cache)
+                        for level in task.reference["finer"]["levels"]}
     return verdict(row, task)
+
+
+def _against_finer(problem: ContactProblem, solution: ContactSolution, task: Task, level: int,
+                   cache: _Cache) -> dict[str, Any]:
+    """The ``finer`` measure at one level: the same scene ``level`` uniform refinements in, solved
+    as ``task.reference["finer"]`` says (once per worker while it is cached)."""
+    how = task.reference["finer"]
+    spec = {**task.problem, "params": {**(task.problem.get("params") or {}), "refine": level}}
+
+    def make() -> tuple[ContactProblem, ContactSolution]:
+        return load_control(build_spec(spec), how["method"], tol=how.get("tol"), coarse=coarse_problem)
+
+    fine, answer = cache.get(_key("finer", spec, how), make)
+    if answer.status != "converged":
+        return {"status": answer.status, "dofs": fine.n}
+    steps = level - (task.problem.get("params") or {}).get("refine", 0)
+    return {"status": answer.status, **energy_error(problem, solution, fine, answer, steps)}
 
 
 def run_on(problem: ContactProblem, task: Task,
@@ -271,10 +294,10 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
     row.update(hertz_errors(problem, solution))
     if "reference" in task.measure:
         row["reference"] = reference_metrics(problem, solution)
-    found = estimate(problem, solution) if "estimate" in task.measure and solution.success else None
+    found = estimate_record(problem, solution) if "estimate" in task.measure and solution.success \
+        else None
     if found is not None:
-        row["estimate"] = {"estimate": found.relative, "pressure_estimate":
-                           found.pressure.relative if found.pressure is not None else float("nan")}
+        row["estimate"] = found
     if "patch" in task.measure:
         row["patch_lam_rel"] = compare(problem, force_controlled_exact(problem), solution).lam_rel
     finite = bool(np.all(np.isfinite(solution.lam)))

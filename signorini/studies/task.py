@@ -37,7 +37,10 @@ MEASURES = {
              "method_s)",
     "vs_reference": "signorini.kkt.compare with the exact answer (vs_reference)",
     "reference": "the errors against the analytic reference the problem declares (reference)",
-    "estimate": "the a posteriori estimates, energy norm and contact pressure (estimate)",
+    "estimate": "the a posteriori estimates, energy norm and contact pressure, η and its parts, "
+                "η without the contact term, and its time (estimate)",
+    "finer": "the energy-norm error against the same scene at each refine of "
+             "reference['finer']['levels'], solved by its 'method' at its 'tol' (finer)",
     "lam": "the contact forces (lam)",
     "answer": "the answer itself: u, λ, status and message (answer)",
     "exact": "the exact answer the task is held to, converged or not (exact)",
@@ -73,7 +76,7 @@ Row = TypedDict("Row", {
     "a_rel": float, "p0_rel": float, "pressure_l2_rel": float, "ref_a_rel": float,
     "ref_p0_rel": float, "ref_pressure_l2_rel": float, "reference": dict[str, float],
     "estimate": dict[str, float], "forward_error": dict[str, float],
-    "factor_memory": dict[str, float], "crosscheck": dict[str, Any],
+    "factor_memory": dict[str, float], "crosscheck": dict[str, Any], "finer": dict[str, Any],
     "profile": dict[str, Any], "lam": list[float], "answer": dict[str, Any],
     # what a method reports about itself
     "rho_over_bound": float, "lambda_max": float, "bound_at_solution": float,
