@@ -97,3 +97,19 @@ def test_an_effectivity_level_is_measured_against_the_finer_solve():
     assert row["finer"]["2"]["dofs"] == fine.problem.n and row["dofs"] == coarse.problem.n
     assert row["finer"]["2"]["error"] == pytest.approx(direct["error"], rel=1e-8)
     assert row["estimate"]["eta"] == pytest.approx(coarse.estimate.total, rel=1e-8)
+
+
+def test_a_whole_command_is_a_process_of_its_own_with_its_record():
+    amg = tool("amg_bench")
+    params = {"delta": 0.0025}
+    run = amg.whole(params, method="pdas")
+    assert run["returncode"] == 0 and run["record"]["status"] == "converged"
+    assert run["record"]["dofs"] == signorini.build_problem("hertz-sphere-3d", params=params).n
+    assert run["peak_gb"] > 0 and run["wall_s"] > 0
+    assert run["command"].endswith("signorini solve hertz-sphere-3d --set delta=0.0025 --method pdas")
+
+
+def test_a_whole_command_past_its_limit_is_stopped():
+    amg = tool("amg_bench")
+    run = amg.timed(["-c", "import time; time.sleep(60)"], timeout=1.0)
+    assert run["returncode"] is None and run["said"] == "timed out" and run["record"] is None

@@ -6,8 +6,13 @@ it compares) and returns numbers for a row of :mod:`signorini.studies.runner`.
 
 from __future__ import annotations
 
+import json
 import os
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,6 +26,7 @@ from signorini.numerics.lcp import delassus
 from signorini.pressure import contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_of
+from signorini.solvers.cluster import mpirun_command
 
 
 def certificate_of(problem: ContactProblem, solution: ContactSolution):
@@ -191,3 +197,27 @@ def energy_error(coarse: ContactProblem, coarse_solution: ContactSolution, fine:
     return {"error": float(np.sqrt(energy * s.force * s.displacement)),
             "complementarity": float(fine_solution.lam @ fine.gap(v)) * s.force * s.displacement,
             "dofs": fine.n}
+
+
+def whole_process(argv: list[str], record: bool = False, ranks: int = 1) -> dict[str, Any]:
+    """``python argv…`` timed whole, start to exit, under ``/usr/bin/time -v`` (``mpirun`` for
+    ``ranks`` > 1): its return code, wall time (``wall_s``), the peak resident memory of its
+    largest process (``peak_gb``), its last line of output, its last line of error output that
+    starts with "signorini" (``said``) and, with ``record``, the JSON it wrote to ``--json``."""
+    with tempfile.TemporaryDirectory(prefix="signorini-") as folder:
+        path = Path(folder) / "record.json"
+        words, env = [sys.executable, *argv] + (["--json", str(path)] if record else []), None
+        if ranks > 1:
+            words, env = mpirun_command(ranks, words)
+        done = subprocess.run(["/usr/bin/time", "-v", *words], capture_output=True, text=True,
+                              env=env)
+        written = json.loads(path.read_text()) if record and path.exists() else None
+    timing = dict(line.strip().rsplit(": ", 1) for line in done.stderr.splitlines()
+                  if ": " in line and line.startswith("\t"))
+    clock = timing.get("Elapsed (wall clock) time (h:mm:ss or m:ss)", "0:0").split(":")
+    said = [line for line in done.stderr.strip().splitlines() if line.startswith("signorini")]
+    out = done.stdout.strip().splitlines()
+    return {"returncode": done.returncode,
+            "wall_s": sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock))),
+            "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2,
+            "said": said[-1] if said else "", "output": out[-1] if out else "", "record": written}

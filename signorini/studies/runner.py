@@ -68,6 +68,7 @@ from signorini.studies.measures import (
     factorisation_time,
     force_error,
     forward_error,
+    whole_process,
     hertz_errors,
     pressure_profile,
     weak_but_penetrating,
@@ -76,6 +77,7 @@ from signorini.studies.problems import build_spec, candidate_spacing, exact_atte
 from signorini.studies.task import (
     ATLAS_TOL,
     BUILD_ONLY,
+    COMMAND,
     CROSSCHECK,
     DEFAULT_TIME_LIMIT,
     MEASURES,
@@ -103,9 +105,9 @@ NUMERIC = ("dofs", "candidates", "iterations", "time_s", "kkt_worst", "lam_rel",
            "pressure_l2_rel", "ref_a_rel", "ref_p0_rel", "ref_pressure_l2_rel", "rho_over_bound",
            "lambda_max", "bound_at_solution", "patch_lam_rel")
 #: the statuses a run can end with besides :data:`signorini.problem.STATUSES`
-EXTRA_STATUSES = ("built", "checked", "refused", "input-error", "raised", "timeout", "crashed")
+EXTRA_STATUSES = ("built", "checked", "ran", "refused", "input-error", "raised", "timeout", "crashed")
 
-__all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "CROSSCHECK", "DEFAULT_TIME_LIMIT",
+__all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "COMMAND", "CROSSCHECK", "DEFAULT_TIME_LIMIT",
            "EXTRA_STATUSES", "ITERATION_CAPS", "MEASURES", "NEAR_FACTOR", "NUMERIC", "Row", "Task",
            "Worker", "in_worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "task_row"]
 #: the verdicts on a row (the name the tests know)
@@ -138,6 +140,12 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
     """Run one task in this process and measure it: one row."""
     cache = cache or _Cache()
     row = task_row(task)
+    if task.method == COMMAND:
+        found = whole_process(task.options["argv"], bool(task.options.get("record")),
+                              int(task.options.get("ranks", 1)))
+        row.update(status="ran", wrapper="returned", claimed_status="", process=found,
+                   message=found["said"] or f"exit {found['returncode']}", time_s=found["wall_s"])
+        return verdict(row, task)
     try:
         problem = cache.get(_key("problem", task.problem), lambda: build_spec(task.problem))
     except InputError as exc:

@@ -26,6 +26,10 @@ BUILD_ONLY = "(build)"
 #: the "method" of a task that cross-checks its problem (:func:`signorini.crosscheck`) by the
 #: methods ``options["methods"]``, each with its ``options["options"][method]`` (crosscheck)
 CROSSCHECK = "(crosscheck)"
+#: the "method" of a task that runs ``python options["argv"]…`` as a process of its own, timed
+#: whole (:func:`signorini.studies.measures.whole_process`; ``options["record"]``,
+#: ``options["ranks"]``); its problem is not built (process)
+COMMAND = "(command)"
 #: what a task may ask to measure besides the row every task gets, and the columns it fills
 MEASURES = {
     "diagnosis": "what signorini.diagnose finds in the problem (diagnosis)",
@@ -77,6 +81,7 @@ Row = TypedDict("Row", {
     "ref_p0_rel": float, "ref_pressure_l2_rel": float, "reference": dict[str, float],
     "estimate": dict[str, float], "forward_error": dict[str, float],
     "factor_memory": dict[str, float], "crosscheck": dict[str, Any], "finer": dict[str, Any],
+    "process": dict[str, Any],
     "profile": dict[str, Any], "lam": list[float], "answer": dict[str, Any],
     # what a method reports about itself
     "rho_over_bound": float, "lambda_max": float, "bound_at_solution": float,
@@ -166,7 +171,7 @@ def verdict(row: Row, task: Task) -> Row:
     claimed_success = claimed == "converged"
     row["claim_correct"] = (not claimed_success) or (cert_ok and exact_ok)
     row["conservative"] = claimed_success and not cert_ok and near_exact
-    if status in ("input-error", "refused", "built", "checked", "timeout", "crashed"):
+    if status in ("input-error", "refused", "built", "checked", "ran", "timeout", "crashed"):
         row["wrapper_right"] = True  # a clear error, or a method that never answered
     elif status == "raised":
         row["wrapper_right"] = False
@@ -176,7 +181,9 @@ def verdict(row: Row, task: Task) -> Row:
         row["wrapper_right"] = exact_ok
     else:
         row["wrapper_right"] = not (claimed_success and cert_ok and exact_ok)
-    if task.method == CROSSCHECK:
+    if task.method == COMMAND:
+        row["outcome"] = "right" if row.get("process", {}).get("returncode") == 0 else "wrong"
+    elif task.method == CROSSCHECK:
         row["outcome"] = "right" if row.get("crosscheck", {}).get("passed") else "wrong"
     elif task.method == BUILD_ONLY:
         flagged = status == "input-error" or bool(row.get("diagnosis"))
