@@ -22,13 +22,12 @@ the default variant to that condition.
 from __future__ import annotations
 
 import os
-import platform
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from readme import fill_blocks, head_commit, study_main
+from readme import fill_blocks, provenance, study_main
 
 from signorini.studies.runner import run_tasks
 from signorini.studies.suite import DEFAULT_CASES
@@ -65,10 +64,7 @@ def tasks(cases=DEFAULT_CASES) -> list[Task]:
 
 
 def run(cases=DEFAULT_CASES) -> dict:
-    data = {"command": "python tools/crosscheck_cases.py", "tol": TOL, "commit": head_commit(),
-            "machine": f"{platform.node()}: {platform.processor() or platform.machine()}, "
-                       f"{os.cpu_count()} cores, Python {platform.python_version()}",
-            "load_before": list(os.getloadavg()), "variants": {}}
+    data = {**provenance("crosscheck_cases.py"), "tol": TOL, "variants": {}}
     start, chosen = time.perf_counter(), tasks(cases)
     for task, row in zip(chosen, run_tasks(chosen, time_limit=TIME_LIMIT, progress=lambda i, n, t, r:
                                            print(f"{t.case:<22} {t.axis:<8} {r['message']}",

@@ -13,13 +13,11 @@ runner's ``factor_memory`` measure).
 from __future__ import annotations
 
 import json
-import os
-import platform
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from readme import head_commit  # noqa: E402  (tools/readme.py)
+from readme import provenance  # noqa: E402  (tools/readme.py)
 
 from signorini.files import atomic_write_text  # noqa: E402
 from signorini.studies.runner import run_tasks  # noqa: E402
@@ -55,10 +53,7 @@ def run(models=MODELS) -> list[dict]:
 
 def main() -> int:
     rows = run()
-    atomic_write_text(OUT, json.dumps({
-        "command": "python tools/factor_memory.py", "commit": head_commit(),
-        "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
-        "rows": rows}, indent=1) + "\n")
+    atomic_write_text(OUT, json.dumps({**provenance("factor_memory.py"), "rows": rows}, indent=1) + "\n")
     return 0
 
 
