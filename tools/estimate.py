@@ -96,8 +96,9 @@ def tasks() -> list[Task]:
 
 def row_of(task: Task, row: dict) -> dict:
     """The study's row from the runner's."""
-    if "finer" not in row:
-        raise RuntimeError(f"{task.case} {task.problem['params']}: {row['status']} ({row['message']})")
+    if "finer" not in row or any(r["status"] != "converged" for r in row["finer"].values()):
+        raise RuntimeError(f"{task.case} {task.problem['params']}: {row['status']} ({row['message']}); "
+                           f"finer: {row.get('finer')}")
     refine, found, hertz = task.value, row["estimate"], row["reference"]
     finest = max(task.reference["finer"]["levels"])
     fine, finest_run = row["finer"][str(refine + REFERENCE_STEPS)], row["finer"][str(finest)]
