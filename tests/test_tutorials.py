@@ -73,7 +73,7 @@ def test_notebook_runs_headless(name, monkeypatch):
 
 
 #: the notebooks rewritten on the public API alone (``import signorini``), with worked exercises
-PUBLIC_API_ONLY = ("01-two-contact-points", "05-multipliers-are-prices")
+PUBLIC_API_ONLY = tuple(NOTEBOOKS)
 
 
 @pytest.mark.parametrize("name", PUBLIC_API_ONLY)
