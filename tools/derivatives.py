@@ -128,15 +128,17 @@ def main() -> None:
         data = widths()
         (OUT / "width.json").write_text(json.dumps(data, indent=1))
         figure(data, OUT / "width.png")
+    sys.path.insert(0, str(ROOT / "tools"))
+    import readme  # noqa: E402  (tools/readme.py: the generated blocks, where a run was made)
+
     if args.set:
         params = {name: _value(value) for name, value in (item.split("=", 1) for item in args.set)}
         data = load() if (OUT / "cost.json").exists() else {"scene": "hertz-cylinder", "rows": []}
-        rows = [row for row in data["rows"] if row["params"] != params] + [cost(params)]
+        where = readme.provenance("derivatives.py " + " ".join(f"--set {item}" for item in args.set))
+        row = {**cost(params), "provenance": where}  # where: taken before the run (its load)
+        rows = [row for row in data["rows"] if row["params"] != params] + [row]
         data["rows"] = sorted(rows, key=lambda row: row["dofs"])
         (OUT / "cost.json").write_text(json.dumps(data, indent=1))
-    sys.path.insert(0, str(ROOT / "tools"))
-    import readme  # noqa: E402  (tools/readme.py: the generated blocks of the docs pages)
-
     readme.fill_blocks(PAGE, {"derivative-cost": cost_table(load())})
 
 
