@@ -57,8 +57,10 @@ def test_the_docs_list_keys():
 
 
 SOLVES = [("block", {"nx": 6, "ny": 6}, "auto"), ("hertz-cylinder", {"n_contact": 10}, "auto"),
-          ("hertz-sphere", {"n_contact": 10}, "uzawa"), ("punch", {}, "qp-osqp"),
-          ("reverse-hertz", {}, "qp-clarabel"), ("hertz-cylinder", {"n_contact": 10}, "cvxpy"),
+          ("hertz-sphere", {"n_contact": 10}, "uzawa"),
+          pytest.param("punch", {}, "qp-osqp", marks=pytest.mark.slow),
+          pytest.param("reverse-hertz", {}, "qp-clarabel", marks=pytest.mark.slow),
+          pytest.param("hertz-cylinder", {"n_contact": 10}, "cvxpy", marks=pytest.mark.slow),
           ("block", {"nx": 6, "ny": 6}, "nested"), ("block", {"nx": 6, "ny": 6}, "pdas-amg"),
           ("block", {"nx": 6, "ny": 6}, "uzawa-nesterov"), ("block", {"nx": 6, "ny": 6}, "condensed")]
 
@@ -81,6 +83,7 @@ def test_every_key_of_a_problem_from_its_qp_and_a_saved_one_is_documented(tmp_pa
     assert undocumented(key_paths(out) | key_paths(saved)) == set()
 
 
+@pytest.mark.slow
 def test_every_key_of_a_failed_and_an_adaptive_solve_is_documented():
     failed = record(signorini.solve("block", "uzawa", params={"nx": 6, "ny": 6}, max_iter=1))
     adaptive = record(signorini.solve_adaptive("hertz-cylinder", 0.05))

@@ -85,8 +85,9 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
     if name not in BACKENDS:
         raise InputError(f"unknown factorisation backend {name!r}: choose auto, {', '.join(BACKENDS)}")
     if name not in available_backends():
+        hint = install_hint(EXTRAS.get(name, ""), [_MODULES[name]])
         raise BackendNotInstalled(f"factorisation backend {name!r} needs the module "
-                                  f"{_MODULES[name]!r}: {install_hint(EXTRAS.get(name, ''), [_MODULES[name]])}")
+                                  f"{_MODULES[name]!r}: {hint}")
     return name
 
 
