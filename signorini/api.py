@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from signorini import derivatives
 from signorini.errors import InputError
 from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.kkt import Certificate, certificate
@@ -162,6 +163,40 @@ class Result:
     def displacement(self) -> np.ndarray:
         """Every dof of the mesh (free and prescribed), in length units."""
         return self.problem.expand(self.solution.u) * self.problem.scales.displacement
+
+    @property
+    def u(self) -> np.ndarray:
+        """The QP's unknown (free dofs) in length units."""
+        return self.solution.u * self.problem.scales.displacement
+
+    @property
+    def energy(self) -> float:
+        """The optimal energy ``½uᵀKu − fᵀu`` of the QP, in force × length units."""
+        scales = self.problem.scales
+        return self.problem.energy(self.solution.u) * scales.force * scales.displacement
+
+    # -- derivatives (signorini.derivatives) ------------------------------------------------
+    @property
+    def sensitivity(self) -> derivatives.Sensitivity:
+        """The KKT system on the active set, factorised at the first derivative asked for."""
+        if not hasattr(self, "_sensitivity"):
+            self._sensitivity = derivatives.Sensitivity(self.problem, self.solution)
+        return self._sensitivity
+
+    def jvp(self, df: Any = None, dd: Any = None, side: str = "auto") -> derivatives.Tangent:
+        """``(du, dforce)``: how ``u`` and the nodal contact forces move when f moves by ``df``
+        (force units, one per free dof) and d by ``dd`` (length units, one per candidate).
+
+        Implicit differentiation on the active set (back-solves once factorised);
+        where candidates are weakly active the answer is one-sided and lists
+        them (``side``: ``auto``, ``in``, ``out``; see :mod:`signorini.derivatives`).
+        """
+        return derivatives.jvp(self.sensitivity, df, dd, side)
+
+    def vjp(self, gu: Any = None, gforce: Any = None, side: str = "out") -> derivatives.Cotangent:
+        """``(gf, gd)``: the gradients with respect to f and d of ``⟨gu, u⟩ + ⟨gforce, force⟩``
+        (the adjoint of :meth:`jvp` on the branch ``side``, ``in`` or ``out``)."""
+        return derivatives.vjp(self.sensitivity, gu, gforce, side)
 
     # -- theory -----------------------------------------------------------------------------
     @property

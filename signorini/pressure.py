@@ -119,14 +119,35 @@ def hertz_fit(x: np.ndarray, pressure: np.ndarray, active: np.ndarray) -> tuple[
     a sphere). Every node of the zone counts, so the fit is not at the mercy
     of the one node at x = 0. NaN when fewer than three nodes are active.
     """
-    idx = np.nonzero(active)[0]
-    idx = idx[np.argsort(x[idx])][:-1]
+    idx = _fitted_nodes(x, active)
     if idx.size < 2 or np.ptp(x[idx]) == 0:
         return float("nan"), float("nan")
     slope, intercept, xs, ps = _line_through_squares(x[idx], pressure[idx])
     if not (intercept > 0 and slope < 0):
         return float("nan"), float("nan")
     return float(ps * np.sqrt(intercept)), float(xs * np.sqrt(-intercept / slope))
+
+
+def _fitted_nodes(x: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """The nodes :func:`hertz_fit` fits: the active ones but the outermost, by increasing x."""
+    return np.nonzero(active)[0][np.argsort(x[active])][:-1]
+
+
+def hertz_fit_tangent(x: np.ndarray, pressure: np.ndarray, active: np.ndarray,
+                      dpressure: np.ndarray) -> tuple[float, float]:
+    """``(dp₀, da)`` of :func:`hertz_fit` when the pressures move by ``dpressure`` (same nodes).
+
+    The line through ``(x², p²)`` is linear in ``p²``: its slope s and intercept c move by
+    the fit of ``d(p²) = 2 p dp``, so ``dp₀ = p₀ dc / 2c`` and ``da = a (dc/c − ds/s) / 2``.
+    """
+    (p0, a), idx = hertz_fit(x, pressure, active), _fitted_nodes(x, active)
+    if not np.isfinite(p0):
+        return p0, a
+    slope, intercept, xs, ps = _line_through_squares(x[idx], pressure[idx])
+    dslope, dintercept = np.polyfit((x[idx] / xs) ** 2,
+                                    2 * pressure[idx] * dpressure[idx] / ps ** 2, 1)
+    return (float(p0 * dintercept / (2 * intercept)),
+            float(a * (dintercept / intercept - dslope / slope) / 2))
 
 
 def _l2_relative(x: np.ndarray, numeric: np.ndarray, reference) -> float:

@@ -1,10 +1,10 @@
-"""``signorini crosscheck``: one scene, several methods, every pair of answers compared."""
+"""``signorini crosscheck``: one scene or problem file, several methods, every pair compared."""
 
 from __future__ import annotations
 
 import argparse
 
-from signorini.cli.common import (EXIT_FAILED, input_files, pairs, parse_tol,
+from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, parse_tol,
                                   stdout_to_stderr, user_methods_in_workers,
                                   write_output)
 from signorini.errors import InputError
@@ -58,7 +58,7 @@ def add_parsers(sub) -> None:
                     "of answers: λ and u (relative), nodes classified differently, each method's "
                     "status and KKT certificate, Hertz's errors. Exit 1 when two methods that say "
                     "converged disagree.")
-    cross.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
+    cross.add_argument("scene", help=SCENE_HELP)
     cross.add_argument("--method", action="append", default=[], metavar="M",
                        help="a method to compare (repeat; default uzawa, qp-osqp, qp-clarabel, "
                             "cvxpy, pdas)")
