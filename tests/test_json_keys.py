@@ -100,6 +100,16 @@ def test_every_key_the_cli_writes_is_documented(tmp_path, capsys):
     assert undocumented(key_paths(out)) == set()
 
 
+def test_every_key_of_a_solve_of_a_problem_file_is_documented(tmp_path, capsys):
+    path = tmp_path / "qp.npz"
+    np.savez(path, K=np.array([[2.0, -1.0], [-1.0, 2.0]]), f=np.array([1.0, 1.0]), N=np.eye(2),
+             d=np.array([0.1, 2.0]))
+    assert main(["solve", str(path), "--json", str(tmp_path / "out.json")]) == 0
+    out = json.loads((tmp_path / "out.json").read_text())
+    assert out["units"]["system"].startswith("the QP's")
+    assert undocumented(key_paths(out)) == set()
+
+
 def test_every_key_of_a_crosscheck_is_documented():
     out = json.loads(to_json(crosscheck("block", ["pdas", "qp-clarabel"],
                                         params={"nx": 6, "ny": 6}).to_dict()))
