@@ -295,8 +295,8 @@ def bogie_shape(problem, displacements: Iterable[tuple[str, np.ndarray]], *, ax=
     two wheels. A wheel below the rail line penetrates it.
     """
     ax = axes(ax)
-    ell = float(problem.params["half_length"])
-    g1, g2 = problem.params["gaps"]
+    ell = float(problem.contact_points[-1, 0])  # the wheels sit at x = ±ℓ
+    g1, g2 = problem.d
     shapes = [(label, *bogie_deflection(problem, u)) for label, u in displacements]
     rail_x = np.array([-1.3 * ell, 1.3 * ell])
     rail_y = -g1 + (rail_x + ell) * (g1 - g2) / (2 * ell)
