@@ -9,7 +9,8 @@ The public API (see the README's "Python" section)::
 :func:`solve` takes a scene name or a :class:`ContactProblem` (from
 :func:`build_problem`, :meth:`ContactProblem.from_qp` or
 :meth:`ContactProblem.load`) and returns a :class:`Result` in the problem's
-own units; :func:`certificate` judges any answer; :func:`crosscheck` solves one
+own units; :func:`certificate` judges any answer; :func:`derivative`
+differentiates an output with respect to a scene parameter; :func:`crosscheck` solves one
 problem with several methods and compares every pair; :func:`methods` and
 :func:`scene_families` list what there is.
 """
@@ -28,6 +29,7 @@ from signorini.api import (
     solve_adaptive,
 )
 from signorini.crosschecking import CrossCheck, crosscheck
+from signorini.derivatives import derivative
 from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
 from signorini.kkt import Certificate
 from signorini.problem import ContactProblem, ContactSolution, Discretisation, Scales
@@ -41,4 +43,4 @@ logging.getLogger(__name__).addHandler(logging.NullHandler())
 __all__ = ["DEFAULT_METHOD", "DEFAULT_TOL", "BackendNotInstalled", "Certificate", "ContactProblem",
            "ContactSolution", "CrossCheck", "Discretisation", "InputError", "Result", "Scales",
            "SignoriniError", "SolverError", "WarmStart", "__version__", "at_load", "build_problem",
-           "certificate", "crosscheck", "methods", "scene_families", "solve", "solve_adaptive"]
+           "certificate", "crosscheck", "derivative", "methods", "scene_families", "solve", "solve_adaptive"]

@@ -8,8 +8,10 @@
 A :class:`Result` gives every quantity in the units of the problem's input
 (SI if the scene's parameters are SI): ``force`` in N (N/m per unit thickness
 in 2D, N per radian in axisymmetric models), ``pressure`` in Pa, ``gap`` and
-``displacement`` in m. The solver's own vectors ``result.solution.u`` and
-``result.solution.lam`` are dimensionless (see :class:`signorini.problem.Scales`).
+``displacement`` in m; a QP of your own (:meth:`ContactProblem.from_qp`) answers in
+your units (``result.u`` is your unknown, ``result.force`` your λ). The solver's own
+vectors ``result.solution.u`` and ``result.solution.lam`` are dimensionless (see
+:class:`signorini.problem.Scales`).
 ``Result.to_dict()`` is the JSON that ``signorini solve --json`` writes.
 """
 
@@ -20,11 +22,13 @@ from typing import Any
 
 import numpy as np
 
+from signorini import derivatives
 from signorini.errors import InputError
 from signorini.fem.estimate import ErrorEstimate, estimate
-from signorini.kkt import Certificate, certificate
+from signorini import kkt
+from signorini.kkt import Certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem import ContactProblem
 from signorini.references import Reference, reference_of, summary_lines
 from signorini import loading
 from signorini.loading import solve as load_control
@@ -33,6 +37,8 @@ from signorini.scenes.adapt import parse_target
 from signorini.scenes.base import scene_params
 from signorini.scenes.adapt import solve_adaptive as adapt
 from signorini.scenes.build import coarse_problem
+from signorini.numerics.arrays import vector_argument
+from signorini.solution import ContactSolution
 from signorini.solvers.registry import Method, check_request
 from signorini.solvers.registry import methods as _all_methods
 
@@ -135,6 +141,41 @@ class Result:
     def displacement(self) -> np.ndarray:
         """Every dof of the mesh (free and prescribed), in length units."""
         return self.problem.expand(self.solution.u) * self.problem.scales.displacement
+
+    @property
+    def u(self) -> np.ndarray:
+        """The QP's unknown (the free dofs) in the problem's units: for
+        :meth:`ContactProblem.from_qp`, the ``u`` of your ``½uᵀKu − fᵀu``."""
+        return self.solution.u * self.problem.scales.displacement
+
+    @property
+    def energy(self) -> float:
+        """The optimal energy ``½uᵀKu − fᵀu`` of the QP, in force × length units."""
+        scales = self.problem.scales
+        return self.problem.energy(self.solution.u) * scales.force * scales.displacement
+
+    # -- derivatives (signorini.derivatives) ------------------------------------------------
+    @property
+    def sensitivity(self) -> derivatives.Sensitivity:
+        """The KKT system on the active set, factorised at the first derivative asked for."""
+        if not hasattr(self, "_sensitivity"):
+            self._sensitivity = derivatives.Sensitivity(self.problem, self.solution)
+        return self._sensitivity
+
+    def jvp(self, df: Any = None, dd: Any = None, side: str = "auto") -> derivatives.Tangent:
+        """``(du, dforce)``: how ``u`` and the nodal contact forces move when f moves by ``df``
+        (force units, one per free dof) and d by ``dd`` (length units, one per candidate).
+
+        Implicit differentiation on the active set (back-solves once factorised);
+        where candidates are weakly active the answer is one-sided and lists
+        them (``side``: ``auto``, ``in``, ``out``; see :mod:`signorini.derivatives`).
+        """
+        return derivatives.jvp(self.sensitivity, df, dd, side)
+
+    def vjp(self, gu: Any = None, gforce: Any = None, side: str = "out") -> derivatives.Cotangent:
+        """``(gf, gd)``: the gradients with respect to f and d of ``⟨gu, u⟩ + ⟨gforce, force⟩``
+        (the adjoint of :meth:`jvp` on the branch ``side``, ``in`` or ``out``)."""
+        return derivatives.vjp(self.sensitivity, gu, gforce, side)
 
     # -- theory -----------------------------------------------------------------------------
     @property
@@ -282,7 +323,7 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
                          "or ContactProblem.from_qp(K, f, N, d)")
     problem, solution = load_control(problem, method, tol=tol, max_iter=max_iter,
                                      warm_start=warm_start, coarse=coarse_problem, **options)
-    return Result(problem, solution, certificate(problem, solution))
+    return Result(problem, solution, kkt.certificate(problem, solution))
 
 
 def at_load(problem: ContactProblem) -> ContactProblem:
@@ -319,9 +360,40 @@ def solve_adaptive(scene: str, target_error: float | str, method: str = DEFAULT_
 
     run = adapt(scene, params, parse_target(target_error), solver, max_dofs=max_dofs,
                 quantity=target_on, solved_by=method)
-    result = Result(run.problem, run.solution, certificate(run.problem, run.solution))
+    result = Result(run.problem, run.solution, kkt.certificate(run.problem, run.solution))
     result._estimate = run.estimate
     return result
+
+
+def certificate(problem: ContactProblem, solution: ContactSolution | None = None, *,
+                u: Any = None, force: Any = None, duality_gap: bool = True) -> Certificate:
+    """The relative KKT residuals of an answer ``(u, λ)`` of ``problem`` (:class:`Certificate`).
+
+    Give the answer as a ``solution`` (a :class:`ContactSolution` in the
+    problem's own, dimensionless arrays: ``result.solution``), or as arrays in
+    your units: ``u`` the QP's unknown (n entries, as ``Result.u``) and
+    ``force`` the contact forces λ (m entries, as ``Result.force``); they are
+    scaled by ``problem.scales`` as every method's answer is.
+    ``cert.passed(tol)`` says whether the answer is certified at ``tol``;
+    ``duality_gap=False`` leaves out what needs K⁻¹ (for a singular K).
+    """
+    if not isinstance(problem, ContactProblem):
+        raise InputError(f"certificate: problem must be a ContactProblem, got {type(problem).__name__}")
+    arrays = u is not None or force is not None
+    if arrays and solution is not None:
+        raise InputError("certificate: give either a solution or the arrays u= and force=, not both")
+    if arrays:
+        if u is None or force is None:
+            raise InputError("certificate: give both u= (the QP's unknown, n entries) and force= "
+                             "(the contact forces λ, m entries), in the problem's units")
+        u, force = vector_argument(u, "u"), vector_argument(force, "force")
+        if u.shape != (problem.n,) or force.shape != (problem.m,):
+            raise InputError(f"certificate: u must have {problem.n} entries and force {problem.m}, "
+                             f"got {u.shape} and {force.shape}")
+        scales = problem.scales
+        solution = ContactSolution(method="given", u=u / scales.displacement,
+                                   lam=force / scales.force, status="converged")
+    return kkt.certificate(problem, solution, duality_gap)
 
 
 def methods(installed_only: bool = False) -> list[Method]:

@@ -21,6 +21,16 @@ residuals, not errors, and W = N K⁻¹ Nᵀ's conditioning turns residuals with
 tol into λ errors of up to 1.6e3 × tol in the formulation runs (docs/crosscheck.md);
 10⁴ leaves room for finer meshes and still catches, at tol 1e-8, a λ off by 1e-4.
 
+The check **passes** when every method converged (certified at the tolerance)
+and no judged pair disagrees; ``allow`` names known-weak methods whose failure
+or disagreement is shown and let through. The QP methods' own answers are
+judged: a method with the option ``polish`` runs with ``polish=False`` unless
+its options say otherwise; ``polish=True`` adds the polished answer as an
+extra column (a second run), never as the one judged. Each method's answer is
+also set against the reference answer (pdas when it is compared, else the
+first exact method that converged): ``lam_ref`` (λ's relative distance),
+``active`` (candidates in contact) and ``apart_ref`` (nodes classified apart).
+
 The methods run one after another in this process (a problem from
 :meth:`ContactProblem.from_qp` cannot be rebuilt in a worker); a method that
 refuses the problem (a dense backend on a large one) or is not installed is a
@@ -37,7 +47,7 @@ import numpy as np
 
 from signorini.api import Result, build_problem, solve
 from signorini.errors import BackendNotInstalled, InputError
-from signorini.kkt import WEAK_TOL, compare
+from signorini.kkt import ACTIVE, WEAK_TOL, classify, compare
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics, reference_of
 from signorini.solvers.base import DEFAULT_TOL, check_tol
@@ -60,7 +70,11 @@ class MethodRun:
     the polished answer is returned, False when polish left the backend's own,
     None when there was no polish. ``reference`` holds the errors against the
     problem's analytic reference (``p0_rel``, ``a_rel``, ``pressure_l2_rel`` for
-    Hertz), empty when it has none.
+    Hertz), empty when it has none. ``lam_ref``, ``active`` and ``apart_ref``
+    set the answer against the reference method's (see the module's
+    docstring; NaN and -1 when there is none); ``polished_lam_ref`` and
+    ``polished_status`` are those of the polished answer when polish was asked
+    for (None otherwise); ``allowed`` says the method was let through.
     """
 
     method: str
@@ -76,6 +90,12 @@ class MethodRun:
     kkt_worst: float = float("nan")
     kkt_worst_name: str = ""
     reference: dict[str, float] = field(default_factory=dict)
+    lam_ref: float = float("nan")
+    active: int = -1
+    apart_ref: int = -1
+    polished_lam_ref: float | None = None
+    polished_status: str | None = None
+    allowed: bool = False
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -134,6 +154,9 @@ class CrossCheck:
     runs: list[MethodRun]
     pairs: list[Pair]
     results: dict[str, Result] = field(default_factory=dict, repr=False)
+    allowed: tuple[str, ...] = ()
+    reference_method: str = ""
+    polish: bool = False
 
     @property
     def disagreements(self) -> list[Pair]:
@@ -141,9 +164,19 @@ class CrossCheck:
         return [pair for pair in self.pairs if pair.verdict == "DISAGREE"]
 
     @property
+    def failures(self) -> list[str]:
+        """What fails the check, one line each: a method that did not converge, a pair that
+        disagrees (methods in ``allowed`` left out)."""
+        said = [f"{run.method} {run.status}" for run in self.runs
+                if run.status != "converged" and run.method not in self.allowed]
+        said += [f"{pair.first} ~ {pair.second} disagree" for pair in self.disagreements
+                 if pair.first not in self.allowed and pair.second not in self.allowed]
+        return said
+
+    @property
     def passed(self) -> bool:
-        """No two methods that said ``converged`` disagree."""
-        return not self.disagreements
+        """Every method converged and no judged pair disagrees (``allowed`` methods aside)."""
+        return not self.failures
 
     def to_dict(self) -> dict[str, Any]:
         """The record ``signorini crosscheck --json`` writes."""
@@ -151,7 +184,9 @@ class CrossCheck:
         return {"scene": problem.scene, "params": problem.params, "dofs": problem.n,
                 "contact_candidates": problem.m, "tol": self.tol,
                 "reference": problem.reference, "agree_factor": AGREE_FACTOR,
-                "passed": self.passed, "methods": [run.as_dict() for run in self.runs],
+                "passed": self.passed, "failures": self.failures, "allowed": list(self.allowed),
+                "reference_method": self.reference_method, "polish": self.polish,
+                "methods": [run.as_dict() for run in self.runs],
                 "pairs": [pair.as_dict() for pair in self.pairs]}
 
     def summary(self) -> str:
@@ -186,7 +221,8 @@ def _run_of(result: Result, tol: float) -> MethodRun:
 
 def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ...] | None = None,
                *, tol: float | None = DEFAULT_TOL, params: dict[str, Any] | None = None,
-               options: dict[str, dict[str, Any]] | None = None) -> CrossCheck:
+               options: dict[str, dict[str, Any]] | None = None,
+               allow: list[str] | tuple[str, ...] = (), polish: bool = False) -> CrossCheck:
     """Solve ``problem`` with every method; for every pair ``‖λ_a − λ_b‖∞ / max(‖λ_a‖∞, ‖λ_b‖∞)``,
     the same for u, and the nodes classified apart (see the module's docstring).
 
@@ -196,19 +232,24 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     methods : method names (default :data:`DEFAULT_METHODS`); ``module:function`` for your own.
     tol : the relative KKT tolerance every method is asked for (default
         :data:`signorini.DEFAULT_TOL`; ``None`` leaves each method its own default).
-    options : per-method options, ``{"qp-osqp": {"polish": False}}``.
+    options : per-method options, ``{"qp-cvxpy": {"solver": "OSQP"}}``; a method
+        with the option ``polish`` gets ``polish=False`` unless given here.
+    allow : methods whose failure or disagreement does not fail the check (known-weak).
+    polish : also polish each QP method's answer (a second run), shown as an extra column.
 
     Returns
     -------
     CrossCheck
-        ``runs`` (status, claim, certificate, Hertz's errors), ``pairs`` (λ, u, nodes
-        apart, verdict), ``passed`` (no two methods that said converged disagree).
+        ``runs`` (status, claim, certificate, distance to the reference answer,
+        Hertz's errors), ``pairs`` (λ, u, nodes apart, verdict), ``passed``
+        (every method converged and no judged pair disagrees), ``failures``.
 
     Raises
     ------
     InputError
         An unknown method, a method named twice, options for a method not
-        compared, a bad tolerance: before anything is solved.
+        compared, a method allowed but not compared, a bad tolerance: before
+        anything is solved.
     """
     if isinstance(methods, str):
         raise InputError(f"methods must be a list of names, got the string {methods!r}: "
@@ -227,6 +268,14 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     if stray:
         raise InputError(f"options for {stray[0]!r}, which is not among the methods "
                          f"({', '.join(names)}): add it with --method {stray[0]}")
+    if isinstance(allow, str):
+        allow = [allow]
+    strange = sorted(set(allow) - set(names))
+    if strange:
+        raise InputError(f"allow names {strange[0]!r}, which is not among the methods "
+                         f"({', '.join(names)}): allow only a method that is compared")
+    if not isinstance(polish, (bool, np.bool_)):
+        raise InputError(f"polish={polish!r} must be True or False")
     tol = check_tol(tol)
     if isinstance(problem, str):
         problem = build_problem(problem, params=params)
@@ -241,7 +290,7 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     results: dict[str, Result] = {}
     for name in names:
         try:
-            result = solve(problem, name, tol=tol, **options.get(name, {}))
+            result = solve(problem, name, tol=tol, **_raw(name, options.get(name, {})))
         except BackendNotInstalled as exc:
             runs.append(MethodRun(name, judged_tol, NOT_INSTALLED, NOT_INSTALLED, str(exc)))
             continue
@@ -255,7 +304,42 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     tol_of = {run.method: run.tol for run in runs}
     pairs = [agreement(problem, results[a].solution, results[b].solution, tol_of[a], tol_of[b])
              for a, b in itertools.combinations(names, 2) if a in results and b in results]
-    return CrossCheck(problem, judged_tol, runs, pairs, results)
+    reference = _reference_method(names, results)
+    for run in runs:
+        run.allowed = run.method in allow
+        if run.method not in results:
+            continue
+        run.active = int(np.sum(classify(problem, results[run.method].solution) == ACTIVE))
+        if reference:
+            run.lam_ref, run.apart_ref = _against(problem, results[reference], results[run.method])
+        if polish and "polish" in get_method(run.method).options:
+            polished = solve(problem, run.method, tol=tol,
+                             **{**options.get(run.method, {}), "polish": True})
+            run.polished_status = polished.status
+            if reference:
+                run.polished_lam_ref = _against(problem, results[reference], polished)[0]
+    return CrossCheck(problem, judged_tol, runs, pairs, results, tuple(allow), reference,
+                      bool(polish))
+
+
+def _raw(name: str, options: dict[str, Any]) -> dict[str, Any]:
+    """A method's options for its own answer: ``polish=False`` unless the caller set it."""
+    if "polish" in get_method(name).options and "polish" not in options:
+        return {**options, "polish": False}
+    return options
+
+
+def _reference_method(names: list[str], results: dict[str, Result]) -> str:
+    """pdas when it converged, else the first exact method that did ("" for none)."""
+    done = [name for name in names if name in results and results[name].converged]
+    exact = [name for name in done if get_method(name).exact]
+    return "pdas" if "pdas" in done else (exact[0] if exact else "")
+
+
+def _against(problem: ContactProblem, reference: Result, result: Result) -> tuple[float, int]:
+    """λ's relative distance to the reference answer and the nodes classified apart."""
+    found = compare(problem, reference.solution, result.solution)
+    return found.lam_rel, found.misclassified
 
 
 # --- the tables ---------------------------------------------------------------------------------
@@ -276,6 +360,16 @@ def _said(run: dict[str, Any]) -> str:
     return run["status"]
 
 
+def _count(value: Any) -> str:
+    return "–" if value is None or value < 0 else str(value)
+
+
+def _polished(run: dict[str, Any]) -> str:
+    if run.get("polished_status") is None:
+        return "–"
+    return f"{_num(run.get('polished_lam_ref'))} ({run['polished_status']})"
+
+
 def _form(run: dict[str, Any]) -> str:
     polish = {None: "", True: ", polished", False: ", raw (polish did not help)"}[run["polished"]]
     return (run["form"] or "–") + polish
@@ -288,13 +382,19 @@ def _tables(record: dict[str, Any]) -> tuple[str, list[str], list[list[str]], li
              f"{record['contact_candidates']:,} contact candidates, tol {record['tol']:.0e}")
     present = [(key, label) for key, label in REFERENCE_COLUMNS
                if any(key in run["reference"] for run in record["methods"])]
-    head = ["method", "said → certificate", "form", "worst KKT", "iterations", "time s"]
-    head += [label for _, label in present]
+    ref = record.get("reference_method") or "reference"
+    head = ["method", "said → certificate", "form", "worst KKT", f"λ vs {ref}", "active",
+            "apart", "iterations", "time s"]
+    polish = record.get("polish", False)
+    head += [f"polished λ vs {ref}"] * polish + [label for _, label in present]
     rows = []
     for run in record["methods"]:
-        row = [run["method"], _said(run), _form(run),
+        row = [run["method"] + " (allowed)" * bool(run.get("allowed")), _said(run), _form(run),
                f"{_num(run['kkt_worst'])} {run['kkt_worst_name']}".strip(),
+               _num(run.get("lam_ref")), _count(run.get("active")), _count(run.get("apart_ref")),
                str(run["iterations"]), _num(run["time_s"], ".2f")]
+        if polish:
+            row.append(_polished(run))
         row += [_num(run["reference"].get(key), ".2e") for key, _ in present]
         rows.append(row)
     pair_head = ["pair", "λ rel", "u rel", "nodes apart", "weak", "limit", "verdict"]
@@ -310,13 +410,15 @@ def _plain(head: list[str], rows: list[list[str]]) -> list[str]:
 
 
 def _verdict_line(record: dict[str, Any]) -> str:
-    bad = [p for p in record["pairs"] if p["verdict"] == "DISAGREE"]
-    if bad:
-        names = ", ".join(f"{p['first']} ~ {p['second']}" for p in bad)
-        return (f"DISAGREE: {names} both said converged and differ beyond "
+    allowed = [r["method"] for r in record["methods"] if r.get("allowed")]
+    let = f" (allowed through: {', '.join(allowed)})" if allowed else ""
+    if record["failures"]:
+        return (f"FAILED: {'; '.join(record['failures'])}{let}. A method fails when it does not "
+                f"converge at tol; a pair when both said converged and they differ beyond "
                 f"{record['agree_factor']:.0e} × tol or classify nodes apart")
     judged = sum(p["judged"] for p in record["pairs"])
-    return f"every judged pair agrees ({judged} of {len(record['pairs'])} pairs said converged on both sides)"
+    return (f"passed: every method converged and every judged pair agrees ({judged} of "
+            f"{len(record['pairs'])} pairs said converged on both sides){let}")
 
 
 def render(record: dict[str, Any]) -> str:
@@ -335,7 +437,11 @@ def render_markdown(record: dict[str, Any]) -> str:
     """The cross-check record as Markdown."""
     title, head, rows, pair_head, pair_rows = _tables(record)
     params = ", ".join(f"{k}={v}" for k, v in record["params"].items()) or "defaults"
-    notes = (f"Parameters: {params}. A pair is judged when both methods said `converged` "
+    notes = (f"Parameters: {params}. Each method's own answer is judged (polish "
+             f"{'shown as an extra column' if record.get('polish') else 'off'}); λ vs "
+             f"{record.get('reference_method') or 'the reference'} is λ's relative distance to "
+             f"that answer, apart the nodes classified apart from it. "
+             f"A pair is judged when both methods said `converged` "
              f"(their own claim); it disagrees when a node is active in one answer and "
              f"inactive in the other (weakly active nodes apart: force and gap both within "
              f"max(1e-6, tol)), or λ or u differ by more than {record['agree_factor']:.0e} × tol.")

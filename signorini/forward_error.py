@@ -28,9 +28,10 @@ interface: ``matrix``, ``fixed``, ``solve``), or the problem's cached one of K.
 A factorisation with the dofs of A pinned solves M in one back-solve; each row in
 which its pinned set and A differ costs one more back-solve (a bordered Schur
 complement, as for the duality gap), and a plain factorisation of K costs
-``|A|`` back-solves for the Delassus operator on A (``N_A K⁻¹ N_Aᵀ``); then two
-back-solves per Newton step. Beyond :data:`MAX_BORDER` such rows the estimate is
-not made (NaN).
+``|A|`` back-solves for the Delassus operator on A (``N_A K⁻¹ N_Aᵀ``); then one
+back-solve per Newton step, when the bordering's solved columns fit in
+:data:`BLOCK_FLOATS` floats and are kept (the border's correction is then a product),
+else two. Beyond :data:`MAX_BORDER` such rows the estimate is not made (NaN).
 """
 
 from __future__ import annotations
@@ -83,12 +84,16 @@ class _Counted:
 
 
 def _blocks(solve: Callable, columns: Callable[[np.ndarray], np.ndarray], k: int, n: int,
-            reduce: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-    """``reduce(solve(columns(j)))`` stacked over blocks ``j`` of ``range(k)`` (bounded memory)."""
+            reduce: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray | None]:
+    """``reduce(solve(columns(j)))`` stacked over blocks ``j`` of ``range(k)`` (bounded memory),
+    and the solved columns themselves when they fit in one block (else None)."""
     block = max(1, min(k, BLOCK_FLOATS // max(n, 1)))
+    if k <= block:
+        solved = solve(columns(np.arange(k))) if k else np.zeros((n, 0))
+        return (reduce(solved) if k else np.zeros((0, 0))), solved
     parts = [reduce(solve(columns(np.arange(start, min(start + block, k)))))
              for start in range(0, k, block)]
-    return np.hstack(parts) if parts else np.zeros((0, 0))
+    return np.hstack(parts), None
 
 
 def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.ndarray,
@@ -111,7 +116,7 @@ def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.
         E[border[j], np.arange(j.size)] = 1.0
         return E
 
-    B = _blocks(solve, unit, k, n, lambda Z: np.vstack([(K @ Z)[Q], Z[P]]))
+    B, Z = _blocks(solve, unit, k, n, lambda Z: np.vstack([(K @ Z)[Q], Z[P]]))
     lu = np.linalg.inv(B) if k else None  # k ≤ MAX_BORDER, dense and small
 
     def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -119,11 +124,14 @@ def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.
         value[dofs] = -g / coef
         rhs = -r.copy()
         rhs[fixed] = value[fixed]
-        if k:
-            x0 = solve(rhs)
-            miss = np.concatenate([-r[Q] - (K @ x0)[Q], value[P] - x0[P]])
-            rhs[border] += lu @ miss
         x = solve(rhs)
+        if k:
+            miss = np.concatenate([-r[Q] - (K @ x)[Q], value[P] - x[P]])
+            if Z is None:
+                rhs[border] += lu @ miss
+                x = solve(rhs)
+            else:  # the border's columns were kept: the correction is a product, not a solve
+                x = x + Z @ (lu @ miss)
         return x, (-r - K @ x)[dofs] / coef
 
     return apply, k
@@ -150,12 +158,12 @@ def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.nd
     N_A = N[rows]
     NT = sp.csc_matrix(N_A.T)
     k = N_A.shape[0]
-    offered = solve.factor
+    offered, Z = solve.factor, None
     if isinstance(offered, WithDelassus) and offered.N.shape == N.shape \
             and (offered.N != N).nnz == 0:
         S = offered.delassus[np.ix_(rows, rows)]
     else:
-        S = _blocks(solve, lambda j: NT[:, j].toarray(), k, K.shape[0], lambda Z: N_A @ Z)
+        S, Z = _blocks(solve, lambda j: NT[:, j].toarray(), k, K.shape[0], lambda Z: N_A @ Z)
     lu = np.linalg.inv(S) if k else None
 
     def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -163,7 +171,9 @@ def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.nd
         if not k:
             return x0, np.zeros(0)
         mu = lu @ (N_A @ x0 + g)
-        return solve(-r - NT @ mu), mu
+        if Z is None:
+            return solve(-r - NT @ mu), mu
+        return x0 - Z @ mu, mu  # K⁻¹ N_Aᵀ was kept: no second solve
 
     return apply, k
 

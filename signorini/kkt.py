@@ -136,6 +136,14 @@ class Certificate:
     def as_dict(self) -> dict[str, float]:
         return self.residuals()
 
+    def passed(self, tol: float) -> bool:
+        """Every residual and error is finite and at most ``tol``: the answer is certified at
+        ``tol`` (what a method's claim of convergence at ``tol`` is held to)."""
+        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
+                or not np.isfinite(tol) or tol <= 0:
+            raise InputError(f"Certificate.passed: tol must be a positive number, got {tol!r}")
+        return shortfall(self, float(tol)) is None
+
 
 def certificate(problem: ContactProblem, solution: ContactSolution,
                 duality_gap: bool = True) -> Certificate:

@@ -24,7 +24,7 @@ from signorini.analytic import (
     punch_pressure,
 )
 from signorini.kkt import ACTIVE, classify
-from signorini.problem import ContactProblem, ContactSolution, ReferenceData
+from signorini.problem import ContactProblem, ContactSolution
 
 
 @dataclass(frozen=True)
@@ -68,14 +68,6 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
         labels=labels,
         total_force=problem.total_contact_force(solution.lam) * s.force,
         applied_load=problem.applied_load(solution.u) * s.force)
-
-
-def reference_data(problem: ContactProblem) -> ReferenceData:
-    """What the scene of ``problem`` hands its analytic reference (E*, R, H, a, ...)."""
-    if problem.reference_data is None:
-        raise ValueError(f"problem {problem.name!r} carries no reference record: build it from a "
-                         "scene that declares an analytic reference")
-    return problem.reference_data
 
 
 def unit_of(values: np.ndarray) -> float:
@@ -126,14 +118,35 @@ def hertz_fit(x: np.ndarray, pressure: np.ndarray, active: np.ndarray) -> tuple[
     a sphere). Every node of the zone counts, so the fit is not at the mercy
     of the one node at x = 0. NaN when fewer than three nodes are active.
     """
-    idx = np.nonzero(active)[0]
-    idx = idx[np.argsort(x[idx])][:-1]
+    idx = _fitted_nodes(x, active)
     if idx.size < 2 or np.ptp(x[idx]) == 0:
         return float("nan"), float("nan")
     slope, intercept, xs, ps = _line_through_squares(x[idx], pressure[idx])
     if not (intercept > 0 and slope < 0):
         return float("nan"), float("nan")
     return float(ps * np.sqrt(intercept)), float(xs * np.sqrt(-intercept / slope))
+
+
+def _fitted_nodes(x: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """The nodes :func:`hertz_fit` fits: the active ones but the outermost, by increasing x."""
+    return np.nonzero(active)[0][np.argsort(x[active])][:-1]
+
+
+def hertz_fit_tangent(x: np.ndarray, pressure: np.ndarray, active: np.ndarray,
+                      dpressure: np.ndarray) -> tuple[float, float]:
+    """``(dp₀, da)`` of :func:`hertz_fit` when the pressures move by ``dpressure`` (same nodes).
+
+    The line through ``(x², p²)`` is linear in ``p²``: its slope s and intercept c move by
+    the fit of ``d(p²) = 2 p dp``, so ``dp₀ = p₀ dc / 2c`` and ``da = a (dc/c − ds/s) / 2``.
+    """
+    (p0, a), idx = hertz_fit(x, pressure, active), _fitted_nodes(x, active)
+    if not np.isfinite(p0):
+        return p0, a
+    slope, intercept, xs, ps = _line_through_squares(x[idx], pressure[idx])
+    dslope, dintercept = np.polyfit((x[idx] / xs) ** 2,
+                                    2 * pressure[idx] * dpressure[idx] / ps ** 2, 1)
+    return (float(p0 * dintercept / (2 * intercept)),
+            float(a * (dintercept / intercept - dslope / slope) / 2))
 
 
 def _l2_relative(x: np.ndarray, numeric: np.ndarray, reference) -> float:
@@ -198,7 +211,7 @@ def _against_cylinder(problem: ContactProblem, profile: ContactProfile, P: float
     if not P > 0:
         nan = float("nan")
         return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
-    scene = reference_data(problem)
+    scene = problem.reference_data  # what the scene hands its reference
     a_ref = hertz_cylinder_half_width(P, scene.R, scene.E_star)
     p0_ref = hertz_cylinder_peak(P, a_ref)
     p0, a = hertz_fit(profile.x, profile.pressure, profile.active)
@@ -226,7 +239,7 @@ class UniformComparison:
 def compare_uniform(problem: ContactProblem, solution: ContactSolution) -> UniformComparison:
     """Compare ``solution`` of the block scene with its uniform pressure."""
     profile = contact_profile(problem, solution)
-    scene = reference_data(problem)
+    scene = problem.reference_data  # what the scene hands its reference
     p_ref = scene.E_star * problem.push.delta / scene.H
     P = profile.total_force
     return UniformComparison(
@@ -342,7 +355,7 @@ def compare_hertz_sphere(problem: ContactProblem, solution: ContactSolution) -> 
     (area-weighted), ``edge_margin`` the outermost candidate's radius over a.
     """
     profile = contact_profile(problem, solution)
-    scene = reference_data(problem)
+    scene = problem.reference_data  # what the scene hands its reference
     P = profile.total_force
     if not P > 0:
         nan = float("nan")
@@ -446,7 +459,7 @@ def compare_punch(problem: ContactProblem, solution: ContactSolution,
                   inner: float = 0.5) -> PunchComparison:
     """Compare ``solution`` of the punch scene with ``p(x) = P/(π√(a² − x²))`` on ``|x| ≤ inner·a``."""
     profile = _half_line(problem, contact_profile(problem, solution))
-    a = float(reference_data(problem).a)
+    a = float(problem.reference_data.a)
     P = load_resultant(problem, solution.lam)
     target = None if problem.push is None else problem.push.P
     nan = float("nan")

@@ -36,46 +36,18 @@ from signorini.numerics.arrays import (
     vector_argument,
 )
 from signorini.numerics.factor import factorize
+from signorini.scales import Scales, qp_scales
 from signorini.solution import STATUSES, ContactSolution
 
 log = logging.getLogger(__name__)
 
 __all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Discretisation", "Push", "ReferenceData",
-           "Scales", "Watch"]
+           "Scales", "Watch", "qp_scales"]
 
 #: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
 ITERATIVE_ENERGY_FROM = 300_000
 ITERATIVE_ENERGY_RTOL = 1e-6
 ITERATIVE_ENERGY_MAX_ITER = 20_000
-
-
-@dataclass(frozen=True)
-class Scales:
-    """Units that make the problem dimensionless.
-
-    A physical quantity is its dimensionless value times its scale:
-    coordinates ``x = length · x̂``, displacements and gaps
-    ``u = displacement · û``, contact forces ``λ = force · λ̂``, weights
-    ``w = weight · ŵ`` and pressures ``p = λ / w = pressure · p̂`` with
-    ``pressure = force / weight``. In 2D (per unit thickness)
-    ``force = E · displacement`` and ``weight = length``; in 3D and in
-    axisymmetric models ``force = E · displacement · length`` and
-    ``weight = length²``. Axisymmetric forces and weights (``∫ φᵢ r ds``) are
-    **per radian**; ``force_multiplicity`` (2π times any other copies) turns
-    ``Σλ`` into the force on the whole body. Scaling the
-    displacement apart from the geometry matters: a Hertz contact at
-    a/R = 0.05 moves by about 1e-3 R, and a solver's absolute tolerances
-    only mean something when the unknowns are of order one.
-    """
-
-    length: float = 1.0
-    displacement: float = 1.0
-    force: float = 1.0
-    weight: float = 1.0
-
-    @property
-    def pressure(self) -> float:
-        return self.force / self.weight
 
 
 @dataclass
@@ -155,6 +127,13 @@ class ContactProblem:
         result has forces but no pressures; without ``contact_points`` no
         positions; there is no analytic reference to compare with. Shapes
         and values are checked (InputError names the array and the fix).
+
+        The arrays are scaled as a scene's are (:func:`qp_scales`), so that
+        every method sees numbers of order one whatever your units; the
+        problem keeps the scaled arrays and their :class:`Scales`, and a
+        :class:`signorini.Result` gives every output back in your units
+        (``result.u`` is your unknown, ``result.force`` your λ). Contact
+        points keep your units (``scales.length`` is 1).
         """
         K = sparse_argument(K, "K")
         n = K.shape[0]
@@ -163,9 +142,14 @@ class ContactProblem:
         if n and abs(K - K.T).max() > 1e-10 * abs(K).max():
             raise InputError("K must be symmetric: pass the stiffness matrix itself, or ½(K + Kᵀ)")
         N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")
-        return cls(K=K, f=f, N=N, d=d, weights=weights,
-                   contact_points=points_argument(contact_points, N),
-                   force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
+        given = cls(K=K, f=f, N=N, d=d, weights=weights,
+                    contact_points=points_argument(contact_points, N),
+                    force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
+        scales = qp_scales(given.K, given.f, given.d, given.weights)
+        return dataclasses.replace(
+            given, K=given.K * (scales.displacement / scales.force), f=given.f / scales.force,
+            d=given.d / scales.displacement, scales=scales,
+            weights=None if given.weights is None else given.weights / scales.weight)
 
     # -- what the discretisation says (neutral values for a QP given as arrays) ---------------
     scene = property(lambda self: self.name, doc="The scene's name (``name``).")

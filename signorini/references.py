@@ -39,7 +39,6 @@ from signorini.pressure import (
     compare_uniform,
     contact_profile,
     radial_distance,
-    reference_data,
 )
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -151,7 +150,7 @@ def _punch_claims(problem: ContactProblem, exact: ContactSolution,
     """The pressure away from the edges, force balance, the load (sharp corners), full contact."""
     claims = [Claim("punch pressure max relative error on |x| <= a/2 (pdas)",
                     metrics["pressure_max_rel"], "punch_pressure_rel"), _force_balance(metrics)]
-    if np.isfinite(metrics["target_rel"]) and reference_data(problem).corner_radius == 0:
+    if np.isfinite(metrics["target_rel"]) and problem.reference_data.corner_radius == 0:
         claims.append(Claim("total contact force equals the load P (pdas)", metrics["target_rel"],
                             "load_target_rel"))
     touching = metrics["active_fraction"] == 1.0

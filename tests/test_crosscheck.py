@@ -48,16 +48,65 @@ def liar(tmp_path):
     return f"{path}:lying"
 
 
-def test_default_methods_agree_on_hertz_cylinder(capsys):
+def test_default_methods_agree_on_hertz_cylinder(capsys, tmp_path):
     require(*DEFAULT_METHODS)
-    code, out, err = run(capsys, "crosscheck", "hertz-cylinder")
+    path = tmp_path / "cross.json"
+    code, out, err = run(capsys, "crosscheck", "hertz-cylinder", "--json", str(path))
     assert code == 0, out + err
     assert "cross-check of hertz-cylinder" in out and "p0 err" in out
     for name in DEFAULT_METHODS:
         assert f"\n{name} " in out
     pairs = [line for line in out.splitlines() if " ~ " in line]
     assert len(pairs) == 10 and all(line.endswith("agree") for line in pairs)
-    assert "every judged pair agrees (10 of 10" in out
+    assert "passed: every method converged and every judged pair agrees (10 of 10" in out
+    # each backend's own answer is judged and shown: no polish of ours, λ against pdas's
+    record = json.loads(path.read_text())
+    assert "λ vs pdas" in out and "polished λ" not in out and not record["polish"]
+    for run_ in record["methods"]:
+        assert run_["polished"] is None and "polished" not in run_["message"], run_["method"]
+        assert run_["lam_ref"] <= AGREE_FACTOR * 1e-8 and run_["apart_ref"] == 0
+        assert run_["active"] == record["methods"][-1]["active"] > 0
+        assert run_["iterations"] > 0, run_["method"]  # the backend's own count (Clarabel's too)
+
+
+def test_an_inaccurate_method_fails_the_check_unless_allowed(capsys):
+    require("qp-ecos")
+    argv = ["crosscheck", "block", "--method", "qp-ecos", "--method", "pdas", "--tol", "1e-9"]
+    code, out, _ = run(capsys, *argv)
+    ecos = next(line for line in out.splitlines() if line.startswith("qp-ecos"))
+    assert "inaccurate" in ecos and code == 1
+    assert out.rstrip().splitlines()[-1].startswith("FAILED: qp-ecos inaccurate")
+    code, out, _ = run(capsys, *argv, "--allow", "qp-ecos")
+    assert code == 0 and "qp-ecos (allowed)" in out and "allowed through: qp-ecos" in out
+    check = signorini.crosscheck("block", ["qp-ecos", "pdas"], tol=1e-9)
+    assert not check.passed and check.failures == ["qp-ecos inaccurate"]
+    assert check.to_dict()["failures"] == check.failures
+
+
+def test_a_method_that_does_not_converge_on_a_users_problem_is_named():
+    require("qp-osqp")
+    check = signorini.crosscheck(small_problem(), ["qp-osqp", "pdas"], tol=1e-10,
+                                 options={"qp-osqp": {"max_iter": 1, "polishing": False}})
+    assert not check.passed and check.failures == [f"qp-osqp {check.runs[0].status}"]
+    assert check.runs[0].status != "converged"
+    assert signorini.crosscheck(small_problem(), ["qp-osqp", "pdas"], tol=1e-10,
+                                options={"qp-osqp": {"max_iter": 1, "polishing": False}},
+                                allow=["qp-osqp"]).passed
+
+
+def test_polish_is_an_extra_column_not_the_judged_answer(capsys):
+    require("qp-clarabel")
+    check = signorini.crosscheck("block", ["qp-clarabel", "pdas"], tol=1e-8, polish=True)
+    clarabel, pdas = check.runs
+    assert clarabel.polished is None and clarabel.polished_status == "converged"
+    assert clarabel.polished_lam_ref is not None and clarabel.polished_lam_ref <= clarabel.lam_ref
+    assert pdas.polished_status is None
+    assert "polished" not in check.results["qp-clarabel"].message
+    assert "polished λ vs pdas" in check.summary()
+    # a caller's own polish wins: then the judged answer is the polished one
+    own = signorini.crosscheck("block", ["qp-clarabel", "pdas"], tol=1e-8,
+                               options={"qp-clarabel": {"polish": True}})
+    assert own.runs[0].polished is not None
 
 
 def test_a_method_that_lies_makes_it_exit_1(capsys, liar, tmp_path):
@@ -70,10 +119,11 @@ def test_a_method_that_lies_makes_it_exit_1(capsys, liar, tmp_path):
     assert "converged → inaccurate" in liar_row
     assert f"pdas ~ {liar}" in out and f"uzawa ~ {liar}" in out
     verdicts = {line.split()[0] + line.split()[2]: line.split()[-1]
-                for line in out.splitlines() if " ~ " in line and not line.startswith("DISAGREE")}
+                for line in out.splitlines() if " ~ " in line and not line.startswith("FAILED")}
     assert verdicts == {"pdasuzawa": "agree", f"pdas{liar}": "DISAGREE",
                         f"uzawa{liar}": "DISAGREE"}
-    assert "DISAGREE:" in md.read_text() and "| pdas ~ uzawa |" in md.read_text()
+    assert f"FAILED: {liar} inaccurate; pdas ~ {liar} disagree; uzawa ~ {liar} disagree" in out
+    assert "FAILED:" in md.read_text() and "| pdas ~ uzawa |" in md.read_text()
 
 
 def test_the_api_returns_the_numbers_of_the_json(capsys, tmp_path):
@@ -138,7 +188,7 @@ def test_a_missing_backend_is_a_row_not_an_error():
     finally:
         del REGISTRY[fake.name]
     assert [run.status for run in check.runs] == ["converged", "converged", "not installed"]
-    assert len(check.pairs) == 1 and check.passed
+    assert len(check.pairs) == 1 and check.failures == ["qp-nowhere not installed"]
 
 
 @pytest.mark.parametrize("argv, words", [
@@ -147,6 +197,7 @@ def test_a_missing_backend_is_a_row_not_an_error():
     (["--method", "pdas", "--method", "pdas"], "named twice"),
     (["--method", "pdas", "--method", "uzawa", "--opt", "qp-osqp:polish=false"], "not among"),
     (["--method", "pdas", "--method", "uzawa", "--opt", "polish=false"], "METHOD:key=value"),
+    (["--method", "pdas", "--method", "uzawa", "--allow", "qp-osqp"], "allow names 'qp-osqp'"),
     (["--tol", "2"], "--tol"),
     (["--json", "."], "is a directory"),
     (["--md", "/no/such/dir/x.md"], "does not exist"),
@@ -180,9 +231,10 @@ def _tool():
 
 def test_the_crosscheck_doc_is_its_runs_and_meets_the_issue():
     """docs/crosscheck.md's tables are what tools/crosscheck_cases.py renders from the committed
-    JSON; in it every validation case has qp-osqp, qp-clarabel and cvxpy at tol 1e-8, in their
-    defaults, converged with λ within 1e-6 of pdas and its active set — and the defaults that
-    run was made with are the code's."""
+    JSON; in it every validation case has qp-osqp, qp-clarabel and cvxpy at tol 1e-8, polished
+    (``solve``'s defaults), converged with λ within 1e-6 of pdas and its active set; their raw
+    answers (what the cross-check judges) do the same on Hertz's cylinder — and the defaults
+    that run was made with are the code's."""
     tool = _tool()
     from readme import current  # tools/readme.py, put on the path by the tool
     data = json.loads(tool.OUT.read_text())
@@ -192,16 +244,22 @@ def test_the_crosscheck_doc_is_its_runs_and_meets_the_issue():
     from signorini.solvers import cvxpy_, qp
     from signorini.studies.suite import DEFAULT_CASES
 
-    default = data["variants"]["default"]
-    assert sorted(default) == sorted(case.name for case in DEFAULT_CASES)
-    for record in default.values():
-        assert record["tol"] == 1e-8 and record["passed"]
+    polished = data["variants"]["polished"]
+    assert sorted(polished) == sorted(case.name for case in DEFAULT_CASES)
+    for record in polished.values():
+        assert record["tol"] == 1e-8 and record["passed"] and not record["polish"]
         for method in ("qp-osqp", "qp-clarabel", "cvxpy", "uzawa"):
             verdict = tool.verdict(record, method)
             assert verdict["ok"], (record["case"], method, verdict)
+    for record in data["variants"]["raw"].values():
+        assert record["passed"] == (not record["failures"])
+        assert all(run_["polished"] is None for run_ in record["methods"])
+    cylinder = data["variants"]["raw"]["hertz-cylinder"]
+    assert cylinder["passed"] and all(tool.verdict(cylinder, m)["ok"] for m in tool.QP_METHODS)
     assert qp.BACKEND_BY_NAME["osqp"].polish and qp.BACKEND_BY_NAME["clarabel"].polish
     assert cvxpy_.DEFAULT_POLISH
     assert qp.BACKEND_BY_NAME["clarabel"].tolerance(1e-8)["tol_gap_abs"] == 1e-14
+    assert qp.BACKEND_BY_NAME["osqp"].tolerance(1e-8)["polishing"] is True
 
 
 def test_the_validation_suite_cross_checks_uzawa_with_osqp_and_clarabel():

@@ -192,6 +192,17 @@ def test_polish_on_a_wrong_active_set_is_not_kept():
     assert out.lam is lam and record["polished"]["dual_sign"] > record["raw"]["dual_sign"]
 
 
+def test_a_polished_answer_that_is_not_certified_says_so():
+    """Polish keeps a better point whose certificate still misses the tolerance: the status
+    stays the method's and the message does not end as if the answer were certified."""
+    problem = signorini.build_problem("block")
+    exact = solve(problem, "pdas", tol=1e-10)
+    raw = ContactSolution("test", 1.001 * exact.u, 1.001 * exact.lam, "failed", message="made up")
+    out = forms.polish(problem, forms.formulate(problem, "primal"), raw, 1e-30)
+    assert out.extras["polish"]["kept"] and out.status == "failed"
+    assert out.message.endswith("the polished answer, still failed (above 1e-30)"), out.message
+
+
 def test_the_formulations_doc_is_its_runs():
     """docs/formulations.md's tables are what tools/formulations.py renders from the committed
     JSON (``python tools/formulations.py --doc``), and its defaults are the code's."""

@@ -4,7 +4,7 @@ Layers, low to high (a module may import its own layer and the layers below):
 
 0. ``errors``, ``files``                 exceptions, atomic writes
 1. ``numerics``                          factorisations, dense LCP, zone kernel, the push kernel
-2. ``problem``, ``discretisation``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
+2. ``problem``, ``problem_files``, ``discretisation``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
 3. ``solvers``                           the registry collects each backend's METHODS
 4. ``loading``                           load control: the one driver around any method
 5. ``scenes``                            families, meshing, scene files, building problems
@@ -35,13 +35,13 @@ PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
 LAYERS = {
     "errors": 0, "files": 0,
     "numerics": 1,
-    "problem": 2, "discretisation": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
-    "adequacy": 2, "forward_error": 2, "fingerprint": 2,
+    "problem": 2, "problem_files": 2, "discretisation": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
+    "adequacy": 2, "forward_error": 2, "fingerprint": 2, "scales": 2,
     "fem": 2,
     "solvers": 3,
     "loading": 4,
     "scenes": 5,
-    "api": 6, "crosschecking": 6, "": 6,
+    "api": 6, "crosschecking": 6, "derivatives": 6, "": 6,
     "studies": 7, "output": 7, "teaching": 7,
     "cli": 8,
 }

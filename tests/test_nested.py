@@ -234,7 +234,7 @@ def test_a_coarse_model_out_of_range_means_no_prediction(monkeypatch):
 
 
 def test_the_committed_bench_holds_nested_near_one_factorisation():
-    """docs/bench-nested (one run, README's line generated from it): nested within 2× one
+    """docs/bench-nested (one run, docs/performance.md's line generated from it): nested within 2× one
     factorisation + solve at 66k dofs and 1.3× at 261k and 1M, every run converged and exact."""
     import csv
     from pathlib import Path

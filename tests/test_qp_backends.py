@@ -215,7 +215,7 @@ def test_tol_none_leaves_backend_defaults_untouched():
         if backend.tolerance is not None:
             assert backend.settings(1e-6, None)
     assert qp.BACKEND_BY_NAME["osqp"].settings(1e-7, 50) == {
-        "eps_abs": 1e-7, "eps_rel": 1e-7, "eps_prim_inf": 1e-7, "max_iter": 50}
+        "eps_abs": 1e-7, "eps_rel": 1e-7, "eps_prim_inf": 1e-7, "polishing": True, "max_iter": 50}
     assert qp.BACKEND_BY_NAME["gurobi"].settings(1e-12, None)["FeasibilityTol"] == 1e-9
 
 

@@ -1,4 +1,4 @@
-"""Numbers the README prints from a run are the committed run's (tools/readme.py writes them)."""
+"""Numbers the docs pages print from a run are the committed run's (tools/readme.py writes them)."""
 
 import importlib.util
 from pathlib import Path
@@ -19,21 +19,21 @@ def test_every_generated_block_is_what_its_artefact_gives():
 
 
 def test_the_check_sees_a_changed_number():
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = readme_tool.RESULTS.read_text(encoding="utf-8")
     body = readme_tool.blocks()["validation"]
     changed = text.replace(body, body.replace("checks passed", "checks passed!"))
     assert readme_tool.current(changed, "validation") != body
 
 
-def test_the_readme_atlas_table_is_the_reports():
+def test_the_results_atlas_table_is_the_reports():
     table = readme_tool.blocks()["stability-table"]
     assert table in (ROOT / "docs" / "stability.md").read_text(encoding="utf-8")
 
 
-def test_the_readme_counts_the_atlas_axes():
+def test_the_results_page_counts_the_atlas_axes():
     data = readme_tool.stability.load()
     words = {8: "eight"}
-    assert f"{words[len(data['axes'])]} sweeps" in (ROOT / "README.md").read_text(encoding="utf-8")
+    assert f"{words[len(data['axes'])]} sweeps" in readme_tool.RESULTS.read_text(encoding="utf-8")
 
 
 def test_a_finding_the_atlas_no_longer_shows_stops_the_tool():

@@ -71,6 +71,23 @@ def test_notebook_runs_headless(name, monkeypatch):
     assert figures >= NOTEBOOKS[name], f"{name} drew {figures} figures"
 
 
+#: the notebooks rewritten on the public API alone (``import signorini``), with worked exercises
+PUBLIC_API_ONLY = tuple(NOTEBOOKS)
+
+
+@pytest.mark.parametrize("name", PUBLIC_API_ONLY)
+def test_notebook_uses_only_the_public_api_and_ends_with_worked_exercises(name):
+    import signorini
+
+    notebook = nbformat.read(_path(name), as_version=4)
+    source = "\n".join(cell.source for cell in notebook.cells if cell.cell_type == "code")
+    assert re.findall(r"^\s*(?:from|import)\s+(signorini\S*)", source, flags=re.M) == ["signorini"]
+    assert set(re.findall(r"\bsignorini\.(\w+)", source)) <= set(signorini.__all__)
+    headings = [line for cell in notebook.cells if cell.cell_type == "markdown"
+                for line in cell.source.splitlines() if line.startswith("## ")]
+    assert headings.index("## Exercises") < headings.index("## Worked solutions")
+
+
 def test_readme_links_every_tutorial():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     section = re.search(r"^## Tutorials\n(.*?)(?=^## |\Z)", readme, flags=re.S | re.M)

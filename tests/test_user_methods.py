@@ -40,6 +40,15 @@ METHODS = textwrap.dedent("""
     def returns_tuple(problem, **options):
         return pdas(problem).u, pdas(problem).lam
 
+    def returns_zero_pair(problem, **options):
+        return pdas(problem).u, np.zeros(problem.m)
+
+    def returns_triple(problem, **options):
+        return pdas(problem).u, pdas(problem).lam, "converged"
+
+    def returns_short_pair(problem, **options):
+        return np.zeros(3), np.zeros(problem.m)
+
     def short_u(problem, **options):
         return answer(problem, u=np.zeros(3))
 
@@ -101,7 +110,8 @@ def user_file(tmp_path, monkeypatch):
 
 BROKEN = [
     ("returns_none", "returned NoneType, not a ContactSolution"),
-    ("returns_tuple", "returned tuple, not a ContactSolution"),
+    ("returns_triple", "returned a tuple of 3 items, not (u, lam) or a ContactSolution"),
+    ("returns_short_pair", "u must be an array of 544 floats, got a float64 array of shape (3,)"),
     ("short_u", "u must be an array of 544 floats, got a float64 array of shape (3,)"),
     ("long_lam", "lam must be an array of 17 floats, got a float64 array of shape (18,)"),
     ("matrix_u", "u must be an array of 544 floats, got a float64 array of shape (544, 1)"),
@@ -129,6 +139,14 @@ def test_an_honest_user_method_converges_and_integer_forces_are_floats(user_file
     assert result.solution.lam.dtype == float
     assert result.status != "failed", result.message  # zero forces: wrong, but judged as an answer
     assert result.status != "converged"
+
+
+def test_a_method_returning_u_and_lam_is_judged_as_a_claim_of_convergence(user_file):
+    right = signorini.solve("block", "mine.py:returns_tuple")  # pdas's (u, λ): the exact answer
+    assert right.status == "converged", right.message
+    assert "returned (u, lam)" in right.message
+    wrong = signorini.solve("block", "mine.py:returns_zero_pair")  # no contact force: not an answer
+    assert wrong.claimed_status == "converged" and wrong.status != "converged"
 
 
 @pytest.mark.parametrize("source, words", [

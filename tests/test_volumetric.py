@@ -116,7 +116,7 @@ def test_a_scene_file_takes_volumetric(tmp_path):
 
 
 def test_the_documented_numbers_are_the_committed_run():
-    """README's and docs/accuracy.md's words on the nodal average, against docs/accuracy/runs.json."""
+    """docs/methods.md's and docs/accuracy.md's words on the nodal average, against docs/accuracy/runs.json."""
     import json
     from pathlib import Path
     root = Path(__file__).resolve().parents[1]
@@ -128,7 +128,7 @@ def test_the_documented_numbers_are_the_committed_run():
                     == (scene, n_contact, volumetric, nu)]
         return found
 
-    readme = (root / "README.md").read_text()
+    readme = (root / "docs" / "methods.md").read_text()
     locked, free = row("hertz-cylinder", 40, "element", 0.499), row("hertz-cylinder", 40, "nodal", 0.499)
     assert f"p₀ +{100 * locked['p0_err']:.1f} % on the\ndefault cylinder at ν = 0.499" in readme
     assert f"(p₀ {100 * free['p0_err']:+.3f} % there)".replace("-", "−") in readme

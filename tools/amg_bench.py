@@ -315,7 +315,7 @@ def whole_sentence(run: dict) -> str:
 
 
 def readme_paragraph(data: dict) -> str:
-    """The README's block ``amg`` (tools/readme.py)."""
+    """The block ``amg`` of docs/performance.md (tools/readme.py)."""
     lines = []
     if "whole-350k-load" in data:
         lines.append("- The scene's default (a target load): " + whole_sentence(data["whole-350k-load"])
@@ -372,7 +372,7 @@ def _scale_cells(run: dict, one_s: float | None) -> list[str]:
 
 
 def scale_table(data: dict) -> str:
-    """The README's block ``amg-scale``: every size and method of part ``scale``."""
+    """The block ``amg-scale`` of docs/performance.md: every size and method of part ``scale``."""
     part = data["scale"]
     lines = [f"`.venv/bin/python tools/amg_bench.py run --part scale` (commit {part['commit']}, "
              f"{part['date']}): `signorini solve hertz-sphere-3d` pushed by `delta=0.0025`, each run "

@@ -167,7 +167,7 @@ def _default_form(method: str) -> str:
 
 
 def summary(data: dict) -> str:
-    """The README's lines: the exact methods, the three named QP methods in their default form,
+    """docs/methods.md's lines: the exact methods, the three named QP methods in their default form,
     and the fastest QP run that ended converged and exact, per size."""
     named = ("qp-osqp", "qp-clarabel", "cvxpy")
     head = ["dofs", "nested", "pdas"] + [f"{m} ({_default_form(m)})" for m in named]
@@ -195,9 +195,9 @@ def blocks(data: dict) -> dict[str, str]:
 
 
 def write_doc(data: dict) -> None:
-    """Every block of docs/bench-forms.md, and the README's summary where it has the block."""
+    """Every block of docs/bench-forms.md, and its summary in docs/methods.md."""
     fill_blocks(DOC, blocks(data))
-    fill_blocks(ROOT / "README.md", blocks(data), required=False)
+    fill_blocks(ROOT / "docs" / "methods.md", blocks(data), required=False)
 
 
 def main() -> int:

@@ -1,5 +1,5 @@
-"""Write the generated blocks of README.md and docs/ (accuracy, estimate, peer, convergence) from
-the committed artefacts they quote.
+"""Write the generated blocks of the docs pages (results, performance, accuracy, estimate, peer,
+convergence) from the committed artefacts they quote; the README itself carries none.
 
     .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`,
                                               # `signorini stability --out docs`, ...
@@ -27,12 +27,13 @@ from signorini.output.report import readme_validation  # noqa: E402
 from signorini.studies.peer import peer_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-README = ROOT / "README.md"
+RESULTS = ROOT / "docs" / "results.md"          # validation, accuracy on demand, GetFEM, the atlas
+PERFORMANCE = ROOT / "docs" / "performance.md"  # 3D at scale, the 1M-dof cylinder, nested's ratios
 ACCURACY = ROOT / "docs" / "accuracy.md"
 ESTIMATE = ROOT / "docs" / "estimate.md"
 PEER = ROOT / "docs" / "peer.md"
 CONVERGENCE = ROOT / "docs" / "convergence.md"
-DOCUMENTS = (README, ACCURACY, ESTIMATE, PEER, CONVERGENCE)
+DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE)
 #: the contact half-width of each convergence study's scene at its defaults (h / a in the tables)
 STUDY_A = {"hertz-cylinder": 0.05, "hertz-sphere": 0.05, "reverse-hertz": 0.02, "punch": 1.0}
 STUDY_COLUMNS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
@@ -79,7 +80,7 @@ def convergence_table(path: Path, method: str = "pdas") -> str:
 
 
 def one_million(run: Path) -> str:
-    """The README's headline from the committed 1M-dof run (its JSON and /usr/bin/time -v)."""
+    """The performance page's headline from the committed 1M-dof run (its JSON and /usr/bin/time -v)."""
     record = json.loads((run / "result.json").read_text())
     timing = dict(line.strip().rsplit(": ", 1) for line in (run / "time.txt").read_text().splitlines()
                   if ": " in line)
@@ -96,30 +97,31 @@ def one_million(run: Path) -> str:
 
 
 def nested_ratios(csv_path: Path) -> str:
-    """The README's line on nested against one factorisation, from the committed bench CSV."""
+    """The performance page's line on nested against one factorisation, from the committed bench CSV."""
     import csv
 
     rows = list(csv.DictReader(csv_path.open()))
     parts = [f"{int(r['dofs']):,} dofs: {float(r['time_s']):.2f} s against {float(r['factor_s']):.2f} s, "
              f"**{float(r['ratio_to_factor']):.2f}×**" for r in rows if r["method"] == "nested"]
     return ("`nested` against one PARDISO factorisation + solve of the same K, in one run "
-            "([`docs/bench-nested/bench.md`](docs/bench-nested/bench.md)): " + "; ".join(parts) + ".")
+            "([`docs/bench-nested/bench.md`](bench-nested/bench.md)): " + "; ".join(parts) + ".")
 
 
-def blocks(document: Path = README) -> dict[str, str]:
+def blocks(document: Path = RESULTS) -> dict[str, str]:
     """The generated blocks of ``document`` by name, from their artefacts."""
-    if document == README:
+    if document == RESULTS:
         report = json.loads((ROOT / "docs" / "validation" / "report.json").read_text())
         peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
         return {"validation": readme_validation(report),
                 "peer": "\n".join(peer[peer.index("") + 1:]),  # the summary of docs/peer/peer.md
-                "one-million": one_million(ROOT / "docs" / "speed" / "one-million"),
                 "adaptive-summary": estimate_study.adaptive_summary(estimate_study.load("adaptive")),
+                **stability.tables(stability.load())}
+    if document == PERFORMANCE:
+        return {"one-million": one_million(ROOT / "docs" / "speed" / "one-million"),
                 "nested-ratios": nested_ratios(ROOT / "docs" / "bench-nested" / "bench.csv"),
                 "amg": amg_bench.readme_paragraph(amg_bench.read()),
                 "amg-scale": amg_bench.scale_table(amg_bench.read()),
-                "amg-nested-again": amg_bench.nested_again(amg_bench.read()),
-                **stability.tables(stability.load())}
+                "amg-nested-again": amg_bench.nested_again(amg_bench.read())}
     if document == ACCURACY:
         runs = {}
         for name in ("peer-nu0", "peer-nu045"):  # every run of docs/peer-nu0, docs/peer-nu045
@@ -150,7 +152,8 @@ def pattern(name: str) -> re.Pattern:
 
 def fill_blocks(document: Path, bodies: dict[str, str], required: bool = True) -> None:
     """Write each generated block of ``document`` from ``bodies``; a block the document lacks
-    stops the tool when ``required`` (the study's own page), else is left out (the README)."""
+    stops the tool when ``required`` (the study's own page), else is left out (a page that
+    quotes only some of them)."""
     text = document.read_text(encoding="utf-8")
     for name, body in bodies.items():
         if not pattern(name).search(text):

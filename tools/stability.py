@@ -1,4 +1,4 @@
-"""The README's "When methods fail" blocks, written from the committed stability atlas.
+"""The "When methods fail" blocks of docs/results.md, written from the committed stability atlas.
 
     .venv/bin/python tools/readme.py        # after `signorini stability --out docs`
 
@@ -9,7 +9,7 @@ axis that its module states (:attr:`signorini.studies.atlas.axis.Axis.headline`,
 of :mod:`signorini.studies.atlas.findings`). A finding also states things the numbers do not show
 by themselves ("growth is never seen"); each such statement is checked against the rows, and
 ``tables`` raises :class:`StaleFinding` when a new run no longer shows it: rewrite the sentence in
-its axis module, then run tools/readme.py. tests/test_readme_numbers.py holds the README to what
+its axis module, then run tools/readme.py. tests/test_readme_numbers.py holds that page to what
 this writes.
 """
 
@@ -35,7 +35,7 @@ def load(path: Path = RUNS) -> dict[str, Any]:
 
 
 def tables(data: dict[str, Any]) -> dict[str, str]:
-    """The README's blocks by name."""
+    """The page's blocks by name."""
     axes = [a for a in AXES if a.name in data["axes"]]
     return {"stability-run": run_headline(data),
             "stability-table": "\n".join(method_axis_table(data["rows"], axes)),

@@ -1,8 +1,10 @@
 """A contact solver with a deliberate flaw, for tutorial 04 (write your own solver).
 
 It follows the package's protocol for a method,
-``solve(problem, *, tol=None, max_iter=None, **options) -> ContactSolution``,
-so that ``signorini validate --method docs/tutorials/one_shot_solver.py:solve``
+``solve(problem, *, tol=None, max_iter=None, **options) -> signorini.ContactSolution``,
+and uses only the public API (``import signorini``), so that
+``signorini.crosscheck(problem, ["one_shot_solver.py:solve", "pdas"])`` and
+``signorini validate --method docs/tutorials/one_shot_solver.py:solve``
 can cross-check it. Its idea is the first half of an active-set method:
 
 1. solve without contact, ``u₀ = K⁻¹ f``;
@@ -11,7 +13,7 @@ can cross-check it. Its idea is the first half of an active-set method:
 
 The flaw: it stops there and claims success. A node that penetrated only
 because its neighbours were not yet held up gets a *pulling* force ``λᵢ < 0``,
-which a contact cannot exert. The validation harness finds this.
+which a contact cannot exert. The certificate and the cross-check find this.
 """
 
 from __future__ import annotations
@@ -20,11 +22,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from signorini.errors import InputError
-from signorini.problem import ContactProblem, ContactSolution
+import signorini
 
 
-def closed_gaps(problem: ContactProblem, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def closed_gaps(problem: signorini.ContactProblem, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(u, λ)`` with the gaps of the ``active`` nodes closed and no force elsewhere.
 
     Solves ``[K N_Aᵀ; N_A 0] [u; λ_A] = [f; d_A]`` and sets ``λᵢ = 0`` off ``A``.
@@ -37,13 +38,14 @@ def closed_gaps(problem: ContactProblem, active: np.ndarray) -> tuple[np.ndarray
     return solution[:problem.n], lam
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
-          **options) -> ContactSolution:
+def solve(problem: signorini.ContactProblem, *, tol: float | None = None,
+          max_iter: int | None = None, **options) -> signorini.ContactSolution:
     """Close every gap the contact-free solution penetrates, in one linear solve (flawed)."""
     if options:
-        raise InputError(f"one_shot_solver takes no options, got {sorted(options)}")
+        raise signorini.InputError(f"one_shot_solver takes no options, got {sorted(options)}")
     u_free = spla.spsolve(sp.csc_matrix(problem.K), problem.f)
     active = problem.N @ u_free - problem.d > 0
     u, lam = closed_gaps(problem, active)
-    return ContactSolution(method="one-shot", u=u, lam=lam, status="converged", iterations=1,
-                           message=f"closed the gaps of {int(active.sum())} penetrating nodes")
+    return signorini.ContactSolution(method="one-shot", u=u, lam=lam, status="converged",
+                                     iterations=1,
+                                     message=f"closed the gaps of {int(active.sum())} penetrating nodes")

@@ -65,7 +65,7 @@ def _main_ranks(argv: Sequence[str] | None) -> int:
             return cluster.serve()
     except ImportError:
         print("signorini: error: started by mpirun but mpi4py is not installed: "
-              "pip install 'signorini[petsc]' (see README, 'PETSc and MPI')", file=sys.stderr)
+              "pip install 'signorini[petsc]' (see docs/performance.md, 'PETSc and MPI')", file=sys.stderr)
         return EXIT_USAGE
     try:
         return _main(argv, ranks=cluster.size())

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from signorini.errors import InputError
-from signorini.cli.common import input_files, out_folder, pairs, parse_sizes
+from signorini.cli.common import PROBLEM_FILES, input_files, out_folder, pairs, parse_sizes
 
 
 def _bench_peer(args: argparse.Namespace) -> int:
@@ -55,19 +55,33 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.default_only_from is not None and args.default_only_from < 0:
         raise InputError(f"--default-only-from {args.default_only_from} must be a refinement "
                          "level >= 0, e.g. --default-only-from 3")
+    if args.peer and args.problem:
+        raise InputError("--peer runs GetFEM on its own Hertz scenes: drop --problem (or --peer)")
     if args.peer:
         return _bench_peer(args)
     import math
 
     # each command loads what it needs (the benchmark's report starts matplotlib)
     from signorini.files import all_or_none, writable_directory
+    from signorini.problem_files import read_problem  # as above
     from signorini.scenes import get_scene  # as above
     from signorini.scenes.size import check_size  # as above
     from signorini.solvers.registry import check_request, methods  # as above
     from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
 
-    family = get_scene(args.scene or "hertz-cylinder")
-    levels = _sizes(args.sizes, "0,1")
+    if args.problem is not None:  # a problem file is one size, solved as stored
+        given = [flag for flag, on in (("--scene", args.scene), ("--sizes", args.sizes),
+                                       ("--set", args.set),
+                                       ("--default-only-from", args.default_only_from is not None))
+                 if on]
+        if given:
+            raise InputError(f"{given[0]} builds a scene, and --problem {args.problem!r} is solved "
+                             f"as stored: drop {given[0]}")
+        problem = read_problem(args.problem)  # a bad file is refused before any work
+        family, levels = None, [0]
+    else:
+        family = get_scene(args.scene or "hertz-cylinder")
+        levels = _sizes(args.sizes, "0,1")
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
                          "e.g. --time-limit 120")
@@ -75,7 +89,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     unknown = [t for t in tolerances if t not in TOLERANCES]
     if unknown:
         raise InputError(f"--tolerance {unknown[0]!r} is not one of {', '.join(TOLERANCES)}")
-    out = out_folder(args.out or "bench-report", input_files(methods=args.method))
+    inputs = input_files(args.problem, args.method)
+    out = out_folder(args.out or "bench-report", inputs)
     csv_path = Path(out) / "bench.csv"
     if args.report_only and not csv_path.is_file():
         raise InputError(f"--report-only: there is no {csv_path}: run the benchmark into --out "
@@ -97,14 +112,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
     base = pairs(args.set, "--set")
     runs = []
     for level in levels:
-        params = {**base, "refine": level}
-        check_size(family.name, family.parse(params))  # bad or too big: refused before any run
+        if family is None:
+            params, scene, size = {}, problem.name or Path(args.problem).stem, "file"
+        else:
+            params, scene, size = {**base, "refine": level}, family.name, f"refine{level}"
+            check_size(family.name, family.parse(params))  # bad or too big: refused before any run
         for method in chosen:
             few = args.default_only_from is not None and level >= args.default_only_from
             for tolerance in (["high"] if method.exact else ["default"] if few else tolerances):
                 for count in (ranks if method.family == "petsc" else [1]):
-                    runs.append(Run(family.name, f"refine{level}", params, method.name, tolerance,
-                                    ranks=count))
+                    runs.append(Run(scene, size, params, method.name, tolerance, ranks=count,
+                                    source=args.problem and os.path.abspath(args.problem)))
 
     def progress(i, n, run, row):
         print(f"[{i}/{n}] {run.size} {run.label}@{run.tolerance}: {row['status']} "
@@ -124,6 +142,8 @@ def add_parsers(sub) -> None:
     """Register ``bench``."""
     bench = sub.add_parser("bench", help="benchmark methods × sizes × tolerances (resumable CSV)")
     bench.add_argument("--scene", help="default hertz-cylinder (with --peer: both Hertz scenes)")
+    bench.add_argument("--problem", metavar="FILE", help="benchmark on a problem file of yours "
+                       f"instead of a scene: {PROBLEM_FILES}")
     bench.add_argument("--sizes", help="refinement levels, e.g. 0,1,2 (default 0,1; with --peer: "
                        "rungs of the peer ladder 0..4, default all)")
     bench.add_argument("--peer", choices=["getfem"], help="the Hertz scenes by GetFEM (system "

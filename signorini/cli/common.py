@@ -11,6 +11,10 @@ from typing import Any, Iterator, Sequence
 from signorini.errors import InputError
 
 EXIT_FAILED, EXIT_USAGE = 1, 2
+#: what a problem file is, in every command's help
+PROBLEM_FILES = ".npz (save's or plain) or Matrix Market (docs/problem-files.md)"
+#: the positional input of solve and crosscheck
+SCENE_HELP = f"scene name (see 'signorini scenes'), a .toml scene file, or a problem file: {PROBLEM_FILES}"
 
 
 class Parser(argparse.ArgumentParser):
@@ -71,14 +75,17 @@ def out_folder(path: str, inputs: dict[str, str] | None = None) -> str:
 
 
 def input_files(scene: str | None = None, methods: Sequence[str] = ()) -> dict[str, str]:
-    """The command's input files (a scene file, a method's file) by what they are.
+    """The command's input files (a scene file, a problem file, a method's file) by what they are.
 
     InputError for one that exists but is not a regular file (a FIFO would
     wait forever); outputs are later checked not to be one of them.
     """
     from signorini.files import check_input_file  # per command (start-up)
+    from signorini.problem_files import is_problem_file, problem_file_paths  # as above
 
     found = {"scene file": scene} if scene and scene.lower().endswith(".toml") else {}
+    if scene and is_problem_file(scene):
+        found.update({f"problem file {path}": path for path in problem_file_paths(scene)})
     found.update({f"file of --method {m}": m.rpartition(":")[0] for m in methods
                   if m.rpartition(":")[0].endswith(".py")})
     for what, path in found.items():

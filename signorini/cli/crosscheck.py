@@ -1,10 +1,10 @@
-"""``signorini crosscheck``: one scene, several methods, every pair of answers compared."""
+"""``signorini crosscheck``: one scene or problem file, several methods, every pair compared."""
 
 from __future__ import annotations
 
 import argparse
 
-from signorini.cli.common import (EXIT_FAILED, input_files, pairs, parse_tol,
+from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, parse_tol,
                                   stdout_to_stderr, user_methods_in_workers,
                                   write_output)
 from signorini.errors import InputError
@@ -13,13 +13,13 @@ from signorini.solvers.options import guess_value
 
 
 def method_options(items: list[str]) -> dict[str, dict]:
-    """``METHOD:key=value`` strings (``--opt qp-osqp:polish=false``) to per-method options."""
+    """``METHOD:key=value`` strings (``--opt qp-osqp:eps_abs=1e-10``) to per-method options."""
     out: dict[str, dict] = {}
     for item in items:
         method, sep, setting = item.rpartition(":")
         if not sep or not method or "=" not in setting:
             raise InputError(f"--opt {item!r} is not METHOD:key=value: write e.g. "
-                             "--opt qp-osqp:polish=false")
+                             "--opt qp-osqp:eps_abs=1e-10")
         for key, value in pairs([setting], "--opt").items():
             out.setdefault(method, {})[key] = guess_value(value)
     return out
@@ -39,7 +39,8 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     # what a method prints stays off the record; a user's method runs in a worker process
     with stdout_to_stderr(STDOUT in outputs.values()), user_methods_in_workers(methods):
         check = crosscheck(args.scene, methods, tol=DEFAULT_TOL if tol is None else tol,
-                           params=params, options=method_options(args.opt))
+                           params=params, options=method_options(args.opt), allow=args.allow,
+                           polish=args.polish)
     texts = {"--json": to_json(check.to_dict()) + "\n", "--md": check.markdown().rstrip("\n") + "\n"}
     with all_or_none():  # both files, or neither
         for flag, path in outputs.items():
@@ -56,9 +57,10 @@ def add_parsers(sub) -> None:
         "crosscheck", help="solve one scene with several methods and compare every pair",
         description="Solve one scene with several methods at one tolerance and compare every pair "
                     "of answers: λ and u (relative), nodes classified differently, each method's "
-                    "status and KKT certificate, Hertz's errors. Exit 1 when two methods that say "
-                    "converged disagree.")
-    cross.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
+                    "status and KKT certificate, its own (unpolished) answer's distance to pdas's "
+                    "and its active set, Hertz's errors. Exit 1 when a method does not converge "
+                    "or two methods that say converged disagree (--allow lets a method through).")
+    cross.add_argument("scene", help=SCENE_HELP)
     cross.add_argument("--method", action="append", default=[], metavar="M",
                        help="a method to compare (repeat; default uzawa, qp-osqp, qp-clarabel, "
                             "cvxpy, pdas)")
@@ -67,7 +69,14 @@ def add_parsers(sub) -> None:
     cross.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="scene parameter, e.g. --set a_over_R=0.05")
     cross.add_argument("--opt", action="append", default=[], metavar="METHOD:KEY=VALUE",
-                       help="an option of one method, e.g. --opt qp-osqp:polish=false")
+                       help="an option of one method, e.g. --opt qp-osqp:eps_abs=1e-10")
+    cross.add_argument("--allow", action="append", default=[], metavar="M",
+                       help="a known-weak method whose failure or disagreement does not fail the "
+                            "check (repeat)")
+    cross.add_argument("--polish", action="store_true",
+                       help="also polish each QP method's answer on its active set and show its "
+                            "distance to pdas in an extra column (the judged answer stays the "
+                            "method's own)")
     cross.add_argument("--json", metavar="FILE", help="write the record as JSON ('-' for stdout)")
     cross.add_argument("--md", metavar="FILE", help="write the tables as Markdown ('-' for stdout)")
     cross.set_defaults(run=cmd_crosscheck)

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
-from signorini.cli.common import (EXIT_FAILED, input_files, pairs, parse_time_limit,
+from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, parse_time_limit,
                                   parse_tol, stdout_to_stderr, write_output)
 from signorini.errors import InputError
 from signorini.solvers.base import DEFAULT_TOL
@@ -16,6 +17,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.api import Result, at_load, build_problem, solve, solve_adaptive  # per command
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
     from signorini.kkt import certificate  # per command (start-up)
+    from signorini.problem_files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
 
     params = pairs(args.set, "--set")
@@ -23,6 +25,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
     max_iter = guess_value(texts.pop("max_iter")) if "max_iter" in texts else None
     tol = parse_tol(args.tol) if args.tol is not None else None
     inputs = input_files(args.scene, [args.method])  # before the method's file is imported
+    from_file = is_problem_file(args.scene)
+    if from_file:  # a problem file is solved as stored: nothing to build, refine or rescale
+        given = [flag for flag, on in (("--set", args.set), ("--raw-units", args.raw_units),
+                                       ("--target-error", args.target_error is not None)) if on]
+        if given:
+            raise InputError(f"{given[0]} applies to a scene; problem file {args.scene!r} is "
+                             f"solved as stored: drop {given[0]}")
     # every option read as its declared kind and checked before the scene is built
     method = get_method(args.method)
     options = method.parse_options(texts)
@@ -59,6 +68,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
         else:
             problem = build_problem(args.scene, params=params, nondimensionalise=not args.raw_units,
                                     solved_by=args.method)
+            if vtk_path and problem.mesh is None:
+                raise InputError(f"--vtk writes the mesh, and {args.scene!r} holds none (a QP "
+                                 "given as arrays): drop --vtk, or save the problem of a scene")
             if time_limit is None:
                 result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
                 problem = result.problem
@@ -66,8 +78,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
                 from signorini.studies.runner import solve_within  # per command (start-up)
 
                 problem = at_load(problem)  # the worker builds it again, matched the same way
-                spec = {"kind": "scene", "scene": args.scene, "params": params,
-                        "nondimensionalise": not args.raw_units}
+                spec = {"kind": "stored", "path": os.path.abspath(args.scene)} if from_file else \
+                    {"kind": "scene", "scene": args.scene, "params": params,
+                     "nondimensionalise": not args.raw_units}
                 solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
                                         max_iter=max_iter, options=options)
                 result = Result(problem, solution, certificate(problem, solution))
@@ -93,7 +106,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 def add_parsers(sub) -> None:
     """Register ``solve``."""
     solve = sub.add_parser("solve", help="solve one scene with one method")
-    solve.add_argument("scene", help="scene name (see 'signorini scenes') or a .toml scene file")
+    solve.add_argument("scene", help=SCENE_HELP)
     solve.add_argument("--method", default="auto",
                        help="method name (see 'signorini methods'; auto: pdas in 2D, pdas-amg for large 3D)")
     solve.add_argument("--tol", help="the method's tolerance (default: the method's own; a QP "

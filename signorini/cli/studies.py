@@ -7,8 +7,9 @@ import shlex
 import sys
 
 from signorini.errors import InputError
-from signorini.cli.common import (EXIT_FAILED, input_files, out_folder, pairs, parse_time_limit,
-                                  user_methods_in_workers)
+from signorini.cli.common import (EXIT_FAILED, PROBLEM_FILES, input_files, out_folder, pairs,
+                                  parse_time_limit, parse_tol, user_methods_in_workers,
+                                  write_output)
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
@@ -48,31 +49,79 @@ def cmd_converge(args: argparse.Namespace) -> int:
     return 0
 
 
+def validate_options(items: list[str], methods: list[str]) -> dict[str, dict]:
+    """``--opt METHOD:key=value`` (or ``key=value`` when one --method is named) per method."""
+    from signorini.cli.crosscheck import method_options  # per command (start-up)
+
+    bare = [item for item in items if ":" not in item.partition("=")[0]]
+    if bare and len(methods) != 1:
+        raise InputError(f"--opt {bare[0]!r} names no method: write --opt METHOD:{bare[0]} (or "
+                         "name one --method)")
+    return method_options([f"{methods[0]}:{item}" if item in bare else item for item in items])
+
+
 def cmd_validate(args: argparse.Namespace) -> int:
     # each command loads what it needs (the report starts matplotlib)
-    from signorini.files import all_or_none
-    from signorini.output.report import checks_summary, write_suite_report  # as above
-    from signorini.studies.suite import run_suite, select_cases  # as above
+    import os
 
+    from signorini.files import all_or_none, check_outputs  # as above
+    from signorini.output.ci import github_annotations, junit_xml  # as above
+    from signorini.output.report import checks_summary, write_suite_report  # as above
+    from signorini.problem_files import problem_file_paths, read_problem  # as above
     from signorini.solvers.registry import check_request  # as above
+    from signorini.studies.suite import (TIGHT_TOL, problem_case, read_limits, run_suite,
+                                         select_cases)  # as above
 
     time_limit = parse_time_limit(args.time_limit)
+    tol = TIGHT_TOL if args.tol is None else parse_tol(args.tol)
     methods = args.method or None
-    out = out_folder(args.out, input_files(methods=args.method))
-    for name in args.method:
-        check_request(name)  # an unknown or missing method is refused before any work
-    cases = select_cases(args.case)
+    inputs = input_files(methods=args.method)
+    for path in args.problem:
+        inputs.update({f"problem file {p}": p for p in problem_file_paths(path)})
+    if args.limits:
+        inputs["limits file"] = args.limits
+    outputs = check_outputs({"--junit": args.junit}, {"--out": args.out}, inputs=inputs)
+    out = outputs["--out"]
+    if args.junit == "-":  # the summary and the annotations are printed there
+        raise InputError("--junit - would mix the XML with the summary on stdout: give a file "
+                         "name, e.g. --junit report.xml")
+    options = validate_options(args.opt, args.method)
+    stray = sorted(set(options) - set(args.method)) if args.method else []
+    if stray:
+        raise InputError(f"--opt for {stray[0]!r}, which is not among the --method: add "
+                         f"--method {stray[0]}")
+    for name in args.method or list(options):
+        check_request(name, options=options.get(name))  # refused before any work
+    limits = read_limits(args.limits) if args.limits else None
+    for path in args.problem:
+        read_problem(path)  # a bad file is refused before any run, in one line
+    cases = select_cases(args.case) if args.case or not args.problem else ()
+    files: dict[str, str] = {}
+    for path in args.problem:
+        case = problem_case(path, [c.name for c in cases])
+        cases += (case,)
+        files[case.name] = path
     limit = {} if time_limit is None else {"time_limit": time_limit}
     suite = run_suite(cases, method_names=methods,
-                      progress=lambda line: print(line, file=sys.stderr), **limit)
-    command = "signorini validate" + "".join(f" --method {m}" for m in args.method)
+                      progress=lambda line: print(line, file=sys.stderr), tol=tol,
+                      options=options, limits=limits, **limit)
+    command = "signorini validate" + "".join(f" --method {shlex.quote(m)}" for m in args.method)
     command += "".join(f" --case {c}" for c in args.case)
-    if time_limit is not None:
-        command += f" --time-limit {args.time_limit}"
+    command += "".join(f" --problem {shlex.quote(p)}" for p in args.problem)
+    command += "".join(f" --opt {shlex.quote(o)}" for o in args.opt)
+    for flag, value in (("--tol", args.tol), ("--limits", args.limits),
+                        ("--time-limit", args.time_limit), ("--junit", args.junit)):
+        if value is not None:
+            command += f" {flag} {shlex.quote(value)}"
     if args.out != "validation-report":
         command += f" --out {shlex.quote(args.out)}"
-    with all_or_none():  # the whole report, or none of it
+    with all_or_none():  # the whole report (and the JUnit file), or none of it
         paths = write_suite_report(suite, out, command)
+        if outputs["--junit"]:
+            write_output(outputs["--junit"], junit_xml(suite, files))
+    if os.environ.get("GITHUB_ACTIONS") == "true":  # annotations on the workflow's summary
+        for line in github_annotations(suite, files):
+            print(line)
     print(checks_summary(suite))
     print(f"report: {paths['report.md']}")
     return 0 if suite.passed else EXIT_FAILED
@@ -153,7 +202,8 @@ def add_parsers(sub) -> None:
     converge.add_argument("--out", default="convergence-report", help="output directory")
     converge.set_defaults(run=cmd_converge)
 
-    validate = sub.add_parser("validate", help="run the validation suite on the default scenes")
+    validate = sub.add_parser("validate", help="run the validation suite on the default scenes "
+                              "or your problem files")
     validate.add_argument("--out", default="validation-report", help="report directory")
     validate.add_argument("--method", action="append", default=[],
                           help="only this method (repeatable; default: every installed one); "
@@ -162,6 +212,19 @@ def add_parsers(sub) -> None:
                           help="only this case (repeatable; default: all)")
     validate.add_argument("--time-limit", metavar="SECONDS", help="seconds per run in the worker "
                           "process (default 600): a method that hangs costs its limit")
+    validate.add_argument("--problem", action="append", default=[], metavar="FILE",
+                          help=f"a problem file of yours (repeatable): {PROBLEM_FILES}; only "
+                               "these unless --case")
+    validate.add_argument("--tol", help="the relative KKT tolerance asked of every method "
+                          "(default 1e-9; the exact answer stays pdas at 1e-9)")
+    validate.add_argument("--opt", action="append", default=[], metavar="METHOD:KEY=VALUE",
+                          help="an option of one method, e.g. --opt uzawa:step_fraction=0.5 "
+                               "(KEY=VALUE alone when one --method is named)")
+    validate.add_argument("--limits", metavar="FILE", help="a TOML file whose [limits] table "
+                          "replaces some of the checks' limits (docs/ci.md)")
+    validate.add_argument("--junit", metavar="FILE", help="also write the checks as JUnit XML "
+                          "for CI, e.g. report.xml; under GitHub Actions failed checks are "
+                          "also annotations")
     validate.set_defaults(run=cmd_validate)
 
     sweep = sub.add_parser("sweep", help="solve many load levels with one factorisation")

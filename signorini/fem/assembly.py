@@ -127,20 +127,32 @@ def stiffness(model: SceneModel, mesh: Any, E: float) -> sp.csr_matrix:
     With ``model.volumetric == "nodal"`` the λ-part averages the volumetric
     strain at the nodes (:mod:`signorini.fem.volumetric`: P1 without locking).
     """
-    Lambda, Mu = lame_parameters(E, model.nu)
-    if model.volumetric == "nodal":
-        return (_elastic_stiffness(model, mesh, 0.0, Mu)
-                + volumetric_stiffness(mesh, Lambda, model.axisymmetric)).tocsr()
-    return _elastic_stiffness(model, mesh, Lambda, Mu)
+    stiffness_form(model, 1.0, 1.0)  # the model's checks
+    return lame_stiffness(mesh, *lame_parameters(E, model.nu), axisymmetric=model.axisymmetric,
+                          volumetric=model.volumetric)
 
 
-def _elastic_stiffness(model: SceneModel, mesh: Any, Lambda: float, Mu: float) -> sp.csr_matrix:
-    if mesh.p.shape[0] == 2 and not model.axisymmetric:
+def lame_stiffness(mesh: Any, Lambda: float, Mu: float, *, axisymmetric: bool = False,
+                   volumetric: str = "element") -> sp.csr_matrix:
+    """``K = Λ K_Λ + μ K_μ`` of the whole mesh, for Lamé parameters ``Λ`` and ``μ``.
+
+    K is linear in the pair, so ``lame_stiffness(mesh, 1, 0)`` and
+    ``lame_stiffness(mesh, 0, 1)`` are its two parts (what ∂K/∂ν is made of).
+    """
+    if volumetric == "nodal":
+        return (_elastic_stiffness(mesh, 0.0, Mu, axisymmetric)
+                + volumetric_stiffness(mesh, Lambda, axisymmetric)).tocsr()
+    return _elastic_stiffness(mesh, Lambda, Mu, axisymmetric)
+
+
+def _elastic_stiffness(mesh: Any, Lambda: float, Mu: float, axisymmetric: bool) -> sp.csr_matrix:
+    if mesh.p.shape[0] == 2 and not axisymmetric:
         return plane_strain_stiffness(mesh, Lambda, Mu)
     if mesh.p.shape[0] == 3 and mesh.t.shape[0] == 4:
         return solid_stiffness(mesh, Lambda, Mu)
     basis = Basis(mesh, ElementVector(mesh.elem()))
-    return asm(stiffness_form(model, Lambda, Mu), basis).tocsr()
+    form = axisymmetric_elasticity(Lambda, Mu) if axisymmetric else linear_elasticity(Lambda, Mu)
+    return asm(form, basis).tocsr()
 
 
 def nodal_dofs(mesh: Any) -> np.ndarray:

@@ -91,8 +91,8 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> 
                          f"mesh does not have (it has {p.shape[1]})")
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is a degenerate element
         rows = np.ascontiguousarray(p.T)
-        longest = np.max([np.linalg.norm(rows[t[i]] - rows[t[j]], axis=1)
-                          for i, j in combinations(range(dim + 1), 2)], axis=0)
+        squares = [rows[t[i]] - rows[t[j]] for i, j in combinations(range(dim + 1), 2)]
+        longest = np.sqrt(np.max([np.einsum("ij,ij->i", e, e) for e in squares], axis=0))
         volume = signed_measures(p, t)
         degenerate = ~(np.abs(volume) > DEGENERATE * longest ** dim)
     if np.any(degenerate):
@@ -101,7 +101,24 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> 
                          f"(its nodes lie on one {'line' if dim == 2 else 'plane'}): remove it or "
                          "move its nodes apart")
     _check_duplicates(t, what, kind)
-    _check_facets(p, t, what, kind, facet)
+    _check_facets(t, np.sign(volume), p.shape[1], what, kind, facet)
+
+
+#: compare-and-swap pairs that sort 2, 3 or 4 rows
+NETWORKS = {2: ((0, 1),), 3: ((0, 1), (1, 2), (0, 1)),
+            4: ((0, 1), (2, 3), (0, 2), (1, 3), (1, 2))}
+
+
+def _sorted_columns(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each column of ``keys`` (2 to 4 rows) sorted, and whether sorting it took an odd
+    permutation (a sorting network: each swap it makes is one transposition)."""
+    rows = [row.copy() for row in keys]
+    odd = np.zeros(keys.shape[1], dtype=bool)
+    for i, j in NETWORKS[len(rows)]:
+        swap = rows[i] > rows[j]
+        rows[i], rows[j] = np.where(swap, rows[j], rows[i]), np.where(swap, rows[i], rows[j])
+        odd ^= swap
+    return np.array(rows), odd
 
 
 def _first_equal_neighbours(keys: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
@@ -118,7 +135,7 @@ def _first_equal_neighbours(keys: np.ndarray, count: int) -> tuple[np.ndarray, n
 
 
 def _check_duplicates(t: np.ndarray, what: str, kind: str) -> None:
-    order, same = _first_equal_neighbours(np.sort(t, axis=0), t.max(initial=0) + 1)
+    order, same = _first_equal_neighbours(_sorted_columns(t)[0], t.max(initial=0) + 1)
     if np.any(same):
         k = int(np.argmax(same))
         first, second = sorted((int(order[k]), int(order[k + 1])))
@@ -126,14 +143,23 @@ def _check_duplicates(t: np.ndarray, what: str, kind: str) -> None:
                          f"{_nodes(t, first)}): remove one of them")
 
 
-def _check_facets(p: np.ndarray, t: np.ndarray, what: str, kind: str, facet: str) -> None:
-    """At most two elements on a facet, and two on either side of it."""
+def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str, kind: str,
+                  facet: str) -> None:
+    """At most two elements on a facet, and two on either side of it.
+
+    The side of a facet an element lies on is the orientation of the simplex (the facet's
+    nodes sorted, then the element's node opposite it): the element's own orientation
+    (``orientation``, the sign of its measure) times the sign of the permutation from its
+    node order to that one, so no coordinate is read again.
+    """
     corners = t.shape[0]
     local = [[i for i in range(corners) if i != j] for j in range(corners)]
-    nodes = np.sort(np.hstack([t[f] for f in local]), axis=0)  # (dim, corners · elements)
-    opposite = np.concatenate([t[j] for j in range(corners)])
+    nodes, odd = _sorted_columns(np.hstack([t[f] for f in local]))  # (dim, corners · elements)
+    # moving node j to the end passes the corners - 1 - j nodes after it
+    moved = np.repeat([(corners - 1 - j) % 2 == 1 for j in range(corners)], t.shape[1])
     element = np.tile(np.arange(t.shape[1]), corners)
-    order, same = _first_equal_neighbours(nodes, p.shape[1])
+    side = np.where(odd ^ moved, -1.0, 1.0) * orientation[element]
+    order, same = _first_equal_neighbours(nodes, count)
     if same.size == 0:
         return
     shared = same[1:] & same[:-1]  # three in a row
@@ -145,16 +171,13 @@ def _check_facets(p: np.ndarray, t: np.ndarray, what: str, kind: str, facet: str
                          "overlaps itself there; remesh it")
     pairs = np.nonzero(same)[0]
     first, second = order[pairs], order[pairs + 1]
-    base = nodes[:, first]  # the shared facet's nodes, sorted: one orientation for both sides
-    side = [np.sign(signed_measures(p, np.vstack([base, opposite[which]])))
-            for which in (first, second)]
-    folded = side[0] == side[1]
+    folded = side[first] == side[second]
     if np.any(folded):
         k = int(np.argmax(folded))
         a, b = sorted((int(element[first[k]]), int(element[second[k]])))
         raise InputError(f"{what}: {PLURAL[kind]} {a} and {b} overlap: they lie on the same side of "
-                         f"their shared {facet} (nodes {', '.join(map(str, base[:, k]))}), so the "
-                         "mesh is folded there (an inverted element); remesh it or move its nodes")
+                         f"their shared {facet} (nodes {', '.join(map(str, nodes[:, first[k]]))}), so "
+                         "the mesh is folded there (an inverted element); remesh it or move its nodes")
 
 
 def _outward_normals(mesh: Any, facets: np.ndarray) -> np.ndarray:

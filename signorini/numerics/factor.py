@@ -310,37 +310,70 @@ class ActiveSetSolver:
         self.backend = resolve_backend(backend, self.n, self.K.nnz)
         self._dofs = selection_dofs(self.N)
         self._coef = self.N.data if self._dofs is not None else None
-        self._pinning = None
-        if self._dofs is not None:
-            self._pinning = Pinning(self.K, self.backend)
+        self._pinning: Pinning | None = None  # made at the first pinning (CHOLMOD's analysis)
         self.factor: Factor | PinnedFactor | None = None
+        self.saddle_point: SaddlePoint | None = None
 
-    def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k)."""
+    def pins(self, active: np.ndarray, factor: object) -> bool:
+        """``factor`` is a :class:`PinnedFactor` of this K with exactly the dofs of ``active`` pinned."""
+        return (self._dofs is not None and isinstance(factor, PinnedFactor)
+                and factor.matrix is self.K
+                and np.array_equal(np.sort(factor.fixed), np.sort(self._dofs[active])))
+
+    def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray,
+              factor: PinnedFactor | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k).
+
+        ``factor``, a factorisation of this very system (see :meth:`pins`; for
+        instance the last one a method made on the same active set), is reused:
+        the solve then costs back-solves only.
+        """
         active = np.asarray(active, dtype=bool)
         f, d = np.asarray(f, float), np.asarray(d, float)
         lam = np.zeros((self.m,) + f.shape[1:])
-        self.factor = None
         if self._dofs is not None:
             fixed = self._dofs[active]
             coef = self._coef[active] if f.ndim == 1 else self._coef[active][:, None]
             rhs = np.array(f)
             rhs[fixed] = d[active] / coef
-            self.factor = PinnedFactor(self.K, fixed, self.backend, self._pinning)
-            u = self.factor.solve(rhs)
-            lam[active] = (f[fixed] - self.factor.fixed_rows(u)) / coef
+            if factor is None or not self.pins(active, factor):
+                self.factor = None  # let go before the next one is made
+                if self._pinning is None:
+                    self._pinning = Pinning(self.K, self.backend)
+                factor = PinnedFactor(self.K, fixed, self.backend, self._pinning)
+            self.factor = factor
+            u = factor.solve(rhs)
+            lam[active] = (f[fixed] - factor.fixed_rows(u)) / coef
             return u, lam
+        self.factor = None
         N_A = self.N[active]
         if N_A.shape[0] == 0:
             self.factor = factorize(self.K, self.backend)
             return self.factor.solve(f), lam
-        scale = float(np.mean(np.abs(self.K.diagonal()))) or 1.0
-        system = sp.bmat([[self.K, scale * N_A.T], [scale * N_A, None]], format="csc")
+        if self.saddle_point is None or not np.array_equal(self.saddle_point.active, active):
+            self.saddle_point = SaddlePoint(self.K, N_A, active)
+        u, lam[active] = self.saddle_point.solve(f, d[active])
+        return u, lam
+
+
+class SaddlePoint:
+    """The factorised saddle-point matrix ``[K N_Aᵀ; N_A 0]`` of one active set (LU).
+
+    Its constraint rows are scaled by ``s = mean |diag K|``, so that both blocks
+    are of one size in any units (``λ = s μ``).
+    """
+
+    def __init__(self, K: sp.spmatrix, N_A: sp.spmatrix, active: np.ndarray):
+        self.active, self.n = active.copy(), K.shape[0]
+        self.scale = float(np.mean(np.abs(K.diagonal()))) or 1.0
+        system = sp.bmat([[K, self.scale * N_A.T], [self.scale * N_A, None]], format="csc")
         COUNTS["factorisations"] += 1
-        rhs = _count_solve(np.concatenate([f, scale * d[active]]))
-        solution = spla.splu(system).solve(rhs)
-        lam[active] = scale * solution[self.n:]
-        return solution[:self.n], lam
+        self._lu = spla.splu(system)
+
+    def solve(self, f: np.ndarray, d_A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(u, λ_A)`` with ``K u + N_Aᵀ λ_A = f`` and ``N_A u = d_A`` (n × k, |A| × k alike)."""
+        solution = self._lu.solve(_count_solve(np.concatenate([f, self.scale * d_A])))
+        return solution[:self.n], self.scale * solution[self.n:]
 
 
 class Pinning:

@@ -118,7 +118,10 @@ def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None
     ax.set_ylabel({"kkt_worst": "worst relative KKT residual",
                    "p0_rel": "Hertz p₀ relative error"}.get(metric, metric))
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=5, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the front
+    if ax.get_legend_handles_labels()[0]:  # no run has the metric: a problem without a reference
+        ax.legend(fontsize=5, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the front
+    else:
+        ax.text(0.5, 0.5, f"no run has {metric}", ha="center", transform=ax.transAxes)
     return ax
 
 

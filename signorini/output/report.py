@@ -153,10 +153,10 @@ def _status_cell(run: dict[str, Any]) -> str:
 
 
 def readme_validation(report: dict[str, Any], case: str = "hertz-cylinder") -> str:
-    """The README's validation paragraph and table, from a suite's ``report.json``.
+    """The validation paragraph and table of docs/results.md, from a suite's ``report.json``.
 
-    ``tests/test_readme_numbers.py`` holds the README to this text, and
-    ``tools/readme.py`` writes it there, so that a number the README prints is
+    ``tests/test_readme_numbers.py`` holds that page to this text, and
+    ``tools/readme.py`` writes it there, so that a number the page prints is
     one the committed report holds.
     """
     runs = [r for r in report["runs"] if r["case"] == case and r["status"] != "skipped"]

@@ -14,6 +14,7 @@ from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.numerics.arrays import flag_argument
 from signorini.problem import ContactProblem, Scales
+from signorini.problem_files import is_problem_file, read_problem
 from signorini.scenes.base import scene_params
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
@@ -56,7 +57,9 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     ``params`` maps the scene's parameter names to values in its units (see
     :func:`signorini.scene_families`; None: the defaults). ``name`` may be the
     path of a TOML scene file (``*.toml``, see :mod:`signorini.scenes.scenefile`);
-    ``params`` then override its parameters. A target load stays pending (load
+    ``params`` then override its parameters. ``name`` may also be a problem
+    file (``.npz`` or Matrix Market, :mod:`signorini.problem_files`): its QP is
+    read as stored, with no parameters to set. A target load stays pending (load
     control matches it when the problem is solved). ``solved_by`` names the
     method that will solve it, for the size guard (a method that never
     factorises needs less memory).
@@ -66,6 +69,14 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
                          f"{type(name).__name__}: e.g. build_problem('hertz-cylinder')")
+    if is_problem_file(name):  # a problem file: read, not built
+        if values:
+            raise InputError(f"problem file {name!r} has no scene parameters to set "
+                             f"({', '.join(values)}): drop params (--set)")
+        if not nondimensionalise:
+            raise InputError(f"problem file {name!r} is solved in the units it was written in: "
+                             "drop nondimensionalise=False (--raw-units)")
+        return read_problem(name)
     if name.lower().endswith(".toml"):  # a scene file: signorini.scenes.scenefile
         name, model = build_scene_model(name, values)
     else:

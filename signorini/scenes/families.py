@@ -6,6 +6,7 @@ to :func:`~signorini.scenes.registry.register` from anywhere).
 
 from __future__ import annotations
 
+from signorini.problem_files import is_problem_file
 from signorini.scenes import block, hertz_cylinder, hertz_sphere, hertz_sphere_3d, punch, reverse_hertz
 from signorini.scenes.registry import SCENES, get_scene, register, scene_reference, unregister
 
@@ -19,8 +20,8 @@ BUILT_IN = frozenset(SCENES)
 
 def portable_scene(name: str) -> bool:
     """A worker process (:mod:`signorini.studies.runner`) can build this scene: a built-in
-    family, or a scene file. A family registered in this process only is not."""
-    return name in BUILT_IN or name.lower().endswith(".toml")
+    family, a scene file or a problem file. A family registered in this process only is not."""
+    return name in BUILT_IN or name.lower().endswith(".toml") or is_problem_file(name)
 
 
 __all__ = ["BUILT_IN", "SCENES", "get_scene", "portable_scene", "register", "scene_reference",

@@ -14,6 +14,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
 from signorini.errors import InputError
+from signorini.problem_files import is_problem_file
 from signorini.scenes.base import Case, SceneFamily
 
 SCENES: dict[str, SceneFamily] = {}
@@ -46,9 +47,14 @@ def unregister(name: str) -> SceneFamily | None:
 
 def get_scene(name: str) -> SceneFamily:
     """Look a scene family up by name; unknown names list the known ones."""
+    if name not in SCENES and is_problem_file(name):
+        raise InputError(f"{name!r} is a problem file, and this needs a scene (see 'signorini "
+                         "scenes'): a problem file goes to solve, crosscheck, validate --problem "
+                         "and bench --problem")
     if name not in SCENES:
         raise InputError(f"unknown scene {name!r}: choose one of {', '.join(sorted(SCENES))} "
-                         "(or give the path of a .toml scene file)")
+                         "(or give the path of a .toml scene file, or of a problem file: .npz or "
+                         "Matrix Market, see docs/problem-files.md)")
     return SCENES[name]
 
 

@@ -129,13 +129,21 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
     A method returns a :class:`ContactSolution` whose ``u`` holds n floats and
     ``lam`` m floats (finite when it claims ``converged``; a method without an
     answer returns NaN, :meth:`ContactSolution.failure`), and whose status is
-    one of :data:`signorini.problem.STATUSES`. A user's method that returns anything
-    else cannot be judged, so it cannot be ``converged``.
+    one of :data:`signorini.problem.STATUSES`; or the pair ``(u, lam)`` (the same two
+    arrays), which claims ``converged`` and is judged by the certificate like any
+    claim. A user's method that returns anything else cannot be judged, so it
+    cannot be ``converged``.
     """
     def failed(reason: str) -> ContactSolution:
         return ContactSolution.failure(method, problem, "failed",
                                        f"the method broke its contract: {reason}")
 
+    if isinstance(solution, tuple) and len(solution) == 2:  # (u, lam): the answer alone
+        solution = ContactSolution(method, solution[0], solution[1], "converged",
+                                   "returned (u, lam)")
+    elif isinstance(solution, tuple):
+        return failed(f"it returned a tuple of {len(solution)} items, not (u, lam) or a "
+                      "ContactSolution")
     if not isinstance(solution, ContactSolution):
         return failed(f"it returned {type(solution).__name__}, not a ContactSolution")
     if solution.status not in STATUSES:

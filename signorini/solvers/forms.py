@@ -257,8 +257,10 @@ def polish(problem: ContactProblem, form: Formulation, raw: ContactSolution,
                        f"certificate ({new_worst:.1e} ≥ {raw_worst:.1e}): the backend's answer"
         return raw
     raw.u, raw.lam = u, lam
-    if new_worst <= acceptance(tol):
+    certified = new_worst <= acceptance(tol)
+    if certified:
         raw.status = "converged"
     raw.message += f"; polished on {int(active.sum())} active nodes (certificate " \
-                   f"{raw_worst:.1e} → {new_worst:.1e}): the polished answer"
+                   f"{raw_worst:.1e} → {new_worst:.1e}): the polished answer" + \
+                   ("" if certified else f", still {raw.status} (above {acceptance(tol):.0e})")
     return raw

@@ -16,11 +16,9 @@ The methods are registered by one loop at the bottom of the module.
 
 from __future__ import annotations
 
-import functools
+import contextlib
 import importlib.util
 import logging
-import os
-import sys
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -30,9 +28,10 @@ import numpy as np
 
 from signorini.errors import BackendNotInstalled, InputError, SolverError
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers import forms
+from signorini.solvers import clarabel_, forms
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare
+from signorini.solvers.backend_output import c_output_discarded, silence_highs_banner
 from signorini.solvers.qp_options import typed
 from signorini.solvers.qp_reports import (Reader, read_clarabel, read_cvxopt, read_ecos, read_found,
                                           read_gurobi, read_info, read_quadprog, read_scs)
@@ -67,7 +66,10 @@ class Backend:
     the default formulation (:data:`signorini.solvers.forms.FORMS`), chosen by
     tools/formulations.py's measurements (docs/formulations.md); a default dual
     falls back to primal when it cannot be built (K singular, m > max_dense_dofs);
-    ``polish`` is the default of the option ``polish`` (docs/crosscheck.md).
+    ``polish`` is the default of the option ``polish`` (docs/crosscheck.md);
+    ``prints`` says the backend writes to stdout from C whatever its verbosity
+    (its calls then run with the process's output sent nowhere); ``call``
+    solves the qpsolvers problem instead of :func:`qpsolvers.solve_problem`.
     """
 
     name: str
@@ -85,6 +87,8 @@ class Backend:
     nest: Callable[[dict[str, Any]], dict[str, Any]] | None = None
     form: str = "primal"
     polish: bool = False
+    prints: bool = False
+    call: Callable[..., Any] | None = None
 
     @property
     def method_name(self) -> str:
@@ -196,8 +200,10 @@ BACKENDS: tuple[Backend, ...] = (
                  "max_iter", "eps_abs", "eps_rel", "eps_prim_inf", "eps_dual_inf",
                  "scaled_termination", "check_termination", "check_dualgap", "time_limit",
                  "polishing", "polish_refine_iter", "warm_starting", "linsys_solver"),
-        tolerance=_each("eps_abs", "eps_rel", "eps_prim_inf"), max_iter_option="max_iter",
-        extra="", fixed={"raise_error": False},
+        # OSQP's own polishing finishes its answer on its active set: at a tolerance of 1e-8
+        # its raw λ is otherwise first-order accurate only (docs/crosscheck.md)
+        tolerance=_each("eps_abs", "eps_rel", "eps_prim_inf", polishing=True),
+        max_iter_option="max_iter", extra="", fixed={"raise_error": False}, prints=True,
         form="dual",  # primal: never converged in 12 runs, dual 7 (docs/formulations.md)
         polish=True),  # raw: 3 of 8 validation cases inaccurate at 1e-8; polished, none
     Backend(
@@ -220,6 +226,7 @@ BACKENDS: tuple[Backend, ...] = (
                  "iterative_refinement_max_iter", "iterative_refinement_stop_ratio",
                  "presolve_enable"),
         tolerance=_clarabel_tolerance, max_iter_option="max_iter", extra="",
+        call=clarabel_.solve_problem,  # qpsolvers drops the iteration count
         polish=True),  # polished, every validation case ends converged and exact at 1e-8
     Backend(
         "proxqp", "ProxQP", "ProxQP (proximal augmented Lagrangian) through qpsolvers",
@@ -347,27 +354,6 @@ def _check_options(backend: Backend, options: Mapping[str, Any]) -> dict[str, An
     return {name: kinds[name].check(backend.method_name, value) for name, value in options.items()}
 
 
-@functools.cache
-def _silence_highs_banner() -> None:
-    """HiGHS prints its banner from C on the first ``Highs()`` of a process, whatever the
-    options (highspy 1.16): make that first one with the process's output sent nowhere."""
-    import highspy
-
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = [os.dup(1), os.dup(2)]
-    sink = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(sink, 1)
-        os.dup2(sink, 2)
-        highspy.Highs()
-    finally:
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        for fd in saved + [sink]:
-            os.close(fd)
-
-
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
              max_iter: int | None = None, **options: Any) -> ContactSolution:
     """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with one qpsolvers backend.
@@ -433,11 +419,13 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
           else qpsolvers.Problem(data.P, data.q, data.G, data.h))
     build_time = time.perf_counter() - start
     if spec.name == "highs":
-        _silence_highs_banner()
+        silence_highs_banner()
+    quiet = c_output_discarded() if spec.prints else contextlib.nullcontext()
     try:
-        with warnings.catch_warnings(record=True) as record:
+        with warnings.catch_warnings(record=True) as record, quiet:
             warnings.simplefilter("always")
-            result = qpsolvers.solve_problem(qp, spec.name, verbose=False, **settings)
+            result = (qpsolvers.solve_problem(qp, spec.name, verbose=False, **settings)
+                      if spec.call is None else spec.call(qp, **settings))
     except qpsolvers.ParamError as exc:
         raise InputError(f"{spec.label}: bad option: {exc}") from exc
     except Exception as exc:

@@ -33,7 +33,9 @@ def read_info(solution: Any, caught: list[str]) -> Report:
 
 
 def read_clarabel(solution: Any, caught: list[str]) -> Report:
-    return Report(str(solution.extras["status"]))  # qpsolvers drops the iteration count
+    """Clarabel's status, and its iterations when the call kept them (qpsolvers drops them)."""
+    iterations = solution.extras.get("iterations")
+    return Report(str(solution.extras["status"]), None if iterations is None else int(iterations))
 
 
 def read_scs(solution: Any, caught: list[str]) -> Report:

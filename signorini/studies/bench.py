@@ -63,6 +63,8 @@ class Run:
     tolerance: str
     #: MPI ranks (petsc methods only; the others run in one process)
     ranks: int = 1
+    #: a problem file (:mod:`signorini.problem_files`) the run solves instead of building ``scene``
+    source: str | None = None
 
     @property
     def label(self) -> str:
@@ -135,12 +137,14 @@ def append_row(path: Path, row: dict[str, Any]) -> None:
         os.fsync(handle.fileno())
 
 
-def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any]) -> Path:
-    """Assemble (once) and store the problem of one scene and size."""
+def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any],
+                 source: str | None = None) -> Path:
+    """Assemble (once) and store the problem of one scene and size, or of the problem file
+    ``source`` (read once and stored in the package's own format)."""
     path = directory / "problems" / f"{scene}-{size}.npz"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        build_problem(scene, params=params).save(path)
+        build_problem(source or scene, params=None if source else params).save(path)
     return path
 
 
@@ -158,7 +162,7 @@ def run_benchmark(runs: Iterable[Run], out: Path, time_limit: float = 600.0,
     csv_path = out / "bench.csv"
     done = done_keys(csv_path)
     todo = [r for r in runs if r.key not in done]
-    paths = {r.key: problem_file(out, r.scene, r.size, r.params) for r in todo}
+    paths = {r.key: problem_file(out, r.scene, r.size, r.params, r.source) for r in todo}
     sizes = {path: stored_size(path) for path in set(paths.values())}
 
     def record(index: int, count: int, task: Task, row: Row) -> None:

@@ -37,6 +37,7 @@ from signorini.fem.model import FlatObstacle
 from signorini.files import atomic_write_bytes
 from signorini.loading import at_load
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem_files import read_problem
 from signorini.scenes import block, build_problem, coarse_problem
 from signorini.scenes.base import scene_params
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
@@ -68,7 +69,7 @@ def _ill_posed(spec: dict[str, Any]) -> ContactProblem:
 
 
 def _stored(spec: dict[str, Any]) -> ContactProblem:
-    return at_load(ContactProblem.load(spec["path"]), coarse_problem)
+    return at_load(read_problem(spec["path"]), coarse_problem)
 
 
 #: the kinds of problem spec and how each is built
@@ -84,7 +85,8 @@ def build_spec(spec: dict[str, Any]) -> ContactProblem:
     ``{"kind": "scene", "scene", "params", "nondimensionalise"}``,
     ``{"kind": "force-controlled", "params", "pressure", "regularisation"}``,
     ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`) or
-    ``{"kind": "stored", "path"}`` (a problem :meth:`ContactProblem.save` stored).
+    ``{"kind": "stored", "path"}`` (a problem file: :meth:`ContactProblem.save`'s, plain
+    ``.npz`` or Matrix Market, :mod:`signorini.problem_files`).
     """
     kind = spec["kind"]
     if kind not in PROBLEM_KINDS:
@@ -95,7 +97,7 @@ def build_spec(spec: dict[str, Any]) -> ContactProblem:
 def candidate_spacing(problem: ContactProblem) -> float:
     """Median distance from each contact candidate to its nearest neighbour (physical units)."""
     points = problem.contact_points * problem.scales.length
-    if len(points) < 2:
+    if len(points) < 2 or not np.all(np.isfinite(points)):  # no positions: a QP given as arrays
         return float("nan")
     distance, _ = cKDTree(points).query(points, k=2)
     return float(np.median(distance[:, 1]))

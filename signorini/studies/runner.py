@@ -139,7 +139,9 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
         return verdict(row, task)
     row.update(scene=problem.scene, dofs=problem.n, candidates=problem.m)
     if "mesh" in task.measure:
-        row.update(h=candidate_spacing(problem), assemble_s=problem.discretisation.assemble_s)
+        made = problem.discretisation  # None for a QP given as arrays (a problem file)
+        row.update(h=candidate_spacing(problem),
+                   assemble_s=float("nan") if made is None else made.assemble_s)
     if "diagnosis" in task.measure:
         row["diagnosis"] = " | ".join(diagnose(problem))
 

@@ -17,9 +17,13 @@ exact answer once (the reference policy :data:`REFERENCE`: PDAS at
 from __future__ import annotations
 
 import logging
+import math
+import os
+import sys
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
@@ -27,6 +31,7 @@ import numpy as np
 from signorini.crosschecking import agreement
 from signorini.errors import InputError
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem_files import is_problem_file
 from signorini.references import reference_metrics, reference_of
 from signorini.scenes import portable_scene
 from signorini.scenes.base import Case
@@ -44,6 +49,11 @@ from signorini.studies.runner import (
     run_tasks,
     task_row,
 )
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
 
 log = logging.getLogger(__name__)
 
@@ -128,20 +138,25 @@ def label(method: str, tol: float | None) -> str:
     return f"{method}@{'default' if tol is None else f'{tol:.0e}'}"
 
 
-def run_task_of(case: Case, method: str, tol: float | None) -> Task:
-    """The task of one run: ``method`` at ``tol`` on the case, held to :data:`REFERENCE`."""
+def run_task_of(case: Case, method: str, tol: float | None,
+                options: dict[str, Any] | None = None) -> Task:
+    """The task of one run: ``method`` at ``tol`` (with ``options``) on the case, held to
+    :data:`REFERENCE`."""
     cap = ITERATION_CAPS.get(method) if tol is not None else None
     return Task("validation", case.name, label(method, tol), case.spec, method, tol=tol,
-                max_iter=cap, reference=REFERENCE, measure=MEASURES)
+                options=dict(options or {}), max_iter=cap, reference=REFERENCE, measure=MEASURES)
 
 
-def case_tasks(case: Case, chosen: list[Method]) -> list[Task]:
-    """Build the case's problem and find its exact answer, then run every method on it."""
+def case_tasks(case: Case, chosen: list[Method], tol: float = TIGHT_TOL,
+               options: dict[str, dict[str, Any]] | None = None) -> list[Task]:
+    """Build the case's problem and find its exact answer, then run every method on it at ``tol``
+    (``options``: each method's options by its name)."""
+    options = options or {}
     tasks = [Task("validation", case.name, "exact", case.spec, BUILD_ONLY, tol=TIGHT_TOL,
                   reference=REFERENCE, measure=("exact", "mesh"))]
     for method in chosen:
-        tolerances = [TIGHT_TOL] + ([None] if method.name in DEFAULT_TOLERANCE_RUNS else [])
-        tasks += [run_task_of(case, method.name, tol) for tol in tolerances]
+        tolerances = [tol] + ([None] if method.name in DEFAULT_TOLERANCE_RUNS else [])
+        tasks += [run_task_of(case, method.name, t, options.get(method.name)) for t in tolerances]
     return tasks
 
 
@@ -184,16 +199,23 @@ def case_result(case: Case, rows: list[Row]) -> CaseResult:
 
 
 def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
-                required: tuple[str, ...] = ()) -> list[Check]:
-    """The suite's claims about one case; ``required`` methods must converge at the tight tolerance."""
+                required: tuple[str, ...] = (), tol: float = TIGHT_TOL,
+                limits: dict[str, float] = LIMITS) -> list[Check]:
+    """The suite's claims about one case; ``required`` methods must converge at ``tol``.
+
+    On a user's problem file (:func:`problem_case`) the claims about the package's own
+    methods (the paper's Uzawa converges and agrees with two QP backends) are not made:
+    the suite judges the methods run against the exact answer.
+    """
     case, problem, ref = result.case, result.problem, result.reference
+    own_case = not is_problem_file(case.scene)
     checks = [Check(case.name, "pdas converged", ref.status == "converged", None,
                     ref.status == "converged", ref.message)]
 
     def limit(name: str, value: float | None, key: str, detail: str = "") -> None:
         value = float("nan") if value is None else float(value)  # None: not finite in a row
-        checks.append(Check(case.name, name, value, LIMITS[key],
-                            bool(np.isfinite(value) and value <= LIMITS[key]), detail))
+        checks.append(Check(case.name, name, value, limits[key],
+                            bool(np.isfinite(value) and value <= limits[key]), detail))
 
     metrics = reference_metrics(problem, ref) if case.check_reference else {}
     reference = reference_of(problem)
@@ -215,17 +237,19 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
         # the reference's own method at the reference's tolerance would be compared with itself
         if row["label"] == REFERENCE_LABEL:
             continue
-        if row["tol"] == TIGHT_TOL and row["status"] == "converged" and "vs_reference" in row:
+        if row["tol"] == tol and row["status"] == "converged" and "vs_reference" in row:
             vs = row["vs_reference"]
             limit(f"{row['label']} converged: λ agrees with pdas", vs["lam_rel"], "lam_rel_vs_pdas")
             checks.append(Check(case.name, f"{row['label']} converged: same active set as pdas",
                                 vs["misclassified"] == 0, None, vs["misclassified"] == 0,
                                 f"{vs['misclassified']} nodes misclassified"))
-    checks += cross_checks(result)
-    must_converge = {"uzawa": "uzawa (the paper's method) converged"}
+    must_converge = {}
+    if own_case:
+        checks += cross_checks(result, tol)
+        must_converge["uzawa"] = "uzawa (the paper's method) converged"
     must_converge.update({name: f"{name} (asked for by name) converged" for name in required})
     for row in result.runs:
-        if row["method"] in must_converge and row["tol"] == TIGHT_TOL:
+        if row["method"] in must_converge and row["tol"] == tol:
             ok = row["status"] == "converged"
             checks.append(Check(case.name, must_converge[row["method"]], ok, None, ok,
                                 row["message"]))
@@ -236,8 +260,8 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
     return checks
 
 
-def cross_checks(result: CaseResult) -> list[Check]:
-    """Uzawa against each of :data:`CROSS_CHECKED`'s QP backends at the tight tolerance.
+def cross_checks(result: CaseResult, tol: float = TIGHT_TOL) -> list[Check]:
+    """Uzawa against each of :data:`CROSS_CHECKED`'s QP backends at ``tol``.
 
     A check for each backend run on the case: it passes when both runs ended
     ``converged`` and :func:`~signorini.crosschecking.agreement` finds them
@@ -245,7 +269,7 @@ def cross_checks(result: CaseResult) -> list[Check]:
     relative difference.
     """
     first, partners = CROSS_CHECKED
-    runs = {row["method"]: row for row in result.runs if row.get("tol") == TIGHT_TOL}
+    runs = {row["method"]: row for row in result.runs if row.get("tol") == tol}
     if first not in runs:
         return []
     checks = []
@@ -253,11 +277,11 @@ def cross_checks(result: CaseResult) -> list[Check]:
         if partner not in runs:
             continue
         name = f"{first} cross-checked with {partner} (default form): both converged and agree"
-        a, b = (result.solutions.get(label(m, TIGHT_TOL)) for m in (first, partner))
+        a, b = (result.solutions.get(label(m, tol)) for m in (first, partner))
         if a is None or b is None:
             checks.append(Check(result.case.name, name, False, None, False, "no answer to compare"))
             continue
-        pair = agreement(result.problem, a, b, TIGHT_TOL, TIGHT_TOL)
+        pair = agreement(result.problem, a, b, tol, tol)
         ok = a.status == "converged" and b.status == "converged" and pair.agree
         checks.append(Check(result.case.name, name, pair.lam_rel, pair.limit, ok,
                             f"{first} {a.status}, {partner} {b.status}; λ {pair.lam_rel:.1e}, "
@@ -270,9 +294,10 @@ class SuiteResult:
     results: list[CaseResult]
     checks: list[Check]
     elapsed_s: float
+    #: what its report shows: the acceptance limits the checks were held to
+    limits: dict[str, float] = field(default_factory=lambda: dict(LIMITS))
 
-    #: what its report shows: the acceptance limits and the label of the reference runs
-    limits = LIMITS
+    #: the label of the reference runs
     reference_label = REFERENCE_LABEL
 
     @property
@@ -312,11 +337,16 @@ def portable(method: Method) -> bool:
 
 def run_suite(cases: Sequence[Case] = DEFAULT_CASES, method_names: list[str] | None = None,
               progress: Callable[[str], None] | None = None, *, isolate: bool | None = None,
-              time_limit: float = TIME_LIMIT) -> SuiteResult:
+              time_limit: float = TIME_LIMIT, tol: float = TIGHT_TOL,
+              options: dict[str, dict[str, Any]] | None = None,
+              limits: dict[str, float] | None = None) -> SuiteResult:
     """Run every case with every installed method (or ``method_names``) and check it.
 
-    Methods named in ``method_names`` must converge at the tight tolerance on
-    every case: a user's method that only claims success fails the suite.
+    Every method runs at ``tol`` (the exact answer it is held to stays PDAS at
+    :data:`TIGHT_TOL`), with its ``options`` (by method name); ``limits``
+    replaces some of :data:`LIMITS` (:func:`read_limits`). Methods named in
+    ``method_names`` must converge at ``tol`` on every case: a user's method
+    that only claims success fails the suite.
     The runs go to one worker process, each within ``time_limit`` seconds;
     ``isolate=False`` runs them in this process without a limit, as happens
     by default when a method or a case's scene family was registered in this
@@ -331,12 +361,14 @@ def run_suite(cases: Sequence[Case] = DEFAULT_CASES, method_names: list[str] | N
         if not isolate:
             log.info("a method or scene family registered in this process only: the suite runs "
                      "here, no time limit")
-    tasks = [task for case in cases for task in case_tasks(case, chosen)]
+    limits = {**LIMITS, **(limits or {})}
+    tasks = [task for case in cases for task in case_tasks(case, chosen, tol, options)]
 
     def report(index: int, count: int, task: Task, row: Row) -> None:
         if task.method == BUILD_ONLY:
             say(f"{task.case}: {row.get('dofs')} dofs, {row.get('candidates')} contact candidates "
-                f"(assembled in {row.get('assemble_s', float('nan')):.2f} s)")
+                + ("(read from a file)" if row.get("assemble_s") is None  # NaN in JSON: None
+                   else f"(assembled in {row['assemble_s']:.2f} s)"))
         else:
             time_s = 0.0 if row["status"] == "refused" else row.get("time_s", 0.0)
             say(f"  {task.value:<26} {suite_row(row)['status']:<10} {time_s:7.2f} s")
@@ -349,5 +381,48 @@ def run_suite(cases: Sequence[Case] = DEFAULT_CASES, method_names: list[str] | N
         result = case_result(case, [row for task, row in zip(tasks, rows) if task.case == case.name])
         results.append(result)
         by_name[case.name] = result
-        checks.extend(case_checks(result, by_name, tuple(method_names or ())))
-    return SuiteResult(results, checks, time.perf_counter() - start)
+        checks.extend(case_checks(result, by_name, tuple(method_names or ()), tol, limits))
+    return SuiteResult(results, checks, time.perf_counter() - start, limits)
+
+
+def problem_case(path: str, taken: Sequence[str] = ()) -> Case:
+    """A user's problem file (:mod:`signorini.problem_files`) as a case of the suite.
+
+    Named after the file (its stem, numbered when ``taken`` has the name
+    already); its spec reads the file in the worker by its absolute path.
+    """
+    name, number = Path(path).stem or "problem", 2
+    while name in taken or any(name == case.name for case in DEFAULT_CASES):
+        name, number = f"{Path(path).stem}-{number}", number + 1
+    return Case(name, os.path.abspath(path))
+
+
+def read_limits(path: str) -> dict[str, float]:
+    """The limits a TOML file's ``[limits]`` table sets (names of :data:`LIMITS`, positive numbers).
+
+    InputError naming the file and the fix for a missing file, bad TOML, an
+    unknown name or a value that is not a positive number.
+    """
+    try:
+        with open(path, "rb") as handle:
+            data = tomllib.load(handle)
+    except FileNotFoundError:
+        raise InputError(f"limits file {path!r} does not exist: give a TOML file with a "
+                         "[limits] table") from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise InputError(f"limits file {path!r} cannot be read as TOML ({exc}): fix it") from None
+    stray = sorted(set(data) - {"limits"})
+    if stray or not isinstance(data.get("limits"), dict):
+        raise InputError(f"limits file {path!r} must hold one [limits] table"
+                         + (f", not {stray[0]!r}" if stray else "")
+                         + f": e.g. [limits] lam_rel_vs_pdas = 1e-5")
+    given = data["limits"]
+    for key, value in given.items():
+        if key not in LIMITS:
+            raise InputError(f"limits file {path!r}: unknown limit {key!r}: one of "
+                             f"{', '.join(LIMITS)}")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not (math.isfinite(value) and value > 0):
+            raise InputError(f"limits file {path!r}: {key} = {value!r} must be a positive number, "
+                             f"e.g. {key} = {LIMITS[key]:g}")
+    return {key: float(value) for key, value in given.items()}

@@ -8,7 +8,7 @@ row: the method's own word, the package's status, the certificate, the
 distance from the exact answer; a backend that hangs or crashes costs one row).
 
 Layout: one module per axis, each holding its constants, tasks, findings (the
-report's lines and the README's paragraph), table, figure, advice and set-up,
+report's lines and docs/results.md's paragraph), table, figure, advice and set-up,
 and ending in ``AXIS``
 (:class:`~signorini.studies.atlas.axis.Axis`):
 
@@ -27,7 +27,7 @@ and ending in ``AXIS``
 package's record, method × axis), :mod:`~signorini.studies.atlas.report`
 writes ``stability.md`` with the runs and figures,
 :mod:`~signorini.studies.atlas.findings` holds what the axes' paragraphs share
-and writes the README's findings, and
+and writes docs/results.md's findings, and
 :mod:`~signorini.studies.atlas.figures` draws the plots the axes share.
 This module collects :data:`AXES` and runs them (:func:`run_atlas`).
 """

@@ -44,7 +44,7 @@ class Axis:
     table : ``rows → Markdown lines``.
     figure : ``rows → Figure``.
     counts : ``row → bool``: whether a run counts for the method × axis verdict.
-    headline : ``rows → paragraph``: the axis's finding as the README states it
+    headline : ``rows → paragraph``: the axis's finding as docs/results.md states it
         (:func:`signorini.studies.atlas.findings.findings`).
     caps : iteration caps the axis's tasks use instead of :data:`ITERATION_CAPS`.
     """

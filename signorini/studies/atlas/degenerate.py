@@ -63,7 +63,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     case = max({r["case"] for r in rows}, key=lambda c: max(r["weak"] for r in pick(rows, case=c)))
     converged = pick(rows, case=case, status="converged")
     claim(all(r["misclassified"] == 0 for r in pick(rows, status="converged")),

@@ -1,6 +1,6 @@
 """The atlas's findings in a paragraph per axis, each number computed from the rows.
 
-:func:`findings` and :func:`run_headline` write the README's "When methods fail" blocks
+:func:`findings` and :func:`run_headline` write the "When methods fail" blocks of docs/results.md
 (tools/stability.py renders them from ``docs/stability/runs.json``); each axis module states its
 own paragraph (:attr:`Axis.headline`) with the helpers here. A paragraph also states things the
 numbers do not show by themselves ("growth is never seen"); each such statement is checked
@@ -37,7 +37,7 @@ class StaleFinding(RuntimeError):
 
 
 def claim(holds: bool, what: str) -> None:
-    """Stop the README's rendering when the atlas no longer shows ``what``."""
+    """Stop the rendering of docs/results.md when the atlas no longer shows ``what``."""
     if not holds:
         raise StaleFinding(f"docs/stability/runs.json no longer shows that {what}: rewrite that "
                            "finding in its axis module (signorini/studies/atlas/)")

@@ -102,7 +102,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     singular, eps = pick(rows, case=SINGULAR), pick(rows, case=REGULARISED)
     claim(len({r["value"] for r in eps}) == 1, "one regularisation is run with every method")
     fine = right(singular)

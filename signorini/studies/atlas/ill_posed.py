@@ -78,7 +78,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     penetrated = method_rows(pick(rows, case="penetrated"))
     statuses = {s: len(pick(penetrated, status=s)) for s in ("infeasible", "failed")}
     claim(sum(statuses.values()) == len(penetrated), "every method says infeasible or failed")

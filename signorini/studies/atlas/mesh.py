@@ -89,7 +89,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     levels = sorted({r["value"] for r in rows})
 
     def series(method: str, key: str) -> list[Any]:

@@ -118,7 +118,7 @@ def _nodal_text(nodal: Rows, plain: Rows, order: list[str], dofs: dict[str, int]
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     every = pick(rows, method="pdas")
     pdas = [r for r in every if not r["case"].endswith(", nodal")]
     nodal = [r for r in every if r["case"].endswith(", nodal")]

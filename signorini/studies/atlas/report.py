@@ -171,7 +171,7 @@ def _package_status(result: AtlasResult) -> list[str]:
 def method_axis_table(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]:
     """The method × axis verdicts (:func:`verdicts`) as Markdown lines, one row per method.
 
-    ``stability.md`` prints it under "Method × axis"; the README quotes it (tools/readme.py).
+    ``stability.md`` prints it under "Method × axis"; docs/results.md quotes it (tools/readme.py).
     """
     table = verdicts(rows, axes)
     methods = list(dict.fromkeys(r["method"] for r in method_rows(rows)))

@@ -108,7 +108,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     cyl, block = (pick(rows, case=c) for c in ("hertz-cylinder", "block"))
     uz_cyl, uz_block = pick(cyl, method="uzawa"), pick(block, method="uzawa")
     diverged = pick(rows, method="uzawa", status="diverged")

@@ -108,7 +108,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     osqp = one(rows, method="qp-osqp", tol=None)
     prox = one(rows, method="qp-proxqp", tol=None)
     claim(osqp["claimed_status"] == prox["claimed_status"] == "converged" and osqp["misclassified"] == 0

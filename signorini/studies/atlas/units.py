@@ -72,7 +72,7 @@ def figure(rows: Rows) -> Figure:
 
 
 def headline(rows: Rows) -> str:
-    """The axis's finding in a paragraph, as the README states it."""
+    """The axis's finding in a paragraph, as docs/results.md states it."""
     systems = list(dict.fromkeys(r["value"] for r in rows))
     scaled, raw = assembled(rows, "scaled"), assembled(rows, "raw")
     methods = methods_of(rows)

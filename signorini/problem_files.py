@@ -1,0 +1,234 @@
+"""A user's problem read from a file: the package's own ``save``, plain ``.npz`` or Matrix Market.
+
+Every command that takes a problem file reads it here (:func:`read_problem`),
+so the three formats mean the same everywhere. The QP is
+
+    minimise ½ uᵀK u − fᵀu   subject to   N u ≤ d
+
+in the units it was written in; ``docs/problem-files.md`` documents the formats:
+
+- a ``.npz`` that :meth:`ContactProblem.save` wrote (a scene's problem, with its mesh);
+- a plain ``.npz`` written by NumPy alone: ``f``, ``d`` (vectors), ``K``, ``N`` each
+  either a dense array or its sparse parts — COO ``K_row``, ``K_col``, ``K_data``
+  or CSR ``K_data``, ``K_indices``, ``K_indptr``, with ``K_shape`` — and optionally
+  ``weights`` (m,), ``contact_points`` (m, dim), ``force_multiplicity`` (a number);
+- Matrix Market: a folder holding ``K.mtx``, ``f.mtx``, ``N.mtx``, ``d.mtx`` and
+  optionally ``weights.mtx`` (``scipy.io.mmwrite`` writes them), given as the
+  folder or as the path of its ``K.mtx``.
+
+Bad input raises :class:`~signorini.errors.InputError` with one line naming the
+file, the array and the fix.
+"""
+
+from __future__ import annotations
+
+import os
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.io
+import scipy.sparse as sp
+
+from signorini.errors import InputError
+from signorini.problem import ContactProblem
+
+__all__ = ["MATRIX_MARKET_NAMES", "PLAIN_KEYS", "is_problem_file", "problem_file_paths",
+           "read_problem"]
+
+#: the arrays of the plain format: what each is (for messages)
+PLAIN_KEYS = {"K": "the stiffness, n × n symmetric positive definite",
+              "f": "the load, n values", "N": "the contact rows, m × n",
+              "d": "the initial gaps, m values"}
+#: optional arrays of the plain format
+OPTIONAL_KEYS = {"weights": "the lumped boundary weight of each candidate, m values",
+                 "contact_points": "each candidate's coordinates, m × dim",
+                 "force_multiplicity": "copies of the model in the whole body, a number"}
+#: the parts of a sparse matrix in a plain file, after its name and an underscore
+SPARSE_PARTS = ("row", "col", "data", "indices", "indptr", "shape")
+#: the files of a Matrix Market problem, in its folder (``weights`` optional)
+MATRIX_MARKET_NAMES = ("K", "f", "N", "d", "weights")
+FORMATS = "see docs/problem-files.md"
+
+
+def is_problem_file(name: Any) -> bool:
+    """Whether ``name`` names a problem file (``.npz``, ``.mtx``, or a folder of ``.mtx`` files)."""
+    if not isinstance(name, (str, os.PathLike)):
+        return False
+    text = os.fspath(name)
+    return text.lower().endswith((".npz", ".mtx")) or (
+        os.path.isdir(text) and os.path.isfile(os.path.join(text, "K.mtx")))
+
+
+def problem_file_paths(name: str | os.PathLike) -> list[str]:
+    """The files a problem file reads: itself, or a Matrix Market folder's ``.mtx`` files."""
+    folder = _matrix_market_folder(name)
+    if folder is None:
+        return [os.fspath(name)]
+    return [str(folder / f"{key}.mtx") for key in MATRIX_MARKET_NAMES
+            if (folder / f"{key}.mtx").exists()]
+
+
+def read_problem(name: str | os.PathLike) -> ContactProblem:
+    """The problem stored at ``name`` in one of the module's formats (its docstring).
+
+    A plain file's problem is named after the file (its stem); a saved one keeps its scene's name.
+    """
+    path = Path(name)
+    if not path.exists():
+        raise InputError(f"problem file {str(path)!r} does not exist: give the path of a .npz "
+                         "file or of a folder of Matrix Market files (.mtx)")
+    folder = _matrix_market_folder(path)
+    try:
+        if folder is not None:
+            return _from_arrays(path, _matrix_market(folder), folder.name)
+        if not path.is_file():
+            raise InputError(f"problem file {str(path)!r} is not a regular file: give a .npz file")
+        if path.suffix.lower() != ".npz":
+            raise InputError(f"{str(path)!r} is not a problem file: give a .npz file or a folder "
+                             f"of Matrix Market files ({FORMATS})")
+        arrays = _npz(path)
+        if "meta" in arrays:  # written by ContactProblem.save
+            return _saved(path)
+        return _from_arrays(path, arrays, path.stem)
+    except InputError as exc:
+        text = str(exc)
+        if text.startswith("problem file"):
+            raise
+        hint = f" ({FORMATS})" if "shape" in text and FORMATS not in text else ""
+        raise InputError(f"problem file {str(path)!r}: {text}{hint}") from None
+
+
+# --- the formats --------------------------------------------------------------------------------
+
+
+def _matrix_market_folder(name: str | os.PathLike) -> Path | None:
+    path = Path(name)
+    if path.is_dir():
+        if not (path / "K.mtx").is_file():
+            raise InputError(f"problem folder {str(path)!r} holds no K.mtx: write K.mtx, f.mtx, "
+                             f"N.mtx and d.mtx into it ({FORMATS})")
+        return path
+    if path.suffix.lower() == ".mtx":
+        if path.name != "K.mtx":
+            raise InputError(f"problem file {str(path)!r}: a Matrix Market problem is a folder of "
+                             f"K.mtx, f.mtx, N.mtx and d.mtx: give the folder or its K.mtx")
+        return path.parent
+    return None
+
+
+def _npz(path: Path) -> dict[str, np.ndarray]:
+    if not zipfile.is_zipfile(path):  # np.load would try it as a pickle
+        raise InputError(f"problem file {str(path)!r} is not a NumPy .npz archive: write it with "
+                         "numpy.savez (see docs/problem-files.md)")
+    try:
+        with np.load(path, allow_pickle=False) as stored:
+            return {key: stored[key] for key in stored.files}
+    except (zipfile.BadZipFile, EOFError, OSError) as exc:
+        raise InputError(f"problem file {str(path)!r} is not a NumPy .npz archive ({exc}): write "
+                         "it with numpy.savez (see docs/problem-files.md)") from None
+    except ValueError as exc:  # an array of Python objects (pickled)
+        raise InputError(f"problem file {str(path)!r} holds an array that is not numbers ({exc}): "
+                         "store plain numeric arrays") from None
+
+
+def _saved(path: Path) -> ContactProblem:
+    try:
+        return ContactProblem.load(path)
+    except (KeyError, ValueError, TypeError) as exc:
+        raise InputError(f"problem file {str(path)!r} looks written by ContactProblem.save but "
+                         f"cannot be read back ({type(exc).__name__}: {exc}): save it again with "
+                         "the installed version") from None
+
+
+def _matrix_market(folder: Path) -> dict[str, Any]:
+    arrays: dict[str, Any] = {}
+    for key in MATRIX_MARKET_NAMES:
+        file = folder / f"{key}.mtx"
+        if not file.exists() and key in PLAIN_KEYS:
+            raise InputError(f"problem folder {str(folder)!r} holds no {key}.mtx "
+                             f"({PLAIN_KEYS[key]}): write it with scipy.io.mmwrite ({FORMATS})")
+        if not file.exists():
+            continue
+        try:
+            arrays[key] = scipy.io.mmread(file)
+        except (ValueError, OSError, IndexError, TypeError) as exc:
+            raise InputError(f"problem file {str(file)!r} is not a Matrix Market file ({exc}): "
+                             "write it with scipy.io.mmwrite") from None
+    return arrays
+
+
+def _sparse(arrays: dict[str, Any], key: str) -> Any:
+    """Matrix ``key``: dense, or from its COO or CSR parts (``K_row``, ``K_col``, ``K_data``...)."""
+    if key in arrays:
+        return arrays[key]
+    parts = {part: arrays[f"{key}_{part}"] for part in SPARSE_PARTS if f"{key}_{part}" in arrays}
+    if not parts:
+        raise InputError(f"no {key!r} ({PLAIN_KEYS[key]}): store it dense as {key}, or sparse as "
+                         f"{key}_row, {key}_col, {key}_data and {key}_shape ({FORMATS})")
+    if "shape" not in parts or "data" not in parts:
+        missing = "shape" if "shape" not in parts else "data"
+        raise InputError(f"{key} is stored sparse without {key}_{missing}: store {key}_data "
+                         f"and {key}_shape with its indices")
+    shape = tuple(int(v) for v in np.ravel(parts["shape"]))
+    try:
+        if "row" in parts and "col" in parts:
+            return sp.coo_matrix((parts["data"], (parts["row"], parts["col"])), shape=shape).tocsr()
+        if "indices" in parts and "indptr" in parts:
+            return sp.csr_matrix((parts["data"], parts["indices"], parts["indptr"]), shape=shape)
+    except (ValueError, TypeError, IndexError) as exc:
+        raise InputError(f"the sparse parts of {key} do not fit together ({exc}): check "
+                         f"{key}_shape and the indices") from None
+    raise InputError(f"{key} is stored sparse without its indices: give {key}_row and {key}_col "
+                     f"(COO) or {key}_indices and {key}_indptr (CSR)")
+
+
+def _vector(arrays: dict[str, Any], key: str, what: str) -> np.ndarray | None:
+    if key not in arrays:
+        return None
+    value = arrays[key]
+    value = value.toarray() if sp.issparse(value) else np.asarray(value)
+    if value.ndim == 2 and 1 in value.shape:  # a Matrix Market column or row
+        value = value.ravel()
+    if value.ndim != 1 or value.dtype.kind not in "fiu":
+        raise InputError(f"{key} ({what}) must be a vector of numbers, got a {value.dtype} array "
+                         f"of shape {value.shape}: store {key} as a 1-D float array")
+    return value.astype(float)
+
+
+def _finite(key: str, values: np.ndarray) -> None:
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise InputError(f"{key} is not finite at {bad.size} entries (the first at {int(bad[0])}: "
+                         f"{values[bad[0]]}): replace NaN and inf by numbers")
+
+
+def _from_arrays(path: Path, arrays: dict[str, Any], name: str) -> ContactProblem:
+    known = set(PLAIN_KEYS) | set(OPTIONAL_KEYS) | {f"{key}_{part}" for key in ("K", "N")
+                                                     for part in SPARSE_PARTS}
+    stray = sorted(set(arrays) - known)
+    if stray:
+        raise InputError(f"{stray[0]!r} is not an array of the format (K, f, N, d, weights, "
+                         f"contact_points, force_multiplicity): rename or drop it ({FORMATS})")
+    K, N = _sparse(arrays, "K"), _sparse(arrays, "N")
+    vectors = {}
+    for key, what in (("f", PLAIN_KEYS["f"]), ("d", PLAIN_KEYS["d"]),
+                      ("weights", OPTIONAL_KEYS["weights"])):
+        vectors[key] = _vector(arrays, key, what)
+        if vectors[key] is None and key != "weights":
+            raise InputError(f"no {key!r} ({what}): store it beside K and N ({FORMATS})")
+    for key, matrix in (("K", K), ("N", N)):
+        data = matrix.data if sp.issparse(matrix) else np.asarray(matrix)
+        if data.dtype.kind not in "fiu":
+            raise InputError(f"{key} must hold numbers, got {data.dtype}: store a float array")
+        _finite(key, np.asarray(data, dtype=float).ravel())
+    for key, values in vectors.items():
+        if values is not None:
+            _finite(key, values)
+    multiplicity = arrays.get("force_multiplicity", 1.0)
+    if np.size(multiplicity) != 1:
+        raise InputError(f"force_multiplicity must be one number, got shape {np.shape(multiplicity)}")
+    return ContactProblem.from_qp(K, vectors["f"], N, vectors["d"], weights=vectors["weights"],
+                                  contact_points=arrays.get("contact_points"),
+                                  force_multiplicity=float(np.ravel(multiplicity)[0]), name=name)
