@@ -219,6 +219,7 @@ def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = 
     stages: dict[str, dict[str, int]] = {}
     zone = None
     if problem.pending and not bordered:
+        log.info("matching the target load: predicting the contact zone on a coarser model")
         zone = predicted_zone(problem, coarse)  # predicted once: load control's, and nested's
         matched = match(problem, zone)
         stages["load control"] = matched.work

@@ -9,7 +9,7 @@ Layers, low to high (a module may import its own layer and the layers below):
 4. ``loading``                           load control: the one driver around any method
 5. ``scenes``                            families, meshing, scene files, building problems
 6. ``api``, ``crosschecking``, the package: the public Python API
-7. ``studies``, ``output``, ``teaching`` one runner and its studies; reports, plots, export
+7. ``studies``, ``output`` one runner and its studies; reports, plots, export
 8. ``cli``                               parsing only
 
 Beyond the order, the data flow: scenes import no solver and no load control (building a
@@ -42,7 +42,7 @@ LAYERS = {
     "loading": 4,
     "scenes": 5,
     "api": 6, "crosschecking": 6, "derivatives": 6, "": 6,
-    "studies": 7, "output": 7, "teaching": 7,
+    "studies": 7, "output": 7,
     "cli": 8,
 }
 #: (package part, what it must not import): the data flow, beyond the order of the layers
@@ -181,9 +181,9 @@ def test_the_resolver_sees_imports():
     assert "signorini.numerics.factor" in targets and "signorini.errors" in targets
 
 
-#: the modules that own scene parameters by name (the scene families and scene files, and the
-#: teaching bogie, which writes its own); every other module reads typed fields
-PARAMETER_OWNERS = ("signorini.scenes", "signorini.teaching.synthetic")
+#: the modules that own scene parameters by name (the scene families and scene files); every
+#: other module reads typed fields
+PARAMETER_OWNERS = ("signorini.scenes",)
 
 
 def parameter_reads(source: str) -> list[int]:

@@ -18,7 +18,7 @@ from signorini.scenes import build as scenes
 from signorini.scenes import build_problem, coarse_values, get_scene
 from signorini.solvers.registry import solve
 from signorini.loading import analytic_zone
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
 

@@ -2,8 +2,10 @@
 
     .venv/bin/python tools/accuracy.py        # ~4 min here; writes docs/accuracy/runs.json
 
-Every run solves with pdas at tol 1e-10 through the public API; p₀ and a are
-Hertz's profile fitted to the nodal pressures (signorini.pressure.hertz_fit).
+Every run is a task of the studies' runner (signorini.studies.runner): pdas at tol 1e-10 on
+the scene as signorini.solve builds it (its load matched with the answer), measured against
+the scene's reference; p₀ and a are Hertz's profile fitted to the nodal pressures
+(signorini.pressure.hertz_fit).
 docs/accuracy.md quotes the tables that ``tables`` renders from the JSON
 (tools/readme.py writes them there; tests/test_readme_numbers.py holds them).
 """
@@ -12,11 +14,11 @@ from __future__ import annotations
 
 import json
 import sys
-import time
 from pathlib import Path
 
-import signorini
 from signorini.files import atomic_write_text, to_json
+from signorini.studies.runner import run_tasks
+from signorini.studies.task import Task
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "accuracy" / "runs.json"
@@ -34,6 +36,8 @@ RATIOS = (0.05, 0.025, 0.0125)
 #: plain P1 against the volumetric strain averaged at the nodes, on the default mesh and a finer one
 VOLUMETRIC_NUS = (0.3, 0.4, 0.45, 0.49, 0.499)
 VOLUMETRIC_MESHES = {"hertz-cylinder": (40, 80), "hertz-sphere": (60, 120)}
+#: seconds a case may take in the runner's worker
+TIME_LIMIT = 300.0
 
 
 def cases() -> list[dict]:
@@ -61,22 +65,35 @@ def cases() -> list[dict]:
     return out
 
 
-def run() -> list[dict]:
-    rows = []
-    for i, case in enumerate(cases(), 1):
-        params = {k: case[k] for k in ("loading", "mesher", "n_contact", "grading", "nu", "a_over_R",
-                                       "volumetric")}
-        start = time.perf_counter()
-        result = signorini.solve(case["scene"], params=params, tol=1e-10)
-        hertz = result.hertz
-        rows.append({**case, "status": result.status, "dofs": result.problem.n,
-                     "nonzeros": int(result.problem.K.nnz),
-                     "a_err": hertz.a / hertz.a_ref - 1, "p0_err": hertz.p0 / hertz.p0_ref - 1,
-                     "p0_nodal_err": hertz.p0_nodal / hertz.p0_ref - 1,
-                     "l2": hertz.pressure_l2_rel, "seconds": time.perf_counter() - start})
-        print(f"{i}/{len(cases())} {case['scene']} {params}: {rows[-1]['a_err']:+.2e}",
-              file=sys.stderr)
-    return rows
+#: the case's keys that are the scene's parameters
+PARAMS = ("loading", "mesher", "n_contact", "grading", "nu", "a_over_R", "volumetric")
+
+
+def task(case: dict) -> Task:
+    """The runner's task of a case: pdas at 1e-10 on the scene as signorini.solve builds it."""
+    return Task(axis=case["table"], case=case["scene"], value=case["nu"],
+                problem={"kind": "scene", "scene": case["scene"], "matched": False,
+                         "params": {k: case[k] for k in PARAMS}},
+                method="pdas", tol=1e-10, reference={"kind": "none"},
+                measure=("reference", "matrix"))
+
+
+def row_of(case: dict, row: dict) -> dict:
+    """The study's row from the runner's: Hertz's a and p₀ fitted, the nodal p₀, the pressure L2."""
+    h = row.get("reference") or {}
+    nan = float("nan")
+    return {**case, "status": row["status"], "dofs": row["dofs"], "nonzeros": row["nonzeros"],
+            "a_err": h.get("a", nan) / h.get("a_ref", nan) - 1,
+            "p0_err": h.get("p0", nan) / h.get("p0_ref", nan) - 1,
+            "p0_nodal_err": h.get("p0_nodal", nan) / h.get("p0_ref", nan) - 1,
+            "l2": h.get("pressure_l2_rel", nan), "seconds": row["time_s"]}
+
+
+def run(chosen: list[dict] | None = None) -> list[dict]:
+    chosen = cases() if chosen is None else chosen
+    rows = run_tasks([task(c) for c in chosen], time_limit=TIME_LIMIT, progress=lambda i, n, t, r:
+                     print(f"{i}/{n} {t.case} {t.problem['params']}: {r['status']}", file=sys.stderr))
+    return [row_of(case, row) for case, row in zip(chosen, rows)]
 
 
 def _pct(x: float) -> str:

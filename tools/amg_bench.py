@@ -20,6 +20,9 @@ Parts (each one a key of the JSON, re-run alone with --part):
   which matches the load with the answer (the push one more unknown, no factorisation).
 
 Every part records the load average before and after it: the machine has 2 cores, shared.
+A whole-process run is a task of the studies' runner (the ``(command)`` kind: a process of its
+own, timed start to exit, stopped at its time limit); ``backends``, ``crossover`` and the
+``petsc`` parts time set-ups and solves inside one process, as the parts describe.
 """
 
 from __future__ import annotations
@@ -30,16 +33,17 @@ import os
 import platform
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
+from signorini.studies.runner import run_tasks
+from signorini.studies.task import COMMAND, Task
+
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "amg"
 JSON = OUT / "bench.json"
-SIGNORINI = str(ROOT / ".venv" / "bin" / "signorini")
 SPHERE_350K = {"refine": 2, "delta": 0.0025}
 SPHERE_1M = {"refine": 2, "n_contact": 24, "delta": 0.0025}
 SPHERE_350K_LOAD = {"refine": 2}
@@ -75,56 +79,44 @@ def load() -> float:
 
 
 def command_line(params: dict) -> list[str]:
-    words = [SIGNORINI, "solve", "hertz-sphere-3d"]
+    words = ["solve", "hertz-sphere-3d"]
     for key, value in params.items():
         words += ["--set", f"{key}={value}"]
     return words
 
 
-def timed(words: list[str], timeout: float | None = None,
-          env: dict | None = None) -> tuple[subprocess.CompletedProcess | None, dict]:
-    """``words`` under /usr/bin/time -v: the finished process (None on timeout) and its wall time
-    (``wall_s``) and peak resident memory of its largest process (``peak_gb``)."""
-    try:
-        proc = subprocess.run(["/usr/bin/time", "-v", *words], capture_output=True, text=True,
-                              cwd=ROOT, timeout=timeout, env=env)
-    except subprocess.TimeoutExpired:
-        return None, {"wall_s": float(timeout), "peak_gb": float("nan")}
-    timing = dict(line.strip().rsplit(": ", 1) for line in proc.stderr.splitlines()
-                  if ": " in line and line.startswith("\t"))
-    clock = timing.get("Elapsed (wall clock) time (h:mm:ss or m:ss)", "0:0").split(":")
-    return proc, {"wall_s": sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock))),
-                  "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2}
+def timed(argv: list[str], timeout: float | None = None, record: bool = False,
+          ranks: int = 1) -> dict:
+    """``python argv…`` as a process of its own (a task of the studies' runner, ``(command)``),
+    timed whole under /usr/bin/time -v and stopped after ``timeout`` seconds: its return code
+    (None when stopped), wall time, peak memory of its largest process, last lines, record."""
+    task = Task(axis="amg", case="command", value="", problem={}, method=COMMAND, fresh=True,
+                options={"argv": argv, "record": record, "ranks": ranks}, reference={"kind": "none"})
+    row = run_tasks([task], time_limit=float("inf") if timeout is None else timeout)[0]
+    if "process" in row:
+        return row["process"]
+    return {"returncode": None, "wall_s": float(timeout or "nan"), "peak_gb": float("nan"),
+            "said": "timed out" if row["status"] == "timeout" else row["message"], "output": "",
+            "record": None}
 
 
 def whole(params: dict, method: str | None = None, options: tuple[str, ...] = (), ranks: int = 1,
           timeout: float | None = None) -> dict:
     """The command (by default the default one) under /usr/bin/time -v: wall time, peak memory
     and its record; ``ranks`` > 1 runs it under mpirun."""
-    with tempfile.TemporaryDirectory() as tmp:
-        record_path = Path(tmp) / "result.json"
-        words = command_line(params) + (["--method", method] if method else [])
-        for option in options:
-            words += ["--opt", option]
-        words += ["--json", str(record_path)]
-        env = None
-        if ranks > 1:
-            from signorini.solvers.cluster import mpirun_command
-
-            words, env = mpirun_command(ranks, words)
-        before = load()
-        proc, timing = timed(words, timeout, env)
-        record = json.loads(record_path.read_text()) if record_path.exists() else None
+    words = command_line(params) + (["--method", method] if method else [])
+    for option in options:
+        words += ["--opt", option]
+    before = load()
+    run = timed(["-m", "signorini.cli", *words], timeout, record=True, ranks=ranks)
     keep = ("scene", "params", "method", "status", "message", "iterations", "dofs",
             "contact_candidates", "time", "kkt", "total_force", "hertz", "extras")
     env = [f"{k}={os.environ[k]}" for k in ("SIGNORINI_MAX_MEMORY_GB",) if k in os.environ]
-    shown = " ".join(words[:-2]).replace(str(ROOT) + "/", "")
-    lines = proc.stderr.strip().splitlines() if proc is not None else []
-    said = [line for line in lines if line.startswith("signorini")]
-    return {"command": " ".join(env + ["/usr/bin/time", "-v", shown]),
-            "returncode": None if proc is None else proc.returncode, **timing,
-            "load_before": before, "load_after": load(),
-            "said": said[-1] if said else ("timed out" if proc is None else ""),
+    mpirun = ["mpirun", "-n", str(ranks)] if ranks > 1 else []
+    record = run["record"]
+    return {"command": " ".join(env + ["/usr/bin/time", "-v", *mpirun, ".venv/bin/signorini", *words]),
+            "returncode": run["returncode"], "wall_s": run["wall_s"], "peak_gb": run["peak_gb"],
+            "load_before": before, "load_after": load(), "said": run["said"],
             "record": None if record is None else {k: record.get(k) for k in keep if k in record}}
 
 
@@ -250,14 +242,14 @@ def scale() -> dict:
     sizes = {}
     for name, params in SCALE_SIZES.items():
         before = load()
-        proc, timing = timed([sys.executable, str(Path(__file__).resolve()), "amg-solve",
-                              json.dumps(params)], timeout=SCALE_TIMEOUT)
-        one = json.loads(proc.stdout.strip().splitlines()[-1]) if proc and proc.returncode == 0 else None
+        timing = timed([str(Path(__file__).resolve()), "amg-solve", json.dumps(params)],
+                       timeout=SCALE_TIMEOUT)
+        one = json.loads(timing.pop("output")) if timing["returncode"] == 0 else None
         runs = {}
         for label, method, options, ranks in SCALE_METHODS:
             runs[label] = whole(params, method, options, ranks, timeout=SCALE_TIMEOUT)
             print(f"{name} {label}: {runs[label]['wall_s']:.0f} s", file=sys.stderr, flush=True)
-        sizes[name] = {"params": params, "one_amg_solve": one, "one_amg_process": timing,
+        sizes[name] = {"params": params, "one_amg_solve": one, "one_amg_process": {k: timing[k] for k in ("wall_s", "peak_gb")},
                        "load_before": before, "load_after": load(), "runs": runs}
     return {"sizes": sizes}
 

@@ -23,13 +23,12 @@ holds docs/bench-forms.md's tables to the JSON.
 from __future__ import annotations
 
 import os
-import platform
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from readme import fill_blocks, head_commit, study_main
+from readme import fill_blocks, provenance, study_main
 
 from signorini.files import atomic_write_text, to_json
 from signorini.solvers import cvxpy_, qp
@@ -85,11 +84,8 @@ def tasks(size: str, path: Path) -> list[Task]:
 
 
 def run() -> dict:
-    data = {"command": "python tools/bench_forms.py", "tol": TOL, "time_limit": TIME_LIMIT,
-            "scene": SCENE, "params": BASE, "commit": head_commit(),
-            "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-                       f"Python {platform.python_version()}",
-            "load_before": list(os.getloadavg()), "sizes": {}}
+    data = {**provenance("bench_forms.py"), "tol": TOL, "time_limit": TIME_LIMIT, "scene": SCENE,
+            "params": BASE, "sizes": {}}
     start = time.perf_counter()
     for size, level in SIZES.items():
         path = problem_file(PROBLEMS, SCENE, size, {**BASE, "refine": level})

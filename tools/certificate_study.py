@@ -2,11 +2,12 @@
 
     PYTHONPATH=. .venv/bin/python tools/certificate_study.py   # ~1 min; writes docs/certificate/study.json
 
-Hertz's cylinder (``n_contact=20``, the default volumetric treatment) for each ν of
-``NUS`` and each method of ``METHODS``: the method's status, the true relative error of λ
-against a reference refined in long double on the same active set
-(:func:`signorini.forward_error.refined_on_active_set`), and the certificate's
-estimate (``force_error``) and its floor (``force_error_floor``). ``table`` renders
+Hertz's cylinder (``n_contact=20``, the default volumetric treatment, its load matched once)
+for each ν of ``NUS`` and each method of ``METHODS``, each a task of the studies' runner:
+the method's status, the true relative error of λ against pdas's answer refined in long
+double on its active set (the ``refined`` reference policy,
+:func:`signorini.forward_error.refined_on_active_set`), and the certificate's estimate
+(``force_error``) and its floor (``force_error_floor``): the ``forward_error`` measure. ``table`` renders
 the page's table from the JSON; tests/test_hostile_answers.py holds the page to it.
 """
 
@@ -17,14 +18,9 @@ import json
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from signorini.files import atomic_write_text, to_json
-from signorini.forward_error import refined_on_active_set
-from signorini.kkt import active_set, certificate
-from signorini.numerics.factor import factorize
-from signorini.scenes import build_problem
-from signorini.solvers.registry import solve
+from signorini.studies.runner import run_tasks
+from signorini.studies.task import Task
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "certificate" / "study.json"
@@ -38,33 +34,24 @@ SCENE = {"n_contact": 20}
 STEPS = 20
 
 
-def reference(problem) -> np.ndarray:
-    """λ on pdas's active set, refined with long-double residuals (as a float array)."""
-    start = solve(problem, "pdas")
-    _, lam = refined_on_active_set(problem.K, problem.f, problem.N, problem.d, start.u, start.lam,
-                                   active_set(problem, start), factorize(problem.K), steps=STEPS)
-    return lam.astype(float)
+def tasks(nus: tuple[float, ...] = NUS) -> list[Task]:
+    """A task per ν and installed method, held to the refined reference."""
+    return [Task(axis="nu", case="hertz-cylinder", value=nu, method=method, tol=tol,
+                 problem={"kind": "scene", "scene": "hertz-cylinder", "params": {"nu": nu, **SCENE}},
+                 reference={"kind": "refined", "steps": STEPS}, measure=("forward_error",))
+            for nu in nus for method, tol in METHODS
+            if method != "qp-qpalm" or importlib.util.find_spec("qpalm") is not None]
 
 
-def run() -> list[dict]:
-    rows = []
-    for nu in NUS:
-        problem = build_problem("hertz-cylinder", params={"nu": nu, **SCENE})
-        lam_ref = reference(problem)
-        for method, tol in METHODS:
-            module = "qpalm" if method == "qp-qpalm" else None
-            if module and importlib.util.find_spec(module) is None:
-                continue
-            solution = solve(problem, method, tol=tol)
-            cert = certificate(problem, solution)
-            error = float(np.max(np.abs(solution.lam - lam_ref)) / np.max(np.abs(lam_ref)))
-            rows.append({"nu": nu, "method": method, "tol": tol, "status": solution.status,
-                         "claimed": solution.own_status, "lam_error": error,
-                         "force_error": cert.force_error, "force_error_floor": cert.force_error_floor,
-                         "back_solves": cert.back_solves})
-            print(f"ν={nu:<14.12g} {method:15s} {solution.status:11s} error {error:.1e} "
-                  f"estimate {cert.force_error:.1e} floor {cert.force_error_floor:.1e}", file=sys.stderr)
-    return rows
+def row_of(row: dict) -> dict:
+    """The study's row from the runner's."""
+    return {"nu": row["value"], "method": row["method"], "tol": row["tol"], "status": row["status"],
+            "claimed": row["claimed_status"], **row["forward_error"]}
+
+
+def run(nus: tuple[float, ...] = NUS) -> list[dict]:
+    return [row_of(row) for row in run_tasks(tasks(nus), progress=lambda i, n, t, r: print(
+        f"{i}/{n} ν={t.value:<14.12g} {t.method:15s} {r['status']}", file=sys.stderr))]
 
 
 def _method(row: dict) -> str:

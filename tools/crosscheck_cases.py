@@ -4,8 +4,9 @@
     .venv/bin/python tools/crosscheck_cases.py --doc  # docs/crosscheck.md's tables from it
 
 Every case of the validation suite (signorini.studies.suite.DEFAULT_CASES) is cross-checked
-at tol 1e-8 with uzawa, qp-osqp, qp-clarabel, cvxpy and pdas (signorini.crosschecking), in
-three variants of the QP methods' options:
+at tol 1e-8 with uzawa, qp-osqp, qp-clarabel, cvxpy and pdas (signorini.crosschecking: the
+runner's ``crosscheck`` task kind, in a worker with a time limit), in three variants of the
+QP methods' options:
 
 - ``raw``: what the cross-check judges by default, each backend's own answer (OSQP's dual
   form with its own polishing, Clarabel and cvxpy primal with Clarabel's gap tolerance at
@@ -23,21 +24,23 @@ the default variant to that condition.
 from __future__ import annotations
 
 import os
-import platform
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from readme import fill_blocks, head_commit, study_main
+from readme import fill_blocks, provenance, study_main
 
-import signorini
+from signorini.studies.runner import run_tasks
 from signorini.studies.suite import DEFAULT_CASES
+from signorini.studies.task import CROSSCHECK, Task
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "crosscheck" / "cases.json"
 DOC = ROOT / "docs" / "crosscheck.md"
 TOL = 1e-8
+#: seconds a case's cross-check (every method) may take in the runner's worker
+TIME_LIMIT = 600.0
 METHODS = ("uzawa", "qp-osqp", "qp-clarabel", "cvxpy", "pdas")
 QP_METHODS = ("qp-osqp", "qp-clarabel", "cvxpy")
 #: the issue's condition on λ against the exact answer
@@ -50,21 +53,27 @@ VARIANTS = {
 }
 
 
-def run() -> dict:
-    data = {"command": "python tools/crosscheck_cases.py", "tol": TOL, "commit": head_commit(),
-            "machine": f"{platform.node()}: {platform.processor() or platform.machine()}, "
-                       f"{os.cpu_count()} cores, Python {platform.python_version()}",
-            "load_before": list(os.getloadavg()), "variants": {}}
-    start = time.perf_counter()
-    for case in DEFAULT_CASES:
-        problem = signorini.build_problem(case.scene, params=case.params)
-        for variant, options in VARIANTS.items():
-            check = signorini.crosscheck(problem, METHODS, tol=TOL, options=options)
-            record = check.to_dict()
-            record["case"] = case.name
-            data["variants"].setdefault(variant, {})[case.name] = record
-            print(f"{case.name:<22} {variant:<8} {'passed' if check.passed else 'FAILED'}",
-                  file=sys.stderr)
+def tasks(cases=DEFAULT_CASES) -> list[Task]:
+    """A crosscheck task per case and variant, on the case's scene as built (each method
+    matches its load, as signorini.crosscheck does)."""
+    return [Task(axis=variant, case=case.name, value="", method=CROSSCHECK, tol=TOL,
+                 problem={"kind": "scene", "scene": case.scene, "params": case.params,
+                          "matched": False},
+                 options={"methods": list(METHODS), "options": options},
+                 reference={"kind": "none"})
+            for case in cases for variant, options in VARIANTS.items()]
+
+
+def run(cases=DEFAULT_CASES) -> dict:
+    data = {**provenance("crosscheck_cases.py"), "tol": TOL, "variants": {}}
+    start, chosen = time.perf_counter(), tasks(cases)
+    for task, row in zip(chosen, run_tasks(chosen, time_limit=TIME_LIMIT, progress=lambda i, n, t, r:
+                                           print(f"{t.case:<22} {t.axis:<8} {r['message']}",
+                                                 file=sys.stderr))):
+        if "crosscheck" not in row:
+            raise RuntimeError(f"{task.case} ({task.axis}): {row['status']}: {row['message']}")
+        data["variants"].setdefault(task.axis, {})[task.case] = {**row["crosscheck"],
+                                                                 "case": task.case}
     data["seconds"] = time.perf_counter() - start
     data["load_after"] = list(os.getloadavg())
     return data

@@ -5,15 +5,17 @@ what adaptive refinement (signorini.scenes.adapt) reaches against uniform and ha
                                                                           # writes docs/estimate/runs.json
     .venv/bin/python tools/estimate.py figure                     # adaptive.png from the JSON
 
-For each scene and base mesh, the scene is solved at ``refine`` = 0, 1, ...
-(uniform refinements of the graded mesh) and at two more levels. The true
-error of level L is measured against the solution at level L + 2 (and, for a
-check on the reference's own error, against the finest one): the coarse P1
-field is carried onto the finer mesh node by node (every new node is the
-midpoint of an old edge, :mod:`signorini.fem.transfer`; nodes moved onto the
-arc keep that average) and ``‖u_ref − u_h‖_E`` is summed element by element
-on the finer mesh. Every solve is ``pdas`` at tol 1e-10 through the public API
-(``nested``, exact too, from refine 2). docs/estimate.md quotes the tables
+Effectivity: for each scene and base mesh, a task of the studies' runner per level
+``refine`` = 0, 1, ... (uniform refinements of the graded mesh). The true error of
+level L is measured against the solution at level L + 2 (and, for a check on the
+reference's own error, against the finest one): the runner's ``finer`` measure
+(:func:`signorini.studies.measures.energy_error`: the coarse P1 field carried onto the
+finer mesh node by node, every new node the midpoint of an old edge,
+:mod:`signorini.fem.transfer`, nodes moved onto the arc keeping that average, and
+``‖u_ref − u_h‖_E`` summed element by element on the finer mesh). Every solve is
+``pdas`` at tol 1e-10 on the scene as signorini.solve builds it (``nested``, exact too,
+from refine 2). The adaptive parts drive signorini.scenes.adapt's loop, each step
+measured against a reference loop: not single solves, they run here. docs/estimate.md quotes the tables
 ``tables`` renders from the JSON (tools/readme.py writes them there;
 tests/test_readme_numbers.py holds them).
 """
@@ -28,13 +30,14 @@ from pathlib import Path
 import numpy as np
 
 import signorini
-from signorini.fem.estimate import element_energies, estimate, material_units
-from signorini.fem.transfer import uniform_prolongation
 from signorini.files import atomic_write_text, to_json
-from signorini.references import reference_of
 from signorini.loading import solve as load_control
+from signorini.references import reference_of
+from signorini.scenes import SCENES as SCENE_FAMILIES
 from signorini.scenes import coarse_problem
 from signorini.scenes.adapt import solve_adaptive
+from signorini.studies.runner import run_tasks
+from signorini.studies.task import Task
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "estimate" / "runs.json"
@@ -42,6 +45,8 @@ SCENES = ("hertz-cylinder", "hertz-sphere")
 #: (n_contact, grading, levels): a coarse base with three levels, each scene's default mesh with two
 BASES = ((16, 0.2, 3), (None, None, 2))
 REFERENCE_STEPS = 2
+#: seconds a level's task (its solve and the finer ones it is measured against) may take
+TIME_LIMIT = 600.0
 #: the adaptive runs: targets (the contact pressure's relative L² error), the dof limit, the
 #: reference (the same loop driven further), the ν values, and the meshes held against them
 TARGETS = (0.003, 0.001)
@@ -69,60 +74,54 @@ def solve(scene: str, n_contact: int | None, grading: float | None, refine: int,
     return result, seconds
 
 
-def nodal(result) -> np.ndarray:
-    """The displacement of every node (nodes, dim) in physical units."""
-    dim = result.problem.mesh.p.shape[0]
-    return result.displacement.reshape(-1, dim)
-
-
-def true_error(coarse, fine, steps: int) -> tuple[float, float]:
-    """``‖u_fine − P u_coarse‖_E`` (physical) and the fine solution's λᵀ·gap(P u_coarse) term."""
-    cp, fp = coarse.problem, fine.problem
-    P = uniform_prolongation(cp.mesh.t, cp.mesh.p.shape[1], steps)
-    moved = P @ nodal(coarse)
-    E, nu = material_units(fp)
-    s = fp.scales
-    error = (nodal(fine) - moved) / s.displacement
-    energy = element_energies(fp.mesh, error, E, nu, fp.axisymmetric).sum() * s.force * s.displacement
-    v = (moved.ravel() / s.displacement)[fp.dofs()[1]]
-    term = float(fine.solution.lam @ fp.gap(v)) * s.force * s.displacement
-    return float(np.sqrt(energy)), term
-
-
-def run() -> list[dict]:
-    rows = []
+def tasks() -> list[Task]:
+    """A task per scene, base mesh and level: solved exactly, estimated, and measured against the
+    same scene REFERENCE_STEPS refinements finer and at the finest level (the ``finer`` measure)."""
+    out = []
     for scene in SCENES:
         for n_contact, grading, levels in BASES:
-            results = {}
-            for refine in range(levels + REFERENCE_STEPS):
-                results[refine] = solve(scene, n_contact, grading, refine)
-                print(f"{scene} ({n_contact}, {grading}) refine {refine}: "
-                      f"{results[refine][0].problem.n} dofs, {results[refine][1]:.1f} s", file=sys.stderr)
+            mesh = {k: v for k, v in (("n_contact", n_contact), ("grading", grading)) if v is not None}
             finest = levels + REFERENCE_STEPS - 1
-            for refine in range(levels):
-                result, seconds = results[refine]
-                start = time.perf_counter()
-                found = estimate(result.problem, result.solution)
-                estimate_s = time.perf_counter() - start
-                recovery_only = estimate(result.problem, result.solution, contact=False)
-                error, term = true_error(result, results[refine + REFERENCE_STEPS][0], REFERENCE_STEPS)
-                error_finest, _ = true_error(result, results[finest][0], finest - refine)
-                hertz = result.hertz
-                rows.append({
-                    "scene": scene, "n_contact": result.problem.params["n_contact"],
-                    "grading": result.problem.params["grading"], "refine": refine,
-                    "dofs": result.problem.n, "estimate": found.total, "relative": found.relative,
-                    "recovery": found.recovery * found.scale, "contact": found.contact * found.scale,
-                    "energy_norm": found.energy_norm * found.scale,
-                    "error": error, "error_finest": error_finest, "finest": finest,
-                    "effectivity": found.total / error,
-                    "effectivity_recovery": recovery_only.total / error,
-                    "effectivity_finest": found.total / error_finest,
-                    "complementarity": term,
-                    "p0_err": hertz.p0 / hertz.p0_ref - 1, "a_err": hertz.a / hertz.a_ref - 1,
-                    "estimate_s": estimate_s, "solve_s": seconds})
-                print(f"  level {refine}: η/‖e‖ = {rows[-1]['effectivity']:.3f}", file=sys.stderr)
-    return rows
+            out += [Task(axis="effectivity", case=scene, value=refine,
+                         problem={"kind": "scene", "scene": scene, "matched": False,
+                                  "params": {**mesh, "refine": refine}},
+                         method="nested" if refine >= 2 else "pdas", tol=1e-10,
+                         reference={"kind": "none", "finer": {
+                             "levels": sorted({refine + REFERENCE_STEPS, finest}),
+                             "method": "nested", "tol": 1e-10}},
+                         measure=("estimate", "reference", "finer"))
+                    for refine in range(levels)]
+    return out
+
+
+def row_of(task: Task, row: dict) -> dict:
+    """The study's row from the runner's."""
+    if "finer" not in row or any(r["status"] != "converged" for r in row["finer"].values()):
+        raise RuntimeError(f"{task.case} {task.problem['params']}: {row['status']} ({row['message']}); "
+                           f"finer: {row.get('finer')}")
+    refine, found, hertz = task.value, row["estimate"], row["reference"]
+    finest = max(task.reference["finer"]["levels"])
+    fine, finest_run = row["finer"][str(refine + REFERENCE_STEPS)], row["finer"][str(finest)]
+    error = fine["error"]
+    mesh = SCENE_FAMILIES[task.case].parse(task.problem["params"])
+    return {"scene": task.case, "n_contact": mesh["n_contact"], "grading": mesh["grading"],
+            "refine": refine, "dofs": row["dofs"], "estimate": found["eta"],
+            "relative": found["estimate"], "recovery": found["eta_recovery"],
+            "contact": found["eta_contact"], "energy_norm": found["energy_norm"],
+            "error": error, "error_finest": finest_run["error"], "finest": finest,
+            "effectivity": found["eta"] / error,
+            "effectivity_recovery": found["eta_without_contact"] / error,
+            "effectivity_finest": found["eta"] / finest_run["error"],
+            "complementarity": fine["complementarity"],
+            "p0_err": hertz["p0"] / hertz["p0_ref"] - 1, "a_err": hertz["a"] / hertz["a_ref"] - 1,
+            "estimate_s": found["estimate_s"], "solve_s": row["time_s"]}
+
+
+def run(chosen: list[Task] | None = None) -> list[dict]:
+    chosen = tasks() if chosen is None else chosen
+    rows = run_tasks(chosen, time_limit=TIME_LIMIT, progress=lambda i, n, t, r: print(
+        f"{i}/{n} {t.case} {t.problem['params']}: {r['status']}", file=sys.stderr))
+    return [row_of(task, row) for task, row in zip(chosen, rows)]
 
 
 def _pct(x: float, digits: int = 3) -> str:

@@ -2,23 +2,26 @@
 
     .venv/bin/python tools/factor_memory.py    # docs/speed/factor-memory.json (≈ 2 min here)
 
-For each model: build it (a prescribed push: no load targeting), then one
+For each model, a ``fresh`` task of the studies' runner (a worker process of its own): the
+model is built (a prescribed push: no load targeting), then one
 :class:`signorini.numerics.factor.PardisoFactor` of K, whose analysis (phase 11) gives
 the estimate the package refuses a factorisation by (``memory``, from iparm 15–17);
-``resident_growth`` is the process's resident set size after it minus before it.
+``resident_growth`` is the worker's resident set size after it minus before it (the
+runner's ``factor_memory`` measure).
 """
 
 from __future__ import annotations
 
 import json
-import os
-import platform
-import subprocess
+import sys
 from pathlib import Path
 
-import signorini
-from signorini.files import atomic_write_text
-from signorini.numerics.factor import PardisoFactor
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from readme import provenance  # noqa: E402  (tools/readme.py)
+
+from signorini.files import atomic_write_text  # noqa: E402
+from signorini.studies.runner import run_tasks  # noqa: E402
+from signorini.studies.task import BUILD_ONLY, Task  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "speed" / "factor-memory.json"
@@ -26,32 +29,31 @@ MODELS = (("hertz-cylinder", {"refine": 2, "delta": 0.001}),
           ("hertz-cylinder", {"refine": 3, "delta": 0.001}),
           ("hertz-sphere-3d", {"refine": 1, "delta": 0.0025}),
           ("hertz-sphere-3d", {"refine": 2, "delta": 0.0025}))
+#: seconds a model's build and factorisation may take
+TIME_LIMIT = 600.0
 
 
-def resident() -> float:
-    """This process's resident set size in bytes."""
-    with open("/proc/self/statm", encoding="ascii") as statm:
-        return float(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+def tasks(models=MODELS) -> list[Task]:
+    """A fresh build-only task per model that measures its factorisation's memory."""
+    return [Task(axis="factor-memory", case=scene, value="", method=BUILD_ONLY, fresh=True,
+                 problem={"kind": "scene", "scene": scene, "params": params},
+                 reference={"kind": "none"}, measure=("factor_memory",))
+            for scene, params in models]
+
+
+def run(models=MODELS) -> list[dict]:
+    rows = []
+    for (scene, params), row in zip(models, run_tasks(tasks(models), time_limit=TIME_LIMIT)):
+        if "factor_memory" not in row:
+            raise RuntimeError(f"{scene} {params}: {row['status']}: {row['message']}")
+        rows.append({"scene": scene, "params": params, "dofs": row["dofs"], **row["factor_memory"]})
+        print(rows[-1], flush=True)
+    return rows
 
 
 def main() -> int:
-    rows = []
-    for scene, params in MODELS:
-        problem = signorini.build_problem(scene, params=params)
-        before = resident()
-        factor = PardisoFactor(problem.K)
-        growth = resident() - before
-        rows.append({"scene": scene, "params": params, "dofs": problem.n,
-                     "estimate_bytes": factor.memory, "resident_growth_bytes": growth,
-                     "ratio": factor.memory / growth})
-        print(rows[-1], flush=True)
-        del factor
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()
-    atomic_write_text(OUT, json.dumps({
-        "command": "python tools/factor_memory.py", "commit": commit,
-        "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
-        "rows": rows}, indent=1) + "\n")
+    rows = run()
+    atomic_write_text(OUT, json.dumps({**provenance("factor_memory.py"), "rows": rows}, indent=1) + "\n")
     return 0
 
 

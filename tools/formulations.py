@@ -19,13 +19,12 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from readme import pattern  # noqa: E402  (tools/readme.py: the generated-block markers)
+from readme import fill_blocks, head_commit, pattern  # noqa: E402  (tools/readme.py)
 
 from signorini.files import atomic_write_text, to_json  # noqa: E402
 from signorini.solvers import forms, qp  # noqa: E402
@@ -95,10 +94,8 @@ def run(case: str) -> dict:
         kept.update(form=form if task.method != "pdas" else "", polish=bool(polish),
                     case=case, message=(row.get("message") or "")[:300])
         out.append(kept)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, cwd=ROOT).stdout.strip()
     return {"case": case, "params": CASES[case], "rows": out, "seconds": time.perf_counter() - start,
-            "load_before": load_before, "load_after": os.getloadavg(), "commit": commit}
+            "load_before": load_before, "load_after": os.getloadavg(), "commit": head_commit()}
 
 
 def load() -> dict:
@@ -209,12 +206,7 @@ def tables(data: dict) -> dict[str, str]:
 
 
 def write_doc() -> None:
-    text = DOC.read_text(encoding="utf-8")
-    for name, body in tables(load()).items():
-        if not pattern(name).search(text):
-            raise SystemExit(f"{DOC.name} has no block '{name}'")
-        text = pattern(name).sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
-    atomic_write_text(DOC, text)
+    fill_blocks(DOC, tables(load()))
 
 
 def main() -> int:

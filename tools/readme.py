@@ -178,6 +178,17 @@ def head_commit() -> str:
         return "unknown"
 
 
+def provenance(script: str) -> dict:
+    """Where a study tool's run was made: its command, HEAD's hash, the machine, the load."""
+    import os
+    import platform
+
+    return {"command": f"python tools/{script}", "commit": head_commit(),
+            "machine": f"{platform.node()}: {platform.processor() or platform.machine()}, "
+                       f"{os.cpu_count()} cores, Python {platform.python_version()}",
+            "load_before": list(os.getloadavg())}
+
+
 def study_main(doc: str, out: Path, run, write_doc) -> int:
     """The command line of a study tool: ``--doc`` renders ``doc``'s tables from the committed
     ``out``; without it the study runs and ``out`` is written (atomically)."""

@@ -6,18 +6,27 @@ it compares) and returns numbers for a row of :mod:`signorini.studies.runner`.
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
+from signorini.fem.estimate import element_energies, estimate, material_units
+from signorini.fem.transfer import uniform_prolongation
 from signorini.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
-from signorini.numerics.factor import factorize, resolve_backend
+from signorini.numerics.factor import PardisoFactor, factorize, resolve_backend
 from signorini.numerics.lcp import delassus
 from signorini.pressure import contact_profile
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_of
+from signorini.solvers.cluster import mpirun_command
 
 
 def certificate_of(problem: ContactProblem, solution: ContactSolution):
@@ -124,3 +133,91 @@ def answer_from(record: dict[str, Any]) -> ContactSolution:
                            message=record["message"], iterations=record["iterations"],
                            build_time=record["build_time"], solve_time=record["solve_time"],
                            claimed_status=record["claimed_status"])
+
+
+def forward_error(problem: ContactProblem, reference: ContactSolution,
+                  solution: ContactSolution) -> dict[str, float]:
+    """The true force error ``‖λ − λ*‖∞ / ‖λ*‖∞`` beside what the certificate estimates of it:
+    its forward error, that estimate's floor and the back-solves it took."""
+    cert = certificate(problem, solution)
+    lam_error = float(np.max(np.abs(solution.lam - reference.lam)) / np.max(np.abs(reference.lam)))
+    return {"lam_error": lam_error, "force_error": cert.force_error,
+            "force_error_floor": cert.force_error_floor, "back_solves": cert.back_solves}
+
+
+def resident() -> float:
+    """This process's resident set size in bytes (Linux)."""
+    with open("/proc/self/statm", encoding="ascii") as statm:
+        return float(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def factor_memory(problem: ContactProblem) -> dict[str, float]:
+    """PARDISO's analysis-phase estimate of its factorisation of K (the package refuses one by
+    it) against the growth of this process's resident memory that factorisation took."""
+    before = resident()
+    factor = PardisoFactor(problem.K)
+    growth = resident() - before
+    return {"estimate_bytes": factor.memory, "resident_growth_bytes": growth,
+            "ratio": factor.memory / growth}
+
+
+def estimate_record(problem: ContactProblem, solution: ContactSolution) -> dict[str, float] | None:
+    """The a posteriori estimate (relative, the pressure's relative, η and its parts in physical
+    units, η without the contact term) and the seconds it took; None where there is none."""
+    start = time.perf_counter()
+    found = estimate(problem, solution)
+    seconds = time.perf_counter() - start
+    if found is None:
+        return None
+    return {"estimate": found.relative, "pressure_estimate":
+            found.pressure.relative if found.pressure is not None else float("nan"),
+            "eta": found.total, "eta_recovery": found.recovery * found.scale,
+            "eta_contact": found.contact * found.scale, "energy_norm": found.energy_norm * found.scale,
+            "eta_without_contact": estimate(problem, solution, contact=False).total,
+            "estimate_s": seconds}
+
+
+def _nodal(problem: ContactProblem, solution: ContactSolution) -> np.ndarray:
+    """The displacement of every node (nodes, dim) in physical units."""
+    return (problem.expand(solution.u) * problem.scales.displacement).reshape(-1, problem.mesh.p.shape[0])
+
+
+def energy_error(coarse: ContactProblem, coarse_solution: ContactSolution, fine: ContactProblem,
+                 fine_solution: ContactSolution, steps: int) -> dict[str, float]:
+    """``‖u_fine − P u_coarse‖_E`` (``error``, physical) with P the prolongation over ``steps``
+    uniform refinements, summed element by element on the finer mesh, and the fine answer's
+    ``λᵀ·gap(P u_coarse)`` (``complementarity``, physical)."""
+    P = uniform_prolongation(coarse.mesh.t, coarse.mesh.p.shape[1], steps)
+    moved = P @ _nodal(coarse, coarse_solution)
+    E, nu = material_units(fine)
+    s = fine.scales
+    difference = (_nodal(fine, fine_solution) - moved) / s.displacement
+    energy = element_energies(fine.mesh, difference, E, nu, fine.axisymmetric).sum()
+    v = (moved.ravel() / s.displacement)[fine.dofs()[1]]
+    return {"error": float(np.sqrt(energy * s.force * s.displacement)),
+            "complementarity": float(fine_solution.lam @ fine.gap(v)) * s.force * s.displacement,
+            "dofs": fine.n}
+
+
+def whole_process(argv: list[str], record: bool = False, ranks: int = 1) -> dict[str, Any]:
+    """``python argv…`` timed whole, start to exit, under ``/usr/bin/time -v`` (``mpirun`` for
+    ``ranks`` > 1): its return code, wall time (``wall_s``), the peak resident memory of its
+    largest process (``peak_gb``), its last line of output, its last line of error output that
+    starts with "signorini" (``said``) and, with ``record``, the JSON it wrote to ``--json``."""
+    with tempfile.TemporaryDirectory(prefix="signorini-") as folder:
+        path = Path(folder) / "record.json"
+        words, env = [sys.executable, *argv] + (["--json", str(path)] if record else []), None
+        if ranks > 1:
+            words, env = mpirun_command(ranks, words)
+        done = subprocess.run(["/usr/bin/time", "-v", *words], capture_output=True, text=True,
+                              env=env)
+        written = json.loads(path.read_text()) if record and path.exists() else None
+    timing = dict(line.strip().rsplit(": ", 1) for line in done.stderr.splitlines()
+                  if ": " in line and line.startswith("\t"))
+    clock = timing.get("Elapsed (wall clock) time (h:mm:ss or m:ss)", "0:0").split(":")
+    said = [line for line in done.stderr.strip().splitlines() if line.startswith("signorini")]
+    out = done.stdout.strip().splitlines()
+    return {"returncode": done.returncode,
+            "wall_s": sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock))),
+            "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2,
+            "said": said[-1] if said else "", "output": out[-1] if out else "", "record": written}

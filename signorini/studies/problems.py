@@ -11,6 +11,7 @@ policy                    the exact answer
 ``pdas``                  PDAS at ``tol`` (:data:`REFERENCE_TOL`), converged
 ``nested``                the nested method at ``tol``, converged
 ``force-controlled-exact`` the patch solution of the force-controlled block
+``refined``               PDAS's answer, refined in long double on its active set
 ``none``                  none: a run is judged by its certificate alone
 ========================= ==========================================================
 
@@ -35,7 +36,10 @@ from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.model import FlatObstacle
 from signorini.files import atomic_write_bytes
+from signorini.forward_error import refined_on_active_set
+from signorini.kkt import active_set
 from signorini.loading import at_load
+from signorini.numerics.factor import factorize
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.problem_files import read_problem
 from signorini.scenes import block, build_problem, coarse_problem
@@ -47,15 +51,19 @@ log = logging.getLogger(__name__)
 
 #: tolerance of the trusted exact answer (PDAS)
 REFERENCE_TOL = 1e-9
+#: long-double refinement steps of the ``refined`` policy
+REFINEMENT_STEPS = 20
 
 
 # --- problem specs ------------------------------------------------------------------------------
 
 
 def _scene(spec: dict[str, Any]) -> ContactProblem:
-    # a study runs every method, cold, on the QP at the scene's load (matched once)
-    return at_load(build_problem(spec["scene"], params=spec.get("params"),
-                                 nondimensionalise=spec.get("nondimensionalise", True)), coarse_problem)
+    # a study runs every method, cold, on the QP at the scene's load (matched once); with
+    # "matched": false the scene as built, its target load left to each method (as signorini.solve)
+    problem = build_problem(spec["scene"], params=spec.get("params"),
+                            nondimensionalise=spec.get("nondimensionalise", True))
+    return at_load(problem, coarse_problem) if spec.get("matched", True) else problem
 
 
 def _force_controlled(spec: dict[str, Any]) -> ContactProblem:
@@ -82,7 +90,7 @@ PROBLEM_KINDS: dict[str, Callable[[dict[str, Any]], ContactProblem]] = {
 def build_spec(spec: dict[str, Any]) -> ContactProblem:
     """The problem a spec describes (a JSON-able dict, so that a worker can rebuild it).
 
-    ``{"kind": "scene", "scene", "params", "nondimensionalise"}``,
+    ``{"kind": "scene", "scene", "params", "nondimensionalise", "matched"}``,
     ``{"kind": "force-controlled", "params", "pressure", "regularisation"}``,
     ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`) or
     ``{"kind": "stored", "path"}`` (a problem file: :meth:`ContactProblem.save`'s, plain
@@ -197,6 +205,23 @@ def _solved_by(method: str) -> Callable[..., ContactSolution]:
     return attempt
 
 
+def _refined(problem: ContactProblem, spec: dict[str, Any],
+             other: ContactProblem | None) -> ContactSolution:
+    """PDAS's answer with (u, λ) refined in long double on its active set (``spec["steps"]``).
+
+    Its active set is taken whatever the certificate said of its λ (near ν = ½ it cannot
+    certify λ, which is what the refinement is for); an answer with no finite λ is returned as is.
+    """
+    start = _solved_by("pdas")(problem, spec, other)
+    if not (np.all(np.isfinite(start.u)) and np.all(np.isfinite(start.lam))):
+        return start
+    u, lam = refined_on_active_set(problem.K, problem.f, problem.N, problem.d, start.u, start.lam,
+                                   active_set(problem, start), factorize(problem.K),
+                                   steps=spec.get("steps", REFINEMENT_STEPS))
+    return ContactSolution("pdas", u.astype(float), lam.astype(float), "converged",
+                           message=f"pdas refined in long double ({start.message})")
+
+
 REFERENCE_POLICIES: dict[str, ReferencePolicy] = {p.name: p for p in (
     ReferencePolicy("pdas", "PDAS (exact when it converges) at tol, REFERENCE_TOL unless given",
                     _solved_by("pdas"), method="pdas"),
@@ -204,6 +229,8 @@ REFERENCE_POLICIES: dict[str, ReferencePolicy] = {p.name: p for p in (
                     _solved_by("nested"), method="nested"),
     ReferencePolicy("force-controlled-exact", "the patch solution of the force-controlled block",
                     lambda problem, spec, other: force_controlled_exact(problem)),
+    ReferencePolicy("refined", "PDAS's answer refined in long double on its active set "
+                    "(steps: REFINEMENT_STEPS unless given)", _refined),
     ReferencePolicy("none", "no exact answer: a run is judged by its certificate alone",
                     lambda problem, spec, other: None),
 )}

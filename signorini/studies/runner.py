@@ -43,9 +43,9 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from signorini.crosschecking import crosscheck
 from signorini.diagnose import diagnose
 from signorini.errors import InputError
-from signorini.fem.estimate import estimate
 from signorini.files import plain
 from signorini.kkt import compare
 from signorini.problem import ContactProblem, ContactSolution
@@ -62,8 +62,13 @@ from signorini.studies.measures import (
     answer_record,
     bound_at_solution,
     certificate_of,
+    energy_error,
+    estimate_record,
+    factor_memory,
     factorisation_time,
     force_error,
+    forward_error,
+    whole_process,
     hertz_errors,
     pressure_profile,
     weak_but_penetrating,
@@ -72,6 +77,8 @@ from signorini.studies.problems import build_spec, candidate_spacing, exact_atte
 from signorini.studies.task import (
     ATLAS_TOL,
     BUILD_ONLY,
+    COMMAND,
+    CROSSCHECK,
     DEFAULT_TIME_LIMIT,
     MEASURES,
     Row,
@@ -98,9 +105,9 @@ NUMERIC = ("dofs", "candidates", "iterations", "time_s", "kkt_worst", "lam_rel",
            "pressure_l2_rel", "ref_a_rel", "ref_p0_rel", "ref_pressure_l2_rel", "rho_over_bound",
            "lambda_max", "bound_at_solution", "patch_lam_rel")
 #: the statuses a run can end with besides :data:`signorini.problem.STATUSES`
-EXTRA_STATUSES = ("built", "refused", "input-error", "raised", "timeout", "crashed")
+EXTRA_STATUSES = ("built", "checked", "ran", "refused", "input-error", "raised", "timeout", "crashed")
 
-__all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "DEFAULT_TIME_LIMIT",
+__all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "COMMAND", "CROSSCHECK", "DEFAULT_TIME_LIMIT",
            "EXTRA_STATUSES", "ITERATION_CAPS", "MEASURES", "NEAR_FACTOR", "NUMERIC", "Row", "Task",
            "Worker", "in_worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "task_row"]
 #: the verdicts on a row (the name the tests know)
@@ -115,7 +122,9 @@ class _Cache:
         self.items: dict[str, Any] = {}
 
     def get(self, key: str, make: Callable[[], Any]) -> Any:
-        if key not in self.items:
+        if key in self.items:
+            self.items[key] = self.items.pop(key)  # the most recently used is kept longest
+        else:
             value = make()  # may raise: nothing is stored then
             self.items[key] = value
             while len(self.items) > self.size:
@@ -131,6 +140,12 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
     """Run one task in this process and measure it: one row."""
     cache = cache or _Cache()
     row = task_row(task)
+    if task.method == COMMAND:
+        found = whole_process(task.options["argv"], bool(task.options.get("record")),
+                              int(task.options.get("ranks", 1)))
+        row.update(status="ran", wrapper="returned", claimed_status="", process=found,
+                   message=found["said"] or f"exit {found['returncode']}", time_s=found["wall_s"])
+        return verdict(row, task)
     try:
         problem = cache.get(_key("problem", task.problem), lambda: build_spec(task.problem))
     except InputError as exc:
@@ -138,6 +153,10 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
                    message=str(exc), scene=task.problem.get("scene", "block"))
         return verdict(row, task)
     row.update(scene=problem.scene, dofs=problem.n, candidates=problem.m)
+    if "matrix" in task.measure:
+        row["nonzeros"] = int(problem.K.nnz)
+    if "factor_memory" in task.measure:
+        row["factor_memory"] = factor_memory(problem)
     if "mesh" in task.measure:
         made = problem.discretisation  # None for a QP given as arrays (a problem file)
         row.update(h=candidate_spacing(problem),
@@ -165,6 +184,12 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
                                                      lambda: bound_at_solution(problem, reference))
         return reference
 
+    if task.method == CROSSCHECK:
+        check = crosscheck(problem, task.options["methods"], tol=task.tol,
+                           options=task.options.get("options"))
+        row.update(status="checked", wrapper="returned", claimed_status="", crosscheck=check.to_dict(),
+                   message="every judged pair agrees" if check.passed else "a pair disagrees")
+        return verdict(row, task)
     if task.method == BUILD_ONLY:
         if "exact" in task.measure:
             exact()
@@ -174,23 +199,47 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
     if "factorisation" in task.measure:
         row["factor_s"] = factorisation_time(problem)
     reference = None if task.fresh else exact()
-    solution = run_on(problem, task, row)
-    if solution is None:
+    solved = run_on(problem, task, row)
+    if solved is None:
         return verdict(row, task)
+    problem, solution = solved
     if task.fresh:
         reference = exact(solution if task.is_policy_run else None)
     measure_answer(problem, task, row, solution, reference)
+    if "finer" in task.measure and solution.success:
+        row["finer"] = {str(level): _against_finer(problem, solution, task, level, cache)
+                        for level in task.reference["finer"]["levels"]}
     return verdict(row, task)
 
 
-def run_on(problem: ContactProblem, task: Task, row: Row) -> ContactSolution | None:
-    """Solve ``problem`` as ``task`` says and record what the method said (None when refused)."""
+def _against_finer(problem: ContactProblem, solution: ContactSolution, task: Task, level: int,
+                   cache: _Cache) -> dict[str, Any]:
+    """The ``finer`` measure at one level: the same scene ``level`` uniform refinements in, solved
+    as ``task.reference["finer"]`` says (once per worker while it is cached)."""
+    how = task.reference["finer"]
+    spec = {**task.problem, "params": {**(task.problem.get("params") or {}), "refine": level}}
+
+    def make() -> tuple[ContactProblem, ContactSolution]:
+        return load_control(build_spec(spec), how["method"], tol=how.get("tol"), coarse=coarse_problem)
+
+    fine, answer = cache.get(_key("finer", spec, how), make)
+    if answer.status != "converged":
+        return {"status": answer.status, "dofs": fine.n}
+    steps = level - (task.problem.get("params") or {}).get("refine", 0)
+    return {"status": answer.status, **energy_error(problem, solution, fine, answer, steps)}
+
+
+def run_on(problem: ContactProblem, task: Task,
+           row: Row) -> tuple[ContactProblem, ContactSolution] | None:
+    """Solve ``problem`` as ``task`` says and record what the method said: the problem solved (at
+    the load matched, for a target load left to the method) and the answer; None when refused."""
     start = time.perf_counter()
     wrapper = "returned"
     try:
         # the scene's predictions reach the methods that take them (nested, pdas-amg)
-        solution = load_control(problem, task.method, tol=task.tol, max_iter=task.max_iter,
-                                coarse=coarse_problem, **task.options)[1]
+        problem, solution = load_control(problem, task.method, tol=task.tol,
+                                         max_iter=task.max_iter, coarse=coarse_problem,
+                                         **task.options)
     except InputError as exc:
         row.update(status="refused", wrapper="input-error", claimed_status="", message=str(exc),
                    time_s=time.perf_counter() - start)
@@ -207,7 +256,7 @@ def run_on(problem: ContactProblem, task: Task, row: Row) -> ContactSolution | N
         row.update(build_s=solution.build_time, solve_s=solution.solve_time, method_s=method_s)
         if "factor_s" in row:
             row["ratio_to_factor"] = method_s / row["factor_s"]
-    return solution
+    return problem, solution
 
 
 def _own_answer(problem: ContactProblem, task: Task) -> ContactSolution:
@@ -255,15 +304,17 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
     row.update(hertz_errors(problem, solution))
     if "reference" in task.measure:
         row["reference"] = reference_metrics(problem, solution)
-    found = estimate(problem, solution) if "estimate" in task.measure and solution.success else None
+    found = estimate_record(problem, solution) if "estimate" in task.measure and solution.success \
+        else None
     if found is not None:
-        row["estimate"] = {"estimate": found.relative, "pressure_estimate":
-                           found.pressure.relative if found.pressure is not None else float("nan")}
+        row["estimate"] = found
     if "patch" in task.measure:
         row["patch_lam_rel"] = compare(problem, force_controlled_exact(problem), solution).lam_rel
     finite = bool(np.all(np.isfinite(solution.lam)))
     if "profile" in task.measure and finite:
         row["profile"] = pressure_profile(problem, solution)
+    if reference is not None and "forward_error" in task.measure:
+        row["forward_error"] = forward_error(problem, reference, solution)
     if "lam" in task.measure:
         row["lam"] = solution.lam.tolist()
     if "answer" in task.measure:

@@ -181,9 +181,11 @@ def run_one(problem: ContactProblem, method: Method, tol: float | None,
     """
     task = run_task_of(Case("", problem.scene), method.name, tol)
     row = task_row(task)
-    solution = run_on(problem, task, row)
-    if solution is not None:
-        measure_answer(problem, task, row, solution, reference)
+    solved = run_on(problem, task, row)
+    if solved is None:
+        return suite_row(row), None
+    problem, solution = solved
+    measure_answer(problem, task, row, solution, reference)
     return suite_row(row), solution
 
 

@@ -23,6 +23,13 @@ ATLAS_TOL = DEFAULT_TOL
 DEFAULT_TIME_LIMIT = 30.0
 #: the "method" of a task that only builds (and diagnoses) its problem
 BUILD_ONLY = "(build)"
+#: the "method" of a task that cross-checks its problem (:func:`signorini.crosscheck`) by the
+#: methods ``options["methods"]``, each with its ``options["options"][method]`` (crosscheck)
+CROSSCHECK = "(crosscheck)"
+#: the "method" of a task that runs ``python options["argv"]…`` as a process of its own, timed
+#: whole (:func:`signorini.studies.measures.whole_process`; ``options["record"]``,
+#: ``options["ranks"]``); its problem is not built (process)
+COMMAND = "(command)"
 #: what a task may ask to measure besides the row every task gets, and the columns it fills
 MEASURES = {
     "diagnosis": "what signorini.diagnose finds in the problem (diagnosis)",
@@ -34,13 +41,21 @@ MEASURES = {
              "method_s)",
     "vs_reference": "signorini.kkt.compare with the exact answer (vs_reference)",
     "reference": "the errors against the analytic reference the problem declares (reference)",
-    "estimate": "the a posteriori estimates, energy norm and contact pressure (estimate)",
+    "estimate": "the a posteriori estimates, energy norm and contact pressure, η and its parts, "
+                "η without the contact term, and its time (estimate)",
+    "finer": "the energy-norm error against the same scene at each refine of "
+             "reference['finer']['levels'], solved by its 'method' at its 'tol' (finer)",
     "lam": "the contact forces (lam)",
     "answer": "the answer itself: u, λ, status and message (answer)",
     "exact": "the exact answer the task is held to, converged or not (exact)",
     "mesh": "the spacing of the contact candidates and the assembly time (h, assemble_s)",
     "factorisation": "one factorisation + solve of K in this process before the method, and the "
                      "method's time over it (factor_s, ratio_to_factor)",
+    "matrix": "the nonzeros of K (nonzeros)",
+    "forward_error": "λ's true error against the exact answer beside the certificate's estimate "
+                     "of it, its floor and back-solves (forward_error)",
+    "factor_memory": "PARDISO's memory estimate for K against the resident memory its "
+                     "factorisation took in the worker: a fresh task's own (factor_memory)",
 }
 
 
@@ -49,7 +64,7 @@ Row = TypedDict("Row", {
     # tolerance and ranks), the method, the problem and what it is
     "axis": str, "case": str, "value": float | str, "label": str, "size": str, "tolerance": str,
     "ranks": int, "method": str, "tol": float | None, "expect": str, "options": str,
-    "problem": str, "scene": str, "dofs": int, "candidates": int, "h": float,
+    "problem": str, "scene": str, "dofs": int, "candidates": int, "h": float, "nonzeros": int,
     "assemble_s": float, "diagnosis": str,
     # what the method said, and the times
     "status": str, "claimed_status": str, "wrapper": str, "message": str, "iterations": int,
@@ -64,7 +79,9 @@ Row = TypedDict("Row", {
     # theory: Hertz's cylinder (the exact answer's prefixed ref_) and the declared reference
     "a_rel": float, "p0_rel": float, "pressure_l2_rel": float, "ref_a_rel": float,
     "ref_p0_rel": float, "ref_pressure_l2_rel": float, "reference": dict[str, float],
-    "estimate": dict[str, float],
+    "estimate": dict[str, float], "forward_error": dict[str, float],
+    "factor_memory": dict[str, float], "crosscheck": dict[str, Any], "finer": dict[str, Any],
+    "process": dict[str, Any],
     "profile": dict[str, Any], "lam": list[float], "answer": dict[str, Any],
     # what a method reports about itself
     "rho_over_bound": float, "lambda_max": float, "bound_at_solution": float,
@@ -154,7 +171,7 @@ def verdict(row: Row, task: Task) -> Row:
     claimed_success = claimed == "converged"
     row["claim_correct"] = (not claimed_success) or (cert_ok and exact_ok)
     row["conservative"] = claimed_success and not cert_ok and near_exact
-    if status in ("input-error", "refused", "built", "timeout", "crashed"):
+    if status in ("input-error", "refused", "built", "checked", "ran", "timeout", "crashed"):
         row["wrapper_right"] = True  # a clear error, or a method that never answered
     elif status == "raised":
         row["wrapper_right"] = False
@@ -164,7 +181,11 @@ def verdict(row: Row, task: Task) -> Row:
         row["wrapper_right"] = exact_ok
     else:
         row["wrapper_right"] = not (claimed_success and cert_ok and exact_ok)
-    if task.method == BUILD_ONLY:
+    if task.method == COMMAND:
+        row["outcome"] = "right" if row.get("process", {}).get("returncode") == 0 else "wrong"
+    elif task.method == CROSSCHECK:
+        row["outcome"] = "right" if row.get("crosscheck", {}).get("passed") else "wrong"
+    elif task.method == BUILD_ONLY:
         flagged = status == "input-error" or bool(row.get("diagnosis"))
         row["outcome"] = "right" if flagged == (task.expect == "refuse") else "wrong"
     elif task.expect == "refuse":
