@@ -89,7 +89,7 @@ def analytic_zone(problem: ContactProblem) -> Zone | None:
     reference = reference_of(problem)
     if reference is None or reference.extent is None:
         return None
-    a = reference.extent(problem.params)
+    a = reference.extent(problem)
     if a is None:
         return None
     return zone_around_points(problem.contact_points, a / problem.scales.length,

@@ -99,7 +99,12 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
             raise InputError(f"scene {name!r} with {given} could not be meshed "
                              f"({type(exc).__name__}: {exc}): make the mesh coarser (a larger "
                              "grading or a smaller n_contact)") from None
+    declared = SCENES[name].reference if name in SCENES else ""
+    if model.reference is None and declared or model.reference and model.reference.name != declared:
+        raise InputError(f"scene family {name!r} declares the reference {declared!r}, but its build "
+                         f"hands on {model.reference!r}: give its SceneModel "
+                         f"reference=ReferenceData({declared!r}, ...) with the fields that "
+                         "reference reads (signorini.problem.ReferenceData)")
     problem = assemble(model, nondimensionalise=nondimensionalise)
     problem.name = name
-    problem.discretisation.reference = SCENES[name].reference if name in SCENES else ""
     return problem
