@@ -17,6 +17,7 @@ vectors ``result.solution.u`` and ``result.solution.lam`` are dimensionless (see
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from typing import Any
 
@@ -43,6 +44,32 @@ from signorini.solvers.registry import Method, check_request
 from signorini.solvers.registry import methods as _all_methods
 
 DEFAULT_METHOD = "auto"
+#: the version of the solve record's layout (docs/json.md): raised when a key changes meaning or goes
+SCHEMA_VERSION = 1
+
+log = logging.getLogger(__name__)
+
+
+def record_units(problem: ContactProblem) -> dict[str, str]:
+    """The unit of each physical quantity of the solve record, in the problem's input units.
+
+    A scene's units are those of its parameters: ``length`` the unit its lengths are given in
+    (R, W, H, mesh coordinates), ``stress`` the unit of E; so a scene given in SI has lengths
+    in m and pressures in Pa. A problem from its QP data (:meth:`ContactProblem.from_qp`) is in
+    the units of d (lengths) and of f (forces).
+    """
+    if problem.mesh is None:
+        return {"system": "the QP's own", "length": "the unit of d", "force": "the unit of f",
+                "total_force": "the unit of f", "pressure": "the unit of f per unit of the weights",
+                "time": "s"}
+    if problem.mesh.p.shape[0] == 2 and not problem.axisymmetric:
+        force = total = "stress·length (per unit thickness, plane strain)"
+    else:
+        total = "stress·length²"
+        force = total + (" (per radian: axisymmetric)" if problem.axisymmetric else "")
+    return {"system": "the scene's own (length: its lengths' unit, stress: E's unit)",
+            "length": "length", "force": force, "total_force": total, "pressure": "stress",
+            "time": "s"}
 
 
 def _scalar_rows(value: Any) -> bool:
@@ -212,6 +239,7 @@ class Result:
         (:meth:`ContactProblem.from_qp`) or an answer that is not finite.
         """
         if not hasattr(self, "_estimate"):
+            log.info("estimating the discretisation error (ZZ)")
             self._estimate = estimate(self.problem, self.solution) if self.finite else None
         return self._estimate
 
@@ -220,6 +248,7 @@ class Result:
         """The record ``signorini solve --json`` writes (arrays as NumPy until serialised)."""
         problem, solution = self.problem, self.solution
         record: dict[str, Any] = {
+            "schema_version": SCHEMA_VERSION, "units": record_units(problem),
             "scene": problem.scene, "params": problem.params, "method": solution.method,
             "status": solution.status, "claimed_status": solution.own_status,
             "message": solution.message,
@@ -272,6 +301,10 @@ def solve_summary(record: dict[str, Any]) -> str:
         if record["estimate"].get("pressure") is not None:
             lines[-1] += f"; contact pressure {100 * record['estimate']['pressure']:.2f} % (L2)"
     lines += summary_lines(record)  # the comparison with the analytic reference
+    units = record.get("units") or {}
+    if units.get("length") == "length":  # a scene's: in the units its parameters were given in
+        lines.append(f"  units: lengths and gaps in the scene's length unit, pressures in E's unit, "
+                     f"forces in {units['force']}")
     steps = record["extras"].get("adaptive", [])
     if steps:
         lines.append(f"  adaptive refinement, {len(steps)} solve{'s' * (len(steps) != 1)} in "
@@ -329,6 +362,7 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     problem, solution = load_control(problem, method, tol=tol, max_iter=max_iter,
                                      warm_start=warm_start, coarse=coarse_problem,
                                      keep_factor=keep_factor, **options)
+    log.info("checking the answer: the KKT certificate")
     return Result(problem, solution, kkt.certificate(problem, solution))
 
 

@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.api import Result, build_problem, solve
+from signorini.api import SCHEMA_VERSION, Result, build_problem, record_units, solve
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.kkt import ACTIVE, WEAK_TOL, classify, compare
 from signorini.problem import ContactProblem, ContactSolution
@@ -181,7 +181,8 @@ class CrossCheck:
     def to_dict(self) -> dict[str, Any]:
         """The record ``signorini crosscheck --json`` writes."""
         problem = self.problem
-        return {"scene": problem.scene, "params": problem.params, "dofs": problem.n,
+        return {"schema_version": SCHEMA_VERSION, "units": record_units(problem),
+                "scene": problem.scene, "params": problem.params, "dofs": problem.n,
                 "contact_candidates": problem.m, "tol": self.tol,
                 "reference": problem.reference, "agree_factor": AGREE_FACTOR,
                 "passed": self.passed, "failures": self.failures, "allowed": list(self.allowed),

@@ -253,7 +253,10 @@ def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Chan
             raise InputError(f"{problem.scene or 'this scene'} is loaded by a target load P, which "
                              "sets the push: differentiate with respect to P (or build the scene "
                              "with delta=)")
-        ratio = push.scale / disc.params["delta"]  # the push moves in proportion to delta
+        if push.delta is None:
+            raise InputError(f"{problem.scene or 'this scene'} names no push delta to differentiate "
+                             "with respect to: build it from a scene with a delta parameter")
+        ratio = push.scale / push.delta  # the push moves in proportion to delta
         return Change(zero_n, push.f1 * ratio, push.d1 * ratio)
     if wrt == "obstacle":  # towards the body along the load axis: each gap shrinks by cᵢ
         tilt = np.ones(problem.m) if push.resultant is None else push.resultant
@@ -267,9 +270,8 @@ def _poisson_change(problem: ContactProblem, u: np.ndarray) -> Change:
     nu, k = disc.nu, 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
     E = disc.E * s.displacement * s.length ** k / s.force  # E in the problem's units
     lame = (1 + 2 * nu ** 2) / ((1 + nu) * (1 - 2 * nu)) ** 2, -0.5 / (1 + nu) ** 2
-    volumetric = disc.params.get("volumetric", disc.volumetric)
     dK = lame_stiffness(disc.mesh, E * lame[0], E * lame[1], axisymmetric=disc.axisymmetric,
-                        volumetric=volumetric)
+                        volumetric=disc.volumetric)
     free = disc.free_dofs
     on_free, prescribed = np.zeros(disc.prescribed.size), disc.prescribed.copy()
     on_free[free] = u

@@ -24,3 +24,16 @@ class SolverError(SignoriniError):
 
 class OutputError(SignoriniError):
     """An output that could not be written (a full disk, say): nothing was left half-written."""
+
+
+#: the pip distribution of a module whose import name differs from it
+DISTRIBUTIONS = {"sksparse": "scikit-sparse"}
+
+
+def install_hint(extra: str, modules: tuple[str, ...] | list[str] = ()) -> str:
+    """The pip command that installs what is missing: the package's ``extra`` when it has one
+    (each extra lists its distributions in pyproject.toml), otherwise the ``modules``' own
+    distributions (``pip install qpsolvers osqp``)."""
+    if extra:
+        return f"pip install 'signorini[{extra}]'"
+    return "pip install " + " ".join(DISTRIBUTIONS.get(m, m) for m in modules)

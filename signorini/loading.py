@@ -89,7 +89,7 @@ def analytic_zone(problem: ContactProblem) -> Zone | None:
     reference = reference_of(problem)
     if reference is None or reference.extent is None:
         return None
-    a = reference.extent(problem.params)
+    a = reference.extent(problem)
     if a is None:
         return None
     return zone_around_points(problem.contact_points, a / problem.scales.length,
@@ -220,6 +220,7 @@ def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = 
     stages: dict[str, dict[str, int]] = {}
     zone = None
     if problem.pending and not bordered:
+        log.info("matching the target load: predicting the contact zone on a coarser model")
         zone = predicted_zone(problem, coarse)  # predicted once: load control's, and nested's
         matched = match(problem, zone)
         stages["load control"] = matched.work

@@ -15,7 +15,6 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from signorini.analytic import (
-    contact_modulus,
     hertz_cylinder_half_width,
     hertz_cylinder_peak,
     hertz_pressure,
@@ -212,8 +211,8 @@ def _against_cylinder(problem: ContactProblem, profile: ContactProfile, P: float
     if not P > 0:
         nan = float("nan")
         return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
-    E_star = contact_modulus(problem.params["E"], problem.params["nu"])
-    a_ref = hertz_cylinder_half_width(P, problem.params["R"], E_star)
+    scene = problem.reference_data  # what the scene hands its reference
+    a_ref = hertz_cylinder_half_width(P, scene.R, scene.E_star)
     p0_ref = hertz_cylinder_peak(P, a_ref)
     p0, a = hertz_fit(profile.x, profile.pressure, profile.active)
     return HertzComparison(
@@ -240,8 +239,8 @@ class UniformComparison:
 def compare_uniform(problem: ContactProblem, solution: ContactSolution) -> UniformComparison:
     """Compare ``solution`` of the block scene with its uniform pressure."""
     profile = contact_profile(problem, solution)
-    params = problem.params
-    p_ref = contact_modulus(params["E"], params["nu"]) * params["delta"] / params["H"]
+    scene = problem.reference_data  # what the scene hands its reference
+    p_ref = scene.E_star * problem.push.delta / scene.H
     P = profile.total_force
     return UniformComparison(
         pressure_ref=p_ref,
@@ -356,12 +355,12 @@ def compare_hertz_sphere(problem: ContactProblem, solution: ContactSolution) -> 
     (area-weighted), ``edge_margin`` the outermost candidate's radius over a.
     """
     profile = contact_profile(problem, solution)
-    params = problem.params
+    scene = problem.reference_data  # what the scene hands its reference
     P = profile.total_force
     if not P > 0:
         nan = float("nan")
         return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
-    a_ref = hertz_sphere_radius(P, params["R"], contact_modulus(params["E"], params["nu"]))
+    a_ref = hertz_sphere_radius(P, scene.R, scene.E_star)
     p0_ref = hertz_sphere_peak(P, a_ref)
     rho = radial_distance(problem.contact_points) * problem.scales.length
 
@@ -460,9 +459,9 @@ def compare_punch(problem: ContactProblem, solution: ContactSolution,
                   inner: float = 0.5) -> PunchComparison:
     """Compare ``solution`` of the punch scene with ``p(x) = P/(π√(a² − x²))`` on ``|x| ≤ inner·a``."""
     profile = _half_line(problem, contact_profile(problem, solution))
-    a = float(problem.params["a"])
+    a = float(problem.reference_data.a)
     P = load_resultant(problem, solution.lam)
-    target = problem.params.get("P")
+    target = None if problem.push is None else problem.push.P
     nan = float("nan")
     if not P > 0:
         return PunchComparison(a, P, profile.applied_load, nan, nan, inner, nan, nan, nan, nan, nan,

@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import io
 import json
+import logging
 import os
 from dataclasses import dataclass, field
 from typing import Any
@@ -25,6 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import MeshTet, MeshTri
 
+from signorini.discretisation import Discretisation, Push, ReferenceData, Watch
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
 from signorini.numerics.arrays import (
@@ -37,115 +39,15 @@ from signorini.numerics.factor import factorize
 from signorini.scales import Scales, qp_scales
 from signorini.solution import STATUSES, ContactSolution
 
-__all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Discretisation", "Push", "Scales", "Watch",
-           "qp_scales"]
+log = logging.getLogger(__name__)
+
+__all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Discretisation", "Push", "ReferenceData",
+           "Scales", "Watch", "qp_scales"]
 
 #: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
 ITERATIVE_ENERGY_FROM = 300_000
 ITERATIVE_ENERGY_RTOL = 1e-6
 ITERATIVE_ENERGY_MAX_ITER = 20_000
-
-
-@dataclass(frozen=True)
-class Push:
-    """How the load depends on the prescribed push ``s`` (dimensionless).
-
-    ``f(s) = s f1 + P f_load``, ``d(s) = d0 + s d1`` and the applied-load
-    offset is ``s · offset1 + P · offset_load``; ``scale`` is the push the
-    problem was assembled with and ``load`` the target load P (dimensionless,
-    full body) when the load is a traction on a cut (``f_load`` its nodal
-    forces per unit P; None when the push alone loads the body). Load
-    sweeps and load targeting use it without assembling again.
-
-    ``target`` is the load (dimensionless, full body) the scene asks for, or
-    None; ``pending`` says that no push has been matched to it yet: the
-    problem is at a nominal push, and load control
-    (:func:`signorini.loading.match`) finds the push whose load is the target.
-    The load is the contact resultant along the push, ``μ Σ cᵢ λᵢ`` with ``cᵢ``
-    the cosine of candidate i's normal's tilt (``resultant``; None: all 1).
-    """
-
-    f1: np.ndarray
-    d0: np.ndarray
-    d1: np.ndarray
-    offset1: float
-    scale: float
-    f_load: np.ndarray | None = None
-    offset_load: float = 0.0
-    load: float = 0.0
-    target: float | None = None
-    pending: bool = False
-    resultant: np.ndarray | None = None
-
-    def f(self, scale: float, load: float | None = None) -> np.ndarray:
-        """The load vector at push ``scale`` (and target ``load``, default the assembled one)."""
-        load = self.load if load is None else load
-        return scale * self.f1 + (load * self.f_load if self.f_load is not None else 0.0)
-
-    def offset(self, scale: float, load: float | None = None) -> float:
-        load = self.load if load is None else load
-        return scale * self.offset1 + load * self.offset_load
-
-
-@dataclass(frozen=True)
-class Watch:
-    """The boundary beyond the contact candidates, checked after every solve.
-
-    ``rows`` (k × all dofs) are the obstacle's normal rows at the k boundary
-    nodes that are not candidates and ``gaps`` their initial gaps, so that
-    their gaps at a state are ``gaps − rows · expand(u)``; ``edge`` indexes the
-    candidates that share a boundary facet facing the obstacle with one of
-    them; ``candidate_gaps`` are the candidates' gaps before any push;
-    ``remedy`` says what to change when the contact outgrows the candidates
-    (see :mod:`signorini.adequacy`).
-    """
-
-    rows: sp.csr_matrix
-    gaps: np.ndarray
-    edge: np.ndarray
-    candidate_gaps: np.ndarray
-    remedy: str = "extend the scene's contact candidates or lower the load"
-    #: the mesh node of each row (adaptive refinement makes the ones that go through candidates)
-    nodes: np.ndarray | None = None
-
-    def gap(self, problem: "ContactProblem", u: np.ndarray) -> np.ndarray:
-        return self.gaps - self.rows @ problem.expand(u)
-
-
-@dataclass
-class Discretisation:
-    """Where a problem came from: the mesh and the model a scene assembled it from.
-
-    ``mesh`` is in dimensionless coordinates; the full dof vector is the free
-    dofs ``free_dofs`` and the prescribed values ``prescribed`` (zero on free
-    dofs). The applied load of the full body is ``load_row @ u + load_offset``
-    (a reaction on the loaded boundary). ``E`` and ``nu`` are the material in
-    the scene's units, ``volumetric`` how K integrates the volumetric strain,
-    ``axisymmetric`` says the mesh is the meridian half-plane (r, z) of a body
-    of revolution (forces and weights per radian). ``reference`` names the
-    analytic reference in :data:`signorini.references.REFERENCES` ("" for
-    none) and ``params`` records the scene's parameters as built. ``push``
-    says how f, d and the load depend on the prescribed push (load control,
-    :mod:`signorini.loading`), ``predicted_contact`` which candidates the
-    scene expects in contact (where load control starts), ``watch`` the
-    boundary beyond the candidates (see :class:`Watch`).
-    """
-
-    mesh: Any
-    free_dofs: np.ndarray
-    prescribed: np.ndarray
-    load_row: np.ndarray | None = None
-    load_offset: float = 0.0
-    E: float = 1.0
-    nu: float = 0.0
-    volumetric: str = "element"
-    axisymmetric: bool = False
-    reference: str = ""
-    params: dict[str, Any] = field(default_factory=dict)
-    push: Push | None = None
-    predicted_contact: np.ndarray | None = None
-    watch: Watch | None = None
-    assemble_s: float = 0.0
 
 
 @dataclass
@@ -267,7 +169,13 @@ class ContactProblem:
 
     @property
     def reference(self) -> str:
-        return "" if self.discretisation is None else self.discretisation.reference
+        """The name of the analytic reference the scene declares ("" for none)."""
+        return "" if self.reference_data is None else self.reference_data.name
+
+    @property
+    def reference_data(self) -> ReferenceData | None:
+        """What the scene hands its analytic reference (None for none)."""
+        return None if self.discretisation is None else self.discretisation.reference
 
     @property
     def push(self) -> Push | None:
@@ -387,14 +295,15 @@ class ContactProblem:
         pu, old = self.push, self.discretisation
         ratio = scale / pu.scale
         load = pu.load if load is None else load
-        params = dict(old.params)
-        if isinstance(params.get("delta"), float):
-            params["delta"] *= ratio
-        if pu.f_load is not None and isinstance(params.get("P"), float):
-            params["P"] = load * self.scales.force
+        changed: dict[str, float] = {}  # δ and P in the scene's units, where the scene names them
+        if pu.delta is not None:
+            changed["delta"] = pu.delta * ratio
+        if pu.f_load is not None and pu.P is not None:
+            changed["P"] = load * self.scales.force
         discretisation = dataclasses.replace(
             old, load_offset=pu.offset(scale, load), prescribed=old.prescribed * ratio,
-            params=params, push=dataclasses.replace(pu, scale=scale, load=load, pending=False))
+            params={**old.params, **changed},  # the record of the parameters says the same
+            push=dataclasses.replace(pu, scale=scale, load=load, pending=False, **changed))
         new = self.with_data(f=pu.f(scale, load), d=pu.d0 + scale * pu.d1,
                              discretisation=discretisation)
         new._factor, new._basis = self._factor, self._basis  # K is unchanged
@@ -441,10 +350,12 @@ class ContactProblem:
             meta["discretisation"] = {
                 "load_offset": disc.load_offset, "E": disc.E, "nu": disc.nu,
                 "volumetric": disc.volumetric, "axisymmetric": disc.axisymmetric,
-                "reference": disc.reference, "params": disc.params, "assemble_s": disc.assemble_s,
+                "reference": None if disc.reference is None else dataclasses.asdict(disc.reference),
+                "params": disc.params, "assemble_s": disc.assemble_s,
                 "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
                                                  "offset_load": pu.offset_load, "load": pu.load,
-                                                 "target": pu.target, "pending": pu.pending}}
+                                                 "target": pu.target, "pending": pu.pending,
+                                                 "delta": pu.delta, "P": pu.P}}
         arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
         buffer = io.BytesIO()
         np.savez(buffer, **arrays)
@@ -465,7 +376,8 @@ class ContactProblem:
                 push = Push(z["push_f1"], z["push_d0"], z["push_d1"], p["offset1"], p["scale"],
                             z["push_f_load"] if "push_f_load" in z else None, p["offset_load"],
                             p["load"], p["target"], p["pending"],
-                            z["push_resultant"] if "push_resultant" in z else None)
+                            z["push_resultant"] if "push_resultant" in z else None,
+                            p.get("delta"), p.get("P"))
             mesh = None
             if "mesh_p" in z:
                 kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
@@ -475,7 +387,7 @@ class ContactProblem:
                 load_row=z["load_row"] if z["load_row"].size else None,
                 load_offset=about["load_offset"], E=about["E"], nu=about["nu"],
                 volumetric=about["volumetric"], axisymmetric=about["axisymmetric"],
-                reference=about["reference"], params=about["params"], push=push,
+                reference=_reference_data(about["reference"]), params=about["params"], push=push,
                 assemble_s=about["assemble_s"])
         return cls(
             K=sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]), shape=(n, n)),
@@ -483,3 +395,14 @@ class ContactProblem:
             d=z["d"], weights=z["weights"] if z["weights"].size else None,
             contact_points=z["contact_points"], force_multiplicity=meta["force_multiplicity"],
             scales=Scales(**meta["scales"]), name=meta["scene"], discretisation=discretisation)
+
+
+def _reference_data(stored: Any) -> ReferenceData | None:
+    """The reference record :meth:`ContactProblem.save` stored; a file that stored the name
+    alone (an older version) has no record to compare with: rebuild it from its scene."""
+    if isinstance(stored, dict):
+        return ReferenceData(**stored)
+    if stored:
+        log.warning("the stored problem names its reference %r without the record it reads: "
+                    "rebuild the problem from its scene to compare with the reference", stored)
+    return None

@@ -29,7 +29,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_sphere_radius
+from signorini.analytic import hertz_cylinder_half_width, hertz_sphere_radius
 from signorini.errors import InputError
 from signorini.pressure import (
     compare_hertz,
@@ -75,7 +75,7 @@ class Reference:
     convergence: tuple[str, ...] = ()
     resultant: bool = False
     figure: bool = False
-    extent: Callable[[dict[str, Any]], float | None] | None = None
+    extent: Callable[[ContactProblem], float | None] | None = None
     extent_margin: float = 0.0
     #: the line a solve's summary shows of the comparison (its ``as_dict()``); None: no line
     summary_line: Callable[[dict[str, Any]], str] | None = None
@@ -150,7 +150,7 @@ def _punch_claims(problem: ContactProblem, exact: ContactSolution,
     """The pressure away from the edges, force balance, the load (sharp corners), full contact."""
     claims = [Claim("punch pressure max relative error on |x| <= a/2 (pdas)",
                     metrics["pressure_max_rel"], "punch_pressure_rel"), _force_balance(metrics)]
-    if np.isfinite(metrics["target_rel"]) and problem.params.get("corner_radius", 0) == 0:
+    if np.isfinite(metrics["target_rel"]) and problem.reference_data.corner_radius == 0:
         claims.append(Claim("total contact force equals the load P (pdas)", metrics["target_rel"],
                             "load_target_rel"))
     touching = metrics["active_fraction"] == 1.0
@@ -165,12 +165,13 @@ def _uniform_claims(problem: ContactProblem, exact: ContactSolution,
 
 
 def _hertz_extent(half_width: Callable[[float, float, float], float]):
-    def extent(params: dict[str, Any]) -> float | None:
-        if not all(isinstance(params.get(k), (int, float)) for k in ("P", "R", "E", "nu")):
-            return None  # no target load (a prescribed push), or not a Hertz scene's parameters
-        if not params["P"] > 0:
+    """``extent(problem)``: Hertz's contact half-width (radius) at the scene's target load
+    (None without a target: a prescribed push)."""
+    def extent(problem: ContactProblem) -> float | None:
+        scene, P = problem.reference_data, problem.push.P if problem.push else None
+        if scene is None or scene.R is None or scene.E_star is None or P is None or not P > 0:
             return None
-        return half_width(params["P"], params["R"], contact_modulus(params["E"], params["nu"]))
+        return half_width(P, scene.R, scene.E_star)
     return extent
 
 REFERENCES: dict[str, Reference] = {r.name: r for r in (

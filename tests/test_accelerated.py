@@ -38,7 +38,7 @@ def test_acceleration_is_an_option_of_uzawa_too(hertz):
 
 
 def test_nesterov_beyond_its_step_bound_says_so():
-    from signorini.teaching.synthetic import bogie
+    from synthetic import bogie
 
     problem = bogie()
     beyond = solve(problem, "uzawa-nesterov", max_iter=3, step_fraction=0.8)  # ρ·λ_max = 1.6

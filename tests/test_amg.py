@@ -18,7 +18,7 @@ from signorini.numerics import factor, multigrid
 from signorini.scenes import build_problem
 from signorini.solvers import amg, auto
 from signorini.solvers.registry import solve
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 pytest.importorskip("pyamg", reason="pdas-amg needs pyamg (a default dependency)")
 

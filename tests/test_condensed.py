@@ -10,7 +10,7 @@ from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 
 @pytest.mark.parametrize("params", [{"n_contact": 20, "grading": 0.4}, {"candidates": 3.0, "n_contact": 12}])

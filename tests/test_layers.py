@@ -4,12 +4,12 @@ Layers, low to high (a module may import its own layer and the layers below):
 
 0. ``errors``, ``files``                 exceptions, atomic writes
 1. ``numerics``                          factorisations, dense LCP, zone kernel, the push kernel
-2. ``problem``, ``problem_files``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
+2. ``problem``, ``problem_files``, ``discretisation``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
 3. ``solvers``                           the registry collects each backend's METHODS
 4. ``loading``                           load control: the one driver around any method
 5. ``scenes``                            families, meshing, scene files, building problems
 6. ``api``, ``crosschecking``, the package: the public Python API
-7. ``studies``, ``output``, ``teaching`` one runner and its studies; reports, plots, export
+7. ``studies``, ``output`` one runner and its studies; reports, plots, export
 8. ``cli``                               parsing only
 
 Beyond the order, the data flow: scenes import no solver and no load control (building a
@@ -35,14 +35,14 @@ PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
 LAYERS = {
     "errors": 0, "files": 0,
     "numerics": 1,
-    "problem": 2, "problem_files": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
+    "problem": 2, "problem_files": 2, "discretisation": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
     "adequacy": 2, "forward_error": 2, "fingerprint": 2, "scales": 2,
     "fem": 2,
     "solvers": 3,
     "loading": 4,
     "scenes": 5,
     "api": 6, "crosschecking": 6, "derivatives": 6, "": 6,
-    "studies": 7, "output": 7, "teaching": 7,
+    "studies": 7, "output": 7,
     "cli": 8,
 }
 #: (package part, what it must not import): the data flow, beyond the order of the layers
@@ -179,3 +179,46 @@ def test_the_resolver_sees_imports():
     """The resolver is not blind: problem.py's own imports include lower layers' modules."""
     targets = {t for t, _, _ in imports("signorini.problem")}
     assert "signorini.numerics.factor" in targets and "signorini.errors" in targets
+
+
+#: the modules that own scene parameters by name (the scene families and scene files); every
+#: other module reads typed fields
+PARAMETER_OWNERS = ("signorini.scenes",)
+
+
+def parameter_reads(source: str) -> list[int]:
+    """Lines that read a parameter by name: ``params[…]`` or ``params.get(…)`` on a name
+    ``params``, an attribute ``….params`` or a name bound to one (``p = problem.params``).
+    Writing one (``params[k] = v``, a dict built for a scene) is not a read; ``+=`` is."""
+    tree = ast.parse(source)
+    aliases = {"params"} | {target.id for node in ast.walk(tree) if isinstance(node, ast.Assign)
+                            and isinstance(node.value, ast.Attribute) and node.value.attr == "params"
+                            for target in node.targets if isinstance(target, ast.Name)}
+    augmented = {id(node.target) for node in ast.walk(tree) if isinstance(node, ast.AugAssign)}
+
+    def is_params(node: ast.AST) -> bool:
+        return (isinstance(node, ast.Name) and node.id in aliases) or \
+            (isinstance(node, ast.Attribute) and node.attr == "params")
+
+    return sorted(node.lineno for node in ast.walk(tree)
+                  if isinstance(node, ast.Subscript) and is_params(node.value)
+                  and (isinstance(node.ctx, ast.Load) or id(node) in augmented)
+                  or isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                  and node.func.attr == "get" and is_params(node.func.value))
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if not any(
+    m == owner or m.startswith(owner + ".") for owner in PARAMETER_OWNERS)))
+def test_scene_parameters_are_read_by_typed_fields(module):
+    lines = parameter_reads(MODULES[module].read_text())
+    assert not lines, (
+        f"{module} reads scene parameters by name (lines {lines}): read the typed record instead "
+        "(ContactProblem.reference_data, ContactProblem.push's delta and P, SceneModel's fields), "
+        "which the scene family builds from its parameters")
+
+
+def test_the_parameter_rule_can_fail():
+    """The matcher sees reads by name, through an alias too, and lets writes be."""
+    assert parameter_reads("E = problem.params['E']\nR = params.get('R')\n") == [1, 2]
+    assert parameter_reads("p = problem.params\nx = p['half_length']\nparams['P'] *= 2\n") == [2, 3]
+    assert parameter_reads("params['delta'] = 1.0\nbuild(params={'E': 1.0})\nd = dict(params)\n") == []

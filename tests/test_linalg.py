@@ -12,7 +12,7 @@ from signorini.numerics.factor import (
     selection_dofs,
 )
 from signorini.scenes import build_problem
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
 

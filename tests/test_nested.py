@@ -1,5 +1,7 @@
 """The nested method and its zone solver against PDAS: exact whatever the predicted zone."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -16,7 +18,7 @@ from signorini.scenes import build as scenes
 from signorini.scenes import build_problem, coarse_values, get_scene
 from signorini.solvers.registry import solve
 from signorini.loading import analytic_zone
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
 
@@ -76,7 +78,7 @@ def test_the_analytic_zone_predicts_the_3d_sphere_by_the_distance_from_the_axis(
     candidates' spacing there: nested is exact on one factorisation from it."""
     problem = signorini.at_load(build_problem("hertz-sphere-3d"))
     zone = analytic_zone(problem)
-    a = reference_of(problem).extent(problem.params) / problem.scales.length
+    a = reference_of(problem).extent(problem) / problem.scales.length
     rho = np.hypot(problem.contact_points[:, 0], problem.contact_points[:, 1])
     assert rho[zone.core].max() < a < rho[zone.band].max()
     assert rho[zone.rest].min() > a and zone.band.sum() < problem.m / 2
@@ -106,7 +108,8 @@ def test_a_wrong_analytic_zone_is_amended_not_trusted():
     """A zone predicted for a load 10 % lower (a 5 % too small): the answer stays exact."""
     problem = signorini.at_load(build_problem("hertz-cylinder", params={"refine": 1}))
     zone = analytic_zone(problem)
-    shifted = analytic_zone(problem.with_data(params={**problem.params, "P": problem.params["P"] * 0.9}))
+    shifted = analytic_zone(problem.with_data(push=dataclasses.replace(problem.push,
+                                                                       P=problem.push.P * 0.9)))
     assert shifted is not None and shifted.core.sum() < zone.core.sum()
     reference = solve(problem, "pdas")
     nested = solve(problem, "nested", zone=shifted)
@@ -164,7 +167,7 @@ def test_the_push_on_a_zone_equals_the_full_active_set_calibration():
     params = family.parse(values)
     model = family.build(params, set(values))
     nominal = assemble(model)
-    nominal.discretisation.reference = "hertz-2d"
+    assert nominal.reference == "hertz-2d"  # the family's model hands on its reference record
     full = loading.match(nominal)  # no zone: one factorisation per active-set step
     zoned = loading.match(nominal, analytic_zone(nominal))
     assert full.how == "full active set" and zoned.how == "zone kernel"

@@ -23,7 +23,7 @@ from signorini.scenes import build_problem
 from signorini.solvers.bounds import InfeasibleBounds, NoBoundForm, bound_form
 from signorini.solvers.cluster import mpirun_command
 from signorini.solvers.registry import solve
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 #: PETSc, MUMPS and mpirun: 25–100 s together here; `pytest -m "not slow"` leaves them out
 pytestmark = pytest.mark.slow

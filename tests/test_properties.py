@@ -1,4 +1,4 @@
-"""Property-based tests on small random contact QPs (``signorini.teaching.synthetic.random_problem``).
+"""Property-based tests on small random contact QPs (``synthetic.random_problem``).
 
 Every installed method must be honest: when it reports ``converged`` the package's certificate
 backs it. PDAS must agree with a brute-force enumeration of the active sets.
@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from signorini.kkt import certificate
 from signorini.solvers import registry
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 TOL = 1e-8
 SETTINGS = settings(max_examples=25, deadline=None, derandomize=True, database=None,

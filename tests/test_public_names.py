@@ -39,7 +39,7 @@ def declared(init: Path) -> list[str] | None:
 def test_every_package_is_seen():
     assert {"signorini", "signorini.numerics", "signorini.fem", "signorini.solvers",
             "signorini.scenes", "signorini.studies", "signorini.studies.atlas", "signorini.output",
-            "signorini.teaching", "signorini.cli"} <= set(PACKAGES)
+            "signorini.cli"} <= set(PACKAGES)
 
 
 @pytest.mark.parametrize("name", PACKAGES)

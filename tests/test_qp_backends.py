@@ -2,7 +2,7 @@
 
 Every method is checked against an exact answer computed here, independently of
 any signorini solver: for the small dense problems of
-:func:`signorini.teaching.synthetic.random_problem` all ``2ᵐ`` active sets are tried,
+:func:`synthetic.random_problem` all ``2ᵐ`` active sets are tried,
 and the one whose equality-constrained KKT solution is feasible with ``λ ≥ 0``
 is the answer (unique: K is SPD and N has full row rank).
 
@@ -24,7 +24,7 @@ from signorini.kkt import certificate
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import registry
 from signorini.solvers.registry import get_method, solve
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 registry.methods()  # every built-in method registered (the exact ones these tests compare with)
 

@@ -1,5 +1,6 @@
 """TOML scene files: family scenes, Gmsh meshes through meshio, and errors that say where."""
 
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -11,8 +12,10 @@ from skfem import MeshTri
 
 import signorini
 from signorini.cli import main
+from signorini.analytic import contact_modulus
 from signorini.errors import InputError
 from signorini.pressure import compare_uniform, contact_profile
+from signorini.problem import ReferenceData
 from signorini.scenes import build_problem
 from signorini.scenes.scenefile import read_mesh
 from signorini.solvers.registry import solve
@@ -164,7 +167,10 @@ def test_mesh_scene_passes_the_patch_test(tmp_path):
     problem = signorini.at_load(build_problem(str(write(tmp_path, MESH_SCENE))))
     solution = solve(problem, "pdas", tol=1e-10)
     assert problem.scene.startswith("file:")
-    problem.params.update(delta=0.02, H=1.0)  # what compare_uniform needs
+    # what compare_uniform reads, which a mesh scene does not name: E*, the height and the push
+    E_star = contact_modulus(problem.discretisation.E, problem.discretisation.nu)
+    problem = problem.with_data(reference=ReferenceData("uniform", E_star=E_star, H=1.0),
+                                push=dataclasses.replace(problem.push, delta=0.02))
     assert compare_uniform(problem, solution).pressure_max_rel < 1e-10
     assert contact_profile(problem, solution).total_force == pytest.approx(
         2 * 4.0 / (1 - 0.09) * 0.02, rel=1e-10)

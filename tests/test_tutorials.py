@@ -19,7 +19,7 @@ import pytest
 from signorini import cli
 from signorini.solvers.registry import get_method, solve
 from signorini.studies import suite
-from signorini.teaching.synthetic import random_problem
+from synthetic import random_problem
 
 ROOT = Path(__file__).resolve().parents[1]
 TUTORIALS = ROOT / "docs" / "tutorials"

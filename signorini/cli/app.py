@@ -19,20 +19,47 @@ import sys
 import threading
 from typing import Sequence
 
+from signorini import __version__
 from signorini.cli import bench, crosscheck, listing, solve, studies
 from signorini.cli.common import EXIT_FAILED, EXIT_USAGE, Parser
+from signorini.cli.progress import progress
 from signorini.errors import InputError, OutputError, SignoriniError
 
 COMMANDS = (solve, crosscheck, studies, bench, listing)
 
 
+def add_verbosity(parser: argparse.ArgumentParser, default) -> None:
+    """``-v`` and ``-q``, before the command or after it (``default`` SUPPRESS on a command's
+    parser, so that one given before the command is not reset by the command's parser)."""
+    parser.add_argument("-v", "--verbose", action="store_true", default=default,
+                        help="log each step of the library to stderr (no progress line)")
+    parser.add_argument("-q", "--quiet", action="store_true", default=default,
+                        help="errors only: no warnings, no progress line")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="signorini", description="Frictionless contact as one QP, solved many ways.")
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    parser = Parser(prog="signorini", description="Frictionless contact as one QP, solved many ways. "
+                    "On a terminal, a step that takes longer than a second shows a progress line "
+                    "on stderr.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    add_verbosity(parser, False)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     for module in COMMANDS:
         module.add_parsers(sub)
+    for command in set(sub.choices.values()):
+        add_verbosity(command, argparse.SUPPRESS)
     return parser
+
+
+def set_up_logging(args: argparse.Namespace) -> None:
+    """Warnings on stderr; with -v every INFO line of the library, with -q errors only."""
+    if args.verbose and args.quiet:
+        raise InputError("-v (every step) and -q (errors only) contradict each other: give one")
+    level = logging.INFO if args.verbose else logging.ERROR if args.quiet else logging.WARNING
+    root = logging.getLogger()
+    if not root.handlers:  # (a host that set up logging, pytest say, keeps its own)
+        logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+        root.handlers[0].setLevel(level)  # the progress line lowers signorini's level, not this
 
 
 def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
@@ -138,11 +165,11 @@ def _run(argv: Sequence[str] | None, ranks: int) -> int:
             raise InputError("standard output is closed: run with it open (> /dev/null "
                              "discards what is printed)")
         args = build_parser().parse_args(argv)
-        logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
-                            format="%(levelname)s %(name)s: %(message)s")
+        set_up_logging(args)
         if ranks > 1:
             _check_distributed(args, ranks)
-        code = args.run(args)
+        with progress(quiet=args.quiet, verbose=args.verbose):
+            code = args.run(args)
         sys.stdout.flush()
         if _reader_gone():  # written into the pipe's buffer, yet never read: as a broken pipe
             raise BrokenPipeError

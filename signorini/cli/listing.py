@@ -23,7 +23,7 @@ def cmd_methods(args: argparse.Namespace) -> int:
     print(f"factorisation backend: {resolve_backend()} (installed: {', '.join(available_backends())}; "
           "set SIGNORINI_FACTOR to choose)")
     for m in methods():
-        state = "installed" if m.installed else f"not installed (pip install 'signorini[{m.extra}]')"
+        state = "installed" if m.installed else f"not installed ({m.install_hint})"
         kind = ", ".join(x for x in ("exact" if m.exact else "", "dense" if m.dense else "") if x)
         print(f"{m.name:<14} {state:<12} {m.summary}" + (f" [{kind}]" if kind else ""))
     return 0

@@ -119,8 +119,8 @@ def add_parsers(sub) -> None:
     solve.add_argument("--raw-units", action="store_true",
                        help="solve in the user's units instead of non-dimensionalising")
     solve.add_argument("--vtk", metavar="FILE",
-                       help="write the deformed mesh with displacement, stress, gap and pressure "
-                            "(.vtu or .vtk, for ParaView)")
+                       help="write the mesh (undeformed: ParaView's Warp By Vector on displacement "
+                            "deforms it) with displacement, stress, gap and pressure (.vtu or .vtk)")
     solve.add_argument("--target-error", metavar="ETA", help="refine adaptively until the estimated "
                        "relative error is at most ETA (0.01 or 1%%): of the contact pressure, or "
                        "see --target-on")

@@ -242,14 +242,17 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
 
     f, d, load_offset, full = lifted(1.0)
     params = dict(model.params, volumetric=model.volumetric)  # auto resolved: what K integrates
-    if model.target_load is not None:
-        params["delta"] = -min(v for c, _, v in model.dirichlet if c == model.load_dofs[0])
+    delta = model.delta
+    if model.target_load is not None:  # the nominal push that load control scales
+        delta = params["delta"] = -min(v for c, _, v in model.dirichlet if c == model.load_dofs[0])
     discretisation = Discretisation(
         mesh=mesh, free_dofs=free, prescribed=full, load_row=load_full[free],
         load_offset=load_offset, E=float(model.E), nu=float(model.nu),
-        volumetric=model.volumetric, axisymmetric=axisymmetric, params=params,
+        volumetric=model.volumetric, axisymmetric=axisymmetric, reference=model.reference,
+        params=params,
         push=_push(lifted, 1.0, None if f_load is None else f_load[free], offset_load, target,
-                   _resultant(N_full, np.intersect1d(dof_table[component], free))),
+                   _resultant(N_full, np.intersect1d(dof_table[component], free)),
+                   delta=delta, P=model.target_load),
         predicted_contact=model.predicted_contact, watch=boundary_watch(model, dof_table, U))
     problem = ContactProblem(
         K=K_II, f=f, N=N_free, d=d, weights=contact_weights(mesh, model.contact_facets, nodes,
@@ -348,11 +351,13 @@ def _resultant(N_full: sp.csr_matrix, axis_dofs: np.ndarray) -> np.ndarray | Non
 
 
 def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
-          load: float | None, resultant: np.ndarray | None) -> Push:
-    """How f, d and the load offset depend on the push and the load (they are affine in both)."""
+          load: float | None, resultant: np.ndarray | None, *, delta: float | None = None,
+          P: float | None = None) -> Push:
+    """How f, d and the load offset depend on the push and the load (they are affine in both);
+    ``delta`` and ``P`` are the push and the target load in the scene's units."""
     f0, d0, offset0, _ = lifted(0.0)
     f1, d_one, offset_one, _ = lifted(1.0)
     return Push(f1=f1 - f0, d0=d0, d1=d_one - d0, offset1=offset_one - offset0, scale=scale,
                 f_load=f_load, offset_load=offset_load if f_load is not None else 0.0,
                 load=load if f_load is not None else 0.0, target=load, pending=load is not None,
-                resultant=resultant)
+                resultant=resultant, delta=delta, P=P)

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from signorini.discretisation import ReferenceData
 from signorini.fem.checks import check_model
 from signorini.fem.volumetric import resolve
 
@@ -86,6 +87,12 @@ class SceneModel:
     predicted_contact: np.ndarray | None = None
     #: what to change when the contact outgrows the candidates (signorini.adequacy)
     candidate_remedy: str = "extend the scene's contact candidates or lower the load"
+    #: the scene parameter ``volumetric``: element, nodal or auto (signorini.fem.volumetric)
+    volumetric_choice: str = "auto"
+    #: the push δ of the loaded boundary (scene units) without a target load (None: none named)
+    delta: float | None = None
+    #: what the scene hands its analytic reference (None: it declares none)
+    reference: ReferenceData | None = None
 
     def __post_init__(self) -> None:
         """Refuse a model that cannot be assembled right (:mod:`signorini.fem.checks`): a bad
@@ -96,5 +103,5 @@ class SceneModel:
     def volumetric(self) -> str:
         """How K integrates λ (tr ε)²: ``element`` (plain P1) or ``nodal`` (signorini.fem.volumetric).
 
-        The scene parameter ``volumetric`` (``auto`` by default: nodal from ν = 0.4 on in 2D)."""
-        return resolve(self.params.get("volumetric", "auto"), self.nu, self.mesh.p.shape[0])
+        The scene's ``volumetric_choice`` (``auto`` by default: nodal from ν = 0.4 on in 2D)."""
+        return resolve(self.volumetric_choice, self.nu, self.mesh.p.shape[0])

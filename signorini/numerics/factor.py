@@ -27,10 +27,12 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from signorini.errors import BackendNotInstalled, InputError
+from signorini.errors import BackendNotInstalled, InputError, install_hint
 
 BACKENDS = ("pardiso", "cholmod", "superlu")
 _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
+#: the package extra that installs each backend's module (SciPy's SuperLU comes with the package)
+EXTRAS = {"cholmod": "fast", "pardiso": "pardiso"}
 
 #: factorisations (of K, of K with dofs pinned, of a saddle-point matrix) and back-solves
 #: (one per right-hand side) done in this process by every class here: read it before and
@@ -83,8 +85,9 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
     if name not in BACKENDS:
         raise InputError(f"unknown factorisation backend {name!r}: choose auto, {', '.join(BACKENDS)}")
     if name not in available_backends():
+        hint = install_hint(EXTRAS.get(name, ""), [_MODULES[name]])
         raise BackendNotInstalled(f"factorisation backend {name!r} needs the module "
-                                  f"{_MODULES[name]!r}: pip install 'signorini[fast]'")
+                                  f"{_MODULES[name]!r}: {hint}")
     return name
 
 

@@ -1,4 +1,4 @@
-"""Export a solved scene for ParaView: the deformed mesh with displacement, stress, gap and pressure.
+"""Export a solved scene for ParaView: the mesh with displacement, stress, gap and pressure.
 
 Written through meshio as VTU (``.vtu``, XML) or legacy VTK (``.vtk``), in
 physical units. With P1 elements the displacement gradient is constant on
@@ -12,16 +12,18 @@ elements. Von Mises is ``√(½[(σ₁₁ − σ₂₂)² + (σ₂₂ − σ₃�
 
 Data written:
 
-- point data ``displacement`` (3 components), ``von_mises``, ``sigma_yy``,
-  ``gap`` (remaining gap ``d − Nu`` at contact candidates, NaN elsewhere),
-  ``pressure`` and ``contact_force`` (zero off the candidates),
-  ``contact_candidate`` (1 or 0);
+- point data ``displacement`` (3 components), ``von_mises_nodal``,
+  ``sigma_yy_nodal`` (the nodal projections), ``gap`` (remaining gap
+  ``d − Nu`` at contact candidates, NaN elsewhere), ``pressure`` and
+  ``contact_force`` (zero off the candidates), ``contact_candidate`` (1 or 0);
 - cell data ``von_mises``, ``sigma_xx``, ``sigma_yy``, ``sigma_xy``,
   ``sigma_zz`` (in 3D also ``sigma_yz``, ``sigma_xz``).
 
-The points are the deformed positions ``x + u`` (``deformed=False`` keeps
-the reference ones; ParaView's *Warp By Vector* on ``displacement`` moves
-either way). In 3D the vertical stress is ``sigma_zz``; ``sigma_yy`` is
+No point array shares a cell array's name, so ParaView lists each once. The
+points are the undeformed (reference) positions: ParaView's *Warp By Vector*
+on ``displacement`` shows the deformed body, once (``deformed=True`` writes
+the positions ``x + u`` instead, for viewers without that filter; do not warp
+those again). In 3D the vertical stress is ``sigma_zz``; ``sigma_yy`` is
 always the y component.
 """
 
@@ -128,7 +130,7 @@ def candidate_nodes(problem: ContactProblem) -> np.ndarray:
     return mesh_nodes_at(problem.mesh, problem.contact_points)
 
 
-def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed: bool = True,
+def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed: bool = False,
                 axisymmetric: bool | None = None):
     """The solved scene as a :class:`meshio.Mesh` (physical units; see the module's docstring)."""
     import meshio  # meshio: only when a file is written
@@ -164,8 +166,8 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
     reference_points = points.T
     point_data = {
         "displacement": disp,
-        "von_mises": project_to_nodes(reference_points, mesh.t, mises),
-        "sigma_yy": project_to_nodes(reference_points, mesh.t, stress[:, 1, 1]),
+        "von_mises_nodal": project_to_nodes(reference_points, mesh.t, mises),
+        "sigma_yy_nodal": project_to_nodes(reference_points, mesh.t, stress[:, 1, 1]),
         "gap": gap, "pressure": pressure, "contact_force": force, "contact_candidate": marker,
     }
     components = {"sigma_xx": (0, 0), "sigma_yy": (1, 1), "sigma_zz": (2, 2), "sigma_xy": (0, 1)}
@@ -191,7 +193,7 @@ def check_vtk_path(path: str | os.PathLike) -> tuple[str, str]:
 
 
 def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | os.PathLike, *,
-               deformed: bool = True, axisymmetric: bool | None = None) -> Path:
+               deformed: bool = False, axisymmetric: bool | None = None) -> Path:
     """Write the solved scene to ``path`` (``.vtu`` or ``.vtk``) whole or not at all.
 
     The file is written under a temporary name in the same directory and

@@ -1,7 +1,6 @@
 """Figures of solves and benchmarks. Every function takes ``ax=None`` and returns the Axes.
 
-The tutorials' figures are in :mod:`signorini.teaching.figures`, the atlas's in
-:mod:`signorini.studies.atlas.figures`.
+The atlas's figures are in :mod:`signorini.studies.atlas.figures`; the tutorials draw their own.
 """
 
 from __future__ import annotations

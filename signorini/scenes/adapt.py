@@ -61,7 +61,7 @@ from signorini.fem.transfer import refined_model, with_candidates
 from signorini.fem.model import SceneModel
 from signorini.kkt import gap_scale
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.scenes.registry import FamilyField, get_scene, scene_reference
+from signorini.scenes.registry import FamilyField, get_scene
 from signorini.scenes.scenefile import build_scene_model, family_scene_values
 from signorini.scenes.size import MEMORY_VARIABLE, check_size, over_limit
 
@@ -319,7 +319,6 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Sol
         start = time.perf_counter()
         problem = assemble(model)
         problem.name = scene.name
-        problem.discretisation.reference = scene_reference(scene.name)
         problem, solution = solver(problem)
         seconds = time.perf_counter() - start
         if solution.status == "model_inadequate" and growths < MAX_GROWTH:

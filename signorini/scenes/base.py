@@ -17,6 +17,8 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Protocol
 
+from signorini.analytic import contact_modulus
+from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel
@@ -194,6 +196,16 @@ def recorded_params(p: dict[str, Any], target: float | None, a_over_R: float,
     params.update(P=target, delta=delta_nominal if target is None else None,
                   a_over_R=a_over_R if target is not None else None)
     return params
+
+
+def hertz_record(p: dict[str, Any], reference: str, target: float | None, a_over_R: float,
+                 delta_nominal: float) -> dict[str, Any]:
+    """What a Hertz scene's model records: its parameters as the problem reports them
+    (:func:`recorded_params`) and the typed fields code reads: the volumetric choice, the push
+    δ, and what the reference ``reference`` reads (E* and R)."""
+    return {"params": recorded_params(p, target, a_over_R, delta_nominal),
+            "volumetric_choice": p["volumetric"], "delta": delta_nominal,
+            "reference": ReferenceData(reference, E_star=contact_modulus(p["E"], p["nu"]), R=p["R"])}
 
 
 class SizeEstimate(Protocol):

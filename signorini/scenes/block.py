@@ -26,6 +26,8 @@ from typing import Any
 import numpy as np
 from skfem import MeshTri
 
+from signorini.analytic import contact_modulus
+from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble, boundary_weights
 from signorini.fem.model import FlatObstacle, SceneModel
@@ -37,6 +39,9 @@ from signorini.problem import ContactProblem, ContactSolution, Scales
 from signorini.scenes.base import (VOLUMETRIC, Case, Param, SceneFamily, at_least, length, poisson_ratio,
                                    positive, scene_params)
 from signorini.scenes.size import CountedSize
+
+#: the analytic reference (signorini.references) this family's problems compare with
+REFERENCE = "uniform"
 
 PARAMS = (
     Param("W", 1.0, "half-width of the block", check=length),
@@ -95,7 +100,9 @@ def _plain_model(p: dict[str, Any], contact_nodes: np.ndarray | None = None,
         dirichlet=[(0, symmetry, 0.0), (1, top, -p["delta"])],
         contact_nodes=nodes, contact_facets=facets,
         obstacle=FlatObstacle(0.0) if obstacle is None else obstacle, load_dofs=(1, top),
-        length_scale=p["H"], force_multiplicity=2.0, params=dict(p))
+        length_scale=p["H"], force_multiplicity=2.0, params=dict(p),
+        volumetric_choice=p["volumetric"], delta=p["delta"],
+        reference=ReferenceData(REFERENCE, E_star=contact_modulus(p["E"], p["nu"]), H=p["H"]))
 
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
@@ -139,7 +146,7 @@ def mesh_dofs(p: dict[str, Any]) -> float:
 
 
 FAMILY = SceneFamily(name="block", summary="elastic block pressed onto a rigid flat (uniform pressure)",
-                     params=PARAMS, build=build, reference="uniform", size_model=CountedSize(mesh_dofs),
+                     params=PARAMS, build=build, reference=REFERENCE, size_model=CountedSize(mesh_dofs),
                      validation=(Case("block", "block"),))
 
 
@@ -189,7 +196,7 @@ def force_controlled_problem(pressure: float = 0.01, params: dict[str, Any] | No
     model = SceneModel(mesh=mesh, E=p["E"], nu=p["nu"], dirichlet=[(0, symmetry, 0.0)],
                        contact_nodes=bottom, contact_facets=bottom_facets,
                        obstacle=FlatObstacle(0.0), load_dofs=(1, top), length_scale=p["H"],
-                       force_multiplicity=2.0, params=dict(p))
+                       force_multiplicity=2.0, params=dict(p), volumetric_choice=p["volumetric"])
     problem = assemble(model, nondimensionalise=nondimensionalise)
     basis = problem.basis
     L, E = problem.scales.length, (p["E"] if nondimensionalise else 1.0)

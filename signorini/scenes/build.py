@@ -8,6 +8,7 @@ coarser, which predicts the contact zone of large models.
 
 from __future__ import annotations
 
+import logging
 from typing import Any
 
 from signorini.errors import InputError
@@ -19,6 +20,9 @@ from signorini.scenes.base import scene_params
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import check_size
+
+log = logging.getLogger(__name__)
+
 
 def coarse_values(name: str, params: dict[str, Any]) -> dict[str, Any] | None:
     """Parameters of a model of scene ``name`` about 16 times coarser than ``params``, or None.
@@ -66,6 +70,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     """
     values = scene_params(params)
     nondimensionalise = flag_argument(nondimensionalise, "nondimensionalise")
+    log.info("building %s: meshing and assembling", name)
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
                          f"{type(name).__name__}: e.g. build_problem('hertz-cylinder')")
@@ -94,7 +99,12 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
             raise InputError(f"scene {name!r} with {given} could not be meshed "
                              f"({type(exc).__name__}: {exc}): make the mesh coarser (a larger "
                              "grading or a smaller n_contact)") from None
+    declared = SCENES[name].reference if name in SCENES else ""
+    if model.reference is None and declared or model.reference and model.reference.name != declared:
+        raise InputError(f"scene family {name!r} declares the reference {declared!r}, but its build "
+                         f"hands on {model.reference!r}: give its SceneModel "
+                         f"reference=ReferenceData({declared!r}, ...) with the fields that "
+                         "reference reads (signorini.problem.ReferenceData)")
     problem = assemble(model, nondimensionalise=nondimensionalise)
     problem.name = name
-    problem.discretisation.reference = SCENES[name].reference if name in SCENES else ""
     return problem

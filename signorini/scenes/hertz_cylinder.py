@@ -41,11 +41,14 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
-    recorded_params,
+    hertz_record,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
 from signorini.scenes.size import SizeModel
+
+#: the analytic reference (signorini.references) this family's problems compare with
+REFERENCE = "hertz-2d"
 
 PARAMS = (
     Param("R", 1.0, "cylinder radius", check=length),
@@ -109,7 +112,7 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
         contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),
         load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0,
-        target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
+        target_load=target, **hertz_record(p, REFERENCE, target, a_est, delta_nominal),
         cut_load=cut_load,
         candidate_remedy=CANDIDATE_REMEDY.format(**p),
         predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
@@ -138,6 +141,6 @@ VALIDATION = (
 FAMILY = SceneFamily(
     name="hertz-cylinder",
     summary="elastic cylinder on a rigid flat, plane strain, quarter model graded to the contact",
-    params=PARAMS, build=build, loads=_load_choice, reference="hertz-2d", size_model=SIZE,
+    params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE, size_model=SIZE,
     coarse=two_refinements_coarser, snap=quarter_disc_snap, validation=VALIDATION,
     convergence_start={"n_contact": 15, "grading": 0.6})

@@ -39,7 +39,7 @@ from signorini.scenes.base import (
     length,
     poisson_ratio,
     positive,
-    recorded_params,
+    hertz_record,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
@@ -89,6 +89,9 @@ def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float
     return hertz_sphere_load(p["a_over_R"] * R, R, E_star), p["a_over_R"]
 
 
+#: the analytic reference (signorini.references) this family's problems compare with
+REFERENCE = "hertz-3d"
+
 def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
     """The axisymmetric model of Hertz's sphere in physical units (meridian plane (r, z))."""
     given = set() if given is None else given
@@ -107,7 +110,7 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
         contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),
         load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0 * np.pi,
-        target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
+        target_load=target, **hertz_record(p, REFERENCE, target, a_est, delta_nominal),
         axisymmetric=True, cut_load=cut_load, candidate_remedy=CANDIDATE_REMEDY.format(**p),
         predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 
@@ -124,7 +127,7 @@ SIZE = SizeModel(6824, 60, 0.15, 0.05, uniform=5.2, alpha=0.65, beta=1.15, far_f
 FAMILY = SceneFamily(
     name="hertz-sphere",
     summary="elastic sphere on a rigid flat, axisymmetric (r, z) model graded to the contact",
-    params=PARAMS, build=build, loads=load_choice, reference="hertz-3d", size_model=SIZE,
+    params=PARAMS, build=build, loads=load_choice, reference=REFERENCE, size_model=SIZE,
     coarse=two_refinements_coarser, snap=quarter_disc_snap,
     validation=(Case("hertz-sphere", "hertz-sphere", {"a_over_R": 0.05}),),
     convergence_start={"n_contact": 12, "grading": 0.6})

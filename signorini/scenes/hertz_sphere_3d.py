@@ -34,7 +34,7 @@ from signorini.scenes.base import (
     SceneFamily,
     at_least,
     between,
-    recorded_params,
+    hertz_record,
     two_refinements_coarser,
 )
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice
@@ -62,6 +62,9 @@ PARAMS = COMMON_PARAMS + (
 #: largest element edge anywhere (unit sphere)
 MAX_SIZE = 0.3
 
+
+#: the analytic reference (signorini.references) this family's problems compare with
+REFERENCE = "hertz-3d"
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The quarter model of Hertz's sphere in physical units (z vertical, contact at the origin)."""
@@ -102,7 +105,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
         contact_nodes=candidates, contact_facets=curved,
         obstacle=FlatObstacle3D(0.0),
         load_dofs=(2, pushed), length_scale=R, force_multiplicity=4.0,
-        target_load=target, params=recorded_params(p, target, a_est, delta_nominal),
+        target_load=target, **hertz_record(p, REFERENCE, target, a_est, delta_nominal),
         cut_load=cut_load, predicted_contact=rho[candidates] < a_est * R,
         candidate_remedy=CANDIDATE_REMEDY.format(**p))
 
@@ -158,7 +161,7 @@ FAMILY = SceneFamily(
     name="hertz-sphere-3d",
     summary="elastic sphere on a rigid flat, 3D quarter model (two symmetry planes) "
             "graded to the contact",
-    params=PARAMS, build=build, loads=load_choice, reference="hertz-3d", size_model=GradedOctant(),
+    params=PARAMS, build=build, loads=load_choice, reference=REFERENCE, size_model=GradedOctant(),
     coarse=two_refinements_coarser,
     validation=(Case("hertz-sphere-3d", "hertz-sphere-3d", {"a_over_R": 0.05},
                      agrees_with="hertz-sphere"),))

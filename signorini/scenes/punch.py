@@ -30,6 +30,7 @@ import numpy as np
 from skfem import MeshTri
 
 from signorini.analytic import contact_modulus
+from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
@@ -158,12 +159,15 @@ def mirrored_about_x0(mesh: MeshTri) -> MeshTri:
 
 def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidate_end: float,
                          half: bool, obstacle: Obstacle, E: float, nu: float, delta_nominal: float,
-                         target: float | None, params: dict[str, Any]) -> SceneModel:
+                         target: float | None, params: dict[str, Any],
+                         reference: ReferenceData) -> SceneModel:
     """A block (half or whole) whose bottom y = 0 is the contact candidate, pushed down at the top.
 
     ``mesh``, ``height`` and ``candidate_end`` are in units of ``scale``; the
     model (and ``obstacle``) are in physical units. The candidates are the
-    bottom nodes with ``|x| ≤ candidate_end``, sorted by x.
+    bottom nodes with ``|x| ≤ candidate_end``, sorted by x. ``params`` are the
+    scene's parameters as its problem reports them, ``reference`` what its
+    analytic reference reads.
     """
     x, y = mesh.p
     tol = 1e-12 * height
@@ -183,7 +187,8 @@ def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidat
         contact_facets=bottom_facets,
         obstacle=ScaledQuery(obstacle, mesh.p[:, candidates].T, scale),
         load_dofs=(1, top), length_scale=scale, force_multiplicity=2.0 if half else 1.0,
-        target_load=target, params=params)
+        target_load=target, params=params, volumetric_choice=params["volumetric"],
+        delta=delta_nominal, reference=reference)
 
 
 def checked_load(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
@@ -213,13 +218,18 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     return bottom_contact_model(
         mesh, scale=a, height=p["size"], candidate_end=zone, half=bool(p["half"]),
         obstacle=FlatPunch(half_width=a, corner_radius=r), E=p["E"], nu=p["nu"],
-        delta_nominal=delta_nominal, target=target, params=params)
+        delta_nominal=delta_nominal, target=target, params=params,
+        reference=ReferenceData(REFERENCE, E_star=E_star, a=a, corner_radius=r))
+
+
+#: the analytic reference (signorini.references) this family's problems compare with
+REFERENCE = "punch"
 
 
 FAMILY = SceneFamily(
     name="punch",
     summary="rigid flat punch (sharp or rounded corners) pressed into an elastic block, plane strain",
-    params=PARAMS, build=build, loads=checked_load, reference="punch",
+    params=PARAMS, build=build, loads=checked_load, reference=REFERENCE,
     # the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
     size_model=SizeModel(7948, 128, 0.2, uniform=6082.0, alpha=0.55, beta=1.5, far_field=1200.0,
                          margin=1.13, block=True),

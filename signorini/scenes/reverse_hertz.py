@@ -21,6 +21,7 @@ from __future__ import annotations
 from typing import Any
 
 from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle
@@ -104,13 +105,18 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     return bottom_contact_model(
         mesh, scale=a, height=p["size"], candidate_end=p["candidates"], half=bool(p["half"]),
         obstacle=Circle(centre=(0.0, -R), radius=R), E=p["E"], nu=p["nu"],
-        delta_nominal=delta_nominal, target=target, params=params)
+        delta_nominal=delta_nominal, target=target, params=params,
+        reference=ReferenceData(REFERENCE, E_star=E_star, R=R))
+
+
+#: the analytic reference (signorini.references) this family's problems compare with
+REFERENCE = "reverse-hertz"
 
 
 FAMILY = SceneFamily(
     name="reverse-hertz",
     summary="elastic block pressed onto a rigid cylinder (a curved obstacle), plane strain",
-    params=PARAMS, build=build, loads=load_choice, reference="reverse-hertz",
+    params=PARAMS, build=build, loads=load_choice, reference=REFERENCE,
     # the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
     size_model=SizeModel(6118, 128, 0.3, uniform=2.66, alpha=0.55, beta=1.4, far_field=1300.0,
                          margin=1.16, block=True),

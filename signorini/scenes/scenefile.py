@@ -135,7 +135,8 @@ def read_scene_file(path: str | Path) -> tuple[dict[str, Any], _Context]:
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise InputError(f"scene file {path} does not exist: give the path to a .toml file") from None
+        raise InputError(f"scene file {path} does not exist: give the path to a .toml file (examples: "
+                         "the sdist's examples/; a built-in scene runs by name: signorini scenes)") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"scene file {path} cannot be read ({exc})") from None
     try:

@@ -17,7 +17,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from signorini.adequacy import adequacy, warnings
-from signorini.errors import InputError
+from signorini.errors import InputError, install_hint
 from signorini.kkt import certificate, shortfall
 from signorini.problem import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.options import Option, check_names, guess_value
@@ -73,6 +73,12 @@ class Method:
     @property
     def installed(self) -> bool:
         return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
+
+    @property
+    def install_hint(self) -> str:
+        """The pip command that installs the modules it misses (its extra, or the modules')."""
+        missing = [mod for mod in self.requires if importlib.util.find_spec(mod) is None]
+        return install_hint(self.extra, missing or self.requires)
 
     def check_options(self, given: Mapping[str, Any]) -> dict[str, Any]:
         """``given`` with every declared option checked and converted; InputError otherwise.

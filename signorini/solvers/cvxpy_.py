@@ -1,4 +1,4 @@
-"""The contact QP written as a cvxpy model (teaching, cross-checks).
+"""The contact QP written as a cvxpy model (read as the maths is written; cross-checks).
 
 ``minimise ½ xᵀKx − fᵀx  subject to  N x ≤ d`` with ``K`` symmetrised, or the
 same in the other formulations of :mod:`signorini.solvers.forms` (option

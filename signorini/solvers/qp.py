@@ -26,7 +26,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from signorini.errors import BackendNotInstalled, InputError, SolverError
+from signorini.errors import BackendNotInstalled, InputError, SolverError, install_hint
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import clarabel_, forms
 from signorini.solvers.base import Method
@@ -326,14 +326,14 @@ BACKENDS: tuple[Backend, ...] = (
                  "IterationLimit", "BarIterLimit", "Method", "Threads", "Presolve",
                  "NumericFocus", "Crossover", "BarHomogeneous", "ScaleFlag"),
         tolerance=_each("FeasibilityTol", "OptimalityTol", "BarConvTol", bounds=(1e-9, 1e-2)),
-        max_iter_option="BarIterLimit"),
+        max_iter_option="BarIterLimit", extra="gurobi"),
     Backend(
         "mosek", "MOSEK", "MOSEK (interior point) through qpsolvers and CVXOPT",
         ("mosek", "cvxopt"), read_cvxopt,
         {"optimal": CONVERGED, "primal infeasible": INFEASIBLE},
         options=("mosek",),
         tolerance=_each("intpnt_qo_tol_rel_gap", "intpnt_qo_tol_pfeas", "intpnt_qo_tol_dfeas"),
-        max_iter_option="intpnt_max_iterations", nest=_mosek_nest),
+        max_iter_option="intpnt_max_iterations", nest=_mosek_nest, extra="mosek"),
 )
 
 BACKEND_BY_NAME: dict[str, Backend] = {backend.name: backend for backend in BACKENDS}
@@ -406,7 +406,7 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         raise BackendNotInstalled(
             f"qpsolvers cannot load backend {spec.name!r} (missing: {', '.join(missing) or '?'}; "
             f"available: {', '.join(qpsolvers.available_solvers)}): "
-            f"pip install 'signorini[{spec.extra or 'all'}]'")
+            f"{install_hint(spec.extra, missing)}")
     settings = {**spec.settings(tol, max_iter), **spec.fixed,
                 **{k: v for k, v in options.items() if k not in COMMON_OPTIONS}}
     if spec.nest is not None:

@@ -113,8 +113,7 @@ def check_request(method: str, tol: Any = None, max_iter: Any = None,
     if not spec.installed:
         missing = [m for m in spec.requires if importlib.util.find_spec(m) is None]
         raise BackendNotInstalled(
-            f"method {method!r} needs {', '.join(missing)}: "
-            f"pip install 'signorini[{spec.extra or 'all'}]'")
+            f"method {method!r} needs {', '.join(missing)}: {spec.install_hint}")
     return spec, tol, max_iter, checked
 
 
@@ -142,6 +141,7 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
             raise InputError(f"method {method!r} takes no warm start: give warm_start to one of "
                              f"{takers}")
         options["warm_start"] = warm_start
+    log.info("solving %d dofs, %d contact candidates with %s", problem.n, problem.m, method)
     start, before = time.perf_counter(), dict(COUNTS, **MULTIGRID_COUNTS)
     held = fingerprint(problem)
     try:

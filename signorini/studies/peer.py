@@ -77,10 +77,11 @@ def fit_hertz(x, p, rel: float = 1e-9) -> tuple[float, float, int]:
     return p0, a, int(active.sum())
 
 
-def hertz_reference(scene: str, params: dict[str, float]) -> tuple[float, float, float]:
+def hertz_reference(scene: str, *, R: float, E: float, nu: float,
+                    a_over_R: float) -> tuple[float, float, float]:
     """(load P, p0, a) of Hertz's solution for ``a_over_R`` (P per unit thickness for the cylinder)."""
-    R, a = params["R"], params["a_over_R"] * params["R"]
-    E_star = contact_modulus(params["E"], params["nu"])
+    a = a_over_R * R
+    E_star = contact_modulus(E, nu)
     if scene == "hertz-cylinder":
         P = hertz_cylinder_load(a, R, E_star)
         return P, hertz_cylinder_peak(P, a), a
@@ -179,7 +180,7 @@ def run_point(point: Point, *, python: str, command: list[str], timeout: float) 
     done, wall, why = _timed(argv, timeout)
     point.walls.append(wall)
     record, message = _decode(done, why)
-    P, p0_ref, a_ref = hertz_reference(point.scene, point.params)
+    P, p0_ref, a_ref = hertz_reference(point.scene, **point.params)
     row: dict[str, Any] = {"scene": point.scene, "code": point.code, "rung": point.rung,
                            "mesh": point.label, "p0_ref": p0_ref, "a_ref": a_ref, "load": P,
                            "status": "failed", "message": message}

@@ -92,7 +92,7 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
     c = problem.N @ factor.solve(pu.f_load) if pu.f_load is not None else np.zeros(problem.m)
     log.info("sweep set-up (factorisation and %d × %d Delassus operator) in %.2f s",
              problem.m, problem.m, time.perf_counter() - start)
-    hertz = problem.params.get("R") is not None and "E" in problem.params
+    hertz = problem.reference_data is not None and problem.reference_data.R is not None
     levels = []
     for i, load in enumerate(loads):
         target = load / problem.scales.force
@@ -108,7 +108,7 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
         ref = compare_hertz(level_problem, solution) if hertz else None
         levels.append(SweepLevel(
             load=float(load), total_force=profile.total_force,
-            delta=float(level_problem.params.get("delta") or np.nan),
+            delta=float(level_problem.push.delta or np.nan),
             a=contact_half_width(profile), p0=float(profile.pressure[np.argmin(profile.x)]),
             a_ref=ref.a_ref if ref else None, p0_ref=ref.p0_ref if ref else None,
             status=solution.status, message=solution.message,

@@ -1,4 +1,4 @@
-"""Small random contact QPs with known structure, for tests and teaching."""
+"""Small random contact QPs with known structure, for the tests (and the two-wheel bogie)."""
 
 from __future__ import annotations
 

@@ -1,0 +1,90 @@
+"""The typed record a scene hands its analytic reference, and the push's δ and P.
+
+Every family builds its :class:`ReferenceData` from its own parameters; the
+comparisons, load control's analytic zone and the sweep read its fields and
+the push's ``delta`` and ``P`` (tests/test_layers.py holds that no module
+outside ``scenes/`` reads a parameter by name).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+
+import numpy as np
+import pytest
+
+from signorini.analytic import contact_modulus
+from signorini.errors import InputError
+from signorini.pressure import compare_uniform
+from signorini.problem import ContactProblem
+from signorini.references import REFERENCES
+from signorini.scenes import SCENES, build_problem, register, unregister
+from signorini.scenes.block import FAMILY as BLOCK
+from signorini.solvers.registry import solve
+
+#: the parameters each reference's record holds, by record field
+RECORD_PARAMS = {"hertz-2d": {"R": "R"}, "hertz-3d": {"R": "R"}, "reverse-hertz": {"R": "R"},
+                 "punch": {"a": "a", "corner_radius": "corner_radius"}, "uniform": {"H": "H"}}
+#: coarse meshes, so that building every family stays quick
+COARSE = {"punch": {"n_contact": 16, "grading": 0.6}, "reverse-hertz": {"n_contact": 16, "grading": 0.6},
+          "hertz-sphere-3d": {"n_contact": 4, "grading": 1.0}}
+
+
+@pytest.mark.parametrize("name", sorted(SCENES))
+def test_every_family_hands_its_reference_the_record_of_its_parameters(name):
+    problem = build_problem(name, params=COARSE.get(name, SCENES[name].convergence_start))
+    record = problem.reference_data
+    assert record.name == problem.reference == SCENES[name].reference
+    assert record.name in REFERENCES
+    assert record.E_star == contact_modulus(problem.params["E"], problem.params["nu"])
+    for field, param in RECORD_PARAMS[record.name].items():
+        assert getattr(record, field) == problem.params[param]
+    # the push carries the scene's δ and target P, as the parameters report them
+    assert problem.push.delta == problem.params["delta"]
+    assert problem.push.P == problem.params.get("P")
+
+
+def test_a_push_moves_delta_and_the_uniform_pressure_with_it():
+    problem = build_problem("block")
+    twice = problem.pushed(2.0 * problem.push.scale)
+    assert twice.push.delta == 2.0 * problem.push.delta == twice.params["delta"]
+    assert problem.push.delta == problem.params["delta"]  # the problem pushed from is unchanged
+    once, doubled = (compare_uniform(p, solve(p, "pdas")) for p in (problem, twice))
+    assert doubled.pressure_ref == pytest.approx(2.0 * once.pressure_ref, rel=1e-14)
+    assert doubled.pressure_max_rel < 1e-8
+
+
+def test_save_and_load_keep_the_record_and_the_push(tmp_path):
+    problem = build_problem("hertz-cylinder", params={"n_contact": 8, "grading": 0.6})
+    problem.save(tmp_path / "p.npz")
+    again = ContactProblem.load(tmp_path / "p.npz")
+    assert again.reference_data == problem.reference_data
+    assert (again.push.delta, again.push.P) == (problem.push.delta, problem.push.P)
+
+
+def test_a_file_that_stored_the_reference_by_name_loads_without_one(tmp_path, caplog):
+    problem = build_problem("block", params={"nx": 4, "ny": 4})
+    problem.save(tmp_path / "p.npz")
+    with np.load(tmp_path / "p.npz") as stored:
+        arrays = dict(stored)
+    meta = json.loads(bytes(arrays["meta"]).decode())
+    meta["discretisation"]["reference"] = "uniform"  # what an older version stored
+    del meta["discretisation"]["push"]["delta"]
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    np.savez(tmp_path / "old.npz", **arrays)
+    with caplog.at_level(logging.WARNING, logger="signorini.problem"):
+        old = ContactProblem.load(tmp_path / "old.npz")
+    assert old.reference_data is None and old.reference == "" and old.push.delta is None
+    assert "'uniform'" in caplog.text and "rebuild" in caplog.text
+
+
+def test_a_family_whose_model_hands_on_another_reference_is_refused():
+    family = register(dataclasses.replace(BLOCK, name="mislabelled", reference="punch"))
+    try:
+        with pytest.raises(InputError, match="declares the reference 'punch'.*ReferenceData"):
+            build_problem("mislabelled", params={"nx": 4, "ny": 4})
+    finally:
+        unregister("mislabelled")
+    assert build_problem("block", params={"nx": 4, "ny": 4}).reference == "uniform"
