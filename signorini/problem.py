@@ -224,6 +224,13 @@ class ContactProblem:
         full[self.discretisation.free_dofs] = u
         return full
 
+    def qp(self) -> tuple[sp.csr_matrix, np.ndarray, sp.csr_matrix, np.ndarray]:
+        """``(K, f, N, d)`` in the problem's own units (its :class:`Scales` undone): for
+        :meth:`from_qp`, the arrays you gave; the problem itself keeps them dimensionless."""
+        s = self.scales
+        return (self.K * (s.force / s.displacement), self.f * s.force, self.N,
+                self.d * s.displacement)
+
     def gap(self, u: np.ndarray) -> np.ndarray:
         """``d − N u``: the remaining gap at each candidate (≥ 0 when feasible)."""
         return self.d - self.N @ u

@@ -82,9 +82,10 @@ def test_uzawa_beyond_the_step_bound_does_not_converge(block):
 
 
 def test_uzawa_step_bound_is_the_largest_eigenvalue_of_W(block):
+    """λ_max(W) of the QP in its own units (W = N K⁻¹ Nᵀ, length per force)."""
     uzawa = registry.solve(block, "uzawa", tol=1e-6)
-    factor = block.factor()
-    W = block.N @ factor.solve(block.N.T.toarray())
+    K, _, N, _ = block.qp()
+    W = N @ np.linalg.solve(K.toarray(), N.T.toarray())
     largest = np.linalg.eigvalsh(0.5 * (W + W.T))[-1]
     assert uzawa.extras["lambda_max"] == pytest.approx(largest, rel=1e-5)
     assert uzawa.extras["lambda_max"] <= largest * (1 + 1e-12)  # Rayleigh quotient: a lower bound
@@ -273,3 +274,20 @@ def test_solve_lcp_converges_on_an_ill_conditioned_spd_lcp():
     lam, _ = solve_lcp(W, b, max_iter=1000)
     (expected,) = brute_force_lcp(W, b)
     np.testing.assert_allclose(lam, expected, rtol=1e-8)
+
+
+def test_uzawa_reads_its_step_in_the_problem_s_own_units():
+    """A step ρ given in the units of a QP from its data is the same step in any units: the
+    iterates, the status and the reported ρ do not depend on the unit of force."""
+    K = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    runs = []
+    for unit in (1.0, 1e6):  # forces in N, or in MN (K and f scale, d does not)
+        problem = signorini.ContactProblem.from_qp(K=K / unit, f=np.array([2.0, 1.0]) / unit,
+                                                   N=np.eye(2), d=np.array([0.5, 1.0]))
+        runs.append(signorini.solve(problem, "uzawa", tol=1e-10, rho=0.5 / unit, lam0=np.zeros(2)))
+    assert [r.status for r in runs] == ["converged", "converged"]
+    assert runs[0].iterations == runs[1].iterations
+    np.testing.assert_allclose(runs[1].force * 1e6, runs[0].force, rtol=1e-9)
+    assert runs[1].solution.extras["rho"] == pytest.approx(0.5e-6)
+    assert runs[0].solution.extras["lambda_max"] == pytest.approx(1.0, rel=1e-6)
+    assert runs[1].solution.extras["lambda_max"] == pytest.approx(1e6, rel=1e-6)

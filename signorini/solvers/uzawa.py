@@ -138,8 +138,11 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         return factor.solve(problem.f - problem.N.T @ lam)
 
     lam_max, power_steps = delassus_max_eigenvalue(problem.N, factor, apply_W=apply_W)
+    # ρ (force per length), λ₀ and λ_max(W) (length per force) are given and reported in the
+    # problem's own units; the method runs on the dimensionless problem, ρ in units of ``own``
+    own = problem.scales.force / problem.scales.displacement
     if opts["rho"] is not None:
-        rho = opts["rho"]
+        rho = opts["rho"] / own
     else:
         rho = opts["step_fraction"] * 2.0 / lam_max
     divergence_factor = opts["divergence_factor"]
@@ -147,7 +150,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     if opts["lam0"] is not None and opts["lam0"].shape != (problem.m,):
         raise InputError(f"method {_name!r}: option lam0 has {opts['lam0'].size} entries, the "
                          f"problem {problem.m} contact candidates")
-    lam = np.zeros(problem.m) if opts["lam0"] is None else np.maximum(opts["lam0"], 0)
+    lam = np.zeros(problem.m) if opts["lam0"] is None else \
+        np.maximum(opts["lam0"], 0) / problem.scales.force
     history: dict[str, list[float]] = {"primal": [], "natural": [], "step": []}
     status, message = "max_iter", f"not converged after {max_iter} iterations"
     limit = None
@@ -186,8 +190,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         if not accelerated and _two_step_cycle(new_lam, lam_prev, history["step"]):
             status = "diverged"
             message = (f"stalled in a two-step cycle at iteration {iteration} (λ returns to the "
-                       f"same value every other step): ρ = {rho:.3g} is beyond the bound "
-                       f"2/λ_max(W) = {2 / lam_max:.3g}; lower rho or step_fraction")
+                       f"same value every other step): ρ = {rho * own:.3g} is beyond the bound "
+                       f"2/λ_max(W) = {2 * own / lam_max:.3g}; lower rho or step_fraction")
             lam_prev, Nu_prev, lam = lam, Nu, new_lam
             break
         lam_prev, Nu_prev, lam = lam, Nu, new_lam
@@ -197,8 +201,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         if not np.isfinite(size) or (limit is not None and size > limit):
             status = "diverged"
             message = (f"|λ| grew beyond {divergence_factor:.0e} × its first value at "
-                       f"iteration {iteration}: ρ = {rho:.3g} exceeds 2/λ_max(W) = "
-                       f"{2 / lam_max:.3g}; lower rho or step_fraction")
+                       f"iteration {iteration}: ρ = {rho * own:.3g} exceeds 2/λ_max(W) = "
+                       f"{2 * own / lam_max:.3g}; lower rho or step_fraction")
             break
     # the step bounds: FISTA needs ρ ≤ 1/λ_max(W), plain Uzawa ρ < 2/λ_max(W)
     nesterov = opts["acceleration"] == "nesterov"
@@ -212,7 +216,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         method=_name, u=u, lam=lam, status=status, message=message, iterations=iteration,
         build_time=build_time, solve_time=time.perf_counter() - start - build_time,
         history=history, factor=factor,
-        extras={"rho": rho, "lambda_max": lam_max, "power_steps": power_steps,
+        extras={"rho": rho * own, "lambda_max": lam_max / own, "power_steps": power_steps,
                 "rho_over_bound": rho * lam_max / 2.0, "operator": choice,
                 "acceleration": opts["acceleration"], "restarts": restarts})
 
