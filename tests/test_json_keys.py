@@ -115,3 +115,19 @@ def test_every_key_of_a_crosscheck_is_documented():
                                         params={"nx": 6, "ny": 6}).to_dict()))
     assert out["schema_version"] == SCHEMA_VERSION and out["units"]
     assert undocumented(key_paths(out)) == set()
+
+
+@pytest.mark.slow
+def test_every_key_of_a_validation_report_is_documented(tmp_path, capsys):
+    """Two built-in cases and a user's problem file, an exact and an iterative method."""
+    K = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    np.savez(tmp_path / "mine.npz", K=K, f=np.array([2.0, 1.0]), N=np.eye(2), d=np.array([0.5, 1.0]))
+    code = main(["validate", "--case", "block", "--case", "hertz-cylinder-coarse",
+                 "--problem", str(tmp_path / "mine.npz"), "--method", "pdas", "--method", "uzawa",
+                 "--out", str(tmp_path / "report")])
+    capsys.readouterr()
+    assert code in (0, 1)
+    out = json.loads((tmp_path / "report" / "report.json").read_text())
+    assert out["schema_version"] == SCHEMA_VERSION
+    assert {"checks[].name", "runs[].kkt.primal", "limits.hertz_a_rel"} <= key_paths(out)
+    assert undocumented(key_paths(out)) == set()

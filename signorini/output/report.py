@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
+from signorini.api import SCHEMA_VERSION
 from signorini.kkt import certificate
 from signorini.output import plots
 from signorini.pressure import contact_profile, load_resultant
@@ -127,7 +128,8 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
                 md += ["", f"![{key}]({figures[key].name})"]
     md += ["", "## Limits", ""] + [f"- `{k}`: {v:g}" for k, v in suite.limits.items()]
     atomic_write_text(directory / "report.md", "\n".join(md) + "\n")
-    payload = {"command": command, "passed": suite.passed, "elapsed_s": suite.elapsed_s,
+    payload = {"schema_version": SCHEMA_VERSION, "command": command, "passed": suite.passed,
+               "elapsed_s": suite.elapsed_s,
                "provenance": info,
                "checks": [vars(c) for c in suite.checks], "runs": suite.runs, "limits": suite.limits}
     atomic_write_text(directory / "report.json", to_json(payload))
