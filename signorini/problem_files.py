@@ -28,7 +28,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import scipy.io
 import scipy.sparse as sp
 
 from signorini.errors import InputError
@@ -143,6 +142,8 @@ def _saved(path: Path) -> ContactProblem:
 
 
 def _matrix_market(folder: Path) -> dict[str, Any]:
+    import scipy.io  # on use: scipy.io is slow to import, and only Matrix Market needs it
+
     arrays: dict[str, Any] = {}
     for key in MATRIX_MARKET_NAMES:
         file = folder / f"{key}.mtx"

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from skfem import Basis, ElementTriP1, ElementVector, MeshTri, asm
+from skfem import Basis, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
 from skfem.models.elasticity import lame_parameters
 
 import signorini
@@ -154,6 +154,20 @@ def test_the_body_normals_follow_the_arc():
     # normal is its one arc edge's, tilted from the vertical by half that edge's angle
     assert normals[:, first] == pytest.approx([0.0, -1.0], abs=1e-3)
     assert normals[0, first] > 0
+
+
+@pytest.mark.parametrize("mesh", [MeshTri().refined(3), MeshTet().refined(2)], ids=["2D", "3D"])
+def test_candidate_nodes_are_found_by_coordinates(mesh):
+    """Points at nodes (exactly, or within a relative 1e-9) give those nodes; any other point is
+    an error, not the nearest node."""
+    from signorini.fem.estimate import candidate_nodes
+
+    nodes = np.random.default_rng(0).permutation(mesh.p.shape[1])[:20]
+    points = mesh.p[:, nodes].T
+    assert np.array_equal(candidate_nodes(mesh, points), nodes)
+    assert np.array_equal(candidate_nodes(mesh, points * (1 + 1e-12)), nodes)
+    with pytest.raises(ValueError, match="not a mesh node"):
+        candidate_nodes(mesh, points + 0.01)
 
 
 def test_the_pressure_estimate_shrinks_with_the_mesh_and_tracks_the_error():

@@ -43,7 +43,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.spatial import cKDTree
 from skfem.quadrature import get_quadrature
 
 from signorini.fem.topology import facets_on
@@ -198,11 +197,34 @@ def element_energies(mesh: Any, u: np.ndarray, E: float, nu: float,
 
 
 def candidate_nodes(mesh: Any, points: np.ndarray) -> np.ndarray:
-    """The mesh node at each contact point (matched by coordinates; ValueError if one is not)."""
+    """The mesh node at each contact point (matched by coordinates; ValueError if one is not).
+
+    A built problem's points are its nodes' own coordinates: they are found by sorting the
+    nodes. Points that only lie near nodes are matched by a k-d tree within a relative 1e-9.
+    """
+    nodes = _same_coordinates(mesh.p, points)
+    if nodes is not None:
+        return nodes
+    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
+
     distance, nodes = cKDTree(mesh.p.T).query(points)
     if np.any(distance > 1e-9 * max(1.0, float(np.max(np.abs(mesh.p))))):
         raise ValueError("a contact candidate is not a mesh node")
     return nodes
+
+
+def _same_coordinates(p: np.ndarray, points: np.ndarray) -> np.ndarray | None:
+    """The column of ``p`` (dim, n) equal to each row of ``points`` (m, dim); None unless all are."""
+    dim = p.shape[0]
+    points = np.atleast_2d(np.asarray(points, dtype=float))
+    if points.shape[1] != dim or p.shape[1] == 0:
+        return None
+    row = [("", np.float64)] * dim  # one record per node: records sort and compare by coordinate
+    nodes = np.ascontiguousarray(p.T, dtype=np.float64).view(row).ravel()
+    wanted = np.ascontiguousarray(points).view(row).ravel()
+    order = np.argsort(nodes, kind="stable")
+    at = np.minimum(np.searchsorted(nodes[order], wanted), nodes.size - 1)
+    return order[at] if np.all(nodes[order[at]] == wanted) else None
 
 
 def candidate_edges(mesh: Any, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

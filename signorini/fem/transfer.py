@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from signorini.fem.obstacles import ScaledQuery
 from signorini.fem.topology import facets_on
@@ -71,6 +70,8 @@ def _split(t: np.ndarray, n: int, parents: np.ndarray) -> np.ndarray:
 def boundary_children(old: Any, new: Any) -> tuple[np.ndarray, np.ndarray]:
     """The new nodes of ``new`` (a conforming refinement of the 2D mesh ``old``) that lie on an
     old boundary facet, and that facet's two ends (2, k)."""
+    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
+
     n_old = old.p.shape[1]
     fresh = np.arange(n_old, new.p.shape[1])
     ends = old.facets[:, old.boundary_facets()]

@@ -31,7 +31,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from signorini.numerics.factor import PinnedFactor, Pinning, resolve_backend, selection_dofs
 from signorini.numerics.lcp import solve_lcp
@@ -81,6 +80,8 @@ def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: n
     one back-solve. (On the cylinder from 66k to 1M dofs this band of 7–9
     nodes held the edge every time; the symmetric one had 11–13.)
     """
+    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
+
     points, coarse_points = np.atleast_2d(points), np.atleast_2d(coarse_points)
     if neighbours is None:
         neighbours = 4 if points.shape[1] == 2 else 10
@@ -127,6 +128,8 @@ def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | No
     radial distances crowd together, so the gap between sorted ones says nothing), and the band
     stops at ``a + margin·a``: a ring of candidates costs a back-solve each, and a node beyond it
     that touches joins it for one back-solve more (docs/calibration.md)."""
+    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
+
     points = np.atleast_2d(np.asarray(points, dtype=float))
     rho = radial_distance(points)
     if points.shape[1] == 2:

@@ -52,7 +52,6 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
@@ -129,6 +128,8 @@ def node_sizes(mesh: Any) -> np.ndarray:
 
 def elements_near(mesh: Any, nodes: np.ndarray, radius: np.ndarray) -> np.ndarray:
     """Elements with a vertex within ``radius[i]`` of ``nodes[i]``, for some i."""
+    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
+
     near = np.zeros(mesh.p.shape[1], dtype=bool)
     for found in cKDTree(mesh.p.T).query_ball_point(mesh.p[:, nodes].T, radius):
         near[found] = True
@@ -150,6 +151,8 @@ def contact_weights(mesh: Any, zone: np.ndarray) -> np.ndarray:
     """Each element's weight ``(ℓ / max(d, ℓ))²`` for the pressure's bulk marking: ``d`` the
     distance from its centroid to the nearest node in contact (``zone``), ``ℓ`` the contact
     zone's extent (the diagonal of the box around ``zone``, at least its largest element edge)."""
+    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
+
     if zone.size == 0:
         return np.ones(mesh.t.shape[1])
     points = mesh.p[:, zone]

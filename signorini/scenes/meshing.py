@@ -16,7 +16,6 @@ from itertools import combinations
 from typing import Any, Callable
 
 import numpy as np
-from scipy.spatial import Delaunay
 from skfem import Mesh, MeshTet, MeshTri
 
 from signorini.fem.model import CutLoad
@@ -54,6 +53,8 @@ def coarse_quarter_disc(rings: int = 4) -> MeshTri:
     The region is ``x ≥ 0, y ≤ 1, x² + (y − 1)² ≤ 1``; its lowest point, the
     first point of contact, is the origin.
     """
+    from scipy.spatial import Delaunay  # on use: scipy.spatial is slow to import
+
     points = [(0.0, 1.0)]
     for k in range(1, rings + 1):
         r = k / rings

@@ -16,7 +16,6 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-from scipy.spatial import Delaunay
 from skfem import MeshTri
 
 Field = Callable[[np.ndarray], np.ndarray]
@@ -38,6 +37,8 @@ def _gradient(distance: Field, p: np.ndarray, eps: float) -> np.ndarray:
 
 def _triangulate(p: np.ndarray, distance: Field, tol: float) -> tuple[np.ndarray, np.ndarray]:
     """Delaunay triangles whose centroid is inside the domain, and their unique edges."""
+    from scipy.spatial import Delaunay  # on use: scipy.spatial is slow to import
+
     t = Delaunay(p.T).simplices
     t = t[distance(p[:, t].mean(axis=2)) < -tol]
     bars = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [0, 2]]]), axis=1)

@@ -64,11 +64,6 @@ from signorini.scenes.base import length, poisson_ratio
 from signorini.scenes.families import SCENES
 from signorini.scenes.size import check_size
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
-
 log = logging.getLogger(__name__)
 
 #: tables of a family scene whose keys are the family's parameters
@@ -131,6 +126,11 @@ class _Context:
 
 def read_scene_file(path: str | Path) -> tuple[dict[str, Any], _Context]:
     """The parsed TOML of a scene file; InputError with the line on a syntax error."""
+    if sys.version_info >= (3, 11):  # on use: only a scene file needs a TOML parser
+        import tomllib
+    else:  # pragma: no cover - exercised on Python 3.10 only
+        import tomli as tomllib
+
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")

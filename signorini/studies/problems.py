@@ -29,7 +29,6 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from signorini.diagnose import regularise
 from signorini.errors import InputError
@@ -104,6 +103,8 @@ def build_spec(spec: dict[str, Any]) -> ContactProblem:
 
 def candidate_spacing(problem: ContactProblem) -> float:
     """Median distance from each contact candidate to its nearest neighbour (physical units)."""
+    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
+
     points = problem.contact_points * problem.scales.length
     if len(points) < 2 or not np.all(np.isfinite(points)):  # no positions: a QP given as arrays
         return float("nan")
