@@ -201,8 +201,12 @@ class PinnedCG:
     Has the interface of :class:`~signorini.numerics.factor.PinnedFactor`:
     ``matrix`` (the problem's K), ``fixed`` (free-dof indices pinned: the
     active rows' dofs when each row bounds one dof, else none) and
-    ``solve(rhs)``: u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``.
+    ``solve(rhs)``: u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``, to the
+    relative residual :data:`CERTIFICATE_RTOL` (``exact`` is False: the forward error takes
+    one Newton step with it, :mod:`signorini.forward_error`).
     """
+
+    exact = False
 
     def __init__(self, problem: ContactProblem, system: PinnedSystem, active: np.ndarray):
         self.matrix, self.system, self.problem = problem.K, system, problem
