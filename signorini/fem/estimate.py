@@ -219,12 +219,16 @@ def _same_coordinates(p: np.ndarray, points: np.ndarray) -> np.ndarray | None:
     points = np.atleast_2d(np.asarray(points, dtype=float))
     if points.shape[1] != dim or p.shape[1] == 0:
         return None
+    # only the nodes whose first coordinate is one of the points' can match: sort those alone
+    near = np.flatnonzero(np.isin(p[0], points[:, 0]))
+    if near.size == 0:
+        return None
     row = [("", np.float64)] * dim  # one record per node: records sort and compare by coordinate
-    nodes = np.ascontiguousarray(p.T, dtype=np.float64).view(row).ravel()
+    nodes = np.ascontiguousarray(p[:, near].T, dtype=np.float64).view(row).ravel()
     wanted = np.ascontiguousarray(points).view(row).ravel()
     order = np.argsort(nodes, kind="stable")
     at = np.minimum(np.searchsorted(nodes[order], wanted), nodes.size - 1)
-    return order[at] if np.all(nodes[order[at]] == wanted) else None
+    return near[order[at]] if np.all(nodes[order[at]] == wanted) else None
 
 
 def candidate_edges(mesh: Any, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
