@@ -298,9 +298,12 @@ def children_of(pid):
     (["validate", "--method", "m.py:sleeps", "--case", "block", "--out", "v"], signal.SIGINT, True),
 ])
 def test_a_signal_ends_the_workers_with_the_command(here, argv, signum, group):
+    # as from a terminal: SIGINT at its default (a shell running the tests in the background
+    # ignores it, and Python then keeps it ignored instead of raising KeyboardInterrupt)
     command = subprocess.Popen([sys.executable, "-m", "signorini.cli", *argv], env=ENV,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
+                               start_new_session=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120  # generous: the worker starts with the package's imports
     while not children_of(command.pid) and time.monotonic() < deadline:
         time.sleep(0.1)
