@@ -17,9 +17,8 @@ def _rel(a, b) -> float:
 def _from_qp_in_mm() -> signorini.Result:
     """The cylinder's QP handed over as arrays in mm and MPa (no scene, no scales)."""
     scene = signorini.solve("hertz-cylinder", params={"R": 10.0, "E": 2.1e5, "n_contact": 20})
-    p, s = scene.problem, scene.problem.scales
-    qp = signorini.ContactProblem.from_qp(p.K * (s.force / s.displacement), p.f * s.force, p.N,
-                                          p.d * s.displacement, weights=p.weights * s.weight)
+    p = scene.problem
+    qp = signorini.ContactProblem.from_qp(*p.qp(), weights=p.weights * p.scales.weight)
     return signorini.solve(qp, "pdas")
 
 
