@@ -251,7 +251,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
         volumetric=model.volumetric, axisymmetric=axisymmetric, reference=model.reference,
         params=params,
         push=_push(lifted, 1.0, None if f_load is None else f_load[free], offset_load, target,
-                   _resultant(N_full, np.intersect1d(dof_table[component], free)),
+                   _resultant(N_full, np.sort(dof_table[component][is_free[dof_table[component]]])),
                    delta=delta, P=model.target_load),
         predicted_contact=model.predicted_contact, watch=boundary_watch(model, dof_table, U))
     problem = ContactProblem(

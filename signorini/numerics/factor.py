@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import sys
 
 import numpy as np
 import scipy.sparse as sp
@@ -207,6 +208,27 @@ def pardiso_factor_bytes(iparm: np.ndarray) -> float:
     return 1024.0 * max(float(iparm[14]), float(iparm[15]) + float(iparm[16]))
 
 
+def _pypardiso():
+    """pypardiso, imported with MKL's library named in its documented ``PYPARDISO_MKL_RT``.
+
+    Unless told, pypardiso finds MKL by a recursive search of the environment on import and
+    again for every new solver (0.3-0.4 s each); a pip-installed MKL sits in ``<prefix>/lib``.
+    """
+    if "PYPARDISO_MKL_RT" not in os.environ:
+        import glob
+        import site
+
+        for lib in (f"{sys.prefix}/lib", f"{site.USER_BASE}/lib"):
+            found = sorted(glob.glob(f"{lib}/libmkl_rt.so*") + glob.glob(f"{lib}/libmkl_rt*.dylib"),
+                           key=len)
+            if found:
+                os.environ["PYPARDISO_MKL_RT"] = found[0]
+                break
+    import pypardiso  # MKL: imported only for a matrix PARDISO factorises
+
+    return pypardiso
+
+
 class PardisoFactor(Factor):
     """MKL PARDISO's symmetric positive definite solver (pypardiso).
 
@@ -218,16 +240,13 @@ class PardisoFactor(Factor):
     backend = "pardiso"
 
     def __init__(self, K: sp.spmatrix, upper: sp.csr_matrix | None = None):
-        import pypardiso  # MKL: 0.2 s to import, only for a matrix PARDISO factorises
-
+        pypardiso = _pypardiso()
         self.matrix, self.shape = K, K.shape
         self._upper = _upper_csr(K) if upper is None else upper
         self._solver = solver = pypardiso.PyPardisoSolver(mtype=2)
+        os.environ.setdefault("PYPARDISO_MKL_RT", solver.libmkl._name)  # where it found MKL
         for index, value in PARDISO_IPARM.items():
             solver.set_iparm(index, value)
-        # pypardiso searches sys.prefix for MKL on every new solver (0.2-0.4 s) unless told where
-        # it is (its documented PYPARDISO_MKL_RT): tell it once
-        os.environ.setdefault("PYPARDISO_MKL_RT", solver.libmkl._name)
         # pypardiso's factorize() runs PARDISO's phases 11 (analysis) and 22 (numeric) as one;
         # they are run apart here (its own _check_A, _call_pardiso and the matrix it remembers,
         # as its factorize does) so that the numeric phase only starts when it fits

@@ -357,13 +357,12 @@ def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
     point of contact: how :func:`graded_quarter_disc` finds the parts of its
     own mesh, and how :mod:`signorini.scenes.adapt` finds them on a refined one.
     """
-    unit = MeshTri(mesh.p / R, mesh.t)
-    arc = on_circle_arc(unit, (0.0, 1.0), 1.0)
-    ends = np.nonzero((np.hypot(*unit.p) < 1e-9)
-                      | (np.hypot(unit.p[0] - 1.0, unit.p[1] - 1.0) < 1e-9))[0]
-    chain = np.union1d(arc, ends)
-    chain = chain[np.argsort(np.arctan2(unit.p[1, chain] - 1.0, unit.p[0, chain]))]
+    mesh = with_topology(mesh)
     x, y = mesh.p
+    arc = on_circle_arc(mesh, (0.0, R), R, tol=1e-9 * R)
+    ends = np.nonzero((np.hypot(x, y) < 1e-9 * R) | (np.hypot(x - R, y - R) < 1e-9 * R))[0]
+    chain = np.union1d(arc, ends)
+    chain = chain[np.argsort(np.arctan2(y[chain] - R, x[chain]))]
     candidates = chain[(x[chain] <= candidate_extent * a_over_R * R * (1 + 1e-9))
                        & (y[chain] < R * (1 - 1e-12))]
     top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
