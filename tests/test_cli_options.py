@@ -98,5 +98,15 @@ def test_the_library_logs_where_its_long_steps_start(caplog):
     with caplog.at_level(logging.INFO, logger="signorini"):
         signorini.solve("hertz-cylinder", params={"n_contact": 10})
     messages = [r.getMessage() for r in caplog.records]
-    for start in ("building hertz-cylinder", "matching the target load", "solving", "checking"):
-        assert any(m.startswith(start) for m in messages), (start, messages)
+    starts = ("meshing hertz-cylinder", "assembling K", "matching the target load",
+              "factorising K", "solving", "pdas step 1", "checking")
+    first = [next((i for i, m in enumerate(messages) if m.startswith(s)), None) for s in starts]
+    assert None not in first, (dict(zip(starts, first)), messages)
+    assert first[:3] == sorted(first[:3]) and first[-1] == max(first), messages  # in this order
+
+
+def test_pdas_amg_logs_each_active_set_step(caplog):
+    with caplog.at_level(logging.INFO, logger="signorini"):
+        result = signorini.solve("hertz-cylinder", method="pdas-amg", params={"n_contact": 10})
+    steps = [r.getMessage() for r in caplog.records if r.getMessage().startswith("pdas-amg step")]
+    assert len(steps) == result.iterations >= 1, steps

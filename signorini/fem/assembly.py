@@ -184,6 +184,8 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     finds the push whose load is the target, from ``problem.push``.
     """
     start = time.perf_counter()
+    log.info("assembling K: %s nodes, %s elements", f"{model.mesh.p.shape[1]:,}",
+             f"{model.mesh.t.shape[1]:,}")
     L = model.length_scale if nondimensionalise else 1.0
     stress = model.E if nondimensionalise else 1.0
     U = displacement_scale(model) if nondimensionalise else 1.0

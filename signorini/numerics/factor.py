@@ -21,6 +21,7 @@ and back-solves done in this process, so that tests can count what a step costs.
 from __future__ import annotations
 
 import importlib.util
+import logging
 import os
 import sys
 
@@ -29,6 +30,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.errors import BackendNotInstalled, InputError, install_hint
+
+log = logging.getLogger(__name__)
 
 BACKENDS = ("pardiso", "cholmod", "superlu")
 _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
@@ -92,6 +95,12 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
     return name
 
 
+def _factorising(backend: str, K: sp.spmatrix) -> None:
+    """Count a factorisation of K and say it starts (a progress line on a terminal)."""
+    COUNTS["factorisations"] += 1
+    log.info("factorising K: %s dofs, %s nonzeros (%s)", f"{K.shape[0]:,}", f"{K.nnz:,}", backend)
+
+
 class Factor:
     """``K⁻¹`` applied to a vector or an (n, k) block of right-hand sides.
 
@@ -105,7 +114,7 @@ class Factor:
 
     def __init__(self, K: sp.spmatrix):
         self.matrix, self.shape = K, K.shape
-        COUNTS["factorisations"] += 1
+        _factorising(self.backend, K)
         self._lu = spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                              options={"SymmetricMode": True})
 
@@ -149,7 +158,7 @@ class CholmodFactor(Factor):
     def __init__(self, K: sp.spmatrix, symbolic=None):
         self.matrix, self.shape = K, K.shape
         K = sp.csc_matrix(K)
-        COUNTS["factorisations"] += 1
+        _factorising(self.backend, K)
         self._factor = cholmod_numeric(cholmod_analysis(K) if symbolic is None else symbolic, K)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
@@ -266,9 +275,9 @@ class PardisoFactor(Factor):
                 "for a 3D scene a push (--set delta=...) instead of a target load")
         solver.factorized_A = (solver._hash_csr_matrix(A) if A.nnz > solver.size_limit_storage
                                else A.copy())
+        _factorising(self.backend, K)
         solver.set_phase(22)
         solver._call_pardiso(A, rhs)
-        COUNTS["factorisations"] += 1
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         return self._solver.solve(self._upper, _count_solve(np.asarray(b, dtype=float)))

@@ -70,7 +70,6 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     """
     values = scene_params(params)
     nondimensionalise = flag_argument(nondimensionalise, "nondimensionalise")
-    log.info("building %s: meshing and assembling", name)
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
                          f"{type(name).__name__}: e.g. build_problem('hertz-cylinder')")
@@ -83,11 +82,13 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
                              "drop nondimensionalise=False (--raw-units)")
         return read_problem(name)
     if name.lower().endswith(".toml"):  # a scene file: signorini.scenes.scenefile
+        log.info("meshing %s", name)
         name, model = build_scene_model(name, values)
     else:
         family = get_scene(name)
         parsed = family.parse(values)
         check_size(name, parsed, solved_by)  # too big for this machine: refused before meshing
+        log.info("meshing %s", name)
         try:
             model = family.build(parsed, set(values))
         except InputError:  # the model's own checks (signorini.fem.checks): said as they are

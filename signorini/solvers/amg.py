@@ -397,6 +397,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     status, message = "max_iter", f"active set still changing after {max_iter} steps"
     step = 0
     for step in range(1, max_iter + 1):
+        log.info("pdas-amg step %d: %d candidates in contact", step, int(np.sum(active)))
         free = system.pin(active, d, x)
         force = max(float(np.max(np.abs(lam * system.coef), initial=0.0)), floor, 1e-300)
         target = SAFETY * tighten * tol * force

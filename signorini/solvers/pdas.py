@@ -25,6 +25,8 @@ Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 
 from __future__ import annotations
 
+import logging
+
 import time
 from typing import Any
 
@@ -39,6 +41,8 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.solution import WarmStart
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare, take_options
+
+log = logging.getLogger(__name__)
 
 DEFAULTS = declare(
     Option("c", "positive", 1.0), Option("lam0", "vector"), Option("callback", "callable"),
@@ -105,6 +109,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             break
         seen.add(new_active.tobytes())
         active = new_active
+        log.info("pdas step %d: %d candidates in contact, %d changed", iteration,
+                 history["active"][-1], changes)
         u, lam = system.solve(active, problem.f, problem.d)
     return ContactSolution(method="pdas", u=u, lam=lam, status=status, message=message,
                            iterations=iteration, solve_time=time.perf_counter() - start,
