@@ -10,7 +10,7 @@ import signorini
 from signorini.errors import InputError
 from signorini.fem.stiffness import plane_strain_stiffness, solid_stiffness
 from signorini.fem.volumetric import (NODAL_FROM_NU, averaging, nodal_volumetric_strain, resolve,
-                                      volumetric_stiffness)
+                                      simplex_gradients, volumetric_stiffness)
 
 
 def _mesh(kind):
@@ -144,3 +144,22 @@ def test_the_documented_numbers_are_the_committed_run():
                if r["scene"] == "hertz-sphere" and r["nu"] >= 0.4)
     assert all(max(abs(r["a_err"]), abs(r["p0_err"])) > 0.01 for r in rows
                if r["volumetric"] == "element" and r["nu"] == 0.499)
+
+
+@pytest.mark.parametrize("kind", ["tri", "tet"])
+def test_the_closed_form_gradients_are_the_inverse_jacobians(kind):
+    """simplex_gradients' closed forms (the 2×2 formula, cross products) give what the general
+    inverse of each element's Jacobian gives, on a mesh whose nodes were moved at random."""
+    mesh = _mesh(kind)
+    h = np.min(np.linalg.norm(mesh.p[:, mesh.t[1]] - mesh.p[:, mesh.t[0]], axis=0))
+    p = mesh.p + np.random.default_rng(7).uniform(-0.2 * h, 0.2 * h, mesh.p.shape)
+    mesh = type(mesh)(p, mesh.t)
+    jacobians = np.moveaxis(p[:, mesh.t[1:]] - p[:, mesh.t[:1]], -1, 0)  # (elements, dim, d)
+    inverse = np.linalg.inv(jacobians)
+    expected = np.concatenate([-inverse.sum(axis=1, keepdims=True), inverse], axis=1)
+    gradients, jacobian = simplex_gradients(mesh)
+    assert gradients.shape == expected.shape
+    scale = np.abs(expected).max(axis=(1, 2), keepdims=True)
+    assert np.max(np.abs(gradients - expected) / scale) < 1e-12
+    np.testing.assert_allclose(jacobian, np.abs(np.linalg.det(jacobians)), rtol=1e-12)
+    assert np.ptp(jacobian) > 0.1 * jacobian.max()  # the mesh is irregular indeed

@@ -46,7 +46,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 
 from signorini.fem.topology import facets_on
-from signorini.fem.volumetric import nodal_volumetric_strain, simplex_gradients
+from signorini.fem.volumetric import barycentric_gradients, nodal_volumetric_strain, simplex_gradients
 from signorini.kkt import active_set
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -121,7 +121,7 @@ def quadrature(mesh: Any, axisymmetric: bool = False, order: int | None = None) 
     X, W = get_quadrature(mesh.refdom, order)
     bary = np.vstack([1.0 - X.sum(axis=0), X])
     gradients, jacobian = simplex_gradients(mesh)
-    points = np.einsum("dke,kq->deq", mesh.p[:, mesh.t], bary)
+    points = np.einsum("dke,kq->deq", np.take(mesh.p, mesh.t, axis=1), bary)
     dx = jacobian[:, None] * W[None, :]
     if axisymmetric:
         dx = dx * points[0]
@@ -135,7 +135,7 @@ def strains(mesh: Any, u: np.ndarray, rule: Quadrature, axisymmetric: bool = Fal
     added in 3D), then the hoop strain ``u_r / r`` when axisymmetric; tensor
     (not engineering) shears.
     """
-    values = u[mesh.t]  # (d + 1, elements, dim)
+    values = np.take(u, mesh.t, axis=0)  # (d + 1, elements, dim)
     grad = np.einsum("kei,ekj->eij", values, rule.gradients)  # ∂u_i/∂x_j per element
     dim = grad.shape[1]
     pairs = STRAIN_PAIRS[dim]
@@ -178,9 +178,22 @@ def nodal_recovery(mesh: Any, eps: np.ndarray, rule: Quadrature) -> np.ndarray:
     return moments / mass
 
 
+def constant_recovery(mesh: Any, eps: np.ndarray, volume: np.ndarray) -> np.ndarray:
+    """:func:`nodal_recovery` of a strain constant on each simplex (components, elements) whose
+    measures are ``volume``: every corner gets ``volume / (d + 1)`` of the element's weight (one
+    sum over all corners at once per component, no quadrature points)."""
+    corners, n = mesh.t.shape[0], mesh.p.shape[1]
+    corner_of = mesh.t.ravel()  # corner k of every element, then corner k + 1, ...
+    share = np.tile(volume / corners, corners)
+    mass = np.bincount(corner_of, share, minlength=n)
+    return np.array([np.bincount(corner_of, np.tile(component, corners) * share, minlength=n)
+                     for component in eps]) / mass
+
+
 def recover(mesh: Any, eps: np.ndarray, rule: Quadrature) -> np.ndarray:
     """ZZ's recovered strain at the quadrature points (:func:`nodal_recovery` interpolated)."""
-    return np.einsum("cke,kq->ceq", nodal_recovery(mesh, eps, rule)[:, mesh.t], rule.bary)
+    return np.einsum("cke,kq->ceq", np.take(nodal_recovery(mesh, eps, rule), mesh.t, axis=1),
+                     rule.bary)
 
 
 def lame(E: float, nu: float) -> tuple[float, float]:
@@ -220,7 +233,10 @@ def _same_coordinates(p: np.ndarray, points: np.ndarray) -> np.ndarray | None:
     if points.shape[1] != dim or p.shape[1] == 0:
         return None
     # only the nodes whose first coordinate is one of the points' can match: sort those alone
-    near = np.flatnonzero(np.isin(p[0], points[:, 0]))
+    if points.shape[0] == 0:
+        return None
+    firsts = np.sort(points[:, 0])  # searched, not merged: np.isin would sort every node's too
+    near = np.flatnonzero(firsts[np.minimum(np.searchsorted(firsts, p[0]), firsts.size - 1)] == p[0])
     if near.size == 0:
         return None
     row = [("", np.float64)] * dim  # one record per node: records sort and compare by coordinate
@@ -402,7 +418,7 @@ def _by_quadrature(problem: ContactProblem, mesh: Any, u: np.ndarray, Lambda: fl
         jump = np.einsum("ke,kq->eq", theta[mesh.t], rule.bary) - theta_points
     energy = np.sum(energy_density(eps, Lambda, Mu, dim, theta_points) * rule.dx, axis=1)
     nodal = nodal_recovery(mesh, eps, rule)
-    recovered = np.einsum("cke,kq->ceq", nodal[:, mesh.t], rule.bary)
+    recovered = np.einsum("cke,kq->ceq", np.take(nodal, mesh.t, axis=1), rule.bary)
     squares = np.sum(energy_density(recovered - eps, Lambda, Mu, dim, jump) * rule.dx, axis=1)
     return energy, squares, nodal, theta
 
@@ -417,19 +433,18 @@ def _constant_strains(mesh: Any, u: np.ndarray, Lambda: float,
     quadrature of order 2 gives (it is exact here), without its points.
     """
     dim = mesh.p.shape[0]
-    gradients, jacobian = simplex_gradients(mesh)
+    gradients, jacobian = barycentric_gradients(mesh)  # (d + 1, dim, elements)
     volume = jacobian / math.factorial(dim)
-    grad = np.einsum("kei,ekj->eij", u[mesh.t], gradients)  # ∂u_i/∂x_j per element
-    eps = np.array([0.5 * (grad[:, i, j] + grad[:, j, i]) for i, j in STRAIN_PAIRS[dim]])  # (c, e)
+    values = np.take(u.T, mesh.t, axis=1)  # (dim, d + 1, elements)
+    grad = np.einsum("ike,kje->ije", values, gradients)  # ∂u_i/∂x_j per element
+    eps = np.array([0.5 * (grad[i, j] + grad[j, i]) for i, j in STRAIN_PAIRS[dim]])  # (c, e)
     energy = energy_density(eps, Lambda, Mu, dim) * volume
     corners = mesh.t.shape[0]
-    centroid = Quadrature(bary=np.full((corners, 1), 1.0 / corners), points=None,
-                          dx=volume[:, None], gradients=gradients)  # exact for constant strains
-    nodal = nodal_recovery(mesh, eps[:, :, None], centroid)
+    nodal = constant_recovery(mesh, eps, volume)
     total = np.zeros_like(eps)
     own = np.zeros_like(volume)
     for nodes in mesh.t:
-        delta = nodal[:, nodes] - eps
+        delta = np.take(nodal, nodes, axis=1) - eps
         total += delta
         own += energy_density(delta, Lambda, Mu, dim)
     squares = volume * (energy_density(total, Lambda, Mu, dim) + own) / (corners * (corners + 1))
