@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.forward_error import ForwardError, forward_error
+from signorini.forward_error import ForwardError, WithDelassus, forward_error
 from signorini.numerics.factor import selection_dofs
 from signorini import problem as problem_module
 from signorini.problem import ContactProblem, ContactSolution
@@ -35,6 +35,8 @@ SAME_MATRIX_RTOL = 1e-12
 #: released, a back-solve each; beyond this many the certificate gives up on the method's
 #: factorisation and takes the problem's own way to K⁻¹
 MAX_RELEASED = 16
+#: right-hand sides a factorisation offered to the certificate remembers (see :class:`_Remembering`)
+REMEMBERED_SOLVES = 3
 
 
 def _inf_norm(x: np.ndarray) -> float:
@@ -192,9 +194,10 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     natural = _inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))
     gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:
-        forward = _forward(problem, solution, lam_norm)
+        offers = _Offers(problem, solution)
+        forward = _forward(problem, solution, lam_norm, offers)
         energy = float(0.5 * u @ Ku - problem.f @ u)
-        absolute = primal_dual_gap(problem, u, lam, (solution.factor, problem.cached_factor), Ku)
+        absolute = primal_dual_gap(problem, u, lam, offers(), Ku)
         if not solution.keep_factor:  # used: a kept solution no longer keeps a factorisation alive
             solution.factor = None
         gap = abs(absolute) / _positive(max(abs(energy), abs(energy - absolute)))
@@ -202,7 +205,54 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
                        forward.force, forward.displacement, forward.floor, forward.back_solves)
 
 
-def _forward(problem: ContactProblem, solution: ContactSolution, scale: float) -> ForwardError:
+class _Remembering:
+    """A factorisation offered to one certificate, which remembers what it was asked.
+
+    The forward error's first Newton step and the duality gap can solve the same system with
+    opposite right-hand sides (the method's pinned set is the active set and λ is zero off
+    it): a solve is linear and exactly odd in floating point, so a right-hand side that is
+    minus one already solved gets minus that answer instead of a second solve — the numbers
+    a second solve gives. Its pinned rows (:func:`_pinned_rows`) are found once.
+    """
+
+    def __init__(self, problem: ContactProblem, factor):
+        self.factor, self.solved = factor, []
+        self.pinned = _pinned_rows(problem, factor)
+
+    def __getattr__(self, name: str):
+        return getattr(self.factor, name)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        rhs = np.asarray(rhs)
+        if rhs.ndim == 1:
+            for asked, answer in self.solved:
+                if np.array_equal(asked, -rhs):
+                    return -answer
+        answer = self.factor.solve(rhs)
+        if rhs.ndim == 1:
+            self.solved = [(rhs.copy(), answer.copy())] + self.solved[:REMEMBERED_SOLVES - 1]
+        return answer
+
+
+class _Offers:
+    """The factorisations on offer to one certificate — the method's, then the problem's cached
+    one — each wrapped once in :class:`_Remembering`."""
+
+    def __init__(self, problem: ContactProblem, solution: ContactSolution):
+        self.problem, self.solution, self.wrapped = problem, solution, {}
+
+    def wrap(self, factor) -> _Remembering:
+        if id(factor) not in self.wrapped:
+            self.wrapped[id(factor)] = (factor, _Remembering(self.problem, factor))
+        return self.wrapped[id(factor)][1]
+
+    def __call__(self) -> list[_Remembering]:
+        return [self.wrap(f) for f in (self.solution.factor, self.problem.cached_factor)
+                if f is not None]
+
+
+def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
+             offers: _Offers | None = None) -> ForwardError:
     """The forward error on the certificate's active set, by the first usable factorisation.
 
     The method's (its pinned set checked as for the duality gap), else the
@@ -210,14 +260,15 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float) -
     makes anyway — except from :data:`signorini.problem.ITERATIVE_ENERGY_FROM` dofs, where the
     duality gap uses CG and the forward error is not estimated (read when called).
     """
-    offered = [f for f in (solution.factor, problem.cached_factor)
-               if f is not None and _pinned_rows(problem, f) is not None]
+    offers = offers or _Offers(problem, solution)
+    offered = [f for f in offers() if f.pinned is not None]
     if not offered and problem.n < problem_module.ITERATIVE_ENERGY_FROM:
-        offered = [problem.factor()]
+        offered = [offers.wrap(problem.factor())]
     if not offered:
         return ForwardError.unknown()
+    factor = offered[0].factor if isinstance(offered[0].factor, WithDelassus) else offered[0]
     return forward_error(problem.K, problem.f, problem.N, problem.d, solution.u, solution.lam,
-                         active_set(problem, solution), offered[0], scale)
+                         active_set(problem, solution), factor, scale)
 
 
 #: what the certificate says when it cannot vouch for the contact force, by the error's name
@@ -299,7 +350,8 @@ def primal_dual_gap(problem: ContactProblem, u: np.ndarray, lam: np.ndarray, fac
     lam_plus = np.maximum(lam, 0.0)
     Ku = problem.K @ u if Ku is None else Ku
     for factor in factors:
-        pinned = _pinned_rows(problem, factor)
+        pinned = getattr(factor, "pinned", None) if isinstance(factor, _Remembering) \
+            else _pinned_rows(problem, factor)
         if pinned is not None:
             gap = _gap_on(problem, u, lam_plus, Ku, factor, *pinned)
             if gap is not None:
