@@ -40,7 +40,7 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
-from signorini.fem.stiffness import plane_strain_stiffness, solid_stiffness
+from signorini.fem.stiffness import simplex_stiffness
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import volumetric_stiffness
 from signorini.problem import ContactProblem, Discretisation, Push, Scales, Watch
@@ -146,10 +146,8 @@ def lame_stiffness(mesh: Any, Lambda: float, Mu: float, *, axisymmetric: bool = 
 
 
 def _elastic_stiffness(mesh: Any, Lambda: float, Mu: float, axisymmetric: bool) -> sp.csr_matrix:
-    if mesh.p.shape[0] == 2 and not axisymmetric:
-        return plane_strain_stiffness(mesh, Lambda, Mu)
-    if mesh.p.shape[0] == 3 and mesh.t.shape[0] == 4:
-        return solid_stiffness(mesh, Lambda, Mu)
+    if not axisymmetric and mesh.t.shape[0] == mesh.p.shape[0] + 1:  # triangles or tetrahedra
+        return simplex_stiffness(mesh, Lambda, Mu)
     basis = Basis(mesh, ElementVector(mesh.elem()))
     form = axisymmetric_elasticity(Lambda, Mu) if axisymmetric else linear_elasticity(Lambda, Mu)
     return asm(form, basis).tocsr()
