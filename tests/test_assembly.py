@@ -434,3 +434,11 @@ def test_triangle_stiffness_has_scikit_fems_pattern_and_entries(make_mesh):
             np.testing.assert_array_equal(row_of[slot[corners * a + b]], mesh.t[a])
             np.testing.assert_array_equal(indices[slot[corners * a + b]], mesh.t[b])
     np.testing.assert_array_equal(mirror[mirror], np.arange(indices.size))
+
+
+@pytest.mark.parametrize("bound", [50, 2 ** 62])  # packed into one value sort; too wide: argsort
+def test_sort_order_is_a_stable_argsort(bound):
+    from signorini.fem.stiffness import sort_order
+
+    keys = np.random.default_rng(5).integers(0, 50, 1000) * (bound // 50)
+    np.testing.assert_array_equal(sort_order(keys, bound), np.argsort(keys, kind="stable"))

@@ -41,38 +41,60 @@ def tetrahedron_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.
     return grads, np.abs(det) / 6.0
 
 
+def sort_order(keys: np.ndarray, bound: int) -> np.ndarray:
+    """``np.argsort(keys, kind="stable")`` of non-negative integer ``keys`` below ``bound``.
+
+    When a key and its position fit in 63 bits together, by one sort of the
+    values ``key · 2ᵇ + position`` (numpy's SIMD value sort, several times
+    faster than an index sort); else by ``argsort``.
+    """
+    shift = max(keys.size - 1, 1).bit_length()
+    if max(bound - 1, 1).bit_length() + shift > 63:
+        return np.argsort(keys, kind="stable")
+    return np.sort((keys.astype(np.int64) << shift) | np.arange(keys.size)) & ((1 << shift) - 1)
+
+
 def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                        np.ndarray]:
-    """K's node-by-node pattern (CSR ``indptr``, ``indices``) of a simplex mesh (triangles or
-    tetrahedra: k = 3 or 4 nodes each), the slot in it of each element's node pair (k², e) —
-    row k·a + b for local nodes a, b — and each slot's mirror (the slot of (j, i) for that
-    of (i, j)).
+    """K's node-by-node pattern (CSR ``indptr``, ``indices``, sorted) of a simplex mesh
+    (triangles or tetrahedra: k = 3 or 4 nodes each), the slot in it of each element's node
+    pair (k², e) — row k·a + b for local nodes a, b — and each slot's mirror (the slot of
+    (j, i) for that of (i, j)).
 
-    Found from the mesh's edges (one sort of an integer key per edge of every element, then
-    one of the pattern's own entries) rather than by sorting all k² pairs of every element.
+    Found from the mesh's edges: one sort of an integer key per edge of every element gives
+    the edges (low, high) in order, which is the order of the upper entries; one sort of the
+    edges by their high end gives the lower ones. Row i holds its lower entries, its diagonal,
+    then its upper entries.
     """
     corners, elements = t.shape
     edges_local = list(combinations(range(corners), 2))
     first = np.concatenate([t[a] for a, _ in edges_local]).astype(np.int64)
     second = np.concatenate([t[b] for _, b in edges_local]).astype(np.int64)
-    low, high = np.minimum(first, second), np.maximum(first, second)
-    edges, edge_of = np.unique(low * nodes + high, return_inverse=True)
-    edge_low, edge_high = np.divmod(edges, nodes)
-    count = edges.size
-    rows = np.concatenate([np.arange(nodes), edge_low, edge_high])  # diagonal, upper, lower
-    cols = np.concatenate([np.arange(nodes), edge_high, edge_low])
-    order = np.argsort(rows * nodes + cols)
-    position = np.empty(order.size, dtype=np.int64)
-    position[order] = np.arange(order.size)
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=nodes))])
-    indices = cols[order]
-    mirror = np.empty(order.size, dtype=np.int64)
-    upper, lower = position[nodes:nodes + count], position[nodes + count:]
-    mirror[position[:nodes]], mirror[upper], mirror[lower] = position[:nodes], lower, upper
+    keys = np.minimum(first, second) * nodes + np.maximum(first, second)
+    order = sort_order(keys, nodes * nodes)
+    sorted_keys = keys[order]
+    is_new = np.ones(keys.size, dtype=bool)
+    is_new[1:] = sorted_keys[1:] != sorted_keys[:-1]
+    edge_of = np.empty(keys.size, dtype=np.int64)
+    edge_of[order] = np.cumsum(is_new) - 1
+    edge_low, edge_high = np.divmod(sorted_keys[is_new], nodes)
+    count = edge_low.size
+    above, below = np.bincount(edge_low, minlength=nodes), np.bincount(edge_high, minlength=nodes)
+    indptr = np.concatenate([[0], np.cumsum(below + 1 + above)])
+    diagonal = indptr[:-1] + below
+    upper = diagonal[edge_low] + 1 + np.arange(count) - (np.cumsum(above) - above)[edge_low]
+    by_high = sort_order(edge_high, nodes)
+    lower = np.empty(count, dtype=np.int64)
+    high = edge_high[by_high]
+    lower[by_high] = indptr[high] + np.arange(count) - (np.cumsum(below) - below)[high]
+    indices = np.empty(indptr[-1], dtype=np.int64)
+    indices[diagonal], indices[upper], indices[lower] = np.arange(nodes), edge_high, edge_low
+    mirror = np.empty(indptr[-1], dtype=np.int64)
+    mirror[diagonal], mirror[upper], mirror[lower] = diagonal, lower, upper
     edge_of = edge_of.reshape(len(edges_local), elements)
     slot = np.empty((corners * corners, elements), dtype=np.int64)
     for a in range(corners):
-        slot[(corners + 1) * a] = position[t[a]]  # the diagonal block of node a
+        slot[(corners + 1) * a] = diagonal[t[a]]
     for k, (a, b) in enumerate(edges_local):
         is_upper = t[a] < t[b]  # (a, b) is (low, high): the upper entry
         up, down = upper[edge_of[k]], lower[edge_of[k]]
