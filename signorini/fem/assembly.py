@@ -219,8 +219,8 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     # applied load = −Σ reactions on the loaded dofs (a push towards the obstacle is positive)
     load_full = -model.force_multiplicity * np.asarray(K_full[load_dofs].sum(axis=0)).ravel()
 
-    K_II = K_full[free][:, free].tocsr()
-    K_ID = K_full[free][:, fixed]
+    K_free = K_full[free]  # the free rows, once: then their free and their fixed columns
+    K_II, K_ID = K_free[:, free], K_free[:, fixed]
     N_free = N_full[:, free].tocsr()
     target = None if model.target_load is None else model.target_load / force_unit
     f_load, offset_load = cut_traction(model, mesh, dof_table, load_dofs)
