@@ -146,8 +146,8 @@ def lame_stiffness(mesh: Any, Lambda: float, Mu: float, *, axisymmetric: bool = 
 
 
 def _elastic_stiffness(mesh: Any, Lambda: float, Mu: float, axisymmetric: bool) -> sp.csr_matrix:
-    if not axisymmetric and mesh.t.shape[0] == mesh.p.shape[0] + 1:  # triangles or tetrahedra
-        return simplex_stiffness(mesh, Lambda, Mu)
+    if mesh.t.shape[0] == mesh.p.shape[0] + 1 and (mesh.p.shape[0] == 2 or not axisymmetric):
+        return simplex_stiffness(mesh, Lambda, Mu, axisymmetric)  # triangles or tetrahedra
     basis = Basis(mesh, ElementVector(mesh.elem()))
     form = axisymmetric_elasticity(Lambda, Mu) if axisymmetric else linear_elasticity(Lambda, Mu)
     return asm(form, basis).tocsr()

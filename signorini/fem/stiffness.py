@@ -1,7 +1,9 @@
-"""P1 stiffness matrices in closed form, vectorised: plane strain (triangles) and 3D (tetrahedra).
+"""P1 stiffness matrices in closed form, vectorised: plane strain and axisymmetric (triangles),
+3D (tetrahedra).
 
-Both are the matrices scikit-fem's ``linear_elasticity`` assembles (tests hold
-them to it, pattern included), built from each simplex's constant strain
+They are the matrices scikit-fem assembles from ``linear_elasticity`` and
+:func:`~signorini.fem.assembly.axisymmetric_elasticity` (tests hold them to it,
+pattern included), built from each simplex's constant strain
 without quadrature points and summed straight into K's pattern, which comes
 from the mesh's edges: several times faster at 10⁶ dofs, where assembly would
 otherwise cost as much as the solve.
@@ -14,7 +16,12 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTri
 
+#: the quadrature order scikit-fem's basis takes for P1 (twice the degree): the axisymmetric
+#: hoop term ∫ φₐ φ_b / r is no polynomial, and :func:`hoop_terms` integrates it with that rule
+HOOP_ORDER = 2
 #: simplices per vectorised block of :func:`simplex_stiffness` (bounds its temporary memory)
 SIMPLEX_BLOCK = 500_000
 
@@ -103,34 +110,65 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     return indptr, indices, slot, mirror
 
 
-def simplex_stiffness(mesh: Any, Lambda: float, Mu: float) -> sp.csr_matrix:
-    """The P1 stiffness of a triangle mesh (plane strain) or a tetrahedral one, dofs interleaved
-    by node (dim·i + c).
+def hoop_terms(p: np.ndarray, t: np.ndarray, grads: np.ndarray, area: np.ndarray,
+               pairs: tuple[np.ndarray, np.ndarray], Lambda: float,
+               Mu: float) -> dict[tuple[int, int], np.ndarray]:
+    """What the hoop strain ``u_r / r`` adds to entry (i, j) of the block of each node pair
+    (a, b) in ``pairs`` of each triangle, over (pair, element), per radian.
 
-    The matrix scikit-fem's ``linear_elasticity`` assembles, in closed form:
-    with the constant gradients gₐ of the barycentric coordinates and the
-    element's measure V (area or volume), the dim × dim block coupling nodes
-    a and b is ``V (λ gₐ g_bᵀ + μ g_b gₐᵀ + μ (gₐ · g_b) I)`` and that of
-    (b, a) its transpose: the pairs a ≤ b of each element (6 of 9 for a
-    triangle, 10 of 16 for a tetrahedron) are summed into K's node-by-node
-    pattern (:func:`node_pair_slots`) by ``bincount``, in element blocks of
-    :data:`SIMPLEX_BLOCK`, and each off-diagonal block then gets its mirror's
-    transpose (K is symmetric to the last bit). Entries that are exactly
-    zero are dropped, as scikit-fem does
+    With ``tr ε = div u + u_r / r`` and the weight r, the block gains
+    ``λ (A/3) (δᵢ₀ g_bⱼ + δⱼ₀ gₐᵢ)`` (``∫ φ = A/3``) and, on (r, r),
+    ``(λ + 2μ) ∫ φₐ φ_b / r``, integrated with scikit-fem's rule of order
+    :data:`HOOP_ORDER` (its quadrature points lie inside, where r > 0).
+    """
+    first, second = pairs
+    points, weights = get_quadrature(RefTri, HOOP_ORDER)
+    shape = np.array([1.0 - points[0] - points[1], points[0], points[1]])  # φₐ at the points
+    radius = shape.T @ p[0, t]  # (points, elements)
+    hoop = np.einsum("pq,qe->pe", shape[first] * shape[second], weights[:, None] / radius)
+    hoop *= 2.0 * area  # |det J|
+    third = Lambda * area / 3.0
+    g_a, g_b = grads[:, first], grads[:, second]  # (2, pairs, elements)
+    return {(0, 0): ((Lambda + 2.0 * Mu) * hoop + third * (g_a[0] + g_b[0])).ravel(),
+            (0, 1): (third * g_b[1]).ravel(), (1, 0): (third * g_a[1]).ravel()}
+
+
+def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
+                      axisymmetric: bool = False) -> sp.csr_matrix:
+    """The P1 stiffness of a triangle mesh (plane strain, or axisymmetric per radian in the
+    meridian half-plane (r, z)) or of a tetrahedral one, dofs interleaved by node (dim·i + c).
+
+    The matrix scikit-fem assembles, in closed form: with the constant
+    gradients gₐ of the barycentric coordinates and the element's measure V
+    (area or volume; ``A r̄`` with the mean radius r̄ when axisymmetric), the
+    dim × dim block coupling nodes a and b is
+    ``V (λ gₐ g_bᵀ + μ g_b gₐᵀ + μ (gₐ · g_b) I)`` (plus :func:`hoop_terms`
+    when axisymmetric) and that of (b, a) its transpose: the pairs a ≤ b of
+    each element (6 of 9 for a triangle, 10 of 16 for a tetrahedron) are
+    summed into K's node-by-node pattern (:func:`node_pair_slots`) by
+    ``bincount``, in element blocks of :data:`SIMPLEX_BLOCK`, and each
+    off-diagonal block then gets its mirror's transpose (K is symmetric to the
+    last bit). Entries that are exactly zero are dropped, as scikit-fem does
     (timings in docs/speed.md, "Building large 3D models" and "2D assembly").
     """
     p, t = mesh.p, mesh.t
     dim, corners = p.shape[0], t.shape[0]
-    if corners != dim + 1:
-        raise ValueError(f"simplex_stiffness needs triangles in 2D or tetrahedra in 3D, got "
-                         f"{corners}-node elements in {dim}D: assemble them with scikit-fem")
+    if corners != dim + 1 or (axisymmetric and dim != 2):
+        raise ValueError(f"simplex_stiffness needs triangles in 2D or tetrahedra in 3D (triangles "
+                         f"when axisymmetric), got {corners}-node elements in {dim}D: assemble "
+                         "them with scikit-fem")
     gradients = triangle_gradients if dim == 2 else tetrahedron_gradients
     nodes, elements = p.shape[1], t.shape[1]
     indptr, indices, slot, mirror = node_pair_slots(t, nodes)
     first, second = np.triu_indices(corners)
     half = np.zeros((dim, dim, indices.size))
     for start in range(0, elements, SIMPLEX_BLOCK):
-        grads, volume = gradients(p, t[:, start:start + SIMPLEX_BLOCK])
+        block = t[:, start:start + SIMPLEX_BLOCK]
+        grads, volume = gradients(p, block)
+        extra = {}
+        if axisymmetric:
+            extra = hoop_terms(p, block, grads, volume, (first, second), Lambda, Mu)
+            volume = volume * p[0, block].mean(axis=0)  # ∫ r dA
         scaled = (grads * volume)[:, first].reshape(dim, -1)  # V gₐ over (pair, element)
         paired = grads[:, second].reshape(dim, -1)  # g_b
         where = np.ascontiguousarray(slot[corners * first + second, start:start + SIMPLEX_BLOCK])
@@ -139,10 +177,12 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float) -> sp.csr_matrix:
         for i in range(dim):
             for j in range(i, dim):
                 ij, ji = scaled[i] * paired[j], scaled[j] * paired[i]
-                half[i, j] += np.bincount(where, Lambda * ij + Mu * ji + (shear if i == j else 0.0),
-                                          minlength=indices.size)
-                if i != j:
-                    half[j, i] += np.bincount(where, Lambda * ji + Mu * ij, minlength=indices.size)
+                entries = ([(i, i, Lambda * ij + Mu * ji + shear)] if i == j else
+                           [(i, j, Lambda * ij + Mu * ji), (j, i, Lambda * ji + Mu * ij)])
+                for row, col, value in entries:
+                    if (row, col) in extra:
+                        value += extra[row, col]
+                    half[row, col] += np.bincount(where, value, minlength=indices.size)
     blocks = np.empty((indices.size, dim, dim))
     on_diagonal = mirror == np.arange(mirror.size)
     for i in range(dim):
