@@ -1,6 +1,9 @@
 """Scene → :class:`ContactProblem`: stiffness, load, gap rows, weights and scales.
 
-Three kinds of model are assembled with P1 elements of scikit-fem:
+Three kinds of model are assembled with P1 elements, K in closed form on
+triangles and tetrahedra (:mod:`signorini.fem.stiffness`: the matrices
+scikit-fem assembles from the forms named below, which tests hold them to, and
+scikit-fem itself on other elements):
 
 - **plane strain** (triangles): scikit-fem's ``linear_elasticity`` with the
   Lamé parameters; quantities are per unit thickness;
