@@ -85,6 +85,40 @@ def in_process(scene: str, params: dict) -> dict:
     return parts
 
 
+def load() -> dict:
+    return json.loads(OUT.read_text())
+
+
+def table(record: dict) -> str:
+    """docs/performance.md's block: the 2D command against one factorisation, and its parts."""
+    two = record["2d"]
+    command, parts = two["command"], two["in_process"]
+    wall, once = command["wall_s"], parts["pardiso_factorise_and_solve_s"]
+    lines = [f"`{command['command']}` ({command['dofs']:,} dofs, {command['status']}), fastest of "
+             f"{record['repeat']} whole processes: **{wall:.1f} s**, {command['peak_gb']:.2f} GB peak; "
+             f"PARDISO's factorisation and one solve of the same K, in the same run: "
+             f"**{once:.1f} s**, so the command is **{wall / once:.2f}×** one factorisation.", "",
+             "| part (in one process, after the command) | seconds | of the command |",
+             "|---|---:|---:|"]
+    for label, key in (("the model built: meshing and assembly", "build_s"),
+                       ("`signorini.solve`: built again, load matched, solved, judged", "solve_s"),
+                       ("the certificate, once more alone (the method's factorisation)",
+                        "certificate_s"),
+                       ("the error estimate", "estimate_s"),
+                       ("PARDISO: factorise K", "pardiso_factorise_s"),
+                       ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s")):
+        lines.append(f"| {label} | {parts[key]:.2f} | {100 * parts[key] / wall:.0f} % |")
+    if "3d" in record:
+        three = record["3d"]["command"]
+        lines += ["", f"3D, `{three['command']}` ({three['dofs']:,} dofs, {three['status']}): "
+                      f"**{three['wall_s']:.1f} s** whole process, {three['peak_gb']:.2f} GB peak."]
+    machine = record["machine"]
+    lines += ["", f"Measured {record['date'][:10]} on {machine['cores']} cores "
+                  f"({machine['processor']}, Python {machine['python']}) by `tools/budget.py`; the "
+                  "run is `docs/speed/budget.json`."]
+    return "\n".join(lines)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=2)
