@@ -349,7 +349,7 @@ def test_vectorised_solid_stiffness_is_scikit_fems(monkeypatch):
     mesh = MeshTet(mesh.p * [[1.3], [0.7], [1.1]] + 0.1 * np.sin(mesh.p), mesh.t)  # distorted
     Lambda, Mu = lame_parameters(2.0, 0.3)
     expected = asm(linear_elasticity(Lambda, Mu), Basis(mesh, ElementVector(mesh.elem())))
-    monkeypatch.setattr(assembly, "TETRA_BLOCK", 97)  # several blocks, a ragged last one
+    monkeypatch.setattr(assembly, "SIMPLEX_BLOCK", 97)  # several blocks, a ragged last one
     difference = abs(assembly.solid_stiffness(mesh, Lambda, Mu) - expected).max()
     assert difference <= 1e-12 * abs(expected).max()
 
@@ -388,3 +388,68 @@ def test_an_obstacle_away_from_the_origin_gives_the_same_gaps_in_any_units():
     np.testing.assert_allclose(scaled.d * scaled.scales.displacement, raw.d, rtol=1e-12)
     first = np.argmin(raw.contact_points[:, 0] ** 2 + raw.contact_points[:, 1] ** 2)
     assert raw.d[first] == pytest.approx(0.02)  # the flat lies 0.02 below the first point
+
+
+def _graded_mesh():
+    from skfem import MeshTri
+
+    x = np.cumsum(np.r_[0.0, 1.3 ** np.arange(12)])  # cells growing by 30 % from the left
+    y = np.cumsum(np.r_[0.0, 0.7 ** np.arange(9)])
+    return MeshTri.init_tensor(x / x[-1], y / y[-1])
+
+
+def _irregular_mesh():
+    from skfem import MeshTri
+
+    mesh = MeshTri.init_circle(4)
+    shift = 0.2 * np.random.default_rng(3).uniform(-1, 1, mesh.p.shape) / 2 ** 4
+    inside = np.ones(mesh.p.shape[1], dtype=bool)
+    inside[mesh.boundary_nodes()] = False
+    # jittered interior (no two elements alike), in r > 0 for the axisymmetric model
+    return MeshTri(mesh.p + shift * inside + [[1.1], [0.0]], mesh.t)
+
+
+@pytest.mark.parametrize("axisymmetric", [False, True])
+@pytest.mark.parametrize("make_mesh", [_graded_mesh, _irregular_mesh])  # graded: nodes on r = 0
+def test_triangle_stiffness_has_scikit_fems_pattern_and_entries(make_mesh, axisymmetric):
+    from skfem import Basis, ElementVector, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    from signorini.fem.assembly import axisymmetric_elasticity
+    from signorini.fem.stiffness import node_pair_slots, simplex_stiffness
+
+    mesh = make_mesh()
+    Lambda, Mu = lame_parameters(2.5, 0.35)
+    form = (axisymmetric_elasticity if axisymmetric else linear_elasticity)(Lambda, Mu)
+    expected = asm(form, Basis(mesh, ElementVector(mesh.elem()))).tocsr()
+    K = simplex_stiffness(mesh, Lambda, Mu, axisymmetric)
+    assert K.has_sorted_indices
+    largest = np.max(np.abs(expected.data))
+    assert abs(K - expected).max() <= 1e-12 * largest
+    if axisymmetric:  # the quadrature's sums may cancel to an exact zero where ours leave round-off
+        ours, theirs = ({(i, j) for i, j, v in zip(M.row, M.col, M.data) if v != 0}
+                        for M in (K.tocoo(), expected.tocoo()))
+        assert theirs <= ours
+        assert all(abs(K[i, j]) <= 1e-15 * largest for i, j in ours - theirs)
+    else:
+        np.testing.assert_array_equal(K.indptr, expected.indptr)
+        np.testing.assert_array_equal(K.indices, expected.indices)
+    assert abs(K - K.T).max() == 0.0  # each off-diagonal block is its mirror's transpose
+    # the node pattern holds every node and both ends of every edge, each pair in its own slot
+    nodes, corners = mesh.p.shape[1], mesh.t.shape[0]
+    indptr, indices, slot, mirror = node_pair_slots(mesh.t, nodes)
+    assert indices.size == nodes + 2 * mesh.facets.shape[1]
+    row_of = np.repeat(np.arange(nodes), np.diff(indptr))
+    for a in range(corners):
+        for b in range(corners):
+            np.testing.assert_array_equal(row_of[slot[corners * a + b]], mesh.t[a])
+            np.testing.assert_array_equal(indices[slot[corners * a + b]], mesh.t[b])
+    np.testing.assert_array_equal(mirror[mirror], np.arange(indices.size))
+
+
+@pytest.mark.parametrize("bound", [50, 2 ** 62])  # packed into one value sort; too wide: argsort
+def test_sort_order_is_a_stable_argsort(bound):
+    from signorini.fem.stiffness import sort_order
+
+    keys = np.random.default_rng(5).integers(0, 50, 1000) * (bound // 50)
+    np.testing.assert_array_equal(sort_order(keys, bound), np.argsort(keys, kind="stable"))

@@ -18,6 +18,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
 import amg_bench  # noqa: E402  (tools/amg_bench.py: 3D at scale, docs/amg)
+import budget  # noqa: E402  (tools/budget.py: the 10⁶-dof command against one factorisation)
 import derivatives as derivative_cost  # noqa: E402  (tools/derivatives.py: a derivative against the solve)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
@@ -123,7 +124,8 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
                 "nested-ratios": nested_ratios(ROOT / "docs" / "bench-nested" / "bench.csv"),
                 "amg": amg_bench.readme_paragraph(amg_bench.read()),
                 "amg-scale": amg_bench.scale_table(amg_bench.read()),
-                "amg-nested-again": amg_bench.nested_again(amg_bench.read())}
+                "amg-nested-again": amg_bench.nested_again(amg_bench.read()),
+                "budget": budget.table(budget.load())}
     if document == ACCURACY:
         runs = {}
         for name in ("peer-nu0", "peer-nu045"):  # every run of docs/peer-nu0, docs/peer-nu045

@@ -1,6 +1,9 @@
 """Scene → :class:`ContactProblem`: stiffness, load, gap rows, weights and scales.
 
-Three kinds of model are assembled with P1 elements of scikit-fem:
+Three kinds of model are assembled with P1 elements, K in closed form on
+triangles and tetrahedra (:mod:`signorini.fem.stiffness`: the matrices
+scikit-fem assembles from the forms named below, which tests hold them to, and
+scikit-fem itself on other elements):
 
 - **plane strain** (triangles): scikit-fem's ``linear_elasticity`` with the
   Lamé parameters; quantities are per unit thickness;
@@ -40,7 +43,7 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
-from signorini.fem.stiffness import plane_strain_stiffness, solid_stiffness
+from signorini.fem.stiffness import simplex_stiffness
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import volumetric_stiffness
 from signorini.problem import ContactProblem, Discretisation, Push, Scales, Watch
@@ -146,10 +149,8 @@ def lame_stiffness(mesh: Any, Lambda: float, Mu: float, *, axisymmetric: bool = 
 
 
 def _elastic_stiffness(mesh: Any, Lambda: float, Mu: float, axisymmetric: bool) -> sp.csr_matrix:
-    if mesh.p.shape[0] == 2 and not axisymmetric:
-        return plane_strain_stiffness(mesh, Lambda, Mu)
-    if mesh.p.shape[0] == 3 and mesh.t.shape[0] == 4:
-        return solid_stiffness(mesh, Lambda, Mu)
+    if mesh.t.shape[0] == mesh.p.shape[0] + 1 and (mesh.p.shape[0] == 2 or not axisymmetric):
+        return simplex_stiffness(mesh, Lambda, Mu, axisymmetric)  # triangles or tetrahedra
     basis = Basis(mesh, ElementVector(mesh.elem()))
     form = axisymmetric_elasticity(Lambda, Mu) if axisymmetric else linear_elasticity(Lambda, Mu)
     return asm(form, basis).tocsr()
@@ -223,8 +224,8 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     # applied load = −Σ reactions on the loaded dofs (a push towards the obstacle is positive)
     load_full = -model.force_multiplicity * np.asarray(K_full[load_dofs].sum(axis=0)).ravel()
 
-    K_II = K_full[free][:, free].tocsr()
-    K_ID = K_full[free][:, fixed]
+    K_free = K_full[free]  # the free rows, once: then their free and their fixed columns
+    K_II, K_ID = K_free[:, free], K_free[:, fixed]
     N_free = N_full[:, free].tocsr()
     target = None if model.target_load is None else model.target_load / force_unit
     f_load, offset_load = cut_traction(model, mesh, dof_table, load_dofs)

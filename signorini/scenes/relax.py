@@ -65,9 +65,10 @@ def relax(points: np.ndarray, distance: Field, size: Field, fixed: np.ndarray,
         if np.max(np.linalg.norm(p - last, axis=0) / h) > RETRIANGULATE:
             last = p.copy()
             t, bars = _triangulate(p, distance, eps)
-        vec = p[:, bars[:, 0]] - p[:, bars[:, 1]]
+        start, end = p[:, bars[:, 0]], p[:, bars[:, 1]]
+        vec = start - end
         length = np.linalg.norm(vec, axis=0)
-        wanted = size(0.5 * (p[:, bars[:, 0]] + p[:, bars[:, 1]]))
+        wanted = size(0.5 * (start + end))
         wanted *= STRETCH * np.sqrt(np.sum(length ** 2) / np.sum(wanted ** 2))
         push = np.maximum(wanted - length, 0.0) / length * vec
         n = p.shape[1]
@@ -75,11 +76,13 @@ def relax(points: np.ndarray, distance: Field, size: Field, fixed: np.ndarray,
                           for k in range(2)])
         move = STEP * force * free
         p += move
-        outside = distance(p) > 0
-        if outside.any():
-            p[:, outside] -= distance(p[:, outside]) * _gradient(distance, p[:, outside], eps)
+        signed = distance(p)
+        outside = signed > 0
+        if outside.any():  # projected back: only their distance changes
+            p[:, outside] -= signed[outside] * _gradient(distance, p[:, outside], eps)
+            signed[outside] = distance(p[:, outside])
         h = size(p)
-        inside = free & (distance(p) < -eps)
+        inside = free & (signed < -eps)
         if not inside.any() or np.max(np.linalg.norm(move[:, inside], axis=0) / h[inside]) < SETTLED:
             break
     p = snap(p, 10 * eps)

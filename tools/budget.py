@@ -1,0 +1,150 @@
+"""A large command against the one solve it cannot avoid, measured in the same run.
+
+    .venv/bin/python tools/budget.py            # ~3 min here; writes docs/speed/budget.json
+    .venv/bin/python tools/budget.py --3d       # also the 3D default at 350k dofs (~2 more min)
+
+2D: the 10⁶-dof cylinder command, whole process (start to exit, ``/usr/bin/time -v`` for its
+peak memory), the fastest of ``--repeat`` runs; then, in one process, its parts: the model
+built (meshing and assembly), the solve through the API, the certificate and the estimate, and
+the same K factorised by PARDISO (SPD, the package's settings) and solved once, which no
+method can do without. 3D: the command's whole process. docs/speed.md quotes the JSON
+(tests/test_readme_numbers.py holds it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs" / "speed" / "budget.json"
+CASES = {
+    "2d": ("hertz-cylinder", {"refine": 3, "n_contact": 110, "grading": 0.1}),
+    "3d": ("hertz-sphere-3d", {"refine": 2}),
+}
+
+
+def whole_process(scene: str, params: dict) -> dict:
+    """One run of ``signorini solve`` in its own process: wall time, peak memory, its record."""
+    with tempfile.TemporaryDirectory() as folder:
+        record = Path(folder) / "result.json"
+        argv = [sys.executable, "-m", "signorini.cli", "solve", scene, "--json", str(record)]
+        for key, value in params.items():
+            argv += ["--set", f"{key}={value}"]
+        start = time.perf_counter()
+        done = subprocess.run(["/usr/bin/time", "-v", *argv], capture_output=True, text=True,
+                              cwd=ROOT)
+        wall = time.perf_counter() - start
+        if done.returncode != 0:
+            raise SystemExit(f"{' '.join(argv)} failed:\n{done.stderr[-2000:]}")
+        peak = re.search(r"Maximum resident set size \(kbytes\): (\d+)", done.stderr)
+        result = json.loads(record.read_text())
+    return {"command": " ".join(["signorini", *argv[3:-2]]), "wall_s": wall,
+            "peak_gb": int(peak.group(1)) / 1e6 if peak else None, "status": result["status"],
+            "dofs": result["dofs"], "time": result["time"], "hertz": result.get("hertz")}
+
+
+def in_process(scene: str, params: dict) -> dict:
+    """The command's parts in one process: the model built (mesh and assembly), the whole solve
+    through the API, the certificate and the estimate (each computed once more, alone), and K
+    factorised by PARDISO and solved once."""
+    import numpy as np
+
+    import signorini
+    from signorini.numerics.factor import PardisoFactor
+    from signorini.scenes.build import build_problem
+
+    start = time.perf_counter()
+    problem = build_problem(scene, params)
+    parts = {"dofs": problem.n, "build_s": time.perf_counter() - start}
+    del problem
+    start = time.perf_counter()
+    result = signorini.solve(scene, params=params)
+    parts["solve_s"] = time.perf_counter() - start  # built again, solved, judged
+    start = time.perf_counter()
+    result.estimate
+    parts["estimate_s"] = time.perf_counter() - start
+    start = time.perf_counter()
+    signorini.certificate(result.problem, result.solution)  # with the method's factorisation
+    parts["certificate_s"] = time.perf_counter() - start
+    K, f = result.problem.K, np.asarray(result.problem.f, dtype=float)
+    del result
+    start = time.perf_counter()
+    factor = PardisoFactor(K)
+    parts["pardiso_factorise_s"] = time.perf_counter() - start
+    factor.solve(f)
+    parts["pardiso_factorise_and_solve_s"] = time.perf_counter() - start
+    return parts
+
+
+def load() -> dict:
+    return json.loads(OUT.read_text())
+
+
+def table(record: dict) -> str:
+    """docs/performance.md's block: the 2D command against one factorisation, and its parts."""
+    two = record["2d"]
+    command, parts = two["command"], two["in_process"]
+    wall, once = command["wall_s"], parts["pardiso_factorise_and_solve_s"]
+    lines = [f"`{command['command']}` ({command['dofs']:,} dofs, {command['status']}), fastest of "
+             f"{record['repeat']} whole processes: **{wall:.1f} s**, {command['peak_gb']:.2f} GB peak; "
+             f"PARDISO's factorisation and one solve of the same K, in the same run: "
+             f"**{once:.1f} s**, so the command is **{wall / once:.2f}×** one factorisation.", "",
+             "| part (in one process, after the command) | seconds | of the command |",
+             "|---|---:|---:|"]
+    for label, key in (("the model built: meshing and assembly", "build_s"),
+                       ("`signorini.solve`: built again, load matched, solved, judged", "solve_s"),
+                       ("the certificate, once more alone (the method's factorisation)",
+                        "certificate_s"),
+                       ("the error estimate", "estimate_s"),
+                       ("PARDISO: factorise K", "pardiso_factorise_s"),
+                       ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s")):
+        lines.append(f"| {label} | {parts[key]:.2f} | {100 * parts[key] / wall:.0f} % |")
+    if "3d" in record:
+        three = record["3d"]["command"]
+        lines += ["", f"3D, `{three['command']}` ({three['dofs']:,} dofs, {three['status']}): "
+                      f"**{three['wall_s']:.1f} s** whole process, {three['peak_gb']:.2f} GB peak."]
+    machine = record["machine"]
+    lines += ["", f"Measured {record['date'][:10]} on {machine['cores']} cores "
+                  f"({machine['processor']}, Python {machine['python']}) by `tools/budget.py`; the "
+                  "run is `docs/speed/budget.json`."]
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=2)
+    parser.add_argument("--3d", dest="three", action="store_true")
+    args = parser.parse_args()
+    out = {"machine": {"system": platform.platform(), "python": platform.python_version(),
+                       "processor": platform.processor() or platform.machine(),
+                       "cores": __import__("os").cpu_count()},
+           "date": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+           "repeat": args.repeat}
+    scene, params = CASES["2d"]
+    runs = [whole_process(scene, params) for _ in range(args.repeat)]
+    out["2d"] = {"command": min(runs, key=lambda r: r["wall_s"]),
+                 "walls_s": [r["wall_s"] for r in runs],
+                 "in_process": in_process(scene, params)}
+    if args.three:
+        scene, params = CASES["3d"]
+        runs = [whole_process(scene, params) for _ in range(args.repeat)]
+        out["3d"] = {"command": min(runs, key=lambda r: r["wall_s"]),
+                     "walls_s": [r["wall_s"] for r in runs]}
+    OUT.write_text(json.dumps(out, indent=1) + "\n")
+    two = out["2d"]
+    once = two["in_process"]["pardiso_factorise_and_solve_s"]
+    print(f"2D: {two['command']['wall_s']:.1f} s whole process, PARDISO's factorisation and solve "
+          f"{once:.1f} s: {two['command']['wall_s'] / once:.2f}x")
+
+
+if __name__ == "__main__":
+    main()
