@@ -350,8 +350,7 @@ def primal_dual_gap(problem: ContactProblem, u: np.ndarray, lam: np.ndarray, fac
     lam_plus = np.maximum(lam, 0.0)
     Ku = problem.K @ u if Ku is None else Ku
     for factor in factors:
-        pinned = getattr(factor, "pinned", None) if isinstance(factor, _Remembering) \
-            else _pinned_rows(problem, factor)
+        pinned = factor.pinned if isinstance(factor, _Remembering) else _pinned_rows(problem, factor)
         if pinned is not None:
             gap = _gap_on(problem, u, lam_plus, Ku, factor, *pinned)
             if gap is not None:
