@@ -218,21 +218,16 @@ def pardiso_factor_bytes(iparm: np.ndarray) -> float:
 
 
 def _pypardiso():
-    """pypardiso, imported with MKL's library named in its documented ``PYPARDISO_MKL_RT``.
-
-    Unless told, pypardiso finds MKL by a recursive search of the environment on import and
-    again for every new solver (0.3-0.4 s each); a pip-installed MKL sits in ``<prefix>/lib``.
-    """
+    """pypardiso, told where a pip-installed MKL is (``<prefix>/lib``) through its documented
+    ``PYPARDISO_MKL_RT``: else it searches the whole environment on import and per solver."""
     if "PYPARDISO_MKL_RT" not in os.environ:
         import glob
         import site
 
-        for lib in (f"{sys.prefix}/lib", f"{site.USER_BASE}/lib"):
-            found = sorted(glob.glob(f"{lib}/libmkl_rt.so*") + glob.glob(f"{lib}/libmkl_rt*.dylib"),
-                           key=len)
-            if found:
-                os.environ["PYPARDISO_MKL_RT"] = found[0]
-                break
+        found = [path for lib in (sys.prefix, site.USER_BASE)
+                 for path in sorted(glob.glob(f"{lib}/lib/libmkl_rt.*"), key=len)]
+        if found:
+            os.environ["PYPARDISO_MKL_RT"] = found[0]
     import pypardiso  # MKL: imported only for a matrix PARDISO factorises
 
     return pypardiso
