@@ -159,12 +159,13 @@ class WithDelassus:
 
 def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.ndarray):
     """``M⁻¹`` from a plain factorisation of K, through ``S = N_A K⁻¹ N_Aᵀ`` (|A| back-solves,
-    none when the factorisation comes with the Delassus operator of N: :class:`WithDelassus`)."""
+    none when the factorisation comes with the Delassus operator of N, as :class:`WithDelassus`
+    and a wrapper of one do)."""
     N_A = N[rows]
     NT = sp.csc_matrix(N_A.T)
     k = N_A.shape[0]
     offered, Z = solve.factor, None
-    if isinstance(offered, WithDelassus) and offered.N.shape == N.shape \
+    if getattr(offered, "delassus", None) is not None and offered.N.shape == N.shape \
             and (offered.N != N).nnz == 0:
         S = offered.delassus[np.ix_(rows, rows)]
     else:

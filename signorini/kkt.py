@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.forward_error import ForwardError, WithDelassus, forward_error
+from signorini.forward_error import ForwardError, forward_error
 from signorini.numerics.factor import selection_dofs
 from signorini import problem as problem_module
 from signorini.problem import ContactProblem, ContactSolution
@@ -266,9 +266,8 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
         offered = [offers.wrap(problem.factor())]
     if not offered:
         return ForwardError.unknown()
-    factor = offered[0].factor if isinstance(offered[0].factor, WithDelassus) else offered[0]
     return forward_error(problem.K, problem.f, problem.N, problem.d, solution.u, solution.lam,
-                         active_set(problem, solution), factor, scale)
+                         active_set(problem, solution), offered[0], scale)
 
 
 #: what the certificate says when it cannot vouch for the contact force, by the error's name

@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import platform
 import re
 import subprocess
@@ -132,7 +133,7 @@ def main() -> None:
     args = parser.parse_args()
     out = {"machine": {"system": platform.platform(), "python": platform.python_version(),
                        "processor": platform.processor() or platform.machine(),
-                       "cores": __import__("os").cpu_count()},
+                       "cores": os.cpu_count()},
            "date": datetime.now(timezone.utc).isoformat(timespec="seconds"),
            "repeat": args.repeat}
     scene, params = CASES["2d"]

@@ -38,7 +38,6 @@ thickness in plane strain and per radian in axisymmetric models.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -46,7 +45,8 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 
 from signorini.fem.topology import facets_on
-from signorini.fem.volumetric import barycentric_gradients, nodal_volumetric_strain, simplex_gradients
+from signorini.fem.stiffness import barycentric_gradients
+from signorini.fem.volumetric import nodal_volumetric_strain, simplex_gradients
 from signorini.kkt import active_set
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -433,10 +433,9 @@ def _constant_strains(mesh: Any, u: np.ndarray, Lambda: float,
     quadrature of order 2 gives (it is exact here), without its points.
     """
     dim = mesh.p.shape[0]
-    gradients, jacobian = barycentric_gradients(mesh)  # (d + 1, dim, elements)
-    volume = jacobian / math.factorial(dim)
+    gradients, volume = barycentric_gradients(mesh.p, mesh.t)  # (dim, d + 1, elements)
     values = np.take(u.T, mesh.t, axis=1)  # (dim, d + 1, elements)
-    grad = np.einsum("ike,kje->ije", values, gradients)  # ∂u_i/∂x_j per element
+    grad = np.einsum("ike,jke->ije", values, gradients)  # ∂u_i/∂x_j per element
     eps = np.array([0.5 * (grad[i, j] + grad[j, i]) for i, j in STRAIN_PAIRS[dim]])  # (c, e)
     energy = energy_density(eps, Lambda, Mu, dim) * volume
     corners = mesh.t.shape[0]

@@ -48,6 +48,15 @@ def tetrahedron_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.
     return grads, np.abs(det) / 6.0
 
 
+def barycentric_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gradients (dim components, d + 1 nodes, elements) of each simplex's barycentric
+    coordinates and its measure: :func:`triangle_gradients` or :func:`tetrahedron_gradients`."""
+    if t.shape[0] != p.shape[0] + 1 or p.shape[0] not in (2, 3):
+        raise ValueError(f"barycentric gradients: triangles or tetrahedra, got {t.shape[0]} "
+                         f"corners in {p.shape[0]}D")
+    return (triangle_gradients if p.shape[0] == 2 else tetrahedron_gradients)(p, t)
+
+
 def sort_order(keys: np.ndarray, bound: int) -> np.ndarray:
     """``np.argsort(keys, kind="stable")`` of non-negative integer ``keys`` below ``bound``.
 
@@ -157,14 +166,13 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
         raise ValueError(f"simplex_stiffness needs triangles in 2D or tetrahedra in 3D (triangles "
                          f"when axisymmetric), got {corners}-node elements in {dim}D: assemble "
                          "them with scikit-fem")
-    gradients = triangle_gradients if dim == 2 else tetrahedron_gradients
     nodes, elements = p.shape[1], t.shape[1]
     indptr, indices, slot, mirror = node_pair_slots(t, nodes)
     first, second = np.triu_indices(corners)
     half = np.zeros((dim, dim, indices.size))
     for start in range(0, elements, SIMPLEX_BLOCK):
         block = t[:, start:start + SIMPLEX_BLOCK]
-        grads, volume = gradients(p, block)
+        grads, volume = barycentric_gradients(p, block)
         extra = {}
         if axisymmetric:
             extra = hoop_terms(p, block, grads, volume, (first, second), Lambda, Mu)

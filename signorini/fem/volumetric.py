@@ -30,10 +30,13 @@ and 5.2 times on tetrahedra (on the Hertz scenes: docs/accuracy.md, §4).
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+
+from signorini.fem.stiffness import barycentric_gradients
 
 #: the scenes' parameter ``volumetric``: element by element (plain P1), averaged at the nodes, or
 #: ``auto``: averaged from :data:`NODAL_FROM_NU` on
@@ -55,46 +58,12 @@ def resolve(choice: str, nu: float, dim: int = 2) -> str:
     return choice
 
 
-def barycentric_gradients(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Gradients (d + 1, dim, elements) of every simplex's barycentric coordinates, and ``|det J|``
-    of its map from the reference simplex (d! times its measure), in closed form.
-
-    With the edges from the first corner as the columns of J, the rows of J⁻¹ are the gradients
-    of the coordinates 1..d: ``(e₂ᵧ, −e₂ₓ) / det``, ``(−e₁ᵧ, e₁ₓ) / det`` on triangles and
-    ``(e₂ × e₃) / det``, ``(e₃ × e₁) / det``, ``(e₁ × e₂) / det`` on tetrahedra (``det =
-    e₁ · (e₂ × e₃)``); the first corner's is minus their sum.
-    """
-    p, t = mesh.p, mesh.t
-    dim = p.shape[0]
-    if dim not in (2, 3) or t.shape[0] != dim + 1:
-        raise ValueError(f"simplex_gradients: triangles or tetrahedra, got {t.shape[0]} corners "
-                         f"in {dim}D")
-    corners = np.take(p, t, axis=1)  # (dim, d + 1, elements); faster than p[:, t]
-    edges = corners[:, 1:] - corners[:, :1]  # (dim, d, elements): edge k from the first corner
-    if dim == 2:
-        (ax, bx), (ay, by) = edges
-        det = ax * by - ay * bx
-        rows = np.array([[by, -bx], [-ay, ax]])
-    else:
-        a, b, c = edges[:, 0], edges[:, 1], edges[:, 2]
-        rows = np.array([_cross(b, c), _cross(c, a), _cross(a, b)])
-        det = np.einsum("ie,ie->e", a, rows[0])
-    rows /= det
-    gradients = np.concatenate([-rows.sum(axis=0, keepdims=True), rows])
-    return gradients, np.abs(det)
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a × b`` of vectors stored by component (3, elements)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 def simplex_gradients(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
     """Gradients (elements, d + 1, dim) of every simplex's barycentric coordinates, and ``|det J|``
-    of its map from the reference simplex (d! times its measure): :func:`barycentric_gradients`
-    laid out by element."""
-    gradients, jacobian = barycentric_gradients(mesh)
-    return np.moveaxis(gradients, -1, 0), jacobian
+    of its map from the reference simplex (d! times its measure), in closed form
+    (:func:`signorini.fem.stiffness.barycentric_gradients`) laid out by element."""
+    gradients, measure = barycentric_gradients(mesh.p, mesh.t)
+    return gradients.transpose(2, 1, 0), measure * math.factorial(mesh.p.shape[0])
 
 
 def averaging(mesh: Any, axisymmetric: bool = False) -> tuple[sp.csr_matrix, np.ndarray]:
