@@ -61,8 +61,8 @@ def _nodes(t: np.ndarray, element: int) -> str:
 def signed_measures(p: np.ndarray, t: np.ndarray) -> np.ndarray:
     """``det[p₁ − p₀, …, p_d − p₀]`` of each simplex (d! times its signed area or volume)."""
     rows = np.ascontiguousarray(p.T)  # gathering rows is several times faster than columns
-    origin = rows[t[0]]
-    edges = [rows[t[i]] - origin for i in range(1, t.shape[0])]
+    origin = np.take(rows, t[0], axis=0)  # np.take: several times faster than rows[t[0]]
+    edges = [np.take(rows, t[i], axis=0) - origin for i in range(1, t.shape[0])]
     if len(edges) == 2:
         return edges[0][:, 0] * edges[1][:, 1] - edges[0][:, 1] * edges[1][:, 0]
     return np.einsum("ij,ij->i", edges[0], np.cross(edges[1], edges[2]))
@@ -91,7 +91,8 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> 
                          f"mesh does not have (it has {p.shape[1]})")
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is a degenerate element
         rows = np.ascontiguousarray(p.T)
-        squares = [rows[t[i]] - rows[t[j]] for i, j in combinations(range(dim + 1), 2)]
+        corners = [np.take(rows, t[i], axis=0) for i in range(dim + 1)]
+        squares = [corners[i] - corners[j] for i, j in combinations(range(dim + 1), 2)]
         longest = np.sqrt(np.max([np.einsum("ij,ij->i", e, e) for e in squares], axis=0))
         volume = signed_measures(p, t)
         degenerate = ~(np.abs(volume) > DEGENERATE * longest ** dim)
