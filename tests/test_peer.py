@@ -158,6 +158,23 @@ def test_a_runner_that_answers_nothing_says_so(tmp_path):
     assert point.solves_message and peer._in_process(point)["in_process_s"] is None
 
 
+@pytest.mark.parametrize("answer, word", [
+    ({"runs_s": [0.3, 0.2], "dofs": 1957, "status": "not converged"}, "not converged"),
+    ({"runs_s": [0.3], "dofs": 1957, "status": "converged"}, "1 of 2 solves timed"),
+    ({"runs_s": [0.3, 0.2], "dofs": 2000, "status": "converged"}, "2000 dofs in process, 1957"),
+    ({"runs_s": [0.3, 0.2], "dofs": 1957, "status": "converged"}, ""),
+])
+def test_an_in_process_answer_that_is_not_the_whole_process_s_says_so(monkeypatch, answer, word):
+    """A solve that failed, fewer solves than asked, or another model than the whole process
+    timed: the point's in-process message says which (and is empty when all is well)."""
+    (point,) = [p for p in peer.ladder(["hertz-cylinder"], [0], {}) if p.code == "signorini"]
+    point.row = {"dofs": 1957}
+    done = subprocess.CompletedProcess([], 0, stdout=json.dumps(answer), stderr="")
+    monkeypatch.setattr(peer, "_timed", lambda argv, timeout: (done, 1.0, ""))
+    assert peer.time_in_process(point, 2, python="python", timeout=1) == answer["runs_s"]
+    assert (word in point.solves_message) and bool(point.solves_message) == bool(word)
+
+
 def test_the_in_process_time_is_the_fastest_after_the_warm_up():
     point = peer.Point("hertz-cylinder", "signorini", 0, {}, {}, solves=[0.1, 0.5, 0.3, 0.4])
     assert peer._in_process(point) == {"in_process_runs_s": [0.1, 0.5, 0.3, 0.4], "in_process_s": 0.3}

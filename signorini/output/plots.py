@@ -218,6 +218,7 @@ def peer_times(rows: list[dict], *, by: str = "wall_s", label: str = "wall time 
         for error, seconds, row in zip(errors, times, mine):
             ax.annotate(f"{row['dofs'] / 1000:.3g}k", (error, seconds), textcoords="offset points",
                         xytext=(4, 3), fontsize=6, color=colour)
+    ax.margins(x=0.1)  # room for the dofs beside the outermost points
     if not drawn:
         ax.text(0.5, 0.5, "not measured", ha="center", va="center", transform=ax.transAxes)
     ax.set_xlabel("max(|p₀ error|, |a error|) against Hertz")

@@ -263,8 +263,12 @@ def time_in_process(point: Point, solves: int, *, python: str, timeout: float) -
     record = record or {}
     point.solves = [float(t) for t in record.get("runs_s", [])]
     status = record.get("status") or ("converged" if record.get("converged") else "not converged")
-    if message or len(point.solves) != solves or status != "converged":
-        point.solves_message = message or f"{len(point.solves)} of {solves} solves timed, {status}"
+    dofs, whole = record.get("dofs"), point.row.get("dofs")
+    point.solves_message = message
+    if not message and (len(point.solves) != solves or status != "converged"):
+        point.solves_message = f"{len(point.solves)} of {solves} solves timed, {status}"
+    elif not message and whole is not None and dofs != whole:  # both measures time one model
+        point.solves_message = f"{dofs} dofs in process, {whole} in the whole process"
     return point.solves
 
 
@@ -397,7 +401,8 @@ def peer_figure(rows: list[dict[str, Any]]):
 
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     figure = Figure(figsize=(10, 3.8 * len(scenes)), layout="constrained")
-    grid = figure.subplots(len(scenes), len(MEASURES), squeeze=False, sharey="row")
+    grid = figure.subplots(len(scenes), len(MEASURES), squeeze=False, sharex="row",
+                           sharey="row")
     for scene, panels in zip(scenes, grid):
         mine = [dict(r, error=_error(r)) for r in rows if r["scene"] == scene]
         for ax, (by, measure) in zip(panels, MEASURES.items()):
