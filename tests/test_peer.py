@@ -107,7 +107,7 @@ def test_getfem_solves_hertz_on_a_coarse_mesh(scene, tolerance):
 def test_the_command_writes_the_table_on_a_tiny_ladder(tmp_path, capsys, saved_figures):
     out = tmp_path / "peer"
     code = main(["bench", "--peer", "getfem", "--scene", "hertz-cylinder", "--sizes", "0",
-                 "--repeat", "1", "--out", str(out)])
+                 "--repeat", "1", "--in-process", "2", "--out", str(out)])
     printed = capsys.readouterr().out
     assert code == 0 and "report:" in printed
     assert {p.name for p in out.iterdir()} == {"peer.csv", "peer.json", "peer.md", "peer.png"}
@@ -116,19 +116,117 @@ def test_the_command_writes_the_table_on_a_tiny_ladder(tmp_path, capsys, saved_f
     assert all(r["status"] == "converged" and abs(float(r["p0_rel"])) < 0.02 for r in rows)
     table = (out / "peer.md").read_text()
     assert "| hertz-cylinder | GetFEM | h = a/16 |" in table and "| signorini |" in table
-    assert "0.3 %" in table
-    # the figure: each code's |p0| and |a| errors against dofs (left) and wall time (right)
-    left, right = saved_figures[0].axes
-    assert left.get_xlabel() == "dofs" and right.get_xlabel() == "whole-process wall time [s]"
-    for ax, x in ((left, "dofs"), (right, "wall_s")):
+    assert "| 0.3 % | whole process |" in table and "| 0.3 % | in process |" in table
+    # the figure: time against the larger of the p0 and a errors, whole process then in process
+    panels = saved_figures[0].axes
+    assert [ax.get_ylabel() for ax in panels] == ["whole process wall time [s]", "in process wall time [s]"]
+    for ax, key in zip(panels, ("wall_s", "in_process_s")):
         lines = {line.get_label(): line for line in ax.get_lines()}
         for row in rows:
-            for key, name in (("p0_rel", "p₀"), ("a_rel", "a")):
-                line = lines[f"{row['code']}: {name}"]
-                assert line.get_xdata()[0] == pytest.approx(float(row[x]))
-                assert line.get_ydata()[0] == pytest.approx(max(abs(float(row[key])), 1e-6))
+            line = lines[peer.NAMES[row["code"]]]
+            error = max(abs(float(row["p0_rel"])), abs(float(row["a_rel"])))
+            assert line.get_xdata()[0] == pytest.approx(error)
+            assert line.get_ydata()[0] == pytest.approx(float(row[key]))
     record = json.loads((out / "peer.json").read_text())
     assert record["repeat"] == 1 and len(record["rows"][0]["walls_s"]) == 1
+    assert record["in_process"] == 2
+    for row, written in zip(record["rows"], rows):
+        assert len(row["in_process_runs_s"]) == 3
+        assert row["in_process_s"] == min(row["in_process_runs_s"][1:])
+        assert [float(t) for t in written["in_process_runs_s"].split()] == pytest.approx(
+            row["in_process_runs_s"], rel=1e-5)
+
+
+def test_our_in_process_runner_times_every_solve_in_one_process():
+    """This package's side: a fresh Python that calls signorini.solve N times, N times back."""
+    (point,) = [p for p in peer.ladder(["hertz-cylinder"], [0], {}) if p.code == "signorini"]
+    solves = peer.time_in_process(point, 2, python=peer.system_python(), timeout=300)
+    assert len(solves) == 2 and all(t > 0 for t in solves) and point.solves_message == ""
+
+
+@pytest.mark.usefixtures("getfem")
+def test_the_getfem_script_times_every_solve_in_one_process():
+    """GetFEM's side: the script's "repeat" solves the same point N times in its process."""
+    (point,) = [p for p in peer.ladder(["hertz-cylinder"], [0], {}) if p.code == "getfem"]
+    solves = peer.time_in_process(point, 2, python=peer.system_python(), timeout=300)
+    assert len(solves) == 2 and all(t > 0 for t in solves) and point.solves_message == ""
+
+
+def test_a_runner_that_answers_nothing_says_so(tmp_path):
+    (point,) = [p for p in peer.ladder(["hertz-cylinder"], [0], {}) if p.code == "getfem"]
+    assert peer.time_in_process(point, 2, python=str(tmp_path / "no-such-python"), timeout=60) == []
+    assert point.solves_message and peer._in_process(point)["in_process_s"] is None
+
+
+@pytest.mark.parametrize("answer, word", [
+    ({"runs_s": [0.3, 0.2], "dofs": 1957, "status": "not converged"}, "not converged"),
+    ({"runs_s": [0.3], "dofs": 1957, "status": "converged"}, "1 of 2 solves timed"),
+    ({"runs_s": [0.3, 0.2], "dofs": 2000, "status": "converged"}, "2000 dofs in process, 1957"),
+    ({"runs_s": [0.3, 0.2], "dofs": 1957, "status": "converged"}, ""),
+])
+def test_an_in_process_answer_that_is_not_the_whole_process_s_says_so(monkeypatch, answer, word):
+    """A solve that failed, fewer solves than asked, or another model than the whole process
+    timed: the point's in-process message says which (and is empty when all is well)."""
+    (point,) = [p for p in peer.ladder(["hertz-cylinder"], [0], {}) if p.code == "signorini"]
+    point.row = {"dofs": 1957}
+    done = subprocess.CompletedProcess([], 0, stdout=json.dumps(answer), stderr="")
+    monkeypatch.setattr(peer, "_timed", lambda argv, timeout: (done, 1.0, ""))
+    assert peer.time_in_process(point, 2, python="python", timeout=1) == answer["runs_s"]
+    assert (word in point.solves_message) and bool(point.solves_message) == bool(word)
+
+
+def test_the_in_process_time_is_the_fastest_after_the_warm_up():
+    point = peer.Point("hertz-cylinder", "signorini", 0, {}, {}, solves=[0.1, 0.5, 0.3, 0.4])
+    assert peer._in_process(point) == {"in_process_runs_s": [0.1, 0.5, 0.3, 0.4], "in_process_s": 0.3}
+    assert peer._in_process(peer.Point("hertz-cylinder", "signorini", 0, {}, {})) == {}
+
+
+def synthetic(code, dofs, error, wall, inside=None, status="converged", scene="hertz-cylinder"):
+    row = {"scene": scene, "code": code, "rung": 0, "mesh": f"{dofs}", "dofs": dofs, "p0_rel": -error,
+           "a_rel": error / 2, "force_rel": 0.0, "status": status, "wall_s": wall, "inner_s": 0.1}
+    return row if inside is None else {**row, "in_process_s": inside}
+
+
+def test_the_summary_picks_the_fastest_run_within_each_target_by_each_measure():
+    rows = [synthetic("getfem", 2000, 0.002, wall=0.2, inside=0.09),
+            synthetic("getfem", 4000, 0.0005, wall=0.3, inside=0.15),
+            synthetic("getfem", 9000, 0.0004, wall=0.25, inside=0.4),    # fastest whole process at 0.1 %
+            synthetic("signorini", 1500, 0.004, wall=0.1, inside=0.01),  # fastest, but not within 0.3 %
+            synthetic("signorini", 3000, 0.0025, wall=0.5, inside=0.3),
+            synthetic("signorini", 5000, 0.0008, wall=0.6, inside=0.2),  # fastest in process at both
+            synthetic("signorini", 8000, 0.0001, wall=0.4, inside=0.01, status="not converged")]
+    whole = peer.at_accuracy(rows, "hertz-cylinder", 0.003)
+    assert (whole["getfem"]["dofs"], whole["signorini"]["dofs"]) == (2000, 3000)
+    inside = peer.at_accuracy(rows, "hertz-cylinder", 0.003, by="in_process_s")
+    assert (inside["getfem"]["dofs"], inside["signorini"]["dofs"]) == (2000, 5000)
+    fine = peer.at_accuracy(rows, "hertz-cylinder", 0.001)
+    assert (fine["getfem"]["dofs"], fine["signorini"]["dofs"]) == (9000, 5000)
+    summary = peer.peer_table(rows)[len(rows) + 5:]
+    assert summary == [
+        "| hertz-cylinder | 0.3 % | whole process | 2,000 dofs, 0.20 s | 3,000 dofs, 0.50 s | 2.50 |",
+        "| hertz-cylinder | 0.3 % | in process | 2,000 dofs, 0.09 s | 5,000 dofs, 0.20 s | 2.22 |",
+        "| hertz-cylinder | 0.1 % | whole process | 9,000 dofs, 0.25 s | 5,000 dofs, 0.60 s | 2.40 |",
+        "| hertz-cylinder | 0.1 % | in process | 4,000 dofs, 0.15 s | 5,000 dofs, 0.20 s | 1.33 |"]
+
+
+def test_runs_without_in_process_times_show_a_dash():
+    """A run recorded before the in-process measure (the committed one until it is run again)."""
+    rows = [synthetic("getfem", 2000, 0.002, wall=0.2), synthetic("signorini", 3000, 0.0025, wall=0.5),
+            synthetic("getfem", 2000, 0.0005, wall=0.2, scene="hertz-sphere"),
+            synthetic("signorini", 3000, 0.02, wall=0.5, inside=0.3, scene="hertz-sphere")]
+    table = peer.peer_table(rows)
+    assert table[2].endswith("| 0.20 | – | 0.10 | converged |")
+    assert "| hertz-cylinder | 0.3 % | in process | – | – | – |" in table
+    assert "| hertz-cylinder | 0.3 % | whole process | 2,000 dofs, 0.20 s | 3,000 dofs, 0.50 s | 2.50 |" in table
+    # a code timed in process whose runs miss the target says so; one not timed has a dash
+    assert "| hertz-sphere | 0.3 % | in process | – | not reached | – |" in table
+    # a run with no in-process time at all has no in-process rows in its summary
+    before = peer.peer_table(rows[:2])
+    assert before[2].endswith("| 0.20 | – | 0.10 | converged |")
+    assert [line for line in before if "| in process |" in line] == []
+    assert sum("| whole process |" in line for line in before) == len(peer.TARGETS)
+    assert peer.at_accuracy(rows, "hertz-cylinder", 0.003, by="in_process_s") == {
+        "getfem": None, "signorini": None}
 
 
 def test_without_getfem_the_command_says_so_and_writes_nothing(tmp_path, capsys, monkeypatch):
@@ -156,6 +254,7 @@ def test_without_the_checkout_the_command_says_so_and_writes_nothing(tmp_path, c
     (["--set", "n_contact=30"], "--set n_contact"),
     (["--scene", "block"], "--scene 'block'"),
     (["--repeat", "0"], "--repeat 0"),
+    (["--in-process", "-1"], "--in-process -1"),
 ])
 def test_bad_peer_input_is_one_line(capsys, tmp_path, argv, word):
     code = main(["bench", "--peer", "getfem", "--out", str(tmp_path / "x"), *argv])

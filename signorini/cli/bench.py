@@ -26,11 +26,12 @@ def _bench_peer(args: argparse.Namespace) -> int:
         print(f"signorini: {missing}; the peer benchmark is skipped, nothing written")
         return 0
     load = {"before": os.getloadavg()}
-    rows = peer.run_peer(points, repeat=args.repeat, timeout=args.time_limit,
-                         progress=lambda line: print(line, file=sys.stderr))
+    rows = peer.run_peer(points, repeat=args.repeat, in_process=args.in_process,
+                         timeout=args.time_limit, progress=lambda line: print(line, file=sys.stderr))
     load["after"] = os.getloadavg()
     given = " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == ["bench"] else ""
-    meta = {"machine": provenance(), "repeat": args.repeat, "getfem_python": peer.system_python(),
+    meta = {"machine": provenance(), "repeat": args.repeat, "in_process": args.in_process,
+            "getfem_python": peer.system_python(),
             "load_average": load,
             "signorini_command": peer.our_command(), "PYTHONPATH": os.environ.get("PYTHONPATH"),
             "getfem": next((r["versions"]["getfem"] for r in rows if "versions" in r), None)}
@@ -52,6 +53,9 @@ def _sizes(text: str | None, default: str) -> list[int]:
 def cmd_bench(args: argparse.Namespace) -> int:
     if args.repeat < 1:
         raise InputError(f"--repeat {args.repeat} must be at least 1")
+    if args.in_process < 0:
+        raise InputError(f"--in-process {args.in_process} must be 0 (not timed in process) or more, "
+                         "e.g. --in-process 5")
     if args.default_only_from is not None and args.default_only_from < 0:
         raise InputError(f"--default-only-from {args.default_only_from} must be a refinement "
                          "level >= 0, e.g. --default-only-from 3")
@@ -148,8 +152,11 @@ def add_parsers(sub) -> None:
                        "rungs of the peer ladder 0..4, default all)")
     bench.add_argument("--peer", choices=["getfem"], help="the Hertz scenes by GetFEM (system "
                        "python3-getfem) and this package side by side: accuracy, whole-process time")
-    bench.add_argument("--repeat", type=int, default=3,
-                       help="with --peer: runs per point, the fastest kept (default 3)")
+    bench.add_argument("--repeat", type=int, default=5,
+                       help="with --peer: whole-process runs per point, the fastest kept (default 5)")
+    bench.add_argument("--in-process", type=int, default=5, metavar="N",
+                       help="with --peer: solves per point in one process after a warm-up, the "
+                            "fastest kept (default 5; 0: whole process only)")
     bench.add_argument("--method", action="append", default=[],
                        help="only this method (repeatable; default: every installed sparse one)")
     bench.add_argument("--tolerance", default="low,mid,high,default",

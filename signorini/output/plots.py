@@ -181,38 +181,49 @@ def bench_time_vs_dofs(rows: list[dict], *, axes=None):
     return left, slopes
 
 
-def peer_errors(rows: list[dict], *, x: str = "dofs", targets: Iterable[float] = (0.003, 0.001),
-                ax=None):
-    """|relative error| of Hertz's p₀ (solid) and a (dashed) against ``x``, one colour per code.
+def peer_times(rows: list[dict], *, by: str = "wall_s", label: str = "wall time [s]",
+               targets: Iterable[float] = (0.003, 0.001), names: dict[str, str] | None = None,
+               ax=None):
+    """Wall time ``by`` against accuracy, max(|p₀ error|, |a error|), one colour per code.
 
     ``rows`` are the peer benchmark's (:mod:`signorini.studies.peer`): ``code``,
-    ``dofs``, ``p0_rel``, ``a_rel`` and ``x`` (``dofs`` or ``wall_s``, the
-    whole-process time). Points join in the order of the code's ladder (dofs);
-    ▲ an error above Hertz, ▼ below; hollow where the code did not report
-    convergence; dotted lines at the ``targets``.
+    ``dofs``, ``status``, ``error`` (the larger relative error against Hertz) and
+    the time ``by`` (``wall_s`` whole process, ``in_process_s`` in process; rows
+    without it are left out). Points join in the order of the code's ladder (dofs),
+    each marked with its dofs; hollow where the code did not report convergence;
+    dotted lines at the ``targets``; ``names`` the codes' names in the legend.
+    Down and to the left is faster and closer.
     """
     from matplotlib.ticker import NullFormatter  # as above
 
-    ax = axes(ax)
+    ax, names = axes(ax), names or {}
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.xaxis.set_minor_formatter(NullFormatter())
     for target in targets:
-        ax.axhline(target, color="0.5", ls=":", lw=1)
+        ax.axvline(target, color="0.5", ls=":", lw=1)
+    drawn = False
     for i, code in enumerate(sorted({r["code"] for r in rows})):
-        mine = sorted((r for r in rows if r["code"] == code and np.isfinite(r.get("p0_rel", np.nan))),
-                      key=lambda r: r["dofs"])
+        mine = sorted((r for r in rows if r["code"] == code and r.get(by) is not None
+                       and np.isfinite(r["error"])), key=lambda r: r["dofs"])
         if not mine:
             continue
-        xs = np.array([r[x] for r in mine], dtype=float)
+        drawn = True
+        colour, marker = series_style(i)
+        errors = np.maximum([r["error"] for r in mine], 1e-6)
+        times = np.array([r[by] for r in mine], dtype=float)
         good = np.array([r["status"] == "converged" for r in mine])
-        for key, style, name in (("p0_rel", "-", "p₀"), ("a_rel", "--", "a")):
-            signed = np.array([r[key] for r in mine])
-            ys = np.maximum(np.abs(signed), 1e-6)
-            ax.loglog(xs, ys, style, color=f"C{i}", lw=1, label=f"{code}: {name}")
-            for sign, marker in ((signed >= 0, "^"), (signed < 0, "v")):
-                ax.loglog(xs[good & sign], ys[good & sign], marker, color=f"C{i}", ms=5)
-                ax.loglog(xs[~good & sign], ys[~good & sign], marker, mfc="none", color=f"C{i}", ms=5)
-    ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_xlabel({"dofs": "dofs", "wall_s": "whole-process wall time [s]"}.get(x, x))
-    ax.set_ylabel("|relative error| against Hertz")
+        ax.plot(errors, times, "-", marker=marker, color=colour, lw=1, ms=5, label=names.get(code, code))
+        ax.plot(errors[~good], times[~good], marker, mfc="white", color=colour, ms=5)
+        for error, seconds, row in zip(errors, times, mine):
+            ax.annotate(f"{row['dofs'] / 1000:.3g}k", (error, seconds), textcoords="offset points",
+                        xytext=(4, 3), fontsize=6, color=colour)
+    ax.margins(x=0.1)  # room for the dofs beside the outermost points
+    if not drawn:
+        ax.text(0.5, 0.5, "not measured", ha="center", va="center", transform=ax.transAxes)
+    ax.set_xlabel("max(|p₀ error|, |a error|) against Hertz")
+    ax.set_ylabel(label)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
+    if drawn:
+        ax.legend(fontsize=7)
     return ax

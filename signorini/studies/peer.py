@@ -4,16 +4,24 @@
 ``python3-getfem`` and ``python3-gmsh``) through our own script,
 ``benchmarks/peers/getfem_hertz.py`` in a checkout of the repository (:data:`SCRIPT`;
 not part of the installed package); this package runs as ``signorini solve SCENE
---json -``. Both are separate processes, timed from start to exit (whole-process
-wall time: interpreter, imports, meshing, assembly, solve, output), each point
-run ``repeat`` times and the fastest kept. Both codes' p₀ and a come from the
-same least-squares fit (:func:`fit_hertz`) of their nodal pressures, and are
-compared with Hertz's values for the applied load.
+--json -``. Each point is timed two ways:
+
+- whole process: each code in its own process, timed from start to exit
+  (interpreter, imports, meshing, assembly, solve, output), ``repeat`` runs
+  interleaved over the points and the fastest kept;
+- in process: one fresh process per code and point that imports the code once
+  and then solves the same point ``1 + in_process`` times, each solve timed from
+  the mesh to the answer's record (the GetFEM script with ``"repeat"``, this
+  package through :func:`solve_repeatedly`, which calls :func:`signorini.solve`);
+  the first solve is a warm-up, the fastest of the others kept.
+
+Both codes' p₀ and a come from the same least-squares fit (:func:`fit_hertz`)
+of their nodal pressures, and are compared with Hertz's values for the applied load.
 
 The ladders differ by code: GetFEM refines its gmsh size field at the contact
 (``h_contact``, a fraction of a), this package its scene parameters
 (``n_contact``, ``refine``; ``grading`` the scene's default). Each ladder spans
-about 2k to 60k dofs; the charts put both on the same axes (dofs and wall time).
+about 2k to 60k dofs; the chart puts both on the same axes (accuracy and time).
 """
 
 from __future__ import annotations
@@ -129,6 +137,15 @@ class Point:
     params: dict[str, float]
     row: dict[str, Any] = field(default_factory=dict)
     walls: list[float] = field(default_factory=list)
+    solves: list[float] = field(default_factory=list)   # in process, the first a warm-up
+    solves_message: str = ""
+
+    @property
+    def given(self) -> dict[str, Any]:
+        """The point's parameters as its code takes them (the script's JSON, the scene's --set)."""
+        if self.code == "getfem":
+            return {**self.params, **self.mesh, "scene": SCENES[self.scene]}
+        return {**self.params, **self.mesh}
 
     @property
     def label(self) -> str:
@@ -150,6 +167,8 @@ def _timed(argv: list[str], timeout: float) -> tuple[subprocess.CompletedProcess
                               env=_environment())
     except subprocess.TimeoutExpired:
         return None, time.perf_counter() - tic, f"killed after {timeout:g} s"
+    except OSError as exc:  # the interpreter or script is not there (any more)
+        return None, time.perf_counter() - tic, f"{argv[0]} cannot run ({exc})"
     return done, time.perf_counter() - tic, ""
 
 
@@ -171,12 +190,10 @@ def run_point(point: Point, *, python: str, command: list[str], timeout: float) 
     import json
 
     if point.code == "getfem":
-        given = {**point.params, **point.mesh, "scene": SCENES[point.scene]}
-        argv = [python, str(SCRIPT), json.dumps(given)]
+        argv = [python, str(SCRIPT), json.dumps(point.given)]
     else:
-        sets = {**point.params, **point.mesh}
         argv = [*command, "solve", point.scene, "--json", "-"]
-        argv += [arg for k, v in sets.items() for arg in ("--set", f"{k}={v!r}")]
+        argv += [arg for k, v in point.given.items() for arg in ("--set", f"{k}={v!r}")]
     done, wall, why = _timed(argv, timeout)
     point.walls.append(wall)
     record, message = _decode(done, why)
@@ -206,6 +223,55 @@ def run_point(point: Point, *, python: str, command: list[str], timeout: float) 
         point.row = {**row, "wall_s": wall}
 
 
+#: what :func:`time_in_process` runs in a fresh Python for this package
+IN_PROCESS = "import sys; from signorini.studies.peer import solve_repeatedly; solve_repeatedly(sys.argv[1])"
+
+
+def solve_repeatedly(given: str) -> None:
+    """This package's in-process measure, run by :func:`time_in_process` in a fresh Python.
+
+    ``given`` is JSON: ``scene``, ``params`` and ``repeat``. Solves the scene with
+    :func:`signorini.solve` ``repeat`` times, each timed from the call to the record
+    ``signorini solve --json`` writes (:meth:`signorini.api.Result.to_dict`: the mesh,
+    assembly, solve, certificate, estimate and profile; not the writing), and prints one
+    JSON line: every solve's wall time (``runs_s``), the last one's dofs and status.
+    """
+    import json
+
+    point = json.loads(given)
+    runs, record = [], {}
+    for _ in range(point["repeat"]):
+        tic = time.perf_counter()
+        record = signorini.solve(point["scene"], params=point["params"]).to_dict()
+        runs.append(time.perf_counter() - tic)
+    print(json.dumps({"runs_s": runs, "dofs": record.get("dofs"), "status": record.get("status")}))
+
+
+def time_in_process(point: Point, solves: int, *, python: str, timeout: float) -> list[float]:
+    """Solve ``point`` ``solves`` times in one fresh process of its code; each solve's wall
+    time, the first a warm-up (kept in ``point.solves``; empty, with ``point.solves_message``
+    saying why, when the process gave none)."""
+    import json
+
+    if point.code == "getfem":
+        argv = [python, str(SCRIPT), json.dumps({**point.given, "repeat": solves})]
+    else:
+        argv = [sys.executable, "-c", IN_PROCESS,
+                json.dumps({"scene": point.scene, "params": point.given, "repeat": solves})]
+    done, _, why = _timed(argv, timeout * solves)
+    record, message = _decode(done, why)
+    record = record or {}
+    point.solves = [float(t) for t in record.get("runs_s", [])]
+    status = record.get("status") or ("converged" if record.get("converged") else "not converged")
+    dofs, whole = record.get("dofs"), point.row.get("dofs")
+    point.solves_message = message
+    if not message and (len(point.solves) != solves or status != "converged"):
+        point.solves_message = f"{len(point.solves)} of {solves} solves timed, {status}"
+    elif not message and whole is not None and dofs != whole:  # both measures time one model
+        point.solves_message = f"{dofs} dofs in process, {whole} in the whole process"
+    return point.solves
+
+
 def ladder(scenes: list[str], sizes: list[int] | None,
            params: dict[str, float]) -> list[Point]:
     """The points to run: per scene, both codes at the chosen rungs (default: every rung)."""
@@ -227,12 +293,14 @@ def ladder(scenes: list[str], sizes: list[int] | None,
             for code, mesh in (("getfem", GETFEM_LADDER[i]), ("signorini", OUR_LADDER[scene][i]))]
 
 
-def run_peer(points: list[Point], *, repeat: int = 3, timeout: float = 600.0,
+def run_peer(points: list[Point], *, repeat: int = 5, in_process: int = 5, timeout: float = 600.0,
              python: str | None = None, command: list[str] | None = None,
              progress: Callable[[str], None] | None = None) -> list[dict[str, Any]]:
-    """Run every point ``repeat`` times (interleaved, so that load on the machine hits both
-    codes alike). Each row is that of the fastest run that answered (``wall_s``), with every
-    run's whole-process time in ``walls_s``."""
+    """Time every point both ways. Whole process: ``repeat`` runs each, interleaved (so that
+    load on the machine hits both codes alike); the row is that of the fastest run that
+    answered (``wall_s``), with every run's time in ``walls_s``. In process (unless
+    ``in_process`` is 0): one process per point solving it ``1 + in_process`` times, every
+    solve's time in ``in_process_runs_s`` and the fastest after the warm-up in ``in_process_s``."""
     python, command = python or system_python(), command or our_command()
     for turn in range(repeat):
         for point in points:
@@ -243,7 +311,22 @@ def run_peer(points: list[Point], *, repeat: int = 3, timeout: float = 600.0,
                          f"{row['status']} {row.get('dofs', '–')} dofs, p0 "
                          f"{100 * row.get('p0_rel', math.nan):+.3f} %, a "
                          f"{100 * row.get('a_rel', math.nan):+.3f} %, {point.walls[-1]:.2f} s")
-    return [{**p.row, "walls_s": list(p.walls)} for p in points]
+    for point in points if in_process else ():
+        time_in_process(point, 1 + in_process, python=python, timeout=timeout)
+        if progress:
+            progress(f"[in process] {point.scene} {point.code} {point.label}: "
+                     + (", ".join(f"{t:.3f}" for t in point.solves) + " s" if point.solves else "")
+                     + (f" ({point.solves_message})" if point.solves_message else ""))
+    return [{**p.row, "walls_s": list(p.walls), **_in_process(p)} for p in points]
+
+
+def _in_process(point: Point) -> dict[str, Any]:
+    """A row's in-process fields (none when the point was not timed in process)."""
+    if not point.solves and not point.solves_message:
+        return {}
+    after = point.solves[1:]
+    fields = {"in_process_runs_s": list(point.solves), "in_process_s": min(after) if after else None}
+    return {**fields, "in_process_message": point.solves_message} if point.solves_message else fields
 
 
 def _pct(value: Any) -> str:
@@ -257,61 +340,80 @@ def _error(row: dict[str, Any]) -> float:
 
 
 NAMES = {"getfem": "GetFEM", "signorini": "signorini"}
+#: the two measures of time: a row's key and its name in the tables
+MEASURES = {"wall_s": "whole process", "in_process_s": "in process"}
 
 
-def at_accuracy(rows: list[dict[str, Any]], scene: str, target: float) -> dict[str, dict | None]:
-    """Per code, its fastest run (whole process) with p₀ and a both within ``target`` of Hertz."""
+def _seconds(value: Any) -> str:
+    return "–" if value is None else f"{value:.2f}"
+
+
+def at_accuracy(rows: list[dict[str, Any]], scene: str, target: float,
+                by: str = "wall_s") -> dict[str, dict | None]:
+    """Per code, its fastest run by the time ``by`` (a key of :data:`MEASURES`) with p₀ and a
+    both within ``target`` of Hertz; rows without that time (not measured) are left out."""
     best: dict[str, dict | None] = {}
     for code in NAMES:
-        good = [r for r in rows if r["scene"] == scene and r["code"] == code
+        good = [r for r in rows if r["scene"] == scene and r["code"] == code and r.get(by) is not None
                 and r["status"] == "converged" and _error(r) <= target]
-        best[code] = min(good, key=lambda r: r["wall_s"]) if good else None
+        best[code] = min(good, key=lambda r: r[by]) if good else None
     return best
 
 
+def _fastest_cells(rows: list[dict[str, Any]], scene: str, target: float, by: str) -> list[str]:
+    """The summary's cells for one scene, target and measure: each code's fastest run ("–" for a
+    code whose runs carry no such time) and the ratio of their times."""
+    best = at_accuracy(rows, scene, target, by)
+    measured = {r["code"] for r in rows if r["scene"] == scene and r.get(by) is not None}
+    cells = [f"{r['dofs']:,} dofs, {r[by]:.2f} s" if r else "not reached" if code in measured else "–"
+             for code, r in best.items()]
+    ratio = f"{best['signorini'][by] / best['getfem'][by]:.2f}" if all(best.values()) else "–"
+    return [*cells, ratio]
+
+
 def peer_table(rows: list[dict[str, Any]]) -> list[str]:
-    """The Markdown tables: every run, then both codes at the target accuracies."""
+    """The Markdown tables: every run, then both codes at the target accuracies by each measure
+    of time the runs carry (whole process always, in process when it was measured)."""
     lines = ["| scene | code | mesh | dofs | contact nodes (active) | p₀ − Hertz | a − Hertz "
-             "| force − P | whole process [s] | inside [s] | status |",
-             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|"]
+             "| force − P | whole process [s] | in process [s] | inside [s] | status |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
     for r in rows:
         lines.append(
             f"| {r['scene']} | {NAMES[r['code']]} | {r['mesh']} | {r.get('dofs', 0):,} "
             f"| {r.get('contact_nodes', '–')} ({r.get('active_nodes', '–')}) | {_pct(r.get('p0_rel'))} "
             f"| {_pct(r.get('a_rel'))} | {_pct(r.get('force_rel'))} | {r['wall_s']:.2f} "
-            f"| {r.get('inner_s', math.nan):.2f} | {r['status']} |")
-    lines += ["", "| scene | p₀ and a within | GetFEM: fastest run | signorini: fastest run "
-              "| signorini / GetFEM (time) |", "|---|---:|---|---|---:|"]
+            f"| {_seconds(r.get('in_process_s'))} | {r.get('inner_s', math.nan):.2f} | {r['status']} |")
+    lines += ["", "| scene | p₀ and a within | time | GetFEM: fastest run | signorini: fastest run "
+              "| signorini / GetFEM |", "|---|---:|---|---|---|---:|"]
+    # a run recorded before the in-process measure (or with --in-process 0) has no such rows
+    measures = {by: name for by, name in MEASURES.items() if any(r.get(by) is not None for r in rows)}
     for scene in dict.fromkeys(r["scene"] for r in rows):
         for target in TARGETS:
-            best = at_accuracy(rows, scene, target)
-            cells = [f"{r['dofs']:,} dofs, {r['wall_s']:.2f} s" if r else "not reached"
-                     for r in best.values()]
-            ratio = (f"{best['signorini']['wall_s'] / best['getfem']['wall_s']:.2f}"
-                     if all(best.values()) else "–")
-            lines.append(f"| {scene} | {100 * target:g} % | {cells[0]} | {cells[1]} | {ratio} |")
+            for by, measure in measures.items():
+                cells = " | ".join(_fastest_cells(rows, scene, target, by))
+                lines.append(f"| {scene} | {100 * target:g} % | {measure} | {cells} |")
     return lines
 
 
 def peer_figure(rows: list[dict[str, Any]]):
-    """|error| of p₀ and a against dofs (left) and whole-process wall time (right), a row per scene."""
+    """Time against accuracy, whole process (left) and in process (right), a row per scene."""
     from matplotlib.figure import Figure
 
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    figure = Figure(figsize=(10, 3.6 * len(scenes)), layout="constrained")
-    grid = figure.subplots(len(scenes), 2, squeeze=False)
-    for scene, (left, right) in zip(scenes, grid):
-        mine = [r for r in rows if r["scene"] == scene]
-        plots.peer_errors(mine, x="dofs", targets=TARGETS, ax=left).set_title(
-            f"{scene}: error against dofs (▲ above Hertz, ▼ below)", fontsize=9)
-        plots.peer_errors(mine, x="wall_s", targets=TARGETS, ax=right).set_title(
-            f"{scene}: error against whole-process time", fontsize=9)
+    figure = Figure(figsize=(10, 3.8 * len(scenes)), layout="constrained")
+    grid = figure.subplots(len(scenes), len(MEASURES), squeeze=False, sharex="row",
+                           sharey="row")
+    for scene, panels in zip(scenes, grid):
+        mine = [dict(r, error=_error(r)) for r in rows if r["scene"] == scene]
+        for ax, (by, measure) in zip(panels, MEASURES.items()):
+            plots.peer_times(mine, by=by, label=f"{measure} wall time [s]", targets=TARGETS,
+                             names=NAMES, ax=ax).set_title(f"{scene}: {measure}", fontsize=9)
     return figure
 
 
 CSV_COLUMNS = ("scene", "code", "rung", "mesh", "dofs", "contact_nodes", "active_nodes", "p0",
                "p0_ref", "p0_rel", "a", "a_ref", "a_rel", "total_force", "load", "force_rel",
-               "wall_s", "inner_s", "status", "message")
+               "wall_s", "in_process_s", "inner_s", "status", "message", "walls_s", "in_process_runs_s")
 
 
 def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
@@ -326,7 +428,9 @@ def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
     writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore",
                             lineterminator="\n")
     writer.writeheader()
-    writer.writerows(rows)
+    # every run's times in one cell each, separated by spaces
+    writer.writerows({k: " ".join(f"{t:.6f}" for t in v) if isinstance(v, list) else v
+                      for k, v in r.items()} for r in rows)
     atomic_write_text(paths["csv"], buffer.getvalue())
     atomic_write_text(paths["json"], to_json({"command": command, **meta, "rows": rows}) + "\n")
     save_figure(peer_figure(rows), paths["png"])
@@ -336,8 +440,11 @@ def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
             f"({machine.get('cores', '?')} cores), GetFEM {meta.get('getfem', '?')}, "
             f"signorini {machine.get('versions', {}).get('signorini', '?')}.", "",
             f"Whole-process wall time: the fastest of {meta.get('repeat', '?')} runs, each from "
-            "process start to exit, with Python's byte-code cache on as on a user's machine; "
-            "'inside' is the time the code reports for its own phases. "
+            "process start to exit, with Python's byte-code cache on as on a user's machine. "
+            + (f"In process: the fastest of {meta['in_process']} solves after one warm-up, in one "
+               "process per code and rung, each solve from the mesh to the answer's record (the "
+               "imports not counted). " if meta.get("in_process") else "In process: not measured. ")
+            + "'inside' is the time the code reports for its own phases (the fastest whole-process run's). "
             "p₀ and a: one least-squares fit of each code's nodal pressures "
             "(`signorini.studies.peer.fit_hertz`), against Hertz for the applied load. "
             "GetFEM's dofs are all its displacement dofs; signorini's its free dofs.", ""]
@@ -346,5 +453,5 @@ def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
         head += [f"Load average of the machine (1, 5, 15 min) before the runs: {before}; after: "
                  f"{after} (other work on the machine slows both codes alike).", ""]
     atomic_write_text(paths["md"], "\n".join(head + peer_table(rows) + [
-        "", "![errors against dofs and time](peer.png)", ""]))
+        "", "![time against accuracy, whole process and in process](peer.png)", ""]))
     return paths
