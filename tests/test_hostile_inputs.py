@@ -289,3 +289,21 @@ def test_a_sphere_in_extreme_units_solves_and_compares():
         record = result.to_dict()
     assert result.solution.status == "converged"
     assert record["hertz"]["a_rel"] < 0.01 and record["hertz"]["p0_rel"] < 0.01
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_duplicated_interior_element_is_named_whatever_its_node_order(dim):
+    """Every facet of an interior element is shared three ways once it is duplicated."""
+    from skfem import MeshTet, MeshTri
+
+    mesh = (MeshTri if dim == 2 else MeshTet)().refined(2)
+    interior = np.nonzero(np.all(mesh.f2t >= 0, axis=0))[0]
+    counts = np.bincount(mesh.t2f.ravel(), minlength=mesh.facets.shape[1])
+    inner = [e for e in range(mesh.t.shape[1]) if np.isin(mesh.t2f[:, e], interior).all()]
+    assert inner and counts.max() <= 2
+    element = inner[len(inner) // 2]
+    for order in ([1, 0, *range(2, dim + 1)], list(range(dim + 1))[::-1]):
+        t = np.hstack([mesh.t, mesh.t[order, element:element + 1]])
+        kind = "triangles" if dim == 2 else "tetrahedra"
+        with pytest.raises(InputError, match=f"{kind} {element} and {mesh.t.shape[1]} are the same"):
+            check_mesh(mesh.p, t)

@@ -101,7 +101,6 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> 
         raise InputError(f"{what}: {kind} {element} (nodes {_nodes(t, element)}) has zero {measure} "
                          f"(its nodes lie on one {'line' if dim == 2 else 'plane'}): remove it or "
                          "move its nodes apart")
-    _check_duplicates(t, what, kind)
     _check_facets(t, np.sign(volume), p.shape[1], what, kind, facet)
 
 
@@ -135,20 +134,13 @@ def _first_equal_neighbours(keys: np.ndarray, count: int) -> tuple[np.ndarray, n
     return order, ordered[1:] == ordered[:-1]
 
 
-def _check_duplicates(t: np.ndarray, what: str, kind: str) -> None:
-    order, same = _first_equal_neighbours(_sorted_columns(t)[0], t.max(initial=0) + 1)
-    if np.any(same):
-        k = int(np.argmax(same))
-        first, second = sorted((int(order[k]), int(order[k + 1])))
-        raise InputError(f"{what}: {PLURAL[kind]} {first} and {second} are the same {kind} (nodes "
-                         f"{_nodes(t, first)}): remove one of them")
-
-
 def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str, kind: str,
                   facet: str) -> None:
-    """At most two elements on a facet, and two on either side of it.
+    """No two elements the same, at most two elements on a facet, and two on either side of it.
 
-    The side of a facet an element lies on is the orientation of the simplex (the facet's
+    Two elements are the same when they share a facet and the node opposite it: the sort of
+    the facets that finds the shared ones finds them too, next to each other or one apart where
+    at most three elements share a facet (more than that is refused anyway). The side of a facet an element lies on is the orientation of the simplex (the facet's
     nodes sorted, then the element's node opposite it): the element's own orientation
     (``orientation``, the sign of its measure) times the sign of the permutation from its
     node order to that one, so no coordinate is read again.
@@ -164,6 +156,15 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     if same.size == 0:
         return
     shared = same[1:] & same[:-1]  # three in a row
+    opposite = t.ravel()[order]  # the node each facet leaves out: t[j] for local facet j
+    duplicate = [np.nonzero(same & (opposite[1:] == opposite[:-1]))[0],
+                 np.nonzero(shared & (opposite[2:] == opposite[:-2]))[0]]
+    pairs = [(int(element[order[i]]), int(element[order[i + gap]]))
+             for gap, found in enumerate(duplicate, start=1) for i in found[:1]]
+    if pairs:
+        first, second = min(tuple(sorted(pair)) for pair in pairs)
+        raise InputError(f"{what}: {PLURAL[kind]} {first} and {second} are the same {kind} (nodes "
+                         f"{_nodes(t, first)}): remove one of them")
     if np.any(shared):
         k = int(np.argmax(shared))
         owners = sorted(int(element[order[i]]) for i in range(k, k + 3))
