@@ -95,10 +95,16 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
     return name
 
 
-def _factorising(backend: str, K: sp.spmatrix) -> None:
-    """Count a factorisation of K and say it starts (a progress line on a terminal)."""
-    COUNTS["factorisations"] += 1
+def _factorising(backend: str, K: sp.spmatrix, counted: bool = True) -> None:
+    """Say a factorisation of K starts (a progress line on a terminal) and count it, unless
+    ``counted`` is False (it may yet be refused: :func:`_counted` counts it then)."""
     log.info("factorising K: %s dofs, %s nonzeros (%s)", f"{K.shape[0]:,}", f"{K.nnz:,}", backend)
+    if counted:
+        _counted()
+
+
+def _counted() -> None:
+    COUNTS["factorisations"] += 1
 
 
 class Factor:
@@ -256,6 +262,7 @@ class PardisoFactor(Factor):
         # as its factorize does) so that the numeric phase only starts when it fits
         A, rhs = self._upper, np.zeros((K.shape[0], 1))
         solver._check_A(A)
+        _factorising(self.backend, K, counted=False)  # the analysis takes about as long
         solver.set_phase(11)
         solver._call_pardiso(A, rhs)
         self.memory = pardiso_factor_bytes(solver.iparm)
@@ -270,7 +277,7 @@ class PardisoFactor(Factor):
                 "for a 3D scene a push (--set delta=...) instead of a target load")
         solver.factorized_A = (solver._hash_csr_matrix(A) if A.nnz > solver.size_limit_storage
                                else A.copy())
-        _factorising(self.backend, K)
+        _counted()
         solver.set_phase(22)
         solver._call_pardiso(A, rhs)
 
