@@ -97,14 +97,9 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
 
 def _factorising(backend: str, K: sp.spmatrix, counted: bool = True) -> None:
     """Say a factorisation of K starts (a progress line on a terminal) and count it, unless
-    ``counted`` is False (it may yet be refused: :func:`_counted` counts it then)."""
+    ``counted`` is False (it may yet be refused, and is counted once it fits)."""
     log.info("factorising K: %s dofs, %s nonzeros (%s)", f"{K.shape[0]:,}", f"{K.nnz:,}", backend)
-    if counted:
-        _counted()
-
-
-def _counted() -> None:
-    COUNTS["factorisations"] += 1
+    COUNTS["factorisations"] += counted
 
 
 class Factor:
@@ -277,7 +272,7 @@ class PardisoFactor(Factor):
                 "for a 3D scene a push (--set delta=...) instead of a target load")
         solver.factorized_A = (solver._hash_csr_matrix(A) if A.nnz > solver.size_limit_storage
                                else A.copy())
-        _counted()
+        COUNTS["factorisations"] += 1
         solver.set_phase(22)
         solver._call_pardiso(A, rhs)
 
