@@ -96,8 +96,7 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
 
 
 def _factorising(backend: str, K: sp.spmatrix, counted: bool = True) -> None:
-    """Say a factorisation of K starts (a progress line on a terminal) and count it, unless
-    ``counted`` is False (it may yet be refused, and is counted once it fits)."""
+    """Say a factorisation of K starts (a progress line) and count it unless ``counted`` is False."""
     log.info("factorising K: %s dofs, %s nonzeros (%s)", f"{K.shape[0]:,}", f"{K.nnz:,}", backend)
     COUNTS["factorisations"] += counted
 
