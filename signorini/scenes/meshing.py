@@ -4,7 +4,10 @@ The target element size is ``h(x) = h_contact + grading · dist(x, zone)``:
 uniform and fine where the pressure varies, growing linearly away from it.
 Elements longer than the target are split (conforming red-green-blue
 refinement of triangles, longest-edge bisection of tetrahedra) until none is;
-nodes created on a curved boundary are moved onto it after every pass.
+nodes created on a curved boundary are moved onto it after every pass. The
+Hertz scenes' quarter disc is then relaxed into near-equilateral triangles
+(:mod:`signorini.scenes.relax`), or meshed by Triangle instead
+(:mod:`signorini.scenes.triangulated`): :func:`graded_quarter_disc`'s ``mesher``.
 """
 
 from __future__ import annotations
