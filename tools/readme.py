@@ -1,5 +1,5 @@
 """Write the generated blocks of the docs pages (results, performance, accuracy, estimate, peer,
-convergence) from the committed artefacts they quote; the README itself carries none.
+convergence, derivatives, mesher) from the committed artefacts they quote; the README itself carries none.
 
     .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`,
                                               # `signorini stability --out docs`, ...
@@ -21,6 +21,7 @@ import amg_bench  # noqa: E402  (tools/amg_bench.py: 3D at scale, docs/amg)
 import budget  # noqa: E402  (tools/budget.py: the 10⁶-dof command against one factorisation)
 import derivatives as derivative_cost  # noqa: E402  (tools/derivatives.py: a derivative against the solve)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
+import mesher_compare  # noqa: E402  (tools/mesher_compare.py: the Hertz discs' three meshers)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 import startup  # noqa: E402  (tools/startup.py: whole-process time before the contact)
 
@@ -36,7 +37,8 @@ ESTIMATE = ROOT / "docs" / "estimate.md"
 PEER = ROOT / "docs" / "peer.md"
 CONVERGENCE = ROOT / "docs" / "convergence.md"
 DERIVATIVES = ROOT / "docs" / "derivatives.md"
-DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE, DERIVATIVES)
+MESHER = ROOT / "docs" / "mesher.md"
+DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE, DERIVATIVES, MESHER)
 #: the contact half-width of each convergence study's scene at its defaults (h / a in the tables)
 STUDY_A = {"hertz-cylinder": 0.05, "hertz-sphere": 0.05, "reverse-hertz": 0.02, "punch": 1.0}
 STUDY_COLUMNS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
@@ -148,6 +150,12 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
                                     estimate_study.load("punch"), estimate_study.load("start"))
     if document == DERIVATIVES:
         return {"derivative-cost": derivative_cost.cost_table(derivative_cost.load())}
+    if document == MESHER:
+        first, rows = mesher_compare.load(mesher_compare.FIRST), mesher_compare.load()
+        return {"mesher-first": mesher_compare.table(first),
+                "mesher-first-summary": mesher_compare.summary(first),
+                "mesher-runs": mesher_compare.table(rows), "mesher-summary": mesher_compare.summary(rows),
+                "mesher-load": mesher_compare.machine_load()}
     raise ValueError(f"no generated blocks for {document}")
 
 

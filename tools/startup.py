@@ -40,7 +40,7 @@ STEPS = (
       "graded_quarter_disc(1.0, 0.05, 40, 0.15)"]),
     ("… and mesh it by bisection alone (`mesher=bisection`)", "venv",
      ["-c", "import signorini.cli.app\nfrom signorini.scenes.meshing import graded_quarter_disc\n"
-      "graded_quarter_disc(1.0, 0.05, 40, 0.15, relaxed=False)"]),
+      "graded_quarter_disc(1.0, 0.05, 40, 0.15, mesher='bisection')"]),
     ("`signorini solve hertz-cylinder` (4,803 dofs)", "venv",
      ["-m", "signorini.cli", "solve", "hertz-cylinder"]),
     ("`signorini solve hertz-cylinder --set n_contact=10` (1,957 dofs)", "venv",

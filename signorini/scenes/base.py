@@ -23,6 +23,7 @@ from signorini.errors import InputError
 from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel
 from signorini.fem.volumetric import CHOICES
+from signorini.scenes.meshing import MESHERS
 
 
 @dataclass(frozen=True)
@@ -125,10 +126,12 @@ LOADING = Param("loading", "traction",
 
 
 #: how the Hertz scenes mesh their disc (signorini.scenes.meshing.graded_quarter_disc)
-MESHER = Param("mesher", "relaxed",
+MESHER = Param("mesher", MESHERS[0],
                "relaxed: the graded mesh's nodes moved into near-equilateral triangles (more "
-               "accurate per dof: docs/accuracy.md); bisection: the graded mesh as refined",
-               kind=str, check=one_of("relaxed", "bisection"))
+               "accurate per dof: docs/accuracy.md); bisection: the graded mesh as refined; "
+               "triangle: Shewchuk's Triangle, much faster meshing, but at equal dofs less "
+               "accurate than relaxed on the default cylinder (docs/mesher.md)",
+               kind=str, check=one_of(*MESHERS))
 
 #: how every scene's K integrates λ (tr ε)² (signorini.fem.volumetric)
 VOLUMETRIC = Param("volumetric", "auto",

@@ -103,7 +103,7 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
         disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
     else:
         disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
-                                   p["candidates"], relaxed=p["mesher"] == "relaxed")
+                                   p["candidates"], mesher=p["mesher"])
     delta_nominal = delta if delta is not None else a_est ** 2 * R
     pushed, cut_load = disc_loading(disc, p["loading"], target)
     return SceneModel(

@@ -4,7 +4,10 @@ The target element size is ``h(x) = h_contact + grading · dist(x, zone)``:
 uniform and fine where the pressure varies, growing linearly away from it.
 Elements longer than the target are split (conforming red-green-blue
 refinement of triangles, longest-edge bisection of tetrahedra) until none is;
-nodes created on a curved boundary are moved onto it after every pass.
+nodes created on a curved boundary are moved onto it after every pass. The
+Hertz scenes' quarter disc is then relaxed into near-equilateral triangles
+(:mod:`signorini.scenes.relax`), or meshed by Triangle instead
+(:mod:`signorini.scenes.triangulated`): :func:`graded_quarter_disc`'s ``mesher``.
 """
 
 from __future__ import annotations
@@ -21,12 +24,15 @@ from skfem import Mesh, MeshTet, MeshTri
 from signorini.fem.model import CutLoad
 from signorini.fem.topology import facets_on, moved, with_topology
 from signorini.scenes.relax import relax
+from signorini.scenes.triangulated import triangle_size, triangulated_quarter_disc
 
 log = logging.getLogger(__name__)
 
 MAX_PASSES = 40
 #: the most triangles a graded 2D mesh may reach (before any uniform refinement)
 MAX_TRIANGLES = 400_000
+#: the meshers of the Hertz scenes' quarter disc (:func:`graded_quarter_disc`), the default first
+MESHERS = ("relaxed", "bisection", "triangle")
 
 
 def refine_to_size(mesh: MeshTri, target: Callable[[np.ndarray], np.ndarray],
@@ -275,15 +281,25 @@ def snap_quarter_disc(p: np.ndarray, tol: float) -> np.ndarray:
 
 def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: float,
                         refine: int = 0, candidate_extent: float = 2.0,
-                        relaxed: bool = True) -> GradedDisc:
+                        mesher: str = "relaxed") -> GradedDisc:
     """Mesh a quarter disc with ``n_contact`` elements across the expected half-width a.
 
     The element size is ``a/n_contact`` on the zone [0, 1.25 a] of the arc and
     grows by ``grading`` per unit distance from it; ``refine`` uniform
     refinements follow, each with the arc's new nodes moved onto the circle.
-    ``relaxed`` moves the nodes of the graded mesh into near-equilateral
-    triangles first (:func:`signorini.scenes.relax.relax`): more accurate per dof.
+    ``mesher`` makes the graded mesh (one of :data:`MESHERS`): ``bisection``
+    refines a coarse mesh to the size (right-angled triangles); ``relaxed`` then
+    moves its nodes into near-equilateral triangles
+    (:func:`signorini.scenes.relax.relax`: more accurate per dof); ``triangle`` is
+    Triangle's quality mesh (:func:`signorini.scenes.triangulated.triangulated_quarter_disc`:
+    much faster, near-equilateral), built from a/R to 12 digits so that the same
+    scene in other units gives the same mesh.
     """
+    if mesher not in MESHERS:
+        raise ValueError(f"mesher={mesher!r} is not a mesher of the quarter disc: "
+                         f"choose one of {', '.join(MESHERS)}")
+    if mesher == "triangle":  # a ratio computed in other units differs in its last bits, which
+        a_over_R = float(f"{a_over_R:.12g}")  # would tip Triangle's near-cocircular choices
     h_contact = a_over_R / n_contact
     zone_end = np.array([1.25 * a_over_R, 0.0])
 
@@ -291,9 +307,11 @@ def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: floa
         dist = distance_to_segment(points, np.zeros(2), zone_end)
         return np.minimum(h_contact + grading * dist, 0.25)
 
-    snap = snap_to_circle((0.0, 1.0), 1.0)
-    mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap)
-    if relaxed:
+    if mesher == "triangle":
+        mesh = triangulated_quarter_disc(triangle_size(target_size), MAX_TRIANGLES)
+    else:
+        mesh = refine_to_size(coarse_quarter_disc(), target_size, snap=snap_to_circle((0.0, 1.0), 1.0))
+    if mesher == "relaxed":
         corners = [int(np.argmin(np.hypot(mesh.p[0] - x, mesh.p[1] - y))) for x, y in ((0, 0), (0, 1), (1, 1))]
         mesh = relax(mesh.p, quarter_disc_distance, target_size, corners, snap_quarter_disc)
     arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)

@@ -92,6 +92,10 @@ def _plain_bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
     return BYTES_PER_DOF[3] * max(1.0, dofs / FILL_GROWS_FROM) ** (1 / 3)
 
 
+#: the estimate's factor for the Hertz discs meshed by Triangle (``mesher=triangle``): over
+#: grading 0.05..2 its meshes had up to 1.18 times the nodes of the relaxed mesh of the same
+#: parameters (more where the grading is fine or coarse, fewer between; docs/calibration.md)
+TRIANGLE_DOFS = 1.2
 #: a half-block's far field per unit of ln(size / 20): punch size=200 built 11,732 dofs, 7,948 at 20
 BLOCK_FAR_GROWTH = 1.4
 
@@ -140,6 +144,8 @@ class SizeModel:
             dofs = self.margin * (dofs + far)
             if self.uniform is not None:  # no finer than uniform at the contact's element size
                 dofs = min(dofs, self.uniform * (n / (a or 1.0)) ** self.dim)
+            if p.get("mesher") == "triangle":
+                dofs *= TRIANGLE_DOFS
             return float(dofs * (2.0 if self.block and p.get("half", 1) == 0 else 1.0))
 
 
