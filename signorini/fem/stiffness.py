@@ -95,7 +95,7 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     second = np.concatenate([t[b] for _, b in edges_local]).astype(np.int64)
     keys = np.minimum(first, second) * nodes + np.maximum(first, second)
     order = sort_order(keys, nodes * nodes)
-    sorted_keys = keys[order]
+    sorted_keys = np.take(keys, order)
     is_new = np.ones(keys.size, dtype=bool)
     is_new[1:] = sorted_keys[1:] != sorted_keys[:-1]
     edge_of = np.empty(keys.size, dtype=np.int64)
@@ -105,11 +105,13 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     above, below = np.bincount(edge_low, minlength=nodes), np.bincount(edge_high, minlength=nodes)
     indptr = np.concatenate([[0], np.cumsum(below + 1 + above)])
     diagonal = indptr[:-1] + below
-    upper = diagonal[edge_low] + 1 + np.arange(count) - (np.cumsum(above) - above)[edge_low]
+    before_low, before_high = np.cumsum(above) - above, np.cumsum(below) - below
+    upper = (np.take(diagonal, edge_low) + 1 + np.arange(count)
+             - np.take(before_low, edge_low))
     by_high = sort_order(edge_high, nodes)
     lower = np.empty(count, dtype=np.int64)
-    high = edge_high[by_high]
-    lower[by_high] = indptr[high] + np.arange(count) - (np.cumsum(below) - below)[high]
+    high = np.take(edge_high, by_high)
+    lower[by_high] = np.take(indptr, high) + np.arange(count) - np.take(before_high, high)
     indices = np.empty(indptr[-1], dtype=np.int64)
     indices[diagonal], indices[upper], indices[lower] = np.arange(nodes), edge_high, edge_low
     mirror = np.empty(indptr[-1], dtype=np.int64)
@@ -117,10 +119,10 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     edge_of = edge_of.reshape(len(edges_local), elements)
     slot = np.empty((corners * corners, elements), dtype=np.int64)
     for a in range(corners):
-        slot[(corners + 1) * a] = diagonal[t[a]]
+        slot[(corners + 1) * a] = np.take(diagonal, t[a])
     for k, (a, b) in enumerate(edges_local):
         is_upper = t[a] < t[b]  # (a, b) is (low, high): the upper entry
-        up, down = upper[edge_of[k]], lower[edge_of[k]]
+        up, down = np.take(upper, edge_of[k]), np.take(lower, edge_of[k])
         slot[corners * a + b] = np.where(is_upper, up, down)
         slot[corners * b + a] = np.where(is_upper, down, up)
     return indptr, indices, slot, mirror
