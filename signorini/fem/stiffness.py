@@ -200,47 +200,18 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
                     if (row, col) in extra:
                         value += extra[row, col]
                     half[row, col] += np.bincount(where, value, minlength=indices.size)
-    K = mirrored_csr(half, indptr, indices, mirror)
-    K.eliminate_zeros()  # the blocks' structural zeros (a pattern as scikit-fem's)
-    return K
-
-
-def mirrored_csr(half: np.ndarray, indptr: np.ndarray, indices: np.ndarray,
-                 mirror: np.ndarray) -> sp.csr_matrix:
-    """K in CSR, dofs interleaved by node, from the sums ``half`` (dim, dim, slots) of the
-    node pairs a ≤ b in the node-by-node pattern ``(indptr, indices)`` of
-    :func:`node_pair_slots`.
-
-    Entry (i, j) of the block of slot s is ``half[i, j, s] + half[j, i, mirror[s]]``, and
-    ``half[i, j, s]`` alone on a node's own block, whose lower part is then copied from its
-    upper part (symmetric to the last bit). Each block entry goes straight to its place in
-    the CSR arrays, which are those of the block (BSR) matrix converted: in node row r, dof
-    row dim·r + c holds row c of each of the row's blocks in turn.
-    """
-    dim, slots = half.shape[0], indices.size
-    length = np.diff(indptr)
-    row = np.repeat(np.arange(length.size), length)  # the node row of each slot
-    start = dim * (dim - 1) * indptr[row] + dim * np.arange(slots)  # block entry (0, 0)
-    stride = dim * length[row]  # from one dof row of a block to the next
-    on_diagonal = mirror == np.arange(slots)
-    data = np.empty(dim * dim * slots)
+    blocks = np.empty((indices.size, dim, dim))
+    on_diagonal = mirror == np.arange(mirror.size)
     for i in range(dim):
         for j in range(dim):
             mirrored = np.take(half[j, i], mirror)
             mirrored[on_diagonal] = 0.0  # a node's own block is symmetric and summed once
-            data[start + i * stride + j] = half[i, j] + mirrored
-    own, own_stride = start[on_diagonal], stride[on_diagonal]
+            blocks[:, i, j] = half[i, j] + mirrored
     for i, j in combinations(range(dim), 2):  # a node's own block, symmetric to the last bit
-        data[own + j * own_stride + i] = data[own + i * own_stride + j]
-    index = np.int32 if data.size < 2 ** 31 else np.int64
-    columns = np.empty(data.size, dtype=index)
-    for i in range(dim):
-        for j in range(dim):
-            columns[start + i * stride + j] = dim * indices + j
-    rows = (dim * dim * indptr[:-1, None] + dim * length[:, None] * np.arange(dim)).ravel()
-    size = dim * length.size
-    return sp.csr_matrix((data, columns, np.append(rows, data.size).astype(index)),
-                         shape=(size, size))
+        blocks[on_diagonal, j, i] = blocks[on_diagonal, i, j]
+    K = sp.bsr_matrix((blocks, indices, indptr), shape=(dim * nodes, dim * nodes)).tocsr()
+    K.eliminate_zeros()  # the blocks' structural zeros (a pattern as scikit-fem's)
+    return K
 
 
 #: the stiffness of a triangle mesh in plane strain, per unit thickness
