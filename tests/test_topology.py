@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from skfem import MeshTet, MeshTri
 
-from signorini.fem.topology import TOPOLOGY, facet_topology, moved, with_topology
+from signorini.fem.topology import (TOPOLOGY, facet_topology, moved, sorted_columns,
+                                    with_edges, with_topology)
 from signorini.scenes.meshing import coarse_ball_octant, refine_simplices_to_size
 
 
@@ -55,3 +56,42 @@ def test_a_moved_mesh_keeps_the_facets_and_takes_the_new_nodes():
 def test_too_many_nodes_to_pack_leaves_the_work_to_scikit_fem():
     t = np.array([[0], [1], [2], [3]])
     assert facet_topology(t, MeshTet().elem.refdom.facets, 2 ** 21 + 1) is None
+
+
+@pytest.mark.parametrize("name", ["ball", "graded octant", "uniform tetrahedra"])
+def test_the_edges_are_scikit_fems_and_so_is_its_uniform_refinement(name):
+    theirs, mine = MESHES[name](), with_edges(MESHES[name]())
+    assert hasattr(mine, "_edges") and not hasattr(theirs, "_edges")
+    assert np.array_equal(mine.edges, theirs.edges) and mine.edges.dtype == theirs.edges.dtype
+    assert np.array_equal(mine.t2e, theirs.t2e)
+    finer, reference = mine.refined(), theirs.refined()
+    assert np.array_equal(finer.p, reference.p) and np.array_equal(finer.t, reference.t)
+
+
+def test_the_sorting_network_sorts_columns_and_counts_swaps():
+    rng = np.random.default_rng(3)
+    for rows in (2, 3, 4):
+        keys = rng.integers(0, 5, size=(rows, 500))
+        ordered, odd = sorted_columns(keys)
+        assert np.array_equal(ordered, np.sort(keys, axis=0))
+        distinct = np.all(np.diff(np.sort(keys, axis=0), axis=0) > 0, axis=0)
+        sign = np.sign([np.linalg.det(np.eye(rows)[np.argsort(column)]) for column in keys.T])
+        assert np.array_equal(odd[distinct], sign[distinct] < 0)
+
+
+def test_snapping_refuses_a_move_that_turns_a_tetrahedron_inside_out():
+    from signorini.scenes.meshing import on_ball_octant_surface, signed_volumes, snap_to_sphere
+
+    snap, centre = snap_to_sphere((0.0, 0.0, 1.0), 1.0), np.array([[0.0], [0.0], [1.0]])
+    mesh = snap(graded_octant())
+    assert np.allclose(snap(mesh).p, mesh.p, rtol=0.0, atol=1e-15)  # on the sphere: stays there
+    surface = on_ball_octant_surface(mesh, (0.0, 0.0, 1.0))
+    node = surface[np.argmin(np.abs(mesh.p[2, surface] - 0.3))]  # off the rims
+    pulled = mesh.p.copy()
+    pulled[:, node] = centre[:, 0] + 0.2 * (pulled[:, node] - centre[:, 0])  # deep inside
+    inside_out = moved(mesh, pulled)
+    touching = np.any(mesh.t == node, axis=0)
+    volumes = signed_volumes(mesh.p, mesh.t[:, touching])
+    assert np.any(np.sign(signed_volumes(pulled, mesh.t[:, touching])) != np.sign(volumes))
+    with pytest.raises(RuntimeError, match="inverted"):
+        snap(inside_out)

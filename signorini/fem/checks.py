@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.fem.topology import _packed, with_topology
+from signorini.fem.topology import _packed, sorted_columns, with_topology
 
 #: an element whose measure is at most this times its longest edge to the dimension is degenerate
 DEGENERATE = 1e-12
@@ -104,23 +104,6 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> 
     _check_facets(t, np.sign(volume), p.shape[1], what, kind, facet)
 
 
-#: compare-and-swap pairs that sort 2, 3 or 4 rows
-NETWORKS = {2: ((0, 1),), 3: ((0, 1), (1, 2), (0, 1)),
-            4: ((0, 1), (2, 3), (0, 2), (1, 3), (1, 2))}
-
-
-def _sorted_columns(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each column of ``keys`` (2 to 4 rows) sorted, and whether sorting it took an odd
-    permutation (a sorting network: each swap it makes is one transposition)."""
-    rows = [row.copy() for row in keys]
-    odd = np.zeros(keys.shape[1], dtype=bool)
-    for i, j in NETWORKS[len(rows)]:
-        swap = rows[i] > rows[j]
-        rows[i], rows[j] = np.where(swap, rows[j], rows[i]), np.where(swap, rows[i], rows[j])
-        odd ^= swap
-    return np.array(rows), odd
-
-
 def _first_equal_neighbours(keys: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
     """The order sorting the columns of ``keys`` (node indices below ``count``) and where a
     sorted column equals the next: one int64 per column where they fit, else a lexsort."""
@@ -147,7 +130,7 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     """
     corners = t.shape[0]
     local = [[i for i in range(corners) if i != j] for j in range(corners)]
-    nodes, odd = _sorted_columns(np.hstack([t[f] for f in local]))  # (dim, corners · elements)
+    nodes, odd = sorted_columns(np.hstack([t[f] for f in local]))  # (dim, corners · elements)
     # moving node j to the end passes the corners - 1 - j nodes after it
     moved = np.repeat([(corners - 1 - j) % 2 == 1 for j in range(corners)], t.shape[1])
     element = np.tile(np.arange(t.shape[1]), corners)

@@ -36,10 +36,17 @@ def triangle_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.nda
     return grads, 0.5 * np.abs(det)
 
 
+def corner_coordinates(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """``p[:, t]`` (dim, corners, elements), laid out in memory as fancy indexing lays it out
+    (component fastest), gathered by ``np.take`` over the rows of ``pᵀ``: several times faster
+    on large meshes. The layout matters: ``einsum`` sums in an order that depends on it."""
+    return np.take(np.ascontiguousarray(p.T), t, axis=0).transpose(2, 0, 1)
+
+
 def tetrahedron_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gradients (3 components, 4 nodes, elements) of each tetrahedron's barycentric coordinates
     and its volume: rows of the inverse of the edge matrix, by cross products."""
-    x = p[:, t]  # (3, 4, e)
+    x = corner_coordinates(p, t)  # (3, 4, e)
     e1, e2, e3 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0], x[:, 3] - x[:, 0]
     rows = np.stack([np.cross(e2, e3, axis=0), np.cross(e3, e1, axis=0), np.cross(e1, e2, axis=0)],
                     axis=1)  # (3, 3, e): det · ∇λ₁..₃
@@ -88,7 +95,7 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     second = np.concatenate([t[b] for _, b in edges_local]).astype(np.int64)
     keys = np.minimum(first, second) * nodes + np.maximum(first, second)
     order = sort_order(keys, nodes * nodes)
-    sorted_keys = keys[order]
+    sorted_keys = np.take(keys, order)
     is_new = np.ones(keys.size, dtype=bool)
     is_new[1:] = sorted_keys[1:] != sorted_keys[:-1]
     edge_of = np.empty(keys.size, dtype=np.int64)
@@ -98,11 +105,13 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     above, below = np.bincount(edge_low, minlength=nodes), np.bincount(edge_high, minlength=nodes)
     indptr = np.concatenate([[0], np.cumsum(below + 1 + above)])
     diagonal = indptr[:-1] + below
-    upper = diagonal[edge_low] + 1 + np.arange(count) - (np.cumsum(above) - above)[edge_low]
+    before_low, before_high = np.cumsum(above) - above, np.cumsum(below) - below
+    upper = (np.take(diagonal, edge_low) + 1 + np.arange(count)
+             - np.take(before_low, edge_low))
     by_high = sort_order(edge_high, nodes)
     lower = np.empty(count, dtype=np.int64)
-    high = edge_high[by_high]
-    lower[by_high] = indptr[high] + np.arange(count) - (np.cumsum(below) - below)[high]
+    high = np.take(edge_high, by_high)
+    lower[by_high] = np.take(indptr, high) + np.arange(count) - np.take(before_high, high)
     indices = np.empty(indptr[-1], dtype=np.int64)
     indices[diagonal], indices[upper], indices[lower] = np.arange(nodes), edge_high, edge_low
     mirror = np.empty(indptr[-1], dtype=np.int64)
@@ -110,10 +119,10 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     edge_of = edge_of.reshape(len(edges_local), elements)
     slot = np.empty((corners * corners, elements), dtype=np.int64)
     for a in range(corners):
-        slot[(corners + 1) * a] = diagonal[t[a]]
+        slot[(corners + 1) * a] = np.take(diagonal, t[a])
     for k, (a, b) in enumerate(edges_local):
         is_upper = t[a] < t[b]  # (a, b) is (low, high): the upper entry
-        up, down = upper[edge_of[k]], lower[edge_of[k]]
+        up, down = np.take(upper, edge_of[k]), np.take(lower, edge_of[k])
         slot[corners * a + b] = np.where(is_upper, up, down)
         slot[corners * b + a] = np.where(is_upper, down, up)
     return indptr, indices, slot, mirror
@@ -195,7 +204,7 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
     on_diagonal = mirror == np.arange(mirror.size)
     for i in range(dim):
         for j in range(dim):
-            mirrored = half[j, i][mirror]
+            mirrored = np.take(half[j, i], mirror)
             mirrored[on_diagonal] = 0.0  # a node's own block is symmetric and summed once
             blocks[:, i, j] = half[i, j] + mirrored
     for i, j in combinations(range(dim), 2):  # a node's own block, symmetric to the last bit

@@ -39,31 +39,72 @@ def _packed(nodes: np.ndarray, count: int) -> np.ndarray | None:
     return key
 
 
-def facet_topology(t: np.ndarray, local_facets, count: int):
-    """``(facets, t2f, f2t)`` of the connectivity ``t`` (scikit-fem's layout), or None when the
-    node count is too large to pack (scikit-fem then computes them itself)."""
-    local = [list(f) for f in local_facets]
-    per_element = len(local)
-    corners = np.sort(np.hstack([t[f] for f in local]), axis=0)  # (facet nodes, per_element · ne)
+#: compare-and-swap pairs that sort 2, 3 or 4 rows
+NETWORKS = {2: ((0, 1),), 3: ((0, 1), (1, 2), (0, 1)),
+            4: ((0, 1), (2, 3), (0, 2), (1, 3), (1, 2))}
+
+
+def sorted_columns(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each column of ``keys`` (2 to 4 rows) sorted, ``np.sort(keys, axis=0)``, and whether
+    sorting it took an odd permutation: a sorting network, each swap one transposition (a few
+    element-wise passes, many times faster than a sort along the short axis)."""
+    rows = [row.copy() for row in keys]
+    odd = np.zeros(keys.shape[1], dtype=bool)
+    for i, j in NETWORKS[len(rows)]:
+        swap = rows[i] > rows[j]
+        rows[i], rows[j] = np.where(swap, rows[j], rows[i]), np.where(swap, rows[i], rows[j])
+        odd ^= swap
+    return np.array(rows), odd
+
+
+def _entities(t: np.ndarray, local_entities, count: int):
+    """The distinct sorted node tuples of the sub-simplices ``local_entities`` of each element
+    of ``t`` (edges or facets), ordered lexicographically, each element's index into them
+    (entities, elements), and the sort that found them: ``(entities, inverse, order, starts,
+    key)``; None when ``count`` nodes do not pack into one int64 per entity."""
+    local = [list(f) for f in local_entities]
+    corners, _ = sorted_columns(np.hstack([t[f] for f in local]))  # (nodes, per_element · ne)
     key = _packed(corners, count)
     if key is None:
         return None
     order = np.argsort(key, kind="stable")
-    ordered = key[order]
+    ordered = np.take(key, order)
     new = np.ones(ordered.size, dtype=bool)
     new[1:] = ordered[1:] != ordered[:-1]
     starts = np.nonzero(new)[0]
-    ends = np.append(starts[1:], ordered.size) - 1
-    index = np.cumsum(new) - 1
     inverse = np.empty(ordered.size, dtype=np.int64)
-    inverse[order] = index
-    facets = np.ascontiguousarray(corners[:, order[starts]])
-    t2f = inverse.reshape(per_element, t.shape[1])
-    element = np.tile(np.arange(t.shape[1]), per_element)
+    inverse[order] = np.cumsum(new) - 1
+    entities = np.ascontiguousarray(np.take(corners, np.take(order, starts), axis=1))
+    return entities, inverse.reshape(len(local), t.shape[1]), order, starts
+
+
+def facet_topology(t: np.ndarray, local_facets, count: int):
+    """``(facets, t2f, f2t)`` of the connectivity ``t`` (scikit-fem's layout), or None when the
+    node count is too large to pack (scikit-fem then computes them itself)."""
+    found = _entities(t, local_facets, count)
+    if found is None:
+        return None
+    facets, t2f, order, starts = found
+    ends = np.append(starts[1:], order.size) - 1
+    element = order % t.shape[1]  # the flat index of a facet is (local facet, element)
     f2t = np.empty((2, starts.size), dtype=np.int32)
-    f2t[0] = element[order[starts]]
-    f2t[1] = np.where(ends > starts, element[order[ends]], -1)
+    f2t[0] = np.take(element, starts)
+    f2t[1] = np.where(ends > starts, np.take(element, ends), -1)
     return facets, t2f, f2t
+
+
+def with_edges(mesh: Any) -> Any:
+    """``mesh`` with its edges (scikit-fem's ``edges`` and ``t2e``, what its uniform
+    refinement of tetrahedra reads) found here by one sort of packed keys, as the facets are
+    (:func:`facet_topology`), if scikit-fem has not found them yet: the same arrays."""
+    edges = getattr(mesh.elem.refdom, "edges", None)
+    if edges is None or hasattr(mesh, "_edges") or mesh.t.shape[0] != mesh.p.shape[0] + 1:
+        return mesh
+    found = _entities(mesh.t, edges, mesh.p.shape[1])
+    if found is not None:
+        object.__setattr__(mesh, "_edges", found[0])
+        object.__setattr__(mesh, "_t2e", found[1])
+    return mesh
 
 
 def with_topology(mesh: Any) -> Any:

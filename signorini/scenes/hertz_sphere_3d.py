@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from signorini.fem.model import CutLoad, FlatObstacle3D, SceneModel
-from signorini.fem.topology import facets_on, moved
+from signorini.fem.topology import facets_on, moved, with_edges
 from signorini.scenes.base import (
     CANDIDATE_REMEDY,
     LOADING,
@@ -81,7 +81,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     snap = snap_to_sphere(centre, 1.0)
     mesh = refine_simplices_to_size(coarse_ball_octant(), target_size, snap=snap)
     for _ in range(p["refine"]):  # eight children per tetrahedron, new surface nodes snapped
-        mesh = snap(mesh.refined())
+        mesh = snap(with_edges(mesh).refined())  # scikit-fem's refinement, its edges found fast
     surface = on_ball_octant_surface(mesh, centre)
     curved = curved_boundary_facets(mesh, centre)
     mesh = moved(mesh, mesh.p * R)
