@@ -15,7 +15,6 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.forward_error import ForwardError, forward_error
 from signorini.numerics.factor import selection_dofs
-from signorini import problem as problem_module
 from signorini.problem import ContactProblem, ContactSolution
 
 #: normalised force and gap below which a node counts as touching with zero force
@@ -257,12 +256,13 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
 
     The method's (its pinned set checked as for the duality gap), else the
     problem's cached one, else a factorisation of K — the one the duality gap
-    makes anyway — except from :data:`signorini.problem.ITERATIVE_ENERGY_FROM` dofs, where the
-    duality gap uses CG and the forward error is not estimated (read when called).
+    makes anyway — unless the problem says it does not factorise for certificates
+    (:attr:`ContactProblem.factorises_for_certificates`: big and not on a 2D mesh), where the
+    duality gap uses CG and the forward error is not estimated.
     """
     offers = offers or _Offers(problem, solution)
     offered = [f for f in offers() if f.pinned is not None]
-    if not offered and problem.n < problem_module.ITERATIVE_ENERGY_FROM:
+    if not offered and problem.factorises_for_certificates:
         offered = [offers.wrap(problem.factor())]
     if not offered:
         return ForwardError.unknown()

@@ -252,15 +252,24 @@ class ContactProblem:
         """``u(λ) = K⁻¹ (f − Nᵀλ)``, the minimiser of the Lagrangian."""
         return self.factor().solve(self.f - self.N.T @ lam)
 
+    @property
+    def factorises_for_certificates(self) -> bool:
+        """Whether a certificate may factorise K when its method held no factorisation: below
+        :data:`ITERATIVE_ENERGY_FROM` dofs, and at any size on a 2D mesh (whose factorisation
+        fills in little: 10⁶ dofs in seconds, where Jacobi-preconditioned CG takes thousands of
+        iterations on such stiff, graded meshes)."""
+        mesh = None if self.discretisation is None else self.discretisation.mesh
+        return self.n < ITERATIVE_ENERGY_FROM or (mesh is not None and mesh.p.shape[0] == 2)
+
     def inverse_energy(self, r: np.ndarray) -> float:
         """``rᵀ K⁻¹ r``: by the cached factorisation, or by conjugate gradients on big problems.
 
-        For a certificate whose method held no factorisation of K: from
-        :data:`ITERATIVE_ENERGY_FROM` dofs Jacobi-preconditioned CG to
-        ``ITERATIVE_ENERGY_RTOL`` (the last resort, slow on stiff 2D meshes)
-        instead of a serial factorisation; without convergence it factorises.
+        For a certificate whose method held no factorisation of K: unless it
+        :attr:`factorises_for_certificates`, Jacobi-preconditioned CG to
+        ``ITERATIVE_ENERGY_RTOL`` (the last resort) instead of a serial
+        factorisation; without convergence it factorises.
         """
-        if self._factor is None and self.n >= ITERATIVE_ENERGY_FROM and np.any(r):
+        if self._factor is None and not self.factorises_for_certificates and np.any(r):
             from scipy.sparse.linalg import cg
 
             diagonal = self.K.diagonal()

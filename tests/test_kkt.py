@@ -305,11 +305,27 @@ def test_duality_gap_by_conjugate_gradients_equals_the_factorised_one(hertz, exa
     rough = with_(exact, u=exact.u * (1 + 1e-4 * rng.standard_normal(exact.u.size)),
                   lam=exact.lam * 1.001)
     expected = certificate(hertz, rough).duality_gap
-    fresh = hertz.with_data()  # no cached factorisation
     monkeypatch.setattr(problem_module, "ITERATIVE_ENERGY_FROM", 0)
+    fresh = hertz.with_data()  # no cached factorisation
+    assert fresh.factorises_for_certificates  # a 2D mesh: factorised at any size
+    fresh.discretisation = dataclasses.replace(fresh.discretisation, mesh=None)  # a mesh unknown
+    assert not fresh.factorises_for_certificates
     by_cg = certificate(fresh, rough).duality_gap
     assert fresh._factor is None
     assert expected > 1e-9 and by_cg == pytest.approx(expected, rel=1e-4)
+
+
+def test_a_big_2d_problem_factorises_for_its_certificate_instead_of_cg(hertz, exact, monkeypatch):
+    """Past ITERATIVE_ENERGY_FROM a 2D mesh is still factorised (little fill), not solved by CG."""
+    from signorini import problem as problem_module
+
+    monkeypatch.setattr(problem_module, "ITERATIVE_ENERGY_FROM", 0)
+    monkeypatch.setattr("scipy.sparse.linalg.cg", lambda *a, **k: pytest.fail("CG was used"))
+    fresh = hertz.with_data()
+    before = COUNTS["factorisations"]
+    cert = certificate(fresh, exact)
+    assert fresh._factor is not None and COUNTS["factorisations"] == before + 1
+    assert np.isfinite(cert.duality_gap) and np.isfinite(cert.force_error)
 
 
 # --- the duality gap on the method's own factorisation ----------------------------------------
