@@ -140,6 +140,8 @@ def installed(dists, tmp_path_factory) -> Path:
     pip = [sys.executable, "-m", "pip", "--python", venv / "bin" / "python", "install",
            "--quiet", "--no-compile", "--no-index", "--find-links", wheelhouse, dists["wheel"]]
     if run(*pip, check=False).returncode != 0:  # the wheelhouse lacks something: fill it
+        for stale in wheelhouse.glob("signorini-*"):  # an older build of the same name would be
+            stale.unlink()  # taken for this one, and its dependencies for this one's
         run(sys.executable, "-m", "pip", "download", "--quiet", "--dest", wheelhouse, dists["wheel"])
         run(*pip)
     return venv / "bin"
