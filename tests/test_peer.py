@@ -255,6 +255,7 @@ def test_without_the_checkout_the_command_says_so_and_writes_nothing(tmp_path, c
     (["--scene", "block"], "--scene 'block'"),
     (["--repeat", "0"], "--repeat 0"),
     (["--in-process", "-1"], "--in-process -1"),
+    (["--set", "mesher=foo"], "--set mesher=foo"),
 ])
 def test_bad_peer_input_is_one_line(capsys, tmp_path, argv, word):
     code = main(["bench", "--peer", "getfem", "--out", str(tmp_path / "x"), *argv])
@@ -301,3 +302,15 @@ def test_docs_peer_reading_is_the_committed_run():
     assert rest < mesh and rest < package
     floor = startup["… and scipy.spatial (Delaunay, k-d trees)"]
     assert floor > startup["GetFEM: the cylinder at h = a/16 (2,298 dofs), our script"]
+
+
+def test_a_mesher_is_set_on_the_package_s_rungs_only():
+    from signorini.studies.peer import ladder
+
+    points = ladder(["hertz-cylinder"], [0, 2], {"mesher": "triangle", "nu": "0.45"})
+    ours = [p for p in points if p.code == "signorini"]
+    theirs = [p for p in points if p.code == "getfem"]
+    assert len(ours) == len(theirs) == 2
+    assert all(p.mesh["mesher"] == "triangle" and "mesher=triangle" in p.label for p in ours)
+    assert all("mesher" not in p.mesh and "mesher" not in p.params for p in theirs)
+    assert all(p.params["nu"] == 0.45 for p in points)

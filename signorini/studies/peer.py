@@ -44,6 +44,7 @@ from signorini.errors import InputError
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output import plots
 from signorini.pressure import hertz_fit
+from signorini.scenes.meshing import MESHERS
 
 #: the standalone GetFEM script, run by the system Python: in the repository's checkout,
 #: beside the package's source tree (an installed package has none)
@@ -55,6 +56,8 @@ INSTALL = "apt-get install python3-getfem python3-gmsh"
 SCENES = {"hertz-cylinder": "cylinder", "hertz-sphere": "sphere"}
 #: parameters both codes take (passed to the script and as --set to the package)
 SHARED = ("R", "E", "nu", "a_over_R")
+#: parameters only the package takes, added to each of its rungs (e.g. --set mesher=triangle)
+OURS_ONLY = ("mesher",)
 DEFAULTS = {"R": 1.0, "E": 1.0, "nu": 0.3, "a_over_R": 0.05}
 #: GetFEM's ladder: the element size at the contact, a fraction of a
 GETFEM_LADDER = ({"h_contact": 1 / 16}, {"h_contact": 1 / 24}, {"h_contact": 1 / 40},
@@ -278,10 +281,15 @@ def ladder(scenes: list[str], sizes: list[int] | None,
     unknown = [s for s in scenes if s not in SCENES]
     if unknown:
         raise InputError(f"--scene {unknown[0]!r} has no peer model: choose from {', '.join(SCENES)}")
-    extra = sorted(set(params) - set(SHARED))
+    extra = sorted(set(params) - set(SHARED) - set(OURS_ONLY))
     if extra:
         raise InputError(f"--set {extra[0]} is not shared by both codes: the peer benchmark "
-                         f"takes {', '.join(SHARED)}")
+                         f"takes {', '.join(SHARED)}, and mesher for the package alone")
+    ours = {k: params[k] for k in OURS_ONLY if k in params}
+    if "mesher" in ours and ours["mesher"] not in MESHERS:
+        raise InputError(f"--set mesher={ours['mesher']} is not a mesher of the Hertz discs: "
+                         f"choose one of {', '.join(MESHERS)}")
+    params = {k: v for k, v in params.items() if k not in OURS_ONLY}
     rungs = range(len(GETFEM_LADDER)) if sizes is None else sizes
     bad = [i for i in rungs if not 0 <= i < len(GETFEM_LADDER)]
     if bad:
@@ -290,7 +298,8 @@ def ladder(scenes: list[str], sizes: list[int] | None,
     values = {**DEFAULTS, **{k: float(v) for k, v in params.items()}}
     return [Point(scene, code, i, dict(mesh), values)
             for scene in scenes for i in rungs
-            for code, mesh in (("getfem", GETFEM_LADDER[i]), ("signorini", OUR_LADDER[scene][i]))]
+            for code, mesh in (("getfem", GETFEM_LADDER[i]),
+                               ("signorini", {**OUR_LADDER[scene][i], **ours}))]
 
 
 def run_peer(points: list[Point], *, repeat: int = 5, in_process: int = 5, timeout: float = 600.0,
