@@ -285,7 +285,7 @@ def ladder(scenes: list[str], sizes: list[int] | None,
     if extra:
         raise InputError(f"--set {extra[0]} is not shared by both codes: the peer benchmark "
                          f"takes {', '.join(SHARED)}, and mesher for the package alone")
-    ours = {k: params[k] for k in OURS_ONLY if k in params}
+    ours = {k: v for k, v in params.items() if k in OURS_ONLY}
     if "mesher" in ours and ours["mesher"] not in MESHERS:
         raise InputError(f"--set mesher={ours['mesher']} is not a mesher of the Hertz discs: "
                          f"choose one of {', '.join(MESHERS)}")
