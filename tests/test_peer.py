@@ -314,3 +314,7 @@ def test_a_mesher_is_set_on_the_package_s_rungs_only():
     assert all(p.mesh["mesher"] == "triangle" and "mesher=triangle" in p.label for p in ours)
     assert all("mesher" not in p.mesh and "mesher" not in p.params for p in theirs)
     assert all(p.params["nu"] == 0.45 for p in points)
+    assert "mesher=triangle" in ours[0].settings and "nu=0.45" in ours[0].settings
+    from signorini.cli import main
+
+    assert main(["solve", "hertz-cylinder", "--json", "/dev/null", *ours[0].settings]) == 0

@@ -151,6 +151,12 @@ class Point:
         return {**self.params, **self.mesh}
 
     @property
+    def settings(self) -> list[str]:
+        """The package's ``--set KEY=VALUE`` arguments: numbers to the last digit, names as they are."""
+        return [arg for k, v in self.given.items()
+                for arg in ("--set", f"{k}={v if isinstance(v, str) else repr(v)}")]
+
+    @property
     def label(self) -> str:
         if self.code == "getfem":
             return f"h = a/{1 / self.mesh['h_contact']:.0f}"
@@ -196,7 +202,7 @@ def run_point(point: Point, *, python: str, command: list[str], timeout: float) 
         argv = [python, str(SCRIPT), json.dumps(point.given)]
     else:
         argv = [*command, "solve", point.scene, "--json", "-"]
-        argv += [arg for k, v in point.given.items() for arg in ("--set", f"{k}={v!r}")]
+        argv += point.settings
     done, wall, why = _timed(argv, timeout)
     point.walls.append(wall)
     record, message = _decode(done, why)
