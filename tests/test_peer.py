@@ -318,3 +318,37 @@ def test_a_mesher_is_set_on_the_package_s_rungs_only():
     from signorini.cli import main
 
     assert main(["solve", "hertz-cylinder", "--json", "/dev/null", *ours[0].settings]) == 0
+
+
+def test_docs_peer_triangle_reading_is_the_committed_run():
+    """docs/peer.md's reading of docs/peer-triangle: faster in process at every accuracy GetFEM
+    reaches, slower as a whole process, and closer to Hertz than the relaxed meshes on the coarse
+    rungs but not on the cylinder's default."""
+    from pathlib import Path
+
+    from signorini.studies.peer import TARGETS, at_accuracy
+
+    root = Path(__file__).resolve().parents[1]
+    triangle = json.loads((root / "docs" / "peer-triangle" / "peer.json").read_text())["rows"]
+    relaxed = json.loads((root / "docs" / "peer" / "peer.json").read_text())["rows"]
+    compared = 0
+    for scene in ("hertz-cylinder", "hertz-sphere"):
+        for target in TARGETS:
+            inside, whole = (at_accuracy(triangle, scene, target, by)
+                             for by in ("in_process_s", "wall_s"))
+            if inside["getfem"] is None:
+                continue
+            compared += 1
+            assert inside["signorini"]["in_process_s"] < inside["getfem"]["in_process_s"]
+            assert whole["signorini"]["wall_s"] > whole["getfem"]["wall_s"]
+    assert compared == 3
+
+    def worst(rows, scene, n_contact):
+        (row,) = [r for r in rows if r["scene"] == scene and r["code"] == "signorini"
+                  and r["mesh"].startswith(f"n_contact={n_contact}") and "refine" not in r["mesh"]]
+        return max(abs(row["p0_rel"]), abs(row["a_rel"]))
+
+    for scene, coarse in (("hertz-cylinder", (10, 20)), ("hertz-sphere", (12, 25, 50))):
+        assert all(worst(triangle, scene, n) < worst(relaxed, scene, n) for n in coarse)
+    assert all(worst(triangle, "hertz-cylinder", n) > worst(relaxed, "hertz-cylinder", n)
+               for n in (40, 80))

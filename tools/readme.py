@@ -137,8 +137,12 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
         return {**accuracy.tables(accuracy.load()), **runs}
     if document == PEER:
         peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
+        triangle = peer_table(json.loads((ROOT / "docs" / "peer-triangle" / "peer.json")
+                                         .read_text())["rows"])  # --set mesher=triangle
         return {"peer-runs": "\n".join(peer[:peer.index("")]),
                 "peer-summary": "\n".join(peer[peer.index("") + 1:]),
+                "peer-triangle-runs": "\n".join(triangle[:triangle.index("")]),
+                "peer-triangle-summary": "\n".join(triangle[triangle.index("") + 1:]),
                 "startup": startup.table(startup.load()), "startup-reading": startup.reading(startup.load())}
     if document == CONVERGENCE:
         return {**{f"convergence-{scene}": convergence_table(
