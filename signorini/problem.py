@@ -256,8 +256,8 @@ class ContactProblem:
     def factorises_for_certificates(self) -> bool:
         """Whether a certificate may factorise K when its method held no factorisation: below
         :data:`ITERATIVE_ENERGY_FROM` dofs, and at any size on a 2D mesh (whose factorisation
-        fills in little: 10⁶ dofs in seconds, where Jacobi-preconditioned CG takes thousands of
-        iterations on such stiff, graded meshes)."""
+        fills in little: 10⁶ dofs in seconds, where Jacobi-preconditioned CG converges slowly on
+        such stiff, graded meshes)."""
         mesh = None if self.discretisation is None else self.discretisation.mesh
         return self.n < ITERATIVE_ENERGY_FROM or (mesh is not None and mesh.p.shape[0] == 2)
 

@@ -80,7 +80,8 @@ def test_the_sorting_network_sorts_columns_and_counts_swaps():
 
 
 def test_snapping_refuses_a_move_that_turns_a_tetrahedron_inside_out():
-    from signorini.scenes.meshing import on_ball_octant_surface, signed_volumes, snap_to_sphere
+    from signorini.fem.checks import signed_measures
+    from signorini.scenes.meshing import on_ball_octant_surface, snap_to_sphere
 
     snap, centre = snap_to_sphere((0.0, 0.0, 1.0), 1.0), np.array([[0.0], [0.0], [1.0]])
     mesh = snap(graded_octant())
@@ -91,7 +92,7 @@ def test_snapping_refuses_a_move_that_turns_a_tetrahedron_inside_out():
     pulled[:, node] = centre[:, 0] + 0.2 * (pulled[:, node] - centre[:, 0])  # deep inside
     inside_out = moved(mesh, pulled)
     touching = np.any(mesh.t == node, axis=0)
-    volumes = signed_volumes(mesh.p, mesh.t[:, touching])
-    assert np.any(np.sign(signed_volumes(pulled, mesh.t[:, touching])) != np.sign(volumes))
+    volumes = signed_measures(mesh.p, mesh.t[:, touching])
+    assert np.any(np.sign(signed_measures(pulled, mesh.t[:, touching])) != np.sign(volumes))
     with pytest.raises(RuntimeError, match="inverted"):
         snap(inside_out)

@@ -123,7 +123,9 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
 
     Two elements are the same when they share a facet and the node opposite it: the sort of
     the facets that finds the shared ones finds them too, next to each other or one apart where
-    at most three elements share a facet (more than that is refused anyway). The side of a facet an element lies on is the orientation of the simplex (the facet's
+    at most three elements share a facet (more than that is refused anyway).
+
+    The side of a facet an element lies on is the orientation of the simplex (the facet's
     nodes sorted, then the element's node opposite it): the element's own orientation
     (``orientation``, the sign of its measure) times the sign of the permutation from its
     node order to that one, so no coordinate is read again.

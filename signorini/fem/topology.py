@@ -60,8 +60,8 @@ def sorted_columns(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _entities(t: np.ndarray, local_entities, count: int):
     """The distinct sorted node tuples of the sub-simplices ``local_entities`` of each element
     of ``t`` (edges or facets), ordered lexicographically, each element's index into them
-    (entities, elements), and the sort that found them: ``(entities, inverse, order, starts,
-    key)``; None when ``count`` nodes do not pack into one int64 per entity."""
+    (entities, elements), and the sort that found them: ``(entities, inverse, order, starts)``;
+    None when ``count`` nodes do not pack into one int64 per entity."""
     local = [list(f) for f in local_entities]
     corners, _ = sorted_columns(np.hstack([t[f] for f in local]))  # (nodes, per_element · ne)
     key = _packed(corners, count)

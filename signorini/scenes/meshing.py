@@ -22,7 +22,7 @@ import numpy as np
 from skfem import Mesh, MeshTet, MeshTri
 
 from signorini.fem.model import CutLoad
-from signorini.fem.stiffness import corner_coordinates
+from signorini.fem.checks import signed_measures
 from signorini.fem.topology import facets_on, moved, with_topology
 from signorini.scenes.relax import relax
 from signorini.scenes.triangulated import triangle_size, triangulated_quarter_disc
@@ -113,13 +113,6 @@ def longest_simplex_edges(mesh: Mesh) -> np.ndarray:
     return np.max([np.linalg.norm(p[:, t[i]] - p[:, t[j]], axis=0) for i, j in pairs], axis=0)
 
 
-def signed_volumes(p: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Signed volume ``det[p₁ − p₀, p₂ − p₀, p₃ − p₀] / 6`` of each tetrahedron of ``(p, t)``."""
-    x = corner_coordinates(p, t)  # (3, 4, e)
-    e1, e2, e3 = (x[:, i] - x[:, 0] for i in (1, 2, 3))
-    return np.einsum("ij,ij->j", e1, np.cross(e2, e3, axis=0)) / 6.0
-
-
 #: the most simplices a graded mesh may reach (before any uniform refinement)
 MAX_ELEMENTS = 2_000_000
 
@@ -207,7 +200,7 @@ def snap_to_sphere(centre: tuple[float, float, float],
     Radial moves from the centre keep nodes in the cut planes through it.
     Raises ``RuntimeError`` if a move turns a tetrahedron inside out (the
     mesh was too coarse near the surface for its curvature): the signed
-    volumes before and after are compared on the tetrahedra with a node
+    volumes (:func:`signorini.fem.checks.signed_measures`) before and after are compared on the tetrahedra with a node
     that moved, the only ones whose volume changed.
     """
     c = np.asarray(centre, dtype=float)[:, None]
@@ -222,7 +215,7 @@ def snap_to_sphere(centre: tuple[float, float, float],
         changed[nodes] = np.any(p[:, nodes] != mesh.p[:, nodes], axis=0)
         touched = np.nonzero(np.take(changed, mesh.t).any(axis=0))[0]
         corners = np.take(mesh.t, touched, axis=1)
-        before, after = signed_volumes(mesh.p, corners), signed_volumes(p, corners)
+        before, after = signed_measures(mesh.p, corners), signed_measures(p, corners)
         if np.any(before * after <= 0):
             raise RuntimeError("snapping to the sphere inverted a tetrahedron: "
                                "start from a finer coarse mesh")

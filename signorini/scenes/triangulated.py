@@ -59,10 +59,10 @@ def axis_cut(s: np.ndarray) -> np.ndarray:
 QUARTER_DISC_BOUNDARY = ((arc, 0.5 * np.pi), (top_cut, 1.0), (axis_cut, 1.0))
 
 
-def triangle_size(size: Field, factor: float | None = None) -> Field:
-    """The edge lengths asked of Triangle: ``factor`` (default :data:`TRIANGLE_SIZE`, read at
-    the call) times the size field ``size``."""
-    scale = TRIANGLE_SIZE if factor is None else factor
+def triangle_size(size: Field) -> Field:
+    """The edge lengths asked of Triangle: :data:`TRIANGLE_SIZE` (read at the call) times the
+    size field ``size``."""
+    scale = TRIANGLE_SIZE
     return lambda points: scale * size(points)
 
 
