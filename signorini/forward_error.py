@@ -88,17 +88,34 @@ class _Counted:
         return self.factor.solve(rhs)
 
 
-def _blocks(solve: Callable, columns: Callable[[np.ndarray], np.ndarray], k: int, n: int,
+def _blocks(solved: Callable[[np.ndarray], np.ndarray], k: int, n: int,
             reduce: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray | None]:
-    """``reduce(solve(columns(j)))`` stacked over blocks ``j`` of ``range(k)`` (bounded memory),
-    and the solved columns themselves when they fit in one block (else None)."""
+    """``reduce(solved(j))`` stacked over blocks ``j`` of ``range(k)`` (bounded memory), and the
+    solved columns themselves when they fit in one block (else None)."""
     block = max(1, min(k, BLOCK_FLOATS // max(n, 1)))
     if k <= block:
-        solved = solve(columns(np.arange(k))) if k else np.zeros((n, 0))
-        return (reduce(solved) if k else np.zeros((0, 0))), solved
-    parts = [reduce(solve(columns(np.arange(start, min(start + block, k)))))
+        columns = solved(np.arange(k)) if k else np.zeros((n, 0))
+        return (reduce(columns) if k else np.zeros((0, 0))), columns
+    parts = [reduce(solved(np.arange(start, min(start + block, k))))
              for start in range(0, k, block)]
     return np.hstack(parts), None
+
+
+def _unit_solutions(solve: Callable, dofs: np.ndarray, n: int) -> np.ndarray:
+    """The factor's solutions for a unit on each of ``dofs`` (n × |dofs|): those its owner kept
+    (``kept``: dof → (solution for a value c there, c), as the contact-zone solver keeps its
+    band's columns) read back, the others solved in one call."""
+    kept = getattr(solve.factor, "kept", None) or {}
+    out = np.empty((n, dofs.size))
+    fresh = np.array([dof not in kept for dof in dofs], dtype=bool)
+    if fresh.any():
+        units = np.zeros((n, int(fresh.sum())))
+        units[dofs[fresh], np.arange(units.shape[1])] = 1.0
+        out[:, fresh] = solve(units)
+    for column in np.flatnonzero(~fresh):
+        solution, value = kept[dofs[column]]
+        out[:, column] = solution / value
+    return out
 
 
 def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.ndarray,
@@ -108,7 +125,8 @@ def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.
     The factor gives x with ``x[fixed] = rhs[fixed]`` and ``(K x)[free] = rhs[free]``.
     M pins ``dofs`` instead: the dofs it pins beyond the factor's (P) take a load ρ
     that brings them to their value, those the factor pins beyond M's (Q) a value y
-    that frees their load — one back-solve per dof of P and Q, once.
+    that frees their load — one back-solve per dof of P and Q, once, none for a dof whose
+    solution the factor's owner kept (:func:`_unit_solutions`).
     """
     n = K.shape[0]
     P = np.setdiff1d(dofs, fixed)
@@ -116,12 +134,8 @@ def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.
     border = np.concatenate([Q, P])
     k = border.size
 
-    def unit(j):
-        E = np.zeros((n, j.size))
-        E[border[j], np.arange(j.size)] = 1.0
-        return E
-
-    B, Z = _blocks(solve, unit, k, n, lambda Z: np.vstack([(K @ Z)[Q], Z[P]]))
+    B, Z = _blocks(lambda j: _unit_solutions(solve, border[j], n), k, n,
+                   lambda Z: np.vstack([(K @ Z)[Q], Z[P]]))
     lu = np.linalg.inv(B) if k else None  # k ≤ MAX_BORDER, dense and small
 
     def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -169,7 +183,7 @@ def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.nd
             and (offered.N != N).nnz == 0:
         S = offered.delassus[np.ix_(rows, rows)]
     else:
-        S, Z = _blocks(solve, lambda j: NT[:, j].toarray(), k, K.shape[0], lambda Z: N_A @ Z)
+        S, Z = _blocks(lambda j: solve(NT[:, j].toarray()), k, K.shape[0], lambda Z: N_A @ Z)
     lu = np.linalg.inv(S) if k else None
 
     def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

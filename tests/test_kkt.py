@@ -395,6 +395,35 @@ def test_the_certificate_costs_a_few_back_solves_of_the_method_factorisation(zon
     assert spent(lambda: certificate(zoned, solution))[0] == {"factorisations": 0, "back_solves": 0}
 
 
+def test_the_forward_error_reads_back_the_band_columns_the_zone_solver_kept(zoned, monkeypatch):
+    """A zone whose core misses the contact's edge: the band nodes that come into contact are
+    rows where the pinned set and the active set differ, and the zone solver has already solved
+    their columns; the forward error reads them back instead of solving them again, and says
+    what solving them gives."""
+    from signorini.numerics.zone import Zone, radial_distance
+
+    exact = registry.solve(zoned, "pdas")
+    rho = radial_distance(zoned.contact_points)
+    edge = rho[exact.lam > 0].max()
+    zone = Zone(core=rho < 0.8 * edge, band=(rho >= 0.8 * edge) & (rho < 1.2 * edge))
+    solution = registry.get_method("nested").function(zoned, zone=zone)
+    active = selection_dofs(zoned.N)[active_set(zoned, solution)]
+    joined = np.setdiff1d(active, solution.factor.fixed)
+    assert joined.size > 2 and np.setdiff1d(solution.factor.fixed, active).size == 0
+    assert set(joined.tolist()) <= set(solution.factor.kept)
+    refuse_the_fallback(monkeypatch)
+    cost, cert = spent(lambda: certificate(zoned, solution))
+    assert cert.back_solves == 2  # one per Newton step: no column solved again
+    again = registry.get_method("nested").function(zoned, zone=zone)
+    again.factor.kept.clear()
+    cost_again, solved = spent(lambda: certificate(zoned, again))
+    assert solved.back_solves == 2 + joined.size
+    assert cost["factorisations"] == cost_again["factorisations"] == 0
+    assert cost_again["back_solves"] - cost["back_solves"] == joined.size
+    assert cert.force_error < 1e-10 and solved.force_error < 1e-10
+    assert cert.force_error_floor == pytest.approx(solved.force_error_floor, rel=0.5, abs=1e-14)
+
+
 @pytest.mark.parametrize("method", ["pdas", "nested"])
 def test_a_remembered_back_solve_gives_what_solving_again_gives(zoned, method, monkeypatch):
     """The duality gap's back-solve, answered by the forward error's first one negated, gives the

@@ -46,6 +46,7 @@ NO_DOFS = np.zeros(0, dtype=int)
 
 
 def _count_solve(b: np.ndarray) -> np.ndarray:
+    b = np.asarray(b, dtype=float)  # counted in COUNTS, one per right-hand side
     COUNTS["back_solves"] += 1 if b.ndim == 1 else b.shape[1]
     return b
 
@@ -71,10 +72,9 @@ PARDISO_OVER_CHOLMOD_FROM_NNZ = 750_000
 
 def resolve_backend(backend: str | None = None, n: int | None = None,
                     nnz: int | None = None) -> str:
-    """Pick the backend: an explicit name, ``SIGNORINI_FACTOR``, or the first installed
-    (when the size is given, PARDISO only from :data:`PARDISO_OVER_CHOLMOD_FROM` dofs — or
-    :data:`PARDISO_OVER_CHOLMOD_FROM_NNZ` nonzeros of K when ``nnz`` is given — when CHOLMOD
-    is installed, from :data:`PARDISO_FROM` dofs when it is not)."""
+    """Pick the backend: an explicit name, ``SIGNORINI_FACTOR``, or the first installed; PARDISO
+    only from :data:`PARDISO_OVER_CHOLMOD_FROM` dofs (:data:`PARDISO_OVER_CHOLMOD_FROM_NNZ`
+    nonzeros of K when given) with CHOLMOD installed, from :data:`PARDISO_FROM` without."""
     name = backend or os.environ.get("SIGNORINI_FACTOR") or "auto"
     if name == "auto":
         installed = available_backends()
@@ -104,9 +104,9 @@ def _factorising(backend: str, K: sp.spmatrix, counted: bool = True) -> None:
 class Factor:
     """``K⁻¹`` applied to a vector or an (n, k) block of right-hand sides.
 
-    ``matrix`` is K as given (kept by reference: a certificate checks that a
-    factorisation it is offered is one of its problem's K); ``fixed`` the
-    pinned dofs, none here (see :class:`PinnedFactor`, which solves alike).
+    ``matrix`` is K as given (kept by reference: a certificate checks that a factorisation it
+    is offered is one of its problem's K); ``fixed`` the pinned dofs, none here (see
+    :class:`PinnedFactor`, which solves alike).
     """
 
     backend = "superlu"
@@ -119,7 +119,7 @@ class Factor:
                              options={"SymmetricMode": True})
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._lu.solve(_count_solve(np.asarray(b, dtype=float)))
+        return self._lu.solve(_count_solve(b))
 
 
 #: from this many dofs CHOLMOD orders by nested dissection (METIS) instead of AMD: below it AMD
@@ -162,7 +162,7 @@ class CholmodFactor(Factor):
         self._factor = cholmod_numeric(cholmod_analysis(K) if symbolic is None else symbolic, K)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._factor(_count_solve(np.asarray(b, dtype=float)))
+        return self._factor(_count_solve(b))
 
 
 #: PARDISO's settings (iparm, counted from 1 as its manual does): 1 — these, not its defaults;
@@ -252,8 +252,8 @@ class PardisoFactor(Factor):
         for index, value in PARDISO_IPARM.items():
             solver.set_iparm(index, value)
         # pypardiso's factorize() runs PARDISO's phases 11 (analysis) and 22 (numeric) as one;
-        # they are run apart here (its own _check_A, _call_pardiso and the matrix it remembers,
-        # as its factorize does) so that the numeric phase only starts when it fits
+        # they are run apart here (its own _check_A and _call_pardiso) so that the numeric
+        # phase only starts when it fits
         A, rhs = self._upper, np.zeros((K.shape[0], 1))
         solver._check_A(A)
         _factorising(self.backend, K, counted=False)  # the analysis takes about as long
@@ -269,14 +269,14 @@ class PardisoFactor(Factor):
                 f"({FACTOR_MEMORY_VARIABLE} or MemAvailable): use a method without a "
                 "factorisation (--method pdas-amg, or petsc-vi --opt ksp=gamg), a coarser mesh, or "
                 "for a 3D scene a push (--set delta=...) instead of a target load")
-        solver.factorized_A = (solver._hash_csr_matrix(A) if A.nnz > solver.size_limit_storage
-                               else A.copy())
         COUNTS["factorisations"] += 1
         solver.set_phase(22)
         solver._call_pardiso(A, rhs)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._solver.solve(self._upper, _count_solve(np.asarray(b, dtype=float)))
+        # PARDISO's solve phase on the factorisation made above (pypardiso's solve() hashes K)
+        self._solver.set_phase(33)
+        return self._solver._call_pardiso(self._upper, np.asfortranarray(_count_solve(b)))
 
     def __del__(self) -> None:
         # MKL keeps a factorisation until told to drop it: without this every PARDISO factor
@@ -298,11 +298,9 @@ def factorize(K: sp.spmatrix, backend: str | None = None) -> Factor:
 
 
 def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
-    """The dof of each row when every row of N has one nonzero on its own dof, else None.
-
-    Then each constraint bounds one dof (a flat obstacle, or dofs rotated
-    into each node's normal frame) and an active set is a Dirichlet condition.
-    """
+    """The dof of each row when every row of N has one nonzero on its own dof, else None: then
+    each constraint bounds one dof (a flat obstacle, or dofs rotated into each node's normal
+    frame) and an active set is a Dirichlet condition."""
     N = sp.csr_matrix(N, copy=True)
     N.eliminate_zeros()
     N.sort_indices()
@@ -486,6 +484,8 @@ class PinnedFactor:
         self.matrix = pinning.K
         self._coupling = _columns(pinning.K, self.fixed)
         self._factor = pinning.factor(self.fixed).solve
+        #: by dof, (the solution for a value c on that free dof, c), kept by its solver
+        self.kept: dict[int, tuple[np.ndarray, float]] = {}
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``."""

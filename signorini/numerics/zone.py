@@ -216,8 +216,10 @@ class ZoneSolver:
             for k, j in enumerate(chunk):
                 whole = (self._whole + 1) * self.n * 8 <= COLUMN_BYTES
                 self._whole += whole
-                self._columns[j] = (gaps[:, k], reactions[:, k],
-                                    block[:, k].copy() if whole else None)
+                column = block[:, k].copy() if whole else None
+                self._columns[j] = (gaps[:, k], reactions[:, k], column)
+                if whole:  # the certificate's bordering reads it back (forward_error)
+                    self._factor.kept[int(self.dofs[j])] = (column, self.coef[j])
         return U0, rhs
 
     def _displacement(self, U0: np.ndarray, rhs: np.ndarray, band: np.ndarray,
