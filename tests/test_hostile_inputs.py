@@ -247,6 +247,25 @@ def test_the_mesh_checks_given_the_facets_found_say_what_they_say_sorting_them(p
     assert opposite_facets(mesh) is not None and said[0] == said[1]
 
 
+def test_a_folded_tetrahedral_mesh_is_named_alike_given_its_facets_or_not():
+    from skfem import MeshTet
+
+    from signorini.fem.checks import opposite_facets
+    from signorini.fem.topology import with_topology
+
+    mesh = MeshTet().refined(2)
+    inner = np.setdiff1d(np.arange(mesh.p.shape[1]), mesh.boundary_nodes())[0]
+    p = mesh.p.copy()
+    p[:, inner] += [0.3, 0.2, 0.1]  # pushed through its neighbours' facets
+    folded = with_topology(MeshTet(p, mesh.t, sort_t=False))
+    said = []
+    for facet_ids in (None, opposite_facets(folded)):
+        with pytest.raises(InputError, match="overlap") as info:
+            check_mesh(p, mesh.t, "the test mesh", facet_ids=facet_ids)
+        said.append(str(info.value))
+    assert said[0] == said[1]
+
+
 def test_a_mesh_of_either_orientation_is_accepted():
     check_mesh(SQUARE_P, SQUARE_T)
     check_mesh(SQUARE_P, SQUARE_T[[0, 2, 1]])  # both clockwise

@@ -155,11 +155,18 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     The side of a facet an element lies on is the orientation of the simplex (the facet's
     nodes sorted, then the element's node opposite it): the element's own orientation
     (``orientation``, the sign of its measure) times the sign of the permutation from its
-    node order to that one, so no coordinate is read again.
+    node order to that one, so no coordinate is read again. With ``facet_ids`` the facets are
+    grouped by them and only the parity of that permutation is found, not the sorted nodes.
     """
     corners = t.shape[0]
     local = [[i for i in range(corners) if i != j] for j in range(corners)]
-    nodes, odd = sorted_columns(np.hstack([t[f] for f in local]))  # (dim, corners · elements)
+    rows = np.hstack([t[f] for f in local])  # (dim, corners · elements)
+    if facet_ids is None:
+        nodes, odd = sorted_columns(rows)
+    else:  # only the sort's parity: that of the number of pairs out of order (distinct nodes)
+        nodes = None
+        odd = np.logical_xor.reduce([rows[i] > rows[j]
+                                     for i, j in combinations(range(rows.shape[0]), 2)])
     # moving node j to the end passes the corners - 1 - j nodes after it
     moved = np.repeat([(corners - 1 - j) % 2 == 1 for j in range(corners)], t.shape[1])
     element = np.tile(np.arange(t.shape[1]), corners)
@@ -181,7 +188,8 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     if np.any(shared):
         k = int(np.argmax(shared))
         owners = sorted(int(element[order[i]]) for i in range(k, k + 3))
-        raise InputError(f"{what}: the {facet} (nodes {', '.join(map(str, nodes[:, order[k]]))}) "
+        shared_nodes = ", ".join(map(str, np.sort(rows[:, order[k]])))
+        raise InputError(f"{what}: the {facet} (nodes {shared_nodes}) "
                          f"bounds {PLURAL[kind]} {', '.join(map(str, owners))}, more than two: the mesh "
                          "overlaps itself there; remesh it")
     pairs = np.nonzero(same)[0]
@@ -190,8 +198,9 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     if np.any(folded):
         k = int(np.argmax(folded))
         a, b = sorted((int(element[first[k]]), int(element[second[k]])))
+        shared_nodes = ", ".join(map(str, np.sort(rows[:, first[k]])))
         raise InputError(f"{what}: {PLURAL[kind]} {a} and {b} overlap: they lie on the same side of "
-                         f"their shared {facet} (nodes {', '.join(map(str, nodes[:, first[k]]))}), so "
+                         f"their shared {facet} (nodes {shared_nodes}), so "
                          "the mesh is folded there (an inverted element); remesh it or move its nodes")
 
 
