@@ -168,12 +168,13 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
     # Σ V gₐ g_bᵀ of each edge's pairs met as (low, high), then of those met as (high, low)
     sums = np.zeros((dim, dim, 2 * count))
     if axisymmetric:  # the hoop terms of the same, then of each node's own pair
-        own_pair = np.concatenate([first, np.arange(corners)]), np.concatenate([second, np.arange(corners)])
+        own_pair = np.r_[first, :corners], np.r_[second, :corners]
         hoop_sums = np.zeros((dim, dim, 2 * count + nodes))
     for start in range(0, elements, SIMPLEX_BLOCK):
         block = t[:, start:start + SIMPLEX_BLOCK]
         grads, volume = barycentric_gradients(p, block)
-        where = (edge_of[:, start:start + SIMPLEX_BLOCK] + count * (block[first] > block[second])).ravel()
+        reverse = block[first] > block[second]  # the pair met as (high, low)
+        where = (edge_of[:, start:start + SIMPLEX_BLOCK] + count * reverse).ravel()
         if axisymmetric:
             hoop = hoop_terms(p, block, grads, volume, own_pair, Lambda, Mu)
             volume = volume * p[0, block].mean(axis=0)  # ∫ r dA
@@ -193,13 +194,14 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
         D[i, j] = D[j, i] if j < i else -np.bincount(ends, np.concatenate([M[i, j], M[j, i]]),
                                                      minlength=nodes)
     blocks = np.empty((indices.size, dim, dim))
-    for summed, where, mirrored in ((M, upper, lower), (D, diagonal, None)):
+    for summed, at, mirrored in ((M, upper, lower), (D, diagonal, None)):
         # the block is V (λ gₐ g_bᵀ + μ g_b gₐᵀ + μ (gₐ · g_b) I) summed
-        block = Lambda * summed + Mu * summed.swapaxes(0, 1) + Mu * np.trace(summed) * np.eye(dim)[:, :, None]
+        block = (Lambda * summed + Mu * summed.swapaxes(0, 1)
+                 + Mu * np.trace(summed) * np.eye(dim)[:, :, None])
         if axisymmetric:
             block += (hoop_sums[..., :count] + hoop_sums[..., count:2 * count].swapaxes(0, 1)
                       if mirrored is not None else hoop_sums[..., 2 * count:])
-        blocks[where] = block.transpose(2, 0, 1)
+        blocks[at] = block.transpose(2, 0, 1)
         if mirrored is not None:  # each (high, low) block: its (low, high)'s transpose
             blocks[mirrored] = block.transpose(2, 1, 0)
     K = sp.bsr_matrix((blocks, indices, indptr), shape=(dim * nodes, dim * nodes)).tocsr()
