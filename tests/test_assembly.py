@@ -4,6 +4,8 @@ Every expected value comes from elasticity theory or from an independent computa
 (scikit-fem assembled here, geometry measured on the mesh), never from a previous run.
 """
 
+from itertools import combinations
+
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -416,7 +418,7 @@ def test_triangle_stiffness_has_scikit_fems_pattern_and_entries(make_mesh, axisy
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
     from signorini.fem.assembly import axisymmetric_elasticity
-    from signorini.fem.stiffness import node_pair_slots, simplex_stiffness
+    from signorini.fem.stiffness import node_pairs, simplex_stiffness
 
     mesh = make_mesh()
     Lambda, Mu = lame_parameters(2.5, 0.35)
@@ -435,16 +437,22 @@ def test_triangle_stiffness_has_scikit_fems_pattern_and_entries(make_mesh, axisy
         np.testing.assert_array_equal(K.indptr, expected.indptr)
         np.testing.assert_array_equal(K.indices, expected.indices)
     assert abs(K - K.T).max() == 0.0  # each off-diagonal block is its mirror's transpose
-    # the node pattern holds every node and both ends of every edge, each pair in its own slot
+    # the node pattern holds every node and both ends of every edge, each in its own entry
     nodes, corners = mesh.p.shape[1], mesh.t.shape[0]
-    indptr, indices, slot, mirror = node_pair_slots(mesh.t, nodes)
+    indptr, indices, diagonal, upper, lower, edge_of = node_pairs(mesh.t, nodes)
     assert indices.size == nodes + 2 * mesh.facets.shape[1]
     row_of = np.repeat(np.arange(nodes), np.diff(indptr))
-    for a in range(corners):
-        for b in range(corners):
-            np.testing.assert_array_equal(row_of[slot[corners * a + b]], mesh.t[a])
-            np.testing.assert_array_equal(indices[slot[corners * a + b]], mesh.t[b])
-    np.testing.assert_array_equal(mirror[mirror], np.arange(indices.size))
+    np.testing.assert_array_equal(np.sort(np.concatenate([diagonal, upper, lower])),
+                                  np.arange(indices.size))
+    np.testing.assert_array_equal(row_of[diagonal], np.arange(nodes))
+    np.testing.assert_array_equal(indices[diagonal], np.arange(nodes))
+    np.testing.assert_array_equal(row_of[upper], indices[lower])
+    np.testing.assert_array_equal(indices[upper], row_of[lower])
+    assert np.all(row_of[upper] < indices[upper])
+    for k, (a, b) in enumerate(combinations(range(corners), 2)):
+        ends = np.sort(mesh.t[[a, b]], axis=0)
+        np.testing.assert_array_equal(row_of[upper[edge_of[k]]], ends[0])
+        np.testing.assert_array_equal(indices[upper[edge_of[k]]], ends[1])
 
 
 @pytest.mark.parametrize("bound", [50, 2 ** 62])  # packed into one value sort; too wide: argsort

@@ -203,7 +203,7 @@ SQUARE_P = np.array([[0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]])
 SQUARE_T = np.array([[0, 1, 2], [0, 2, 3]]).T
 
 
-@pytest.mark.parametrize("p, t, words", [
+BAD_MESHES = [
     (SQUARE_P, np.hstack([SQUARE_T, [[2], [0], [1]]]), ["triangles 0 and 2 are the same", "nodes 0, 1, 2"]),
     (np.hstack([SQUARE_P, [[0.5], [0.0]]]), np.hstack([SQUARE_T, [[0], [4], [1]]]),
      ["triangle 2 (nodes 0, 4, 1)", "zero area"]),
@@ -216,12 +216,54 @@ SQUARE_T = np.array([[0, 1, 2], [0, 2, 3]]).T
      np.hstack([SQUARE_T, [[0], [1], [4]], [[0], [2], [5]]]), ["edge (nodes 0, 2) bounds triangles 0, 1, 3", "more than two"]),
     (np.array([[0.0, 1.0, np.nan], [0.0, 0.0, 1.0]]), np.array([[0, 1, 2]]).T, ["node 2", "non-finite"]),
     (SQUARE_P, np.array([[0, 1, 7]]).T, ["triangle 0", "node the mesh does not have"]),
-])
+]
+
+
+@pytest.mark.parametrize("p, t, words", BAD_MESHES)
 def test_a_bad_mesh_is_refused_naming_the_element(p, t, words):
     with pytest.raises(InputError) as info:
         check_mesh(p, t, "the test mesh")
     for word in words:
         assert word in str(info.value), (word, str(info.value))
+
+
+@pytest.mark.parametrize("p, t", [(p, t) for p, t, _ in BAD_MESHES
+                                  if np.isfinite(p).all() and t.max() < p.shape[1]]
+                         + [(SQUARE_P, SQUARE_T)])
+def test_the_mesh_checks_given_the_facets_found_say_what_they_say_sorting_them(p, t):
+    from skfem import MeshTri
+
+    from signorini.fem.checks import opposite_facets
+    from signorini.fem.topology import with_topology
+
+    mesh = with_topology(MeshTri(p, t))
+    said = []
+    for facet_ids in (None, opposite_facets(mesh)):
+        try:
+            check_mesh(mesh.p, mesh.t, "the test mesh", facet_ids=facet_ids)
+            said.append(None)
+        except InputError as error:
+            said.append(str(error))
+    assert opposite_facets(mesh) is not None and said[0] == said[1]
+
+
+def test_a_folded_tetrahedral_mesh_is_named_alike_given_its_facets_or_not():
+    from skfem import MeshTet
+
+    from signorini.fem.checks import opposite_facets
+    from signorini.fem.topology import with_topology
+
+    mesh = MeshTet().refined(2)
+    inner = np.setdiff1d(np.arange(mesh.p.shape[1]), mesh.boundary_nodes())[0]
+    p = mesh.p.copy()
+    p[:, inner] += [0.3, 0.2, 0.1]  # pushed through its neighbours' facets
+    folded = with_topology(MeshTet(p, mesh.t, sort_t=False))
+    said = []
+    for facet_ids in (None, opposite_facets(folded)):
+        with pytest.raises(InputError, match="overlap") as info:
+            check_mesh(p, mesh.t, "the test mesh", facet_ids=facet_ids)
+        said.append(str(info.value))
+    assert said[0] == said[1]
 
 
 def test_a_mesh_of_either_orientation_is_accepted():
@@ -293,8 +335,12 @@ def test_a_sphere_in_extreme_units_solves_and_compares():
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_a_duplicated_interior_element_is_named_whatever_its_node_order(dim):
-    """Every facet of an interior element is shared three ways once it is duplicated."""
+    """Every facet of an interior element is shared three ways once it is duplicated (found by
+    a sort of the facets, or from the facets found for the mesh)."""
     from skfem import MeshTet, MeshTri
+
+    from signorini.fem.checks import opposite_facets
+    from signorini.fem.topology import with_topology
 
     mesh = (MeshTri if dim == 2 else MeshTet)().refined(2)
     interior = np.nonzero(np.all(mesh.f2t >= 0, axis=0))[0]
@@ -305,5 +351,7 @@ def test_a_duplicated_interior_element_is_named_whatever_its_node_order(dim):
     for order in ([1, 0, *range(2, dim + 1)], list(range(dim + 1))[::-1]):
         t = np.hstack([mesh.t, mesh.t[order, element:element + 1]])
         kind = "triangles" if dim == 2 else "tetrahedra"
-        with pytest.raises(InputError, match=f"{kind} {element} and {mesh.t.shape[1]} are the same"):
-            check_mesh(mesh.p, t)
+        for facet_ids in (None, opposite_facets(with_topology(type(mesh)(mesh.p, t, sort_t=False)))):
+            with pytest.raises(InputError,
+                               match=f"{kind} {element} and {mesh.t.shape[1]} are the same"):
+                check_mesh(mesh.p, t, facet_ids=facet_ids)

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.fem.topology import _packed, sorted_columns, with_topology
+from signorini.fem.topology import _packed, sort_order, sorted_columns, with_topology
 
 #: an element whose measure is at most this times its longest edge to the dimension is degenerate
 DEGENERATE = 1e-12
@@ -62,14 +62,24 @@ def signed_measures(p: np.ndarray, t: np.ndarray) -> np.ndarray:
     """``det[p₁ − p₀, …, p_d − p₀]`` of each simplex (d! times its signed area or volume)."""
     rows = np.ascontiguousarray(p.T)  # gathering rows is several times faster than columns
     origin = np.take(rows, t[0], axis=0)  # np.take: several times faster than rows[t[0]]
-    edges = [np.take(rows, t[i], axis=0) - origin for i in range(1, t.shape[0])]
+    return _determinants([np.take(rows, t[i], axis=0) - origin for i in range(1, t.shape[0])])
+
+
+def _determinants(edges: list[np.ndarray]) -> np.ndarray:
+    """``det[e₁, …, e_d]`` of each simplex from its edge vectors (d of them, (elements, d))."""
     if len(edges) == 2:
         return edges[0][:, 0] * edges[1][:, 1] - edges[0][:, 1] * edges[1][:, 0]
     return np.einsum("ij,ij->i", edges[0], np.cross(edges[1], edges[2]))
 
 
-def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> None:
-    """InputError naming the first bad element of the simplex mesh ``(p, t)`` (see the module)."""
+def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh",
+               facet_ids: np.ndarray | None = None) -> None:
+    """InputError naming the first bad element of the simplex mesh ``(p, t)`` (see the module).
+
+    ``facet_ids`` (corners, elements), when known: the index of the facet opposite each node of
+    each element among the mesh's facets in lexicographic order of their sorted nodes
+    (:func:`opposite_facets`); the facets are then grouped by it instead of by a sort.
+    """
     p, t = np.asarray(p, dtype=float), np.asarray(t)
     dim = p.shape[0]
     kind, measure, facet = NAMES.get(dim, ("element", "measure", "facet"))
@@ -92,21 +102,27 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh") -> 
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is a degenerate element
         rows = np.ascontiguousarray(p.T)
         corners = [np.take(rows, t[i], axis=0) for i in range(dim + 1)]
-        squares = [corners[i] - corners[j] for i, j in combinations(range(dim + 1), 2)]
-        longest = np.sqrt(np.max([np.einsum("ij,ij->i", e, e) for e in squares], axis=0))
-        volume = signed_measures(p, t)
+        edges = {(i, j): corners[j] - corners[i] for i, j in combinations(range(dim + 1), 2)}
+        longest = np.sqrt(np.max([np.einsum("ij,ij->i", e, e) for e in edges.values()], axis=0))
+        volume = _determinants([edges[0, i] for i in range(1, dim + 1)])  # signed_measures
         degenerate = ~(np.abs(volume) > DEGENERATE * longest ** dim)
     if np.any(degenerate):
         element = int(np.argmax(degenerate))
         raise InputError(f"{what}: {kind} {element} (nodes {_nodes(t, element)}) has zero {measure} "
                          f"(its nodes lie on one {'line' if dim == 2 else 'plane'}): remove it or "
                          "move its nodes apart")
-    _check_facets(t, np.sign(volume), p.shape[1], what, kind, facet)
+    _check_facets(t, np.sign(volume), p.shape[1], what, kind, facet, facet_ids)
 
 
-def _first_equal_neighbours(keys: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+def _first_equal_neighbours(keys: np.ndarray, count: int,
+                            ids: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The order sorting the columns of ``keys`` (node indices below ``count``) and where a
-    sorted column equals the next: one int64 per column where they fit, else a lexsort."""
+    sorted column equals the next: by their ``ids`` when given (their ranks in that order),
+    one int64 per column where they fit, else a lexsort."""
+    if ids is not None:
+        order = sort_order(ids, int(ids.max(initial=0)) + 1)
+        ordered = np.take(ids, order)
+        return order, ordered[1:] == ordered[:-1]
     packed = _packed(keys, count)
     if packed is None:
         order = np.lexsort(keys[::-1])
@@ -117,8 +133,19 @@ def _first_equal_neighbours(keys: np.ndarray, count: int) -> tuple[np.ndarray, n
     return order, ordered[1:] == ordered[:-1]
 
 
+def opposite_facets(mesh: Any) -> np.ndarray | None:
+    """The ``facet_ids`` of :func:`check_mesh` of a simplex mesh whose facets scikit-fem (or
+    :func:`~signorini.fem.topology.with_topology`) has found: its ``t2f``, row j the facet
+    opposite node j; None when they are not found yet."""
+    if not hasattr(mesh, "_t2f") or mesh.t.shape[0] != mesh.p.shape[0] + 1:
+        return None
+    local = [set(f) for f in mesh.elem.refdom.facets]
+    return mesh.t2f[[next(k for k, f in enumerate(local) if j not in f)
+                     for j in range(mesh.t.shape[0])]]
+
+
 def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str, kind: str,
-                  facet: str) -> None:
+                  facet: str, facet_ids: np.ndarray | None = None) -> None:
     """No two elements the same, at most two elements on a facet, and two on either side of it.
 
     Two elements are the same when they share a facet and the node opposite it: the sort of
@@ -128,16 +155,24 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     The side of a facet an element lies on is the orientation of the simplex (the facet's
     nodes sorted, then the element's node opposite it): the element's own orientation
     (``orientation``, the sign of its measure) times the sign of the permutation from its
-    node order to that one, so no coordinate is read again.
+    node order to that one, so no coordinate is read again. With ``facet_ids`` the facets are
+    grouped by them and only the parity of that permutation is found, not the sorted nodes.
     """
     corners = t.shape[0]
     local = [[i for i in range(corners) if i != j] for j in range(corners)]
-    nodes, odd = sorted_columns(np.hstack([t[f] for f in local]))  # (dim, corners · elements)
+    rows = np.hstack([t[f] for f in local])  # (dim, corners · elements)
+    if facet_ids is None:
+        nodes, odd = sorted_columns(rows)
+    else:  # only the sort's parity: that of the number of pairs out of order (distinct nodes)
+        nodes = None
+        odd = np.logical_xor.reduce([rows[i] > rows[j]
+                                     for i, j in combinations(range(rows.shape[0]), 2)])
     # moving node j to the end passes the corners - 1 - j nodes after it
     moved = np.repeat([(corners - 1 - j) % 2 == 1 for j in range(corners)], t.shape[1])
     element = np.tile(np.arange(t.shape[1]), corners)
     side = np.where(odd ^ moved, -1.0, 1.0) * orientation[element]
-    order, same = _first_equal_neighbours(nodes, count)
+    order, same = _first_equal_neighbours(
+        nodes, count, None if facet_ids is None else facet_ids.ravel())
     if same.size == 0:
         return
     shared = same[1:] & same[:-1]  # three in a row
@@ -153,7 +188,8 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     if np.any(shared):
         k = int(np.argmax(shared))
         owners = sorted(int(element[order[i]]) for i in range(k, k + 3))
-        raise InputError(f"{what}: the {facet} (nodes {', '.join(map(str, nodes[:, order[k]]))}) "
+        shared_nodes = ", ".join(map(str, np.sort(rows[:, order[k]])))
+        raise InputError(f"{what}: the {facet} (nodes {shared_nodes}) "
                          f"bounds {PLURAL[kind]} {', '.join(map(str, owners))}, more than two: the mesh "
                          "overlaps itself there; remesh it")
     pairs = np.nonzero(same)[0]
@@ -162,8 +198,9 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
     if np.any(folded):
         k = int(np.argmax(folded))
         a, b = sorted((int(element[first[k]]), int(element[second[k]])))
+        shared_nodes = ", ".join(map(str, np.sort(rows[:, first[k]])))
         raise InputError(f"{what}: {PLURAL[kind]} {a} and {b} overlap: they lie on the same side of "
-                         f"their shared {facet} (nodes {', '.join(map(str, nodes[:, first[k]]))}), so "
+                         f"their shared {facet} (nodes {shared_nodes}), so "
                          "the mesh is folded there (an inverted element); remesh it or move its nodes")
 
 
@@ -247,6 +284,6 @@ def check_units(model: Any) -> None:
 
 def check_model(model: Any) -> None:
     """Every check of this module on a :class:`~signorini.fem.model.SceneModel`."""
-    check_mesh(model.mesh.p, model.mesh.t)
+    check_mesh(model.mesh.p, model.mesh.t, facet_ids=opposite_facets(model.mesh))
     check_units(model)
     check_obstacle_outside(model)

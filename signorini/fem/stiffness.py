@@ -11,13 +11,15 @@ otherwise cost as much as the solve.
 
 from __future__ import annotations
 
-from itertools import combinations
+from itertools import combinations, product
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
+
+from signorini.fem.topology import sort_order
 
 #: the quadrature order scikit-fem's basis takes for P1 (twice the degree): the axisymmetric
 #: hoop term ∫ φₐ φ_b / r is no polynomial, and :func:`hoop_terms` integrates it with that rule
@@ -64,30 +66,18 @@ def barycentric_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.
     return (triangle_gradients if p.shape[0] == 2 else tetrahedron_gradients)(p, t)
 
 
-def sort_order(keys: np.ndarray, bound: int) -> np.ndarray:
-    """``np.argsort(keys, kind="stable")`` of non-negative integer ``keys`` below ``bound``.
-
-    When a key and its position fit in 63 bits together, by one sort of the
-    values ``key · 2ᵇ + position`` (numpy's SIMD value sort, several times
-    faster than an index sort); else by ``argsort``.
-    """
-    shift = max(keys.size - 1, 1).bit_length()
-    if max(bound - 1, 1).bit_length() + shift > 63:
-        return np.argsort(keys, kind="stable")
-    return np.sort((keys.astype(np.int64) << shift) | np.arange(keys.size)) & ((1 << shift) - 1)
-
-
-def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                       np.ndarray]:
+def node_pairs(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                                  np.ndarray, np.ndarray]:
     """K's node-by-node pattern (CSR ``indptr``, ``indices``, sorted) of a simplex mesh
-    (triangles or tetrahedra: k = 3 or 4 nodes each), the slot in it of each element's node
-    pair (k², e) — row k·a + b for local nodes a, b — and each slot's mirror (the slot of
-    (j, i) for that of (i, j)).
+    (triangles or tetrahedra: k = 3 or 4 nodes each), where each entry of it sits, and each
+    element's edges.
 
-    Found from the mesh's edges: one sort of an integer key per edge of every element gives
-    the edges (low, high) in order, which is the order of the upper entries; one sort of the
-    edges by their high end gives the lower ones. Row i holds its lower entries, its diagonal,
-    then its upper entries.
+    Returns ``(indptr, indices, diagonal, upper, lower, edge_of)``: ``diagonal`` the entry
+    (i, i) of each node, ``upper`` and ``lower`` the entries (low, high) and (high, low) of
+    each edge, edges in the order of their (low, high), and ``edge_of`` (pairs, elements) the
+    edge of each element's local node pair (a, b), a < b, in ``combinations`` order. Found by
+    one sort of an integer key per edge of every element (:func:`sort_order`); row i holds its
+    lower entries, its diagonal, then its upper entries.
     """
     corners, elements = t.shape
     edges_local = list(combinations(range(corners), 2))
@@ -114,18 +104,7 @@ def node_pair_slots(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, 
     lower[by_high] = np.take(indptr, high) + np.arange(count) - np.take(before_high, high)
     indices = np.empty(indptr[-1], dtype=np.int64)
     indices[diagonal], indices[upper], indices[lower] = np.arange(nodes), edge_high, edge_low
-    mirror = np.empty(indptr[-1], dtype=np.int64)
-    mirror[diagonal], mirror[upper], mirror[lower] = diagonal, lower, upper
-    edge_of = edge_of.reshape(len(edges_local), elements)
-    slot = np.empty((corners * corners, elements), dtype=np.int64)
-    for a in range(corners):
-        slot[(corners + 1) * a] = np.take(diagonal, t[a])
-    for k, (a, b) in enumerate(edges_local):
-        is_upper = t[a] < t[b]  # (a, b) is (low, high): the upper entry
-        up, down = np.take(upper, edge_of[k]), np.take(lower, edge_of[k])
-        slot[corners * a + b] = np.where(is_upper, up, down)
-        slot[corners * b + a] = np.where(is_upper, down, up)
-    return indptr, indices, slot, mirror
+    return indptr, indices, diagonal, upper, lower, edge_of.reshape(len(edges_local), elements)
 
 
 def hoop_terms(p: np.ndarray, t: np.ndarray, grads: np.ndarray, area: np.ndarray,
@@ -161,12 +140,17 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
     (area or volume; ``A r̄`` with the mean radius r̄ when axisymmetric), the
     dim × dim block coupling nodes a and b is
     ``V (λ gₐ g_bᵀ + μ g_b gₐᵀ + μ (gₐ · g_b) I)`` (plus :func:`hoop_terms`
-    when axisymmetric) and that of (b, a) its transpose: the pairs a ≤ b of
-    each element (6 of 9 for a triangle, 10 of 16 for a tetrahedron) are
-    summed into K's node-by-node pattern (:func:`node_pair_slots`) by
-    ``bincount``, in element blocks of :data:`SIMPLEX_BLOCK`, and each
-    off-diagonal block then gets its mirror's transpose (K is symmetric to the
-    last bit). Entries that are exactly zero are dropped, as scikit-fem does
+    when axisymmetric) and that of (b, a) its transpose. Summed by ``bincount``
+    over each edge of the mesh (:func:`node_pairs`), in element blocks of
+    :data:`SIMPLEX_BLOCK` with the elements taken in the order of their lowest
+    node, is only ``M = Σ V gₐ g_bᵀ`` of the pairs a < b (3 of 9 for a
+    triangle, 6 of 16 for a tetrahedron), whose block is then
+    ``λ M + μ Mᵀ + μ tr(M) I``; a node's own M is minus the sum of its edges'
+    (``Σ_b g_b = 0`` on every simplex); the hoop terms are summed over every
+    pair a ≤ b. Each (high, low) block is its (low, high) block's transpose and
+    a node's own block is symmetric, so K is symmetric to the last bit. Entries
+    that are exactly zero are dropped, as scikit-fem does; sums that cancel may
+    leave a round-off entry where scikit-fem's leave none, or the reverse
     (timings in docs/speed.md, "Building large 3D models" and "2D assembly").
     """
     p, t = mesh.p, mesh.t
@@ -176,39 +160,50 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
                          f"when axisymmetric), got {corners}-node elements in {dim}D: assemble "
                          "them with scikit-fem")
     nodes, elements = p.shape[1], t.shape[1]
-    indptr, indices, slot, mirror = node_pair_slots(t, nodes)
-    first, second = np.triu_indices(corners)
-    half = np.zeros((dim, dim, indices.size))
+    # the elements in the order of their lowest node: what each sum reads and writes lies near
+    t = np.take(t, sort_order(t.min(axis=0), nodes), axis=1)
+    indptr, indices, diagonal, upper, lower, edge_of = node_pairs(t, nodes)
+    count = upper.size
+    first, second = np.array(list(combinations(range(corners), 2))).T
+    # Σ V gₐ g_bᵀ of each edge's pairs met as (low, high), then of those met as (high, low)
+    sums = np.zeros((dim, dim, 2 * count))
+    if axisymmetric:  # the hoop terms of the same, then of each node's own pair
+        own_pair = np.r_[first, :corners], np.r_[second, :corners]
+        hoop_sums = np.zeros((dim, dim, 2 * count + nodes))
     for start in range(0, elements, SIMPLEX_BLOCK):
         block = t[:, start:start + SIMPLEX_BLOCK]
         grads, volume = barycentric_gradients(p, block)
-        extra = {}
+        reverse = block[first] > block[second]  # the pair met as (high, low)
+        where = (edge_of[:, start:start + SIMPLEX_BLOCK] + count * reverse).ravel()
         if axisymmetric:
-            extra = hoop_terms(p, block, grads, volume, (first, second), Lambda, Mu)
+            hoop = hoop_terms(p, block, grads, volume, own_pair, Lambda, Mu)
             volume = volume * p[0, block].mean(axis=0)  # ∫ r dA
-        scaled = (grads * volume)[:, first].reshape(dim, -1)  # V gₐ over (pair, element)
-        paired = grads[:, second].reshape(dim, -1)  # g_b
-        where = np.ascontiguousarray(slot[corners * first + second, start:start + SIMPLEX_BLOCK])
-        where = where.ravel()
-        shear = Mu * np.einsum("ip,ip->p", scaled, paired)
-        for i in range(dim):
-            for j in range(i, dim):
-                ij, ji = scaled[i] * paired[j], scaled[j] * paired[i]
-                entries = ([(i, i, Lambda * ij + Mu * ji + shear)] if i == j else
-                           [(i, j, Lambda * ij + Mu * ji), (j, i, Lambda * ji + Mu * ij)])
-                for row, col, value in entries:
-                    if (row, col) in extra:
-                        value += extra[row, col]
-                    half[row, col] += np.bincount(where, value, minlength=indices.size)
+            hoop_where = np.concatenate([where, 2 * count + block.ravel()])
+            for (i, j), value in hoop.items():
+                hoop_sums[i, j] += np.bincount(hoop_where, value, minlength=hoop_sums.shape[-1])
+        scaled, paired = (grads * volume)[:, first], grads[:, second]  # V gₐ, g_b
+        for i, j in product(range(dim), repeat=2):
+            sums[i, j] += np.bincount(where, (scaled[i] * paired[j]).ravel(), minlength=2 * count)
+    M = sums[..., :count] + sums[..., count:].swapaxes(0, 1)  # each edge's, as (low, high)
+    # each node's own Σ V gₐ gₐᵀ is minus that of its edges (Σ_b g_b = 0 on every simplex),
+    # made symmetric to the last bit
+    low, high = np.take(indices, lower), np.take(indices, upper)
+    ends = np.concatenate([low, high])
+    D = np.empty((dim, dim, nodes))
+    for i, j in product(range(dim), repeat=2):
+        D[i, j] = D[j, i] if j < i else -np.bincount(ends, np.concatenate([M[i, j], M[j, i]]),
+                                                     minlength=nodes)
     blocks = np.empty((indices.size, dim, dim))
-    on_diagonal = mirror == np.arange(mirror.size)
-    for i in range(dim):
-        for j in range(dim):
-            mirrored = np.take(half[j, i], mirror)
-            mirrored[on_diagonal] = 0.0  # a node's own block is symmetric and summed once
-            blocks[:, i, j] = half[i, j] + mirrored
-    for i, j in combinations(range(dim), 2):  # a node's own block, symmetric to the last bit
-        blocks[on_diagonal, j, i] = blocks[on_diagonal, i, j]
+    for summed, at, mirrored in ((M, upper, lower), (D, diagonal, None)):
+        # the block is V (λ gₐ g_bᵀ + μ g_b gₐᵀ + μ (gₐ · g_b) I) summed
+        block = (Lambda * summed + Mu * summed.swapaxes(0, 1)
+                 + Mu * np.trace(summed) * np.eye(dim)[:, :, None])
+        if axisymmetric:
+            block += (hoop_sums[..., :count] + hoop_sums[..., count:2 * count].swapaxes(0, 1)
+                      if mirrored is not None else hoop_sums[..., 2 * count:])
+        blocks[at] = block.transpose(2, 0, 1)
+        if mirrored is not None:  # each (high, low) block: its (low, high)'s transpose
+            blocks[mirrored] = block.transpose(2, 1, 0)
     K = sp.bsr_matrix((blocks, indices, indptr), shape=(dim * nodes, dim * nodes)).tocsr()
     K.eliminate_zeros()  # the blocks' structural zeros (a pattern as scikit-fem's)
     return K

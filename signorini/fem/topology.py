@@ -39,6 +39,19 @@ def _packed(nodes: np.ndarray, count: int) -> np.ndarray | None:
     return key
 
 
+def sort_order(keys: np.ndarray, bound: int) -> np.ndarray:
+    """``np.argsort(keys, kind="stable")`` of non-negative integer ``keys`` below ``bound``.
+
+    When a key and its position fit in 63 bits together, by one sort of the
+    values ``key · 2ᵇ + position`` (numpy's SIMD value sort, several times
+    faster than an index sort); else by ``argsort``.
+    """
+    shift = max(keys.size - 1, 1).bit_length()
+    if max(bound - 1, 1).bit_length() + shift > 63:
+        return np.argsort(keys, kind="stable")
+    return np.sort((keys.astype(np.int64) << shift) | np.arange(keys.size)) & ((1 << shift) - 1)
+
+
 #: compare-and-swap pairs that sort 2, 3 or 4 rows
 NETWORKS = {2: ((0, 1),), 3: ((0, 1), (1, 2), (0, 1)),
             4: ((0, 1), (2, 3), (0, 2), (1, 3), (1, 2))}
@@ -67,7 +80,7 @@ def _entities(t: np.ndarray, local_entities, count: int):
     key = _packed(corners, count)
     if key is None:
         return None
-    order = np.argsort(key, kind="stable")
+    order = sort_order(key, count ** corners.shape[0])
     ordered = np.take(key, order)
     new = np.ones(ordered.size, dtype=bool)
     new[1:] = ordered[1:] != ordered[:-1]
