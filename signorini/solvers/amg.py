@@ -102,7 +102,7 @@ CERTIFICATE_RTOL = 1e-2
 GAMG_OPTIONS = {"pc_gamg_agg_nsmooths": "0", "pc_gamg_coarse_eq_limit": "10000",
                 "mg_levels_ksp_max_it": "1"}
 #: ... and, when PETSc has MUMPS, the coarsest level factorised by it rather than PETSc's own LU
-#: (several times faster there, the same answer to round-off); aggregates with fewer dofs than
+#: (faster, the same preconditioner to round-off: docs/amg.md); aggregates with fewer dofs than
 #: near-null modes leave rows of zeros in that level, which MUMPS is told to detect as null
 #: pivots (PETSc's LU shifts them)
 MUMPS_COARSE_OPTIONS = {"mg_coarse_sub_pc_factor_mat_solver_type": "mumps",
