@@ -24,11 +24,9 @@ algebraic multigrid given the rigid-body modes as near-null space
   sets differ in a few rows and CG pays for them in iterations;
 - CG starts from the last step's displacement, and its tolerance follows
   Eisenstat & Walker (1996, choice 2) while the active set still moves:
-  ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²``, ``γ = 0.9``, within [:data:`ETA_MIN`,
-  :data:`ETA_MAX`]. The first solve, from far (zero, or a warm start), is held
-  to :data:`ETA_MIN`; its residual is no yardstick for the next ones (the ratio
-  would hold every later step at ETA_MIN too), so the second step starts the
-  sequence at :data:`ETA_MAX`;
+  ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²``, ``γ = 0.9``, in [:data:`ETA_MIN`, :data:`ETA_MAX`]:
+  the first solve, from far, at ETA_MIN; the ratio against it would hold every
+  later step there, so the second step starts the sequence again at ETA_MAX;
 - when the set repeats, CG is driven to a stationarity residual of
   :data:`SAFETY` · tol against the contact forces, and the method stops only
   when the package's certificate (:func:`signorini.kkt.certificate`) is within
@@ -76,9 +74,8 @@ DEFAULTS = {"amg": "auto", "c": 1.0, "active0": None, "coarse": None, "callback"
             "warm_start": None, "push0": None}
 #: stationarity is driven to SAFETY · tol so that the certificate's other residuals have room
 SAFETY = 0.1
-#: Eisenstat–Walker: γ, the exponent, the largest and smallest forcing terms (the first
-#: step's is the smallest: the predicted set is nearly right, and a loose first solve lost it;
-#: the second step's the largest, see the module doc)
+#: Eisenstat–Walker: γ, the exponent, the largest and smallest forcing terms (the first step's
+#: is the smallest: the predicted set is nearly right, a loose first solve lost it; module doc)
 GAMMA, ALPHA, ETA_MAX, ETA_MIN = 0.9, 2.0, 0.1, 1e-4
 #: a coarse model below this many dofs is solved by pdas (a factorisation is cheap there)
 DIRECT_BELOW = 30_000
@@ -101,10 +98,9 @@ CERTIFICATE_RTOL = 1e-2
 #: docs/amg.md)
 GAMG_OPTIONS = {"pc_gamg_agg_nsmooths": "0", "pc_gamg_coarse_eq_limit": "10000",
                 "mg_levels_ksp_max_it": "1"}
-#: ... and, when PETSc has MUMPS, the coarsest level factorised by it rather than PETSc's own LU
-#: (faster, the same preconditioner to round-off: docs/amg.md); aggregates with fewer dofs than
-#: near-null modes leave rows of zeros in that level, which MUMPS is told to detect as null
-#: pivots (PETSc's LU shifts them)
+#: ... and, when PETSc has MUMPS, the coarsest level factorised by it, not PETSc's own LU (faster,
+#: the same preconditioner to round-off: docs/amg.md); plain aggregation leaves rows of zeros
+#: there (aggregates of fewer dofs than modes), which MUMPS is told to detect as null pivots
 MUMPS_COARSE_OPTIONS = {"mg_coarse_sub_pc_factor_mat_solver_type": "mumps",
                         "mg_coarse_sub_mat_mumps_icntl_24": "1"}
 
