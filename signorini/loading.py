@@ -40,7 +40,8 @@ from signorini.errors import InputError
 from signorini.numerics import factor, loading, multigrid
 from signorini.numerics.factor import FactorTooLarge, selection_dofs
 from signorini.numerics.loading import calibrate_push
-from signorini.numerics.zone import Zone, ZoneSolver, predict_zone, zone_around_points
+from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
+                                     zone_around_points)
 from signorini.problem import ContactProblem
 from signorini.references import reference_of
 from signorini.solution import ContactSolution, WarmStart
@@ -84,16 +85,18 @@ class Matched:
     work: dict[str, int]
 
 
+def analytic_extent(problem: ContactProblem) -> float | None:
+    """The reference's contact half-width (radius) at the target load, in the problem's lengths."""
+    reference = reference_of(problem)
+    a = reference.extent(problem) if reference is not None and reference.extent else None
+    return None if a is None else a / problem.scales.length
+
+
 def analytic_zone(problem: ContactProblem) -> Zone | None:
     """The contact zone from the reference's contact half-width (radius) at the target load."""
-    reference = reference_of(problem)
-    if reference is None or reference.extent is None:
-        return None
-    a = reference.extent(problem)
-    if a is None:
-        return None
-    return zone_around_points(problem.contact_points, a / problem.scales.length,
-                              reference.extent_margin)
+    a = analytic_extent(problem)
+    return None if a is None else zone_around_points(problem.contact_points, a,
+                                                     reference_of(problem).extent_margin)
 
 
 def coarse_zone(problem: ContactProblem, coarse: ContactProblem | None,
@@ -188,8 +191,12 @@ def _predictions(problem: ContactProblem, method: str, options: dict[str, Any],
         if zone is None and coarse is not None:
             zone = coarse_zone(problem, coarse(problem))[0]
         return {"zone": zone} if zone is not None else {}
-    if method == "pdas-amg" and not given & {"active0", "coarse", "warm_start"} \
-            and coarse is not None:
+    if method == "pdas-amg" and not given & {"active0", "coarse", "warm_start"}:
+        a = analytic_extent(problem)  # the candidates inside it: no coarse model to solve
+        if a is not None:
+            return {"active0": radial_distance(problem.contact_points) < a}
+        if coarse is None:
+            return {}
         zone, settled = coarse_zone(problem, coarse(problem), neighbours=1)
         if zone is None:
             return {}
@@ -245,5 +252,5 @@ def _said(work: dict[str, int]) -> str:
     return ", ".join(f"{value} {key.replace('_', ' ')}" for key, value in work.items()) or "no work"
 
 
-__all__ = ["CoarseModel", "Matched", "ZONE_FROM_DOFS", "analytic_zone", "at_load", "coarse_zone",
-           "counters", "match", "predicted_zone", "solve", "spent"]
+__all__ = ["CoarseModel", "Matched", "ZONE_FROM_DOFS", "analytic_extent", "analytic_zone", "at_load",
+           "coarse_zone", "counters", "match", "predicted_zone", "solve", "spent"]

@@ -10,8 +10,10 @@ algebraic multigrid given the rigid-body modes as near-null space
 (:mod:`signorini.numerics.multigrid`), never factorised. Then:
 
 - the first active set is given (``active0``: ``signorini.solve`` passes the
-  one a coarser model of the scene predicts), or comes from a warm start's
-  forces or from a coarse QP (``coarse``), so that few steps remain;
+  candidates inside the reference's contact radius when the scene has one at its
+  target load, Hertz's, else the set a coarser model of the scene predicts), or
+  comes from a warm start's forces or from a coarse QP (``coarse``), so that few
+  steps remain;
 - a target load that is still pending (``problem.pending``: load control,
   :mod:`signorini.loading`, leaves it to this method for large 3D models) is
   matched with the answer: the push is one more unknown of every CG system
@@ -22,7 +24,9 @@ algebraic multigrid given the rigid-body modes as near-null space
   sets differ in a few rows and CG pays for them in iterations;
 - CG starts from the last step's displacement, and its tolerance follows
   Eisenstat & Walker (1996, choice 2) while the active set still moves:
-  ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²``, ``γ = 0.9``, capped at :data:`ETA_MAX`;
+  ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²``, ``γ = 0.9``, in [:data:`ETA_MIN`, :data:`ETA_MAX`]:
+  the first solve, from far, at ETA_MIN; the ratio against it would hold every
+  later step there, so the second step starts the sequence again at ETA_MAX;
 - when the set repeats, CG is driven to a stationarity residual of
   :data:`SAFETY` · tol against the contact forces, and the method stops only
   when the package's certificate (:func:`signorini.kkt.certificate`) is within
@@ -70,8 +74,8 @@ DEFAULTS = {"amg": "auto", "c": 1.0, "active0": None, "coarse": None, "callback"
             "warm_start": None, "push0": None}
 #: stationarity is driven to SAFETY · tol so that the certificate's other residuals have room
 SAFETY = 0.1
-#: Eisenstat–Walker: γ, the exponent, the largest and smallest forcing terms (the first
-#: step's is the smallest: the predicted set is nearly right, and a loose first solve lost it)
+#: Eisenstat–Walker: γ, the exponent, the largest and smallest forcing terms (the first step's
+#: is the smallest: the predicted set is nearly right, a loose first solve lost it; module doc)
 GAMMA, ALPHA, ETA_MAX, ETA_MIN = 0.9, 2.0, 0.1, 1e-4
 #: a coarse model below this many dofs is solved by pdas (a factorisation is cheap there)
 DIRECT_BELOW = 30_000
@@ -94,6 +98,11 @@ CERTIFICATE_RTOL = 1e-2
 #: docs/amg.md)
 GAMG_OPTIONS = {"pc_gamg_agg_nsmooths": "0", "pc_gamg_coarse_eq_limit": "10000",
                 "mg_levels_ksp_max_it": "1"}
+#: ... and, when PETSc has MUMPS, the coarsest level factorised by it, not PETSc's own LU (faster,
+#: the same preconditioner to round-off: docs/amg.md); plain aggregation leaves rows of zeros
+#: there (aggregates of fewer dofs than modes), which MUMPS is told to detect as null pivots
+MUMPS_COARSE_OPTIONS = {"mg_coarse_sub_pc_factor_mat_solver_type": "mumps",
+                        "mg_coarse_sub_mat_mumps_icntl_24": "1"}
 
 
 class GamgHierarchy:
@@ -120,7 +129,9 @@ class GamgHierarchy:
                 vectors.append(vector)
             self._A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=comm))
         options = PETSc.Options("signorini_amg_")
-        for name, value in GAMG_OPTIONS.items():  # see GAMG_OPTIONS; a user's wins
+        wanted = {**GAMG_OPTIONS,
+                  **(MUMPS_COARSE_OPTIONS if PETSc.Sys.hasExternalPackage("mumps") else {})}
+        for name, value in wanted.items():  # see GAMG_OPTIONS; a user's wins
             if not options.hasName(name):
                 options.setValue(name, value)
         self._pc = PETSc.PC().create(comm)
@@ -129,6 +140,7 @@ class GamgHierarchy:
         self._pc.setOptionsPrefix("signorini_amg_")
         self._pc.setFromOptions()
         self._pc.setUp()
+        self._pc.getMGCoarseSolve().setUpOnBlocks()  # the coarsest level's LU (else: first cycle)
         self._x, self._y = self._A.createVecRight(), self._A.createVecLeft()
         self.levels = [int(self._pc.getMGLevels())]
         self.setup_s = time.perf_counter() - start
@@ -457,7 +469,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             cycles, final = cycles + 1, True
             continue
         seen.add(new_active.tobytes())
-        eta, r0_last = (forcing[0] if forcing else eta), result.initial
+        # the first solve's residual, from far, is no yardstick for the next ones (module doc)
+        eta, r0_last = (ETA_MAX, None) if step == 1 else (forcing[0] if forcing else eta,
+                                                            result.initial)
         active, final = new_active, False
     counts = {key: COUNTS[key] - counts[key] for key in COUNTS}
     u = form.displacement(x)
