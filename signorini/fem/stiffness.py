@@ -19,7 +19,7 @@ import scipy.sparse as sp
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
-from signorini.fem.topology import sort_order
+from signorini.fem.topology import _entities, sort_order
 
 #: the quadrature order scikit-fem's basis takes for P1 (twice the degree): the axisymmetric
 #: hoop term ∫ φₐ φ_b / r is no polynomial, and :func:`hoop_terms` integrates it with that rule
@@ -75,22 +75,14 @@ def node_pairs(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.nd
     Returns ``(indptr, indices, diagonal, upper, lower, edge_of)``: ``diagonal`` the entry
     (i, i) of each node, ``upper`` and ``lower`` the entries (low, high) and (high, low) of
     each edge, edges in the order of their (low, high), and ``edge_of`` (pairs, elements) the
-    edge of each element's local node pair (a, b), a < b, in ``combinations`` order. Found by
-    one sort of an integer key per edge of every element (:func:`sort_order`); row i holds its
-    lower entries, its diagonal, then its upper entries.
+    edge of each element's local node pair (a, b), a < b, in ``combinations`` order. The edges
+    are found as the mesh's facets are (one sort of packed keys, :func:`_entities`); row i
+    holds its lower entries, its diagonal, then its upper entries.
     """
-    corners, elements = t.shape
-    edges_local = list(combinations(range(corners), 2))
-    first = np.concatenate([t[a] for a, _ in edges_local]).astype(np.int64)
-    second = np.concatenate([t[b] for _, b in edges_local]).astype(np.int64)
-    keys = np.minimum(first, second) * nodes + np.maximum(first, second)
-    order = sort_order(keys, nodes * nodes)
-    sorted_keys = np.take(keys, order)
-    is_new = np.ones(keys.size, dtype=bool)
-    is_new[1:] = sorted_keys[1:] != sorted_keys[:-1]
-    edge_of = np.empty(keys.size, dtype=np.int64)
-    edge_of[order] = np.cumsum(is_new) - 1
-    edge_low, edge_high = np.divmod(sorted_keys[is_new], nodes)
+    found = _entities(t, combinations(range(t.shape[0]), 2), nodes)
+    if found is None:
+        raise ValueError(f"K's pattern: {nodes:,} nodes are too many to pack an edge in an int64")
+    (edge_low, edge_high), edge_of = found[0].astype(np.int64), found[1]
     count = edge_low.size
     above, below = np.bincount(edge_low, minlength=nodes), np.bincount(edge_high, minlength=nodes)
     indptr = np.concatenate([[0], np.cumsum(below + 1 + above)])
@@ -104,7 +96,7 @@ def node_pairs(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.nd
     lower[by_high] = np.take(indptr, high) + np.arange(count) - np.take(before_high, high)
     indices = np.empty(indptr[-1], dtype=np.int64)
     indices[diagonal], indices[upper], indices[lower] = np.arange(nodes), edge_high, edge_low
-    return indptr, indices, diagonal, upper, lower, edge_of.reshape(len(edges_local), elements)
+    return indptr, indices, diagonal, upper, lower, edge_of
 
 
 def hoop_terms(p: np.ndarray, t: np.ndarray, grads: np.ndarray, area: np.ndarray,
