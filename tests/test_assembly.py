@@ -461,3 +461,29 @@ def test_sort_order_is_a_stable_argsort(bound):
 
     keys = np.random.default_rng(5).integers(0, 50, 1000) * (bound // 50)
     np.testing.assert_array_equal(sort_order(keys, bound), np.argsort(keys, kind="stable"))
+
+
+def _ball():
+    from skfem import MeshTet
+
+    return MeshTet.init_ball(2)
+
+
+@pytest.mark.parametrize("make_mesh", [_irregular_mesh, _ball])
+def test_stiffness_reads_the_edges_a_mesh_already_has_and_is_bit_identical(make_mesh):
+    """A triangle mesh whose facets were found, or a tetrahedral one whose edges were, gives
+    K its pattern (no second sort), and K is the same to the last bit as without them."""
+    from signorini.fem.stiffness import mesh_edges, node_pairs, simplex_stiffness
+    from signorini.fem.topology import with_edges, with_topology
+
+    fresh, known = make_mesh(), make_mesh()
+    assert mesh_edges(fresh) is None
+    known = with_topology(known) if known.t.shape[0] == 3 else with_edges(known)
+    edges = mesh_edges(known)
+    assert edges is not None
+    nodes = known.p.shape[1]
+    for ours, theirs in zip(node_pairs(known.t, nodes, edges), node_pairs(known.t, nodes)):
+        np.testing.assert_array_equal(ours, theirs)
+    A, B = simplex_stiffness(fresh, 1.3, 0.7), simplex_stiffness(known, 1.3, 0.7)
+    for name in ("data", "indices", "indptr"):
+        assert getattr(A, name).tobytes() == getattr(B, name).tobytes()

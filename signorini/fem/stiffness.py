@@ -66,8 +66,9 @@ def barycentric_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.
     return (triangle_gradients if p.shape[0] == 2 else tetrahedron_gradients)(p, t)
 
 
-def node_pairs(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                                  np.ndarray, np.ndarray]:
+def node_pairs(t: np.ndarray, nodes: int,
+               edges: tuple[np.ndarray, np.ndarray] | None = None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """K's node-by-node pattern (CSR ``indptr``, ``indices``, sorted) of a simplex mesh
     (triangles or tetrahedra: k = 3 or 4 nodes each), where each entry of it sits, and each
     element's edges.
@@ -76,10 +77,12 @@ def node_pairs(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.nd
     (i, i) of each node, ``upper`` and ``lower`` the entries (low, high) and (high, low) of
     each edge, edges in the order of their (low, high), and ``edge_of`` (pairs, elements) the
     edge of each element's local node pair (a, b), a < b, in ``combinations`` order. The edges
-    are found as the mesh's facets are (one sort of packed keys, :func:`_entities`); row i
-    holds its lower entries, its diagonal, then its upper entries.
+    are ``edges`` (``(edges, edge_of)`` as returned, from :func:`mesh_edges`) when given, else
+    found as the mesh's facets are (one sort of packed keys, :func:`_entities`); row i holds
+    its lower entries, its diagonal, then its upper entries.
     """
-    found = _entities(t, combinations(range(t.shape[0]), 2), nodes)
+    found = edges if edges is not None else \
+        _entities(t, combinations(range(t.shape[0]), 2), nodes)
     if found is None:
         raise ValueError(f"K's pattern: {nodes:,} nodes are too many to pack an edge in an int64")
     (edge_low, edge_high), edge_of = found[0].astype(np.int64), found[1]
@@ -97,6 +100,21 @@ def node_pairs(t: np.ndarray, nodes: int) -> tuple[np.ndarray, np.ndarray, np.nd
     indices = np.empty(indptr[-1], dtype=np.int64)
     indices[diagonal], indices[upper], indices[lower] = np.arange(nodes), edge_high, edge_low
     return indptr, indices, diagonal, upper, lower, edge_of
+
+
+def mesh_edges(mesh: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """The edges a simplex mesh already has, sorted lexicographically as :func:`node_pairs`
+    finds them, and the edge of each element's local pair (a, b), a < b, in ``combinations``
+    order: a triangle mesh's facets, a tetrahedral mesh's edges once scikit-fem or
+    :func:`~signorini.fem.topology.with_edges` has found them; else None."""
+    names = ("_facets", "_t2f") if mesh.t.shape[0] == 3 else ("_edges", "_t2e")
+    if not all(hasattr(mesh, name) for name in names):
+        return None
+    edges, of = (getattr(mesh, name) for name in names)
+    local = [sorted(pair) for pair in (mesh.elem.refdom.facets if mesh.t.shape[0] == 3
+                                       else mesh.elem.refdom.edges)]
+    rows = [local.index(list(pair)) for pair in combinations(range(mesh.t.shape[0]), 2)]
+    return edges, of[rows]
 
 
 def hoop_terms(p: np.ndarray, t: np.ndarray, grads: np.ndarray, area: np.ndarray,
@@ -153,8 +171,11 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
                          "them with scikit-fem")
     nodes, elements = p.shape[1], t.shape[1]
     # the elements in the order of their lowest node: what each sum reads and writes lies near
-    t = np.take(t, sort_order(t.min(axis=0), nodes), axis=1)
-    indptr, indices, diagonal, upper, lower, edge_of = node_pairs(t, nodes)
+    order = sort_order(t.min(axis=0), nodes)
+    t, edges = np.take(t, order, axis=1), mesh_edges(mesh)
+    if edges is not None:
+        edges = edges[0], np.take(edges[1], order, axis=1)
+    indptr, indices, diagonal, upper, lower, edge_of = node_pairs(t, nodes, edges)
     count = upper.size
     first, second = np.array(list(combinations(range(corners), 2))).T
     # Σ V gₐ g_bᵀ of each edge's pairs met as (low, high), then of those met as (high, low)

@@ -78,7 +78,7 @@ def coarse_quarter_disc(rings: int = 4) -> MeshTri:
 def on_circle_arc(mesh: MeshTri, centre: tuple[float, float], radius: float,
                   tol: float = 1e-9) -> np.ndarray:
     """Boundary nodes that lie on the curved part of a quarter disc (not on its two cuts)."""
-    nodes = mesh.boundary_nodes()
+    nodes = with_topology(mesh).boundary_nodes()
     x, y = mesh.p[:, nodes]
     return nodes[(x > centre[0] + tol) & (y < centre[1] - tol)]
 
@@ -92,7 +92,7 @@ def snap_to_circle(centre: tuple[float, float], radius: float) -> Callable[[Mesh
         p = mesh.p.copy()
         offset = p[:, nodes] - c[:, None]
         p[:, nodes] = c[:, None] + radius * offset / np.linalg.norm(offset, axis=0)
-        return MeshTri(p, mesh.t)
+        return moved(mesh, p)
 
     return snap
 
@@ -134,7 +134,7 @@ def refine_simplices_to_size(mesh: Mesh, target: Callable[[np.ndarray], np.ndarr
         if mesh.t.shape[1] > max_elements:
             raise RuntimeError(f"mesh grading exceeded {max_elements} elements")
         with _skfem_copy_warnings_silenced():
-            mesh = mesh.refined(marked)
+            mesh = with_topology(mesh).refined(marked)
         if snap is not None:
             mesh = snap(mesh)
     log.warning("mesh grading stopped after %d passes", max_passes)
