@@ -17,6 +17,7 @@ from signorini.kkt import certificate, compare
 from signorini.numerics import factor, multigrid
 from signorini.scenes import build_problem
 from signorini.solvers import amg, auto
+from signorini.solvers.bounds import bound_form
 from signorini.solvers.registry import solve
 from synthetic import random_problem
 
@@ -128,6 +129,22 @@ def test_the_second_step_starts_the_forcing_terms_at_their_loosest(problems):
     solution = solve(problems["hertz-sphere-3d"], "pdas-amg", amg="pyamg")
     assert solution.history["eta"][:2] == [amg.ETA_MIN, amg.ETA_MAX], solution.history
     assert solution.extras["cg_iterations"] <= 70, solution.history
+
+
+def test_the_gamg_hierarchy_reads_the_matrix_in_place_with_its_node_blocks(problems):
+    """GAMG is handed A's own arrays, not a copy, with K's node blocks (which it aggregates by):
+    its matrix is A's to the bit and its V-cycle that of a hierarchy of a copy of A."""
+    pytest.importorskip("petsc4py", reason="PETSc's GAMG needs petsc4py (extra 'petsc')")
+    form = bound_form(problems["hertz-sphere-3d"])
+    A = multigrid.pinned_matrix(sp.csr_matrix(form.K), form.lower == form.upper)
+    first = amg.GamgHierarchy(A, form.rigid_modes(), form.block)
+    second = amg.GamgHierarchy(A.copy(), form.rigid_modes(), form.block)
+    assert form.block == 3 and first._A.getBlockSize() == 3
+    indptr, indices, data = first._A.getValuesCSR()
+    assert np.array_equal(indptr, A.indptr) and np.array_equal(indices, A.indices)
+    assert np.array_equal(data, A.data)
+    r = np.random.default_rng(0).standard_normal(A.shape[0])
+    assert np.array_equal(first.apply(r), second.apply(r))
 
 
 def test_bad_options_are_refused(problems):

@@ -1,14 +1,17 @@
 """A large command against the one solve it cannot avoid, measured in the same run.
 
     .venv/bin/python tools/budget.py            # ~3 min here; writes docs/speed/budget.json
-    .venv/bin/python tools/budget.py --3d       # also the 3D sphere at 350k and 10^6 dofs (~4 more min)
+    .venv/bin/python tools/budget.py --3d       # also the 3D sphere at 350k and 10^6 dofs (~6 more min)
+    .venv/bin/python tools/budget.py --parts 3d-1m   # one case's in-process parts, printed only
 
 2D: the 10⁶-dof cylinder command, whole process (start to exit, ``/usr/bin/time -v`` for its
 peak memory), the fastest of ``--repeat`` runs; then, in one process, its parts: the model
 built (meshing and assembly), the solve through the API, the certificate and the estimate, and
 the same K factorised by PARDISO (SPD, the package's settings) and solved once, which no
-method can do without. 3D: the command's whole process, at 350k and at 10⁶ dofs. docs/speed.md quotes the JSON
-(tests/test_readme_numbers.py holds it).
+method can do without. 3D: the command's whole process, at 350k and at 10⁶ dofs, and at 10⁶ its
+parts in one process: the model built, the solve through the API, the estimate, and the one
+multigrid solve of K no method without a factorisation can avoid (:func:`in_process_amg`).
+docs/speed.md quotes the JSON (tests/test_readme_numbers.py holds it).
 """
 
 from __future__ import annotations
@@ -93,6 +96,62 @@ def in_process(scene: str, params: dict) -> dict:
     return parts
 
 
+def in_process_amg(scene: str, params: dict) -> dict:
+    """The 3D command's parts in one process: the model built, the whole solve through the API
+    (``pdas-amg``: its method time, steps, hierarchy set-up and CG iterations), the estimate,
+    and one multigrid solve of K: K of the solved problem (at the push found) with the
+    prescribed dofs and the answer's active set pinned, a GAMG hierarchy of it set up with
+    the package's options (:class:`~signorini.solvers.amg.GamgHierarchy`), and CG
+    (:func:`~signorini.numerics.multigrid.pinned_cg`) from the pinned values and zero
+    elsewhere to the stationarity residual pdas-amg's final solve stops at
+    (``SAFETY · tol ·`` the largest contact force, in the max norm)."""
+    import numpy as np
+
+    import signorini
+    from signorini.numerics.multigrid import pinned_cg, pinned_matrix
+    from signorini.scenes.build import build_problem
+    from signorini.solvers import amg
+    from signorini.solvers.bounds import bound_form
+
+    start = time.perf_counter()
+    problem = build_problem(scene, params, solved_by="auto")  # as the command builds it
+    parts = {"dofs": problem.n, "build_s": time.perf_counter() - start}
+    del problem
+    start = time.perf_counter()
+    result = signorini.solve(scene, params=params)
+    parts["solve_s"] = time.perf_counter() - start  # built again, solved, judged
+    extras = result.solution.extras
+    parts.update(method=result.method, status=result.status,
+                 method_s=extras["method_s"], steps=result.iterations,
+                 hierarchy_s=extras["hierarchy_s"], cg_iterations=extras["cg_iterations"])
+    start = time.perf_counter()
+    result.estimate
+    parts["estimate_s"] = time.perf_counter() - start
+    problem, lam = result.problem, result.solution.lam
+    del result
+    system = amg.PinnedSystem(bound_form(problem))
+    active = lam > 0
+    x = np.zeros(system.form.n)
+    free = system.pin(active, problem.d, x)
+    force = max(float(np.max(np.abs(lam * system.coef), initial=0.0)),
+                1e-5 * float(np.max(np.abs(problem.f), initial=0.0)))
+    target = amg.SAFETY * amg.DEFAULT_TOL * force
+    start = time.perf_counter()
+    pinned, modes = pinned_matrix(system.K, ~free), system.form.rigid_modes()
+    parts["amg_pin_s"] = time.perf_counter() - start  # the pinned matrix and the rigid modes
+    hierarchy = amg.GamgHierarchy(pinned, modes, system.form.block)
+    parts["amg_setup_s"] = hierarchy.setup_s  # as the method's hierarchy_s: GAMG's set-up
+    del pinned
+    start = time.perf_counter()
+    solved = pinned_cg(system.K, system.f, x, free, hierarchy.apply,
+                       lambda r2, rinf, r0: rinf <= target, amg.CG_MAX_ITER)
+    parts["amg_solve_s"] = time.perf_counter() - start
+    parts.update(amg_cg_iterations=solved.iterations, amg_levels=hierarchy.levels[0],
+                 amg_reduction=solved.final / solved.initial,
+                 amg_pinned="the prescribed dofs and the answer's active set")
+    return parts
+
+
 def load() -> dict:
     return json.loads(OUT.read_text())
 
@@ -121,6 +180,8 @@ def table(record: dict) -> str:
             three = record[case]["command"]
             lines += ["", f"3D, `{three['command']}` ({three['dofs']:,} dofs, {three['status']}): "
                           f"**{three['wall_s']:.1f} s** whole process, {three['peak_gb']:.2f} GB peak."]
+            if "in_process" in record[case]:
+                lines += ["", *amg_lines(three["wall_s"], record[case]["in_process"])]
     machine = record["machine"]
     lines += ["", f"Measured {record['date'][:10]} on {machine['cores']} cores "
                   f"({machine['processor']}, Python {machine['python']}) by `tools/budget.py`; the "
@@ -128,11 +189,38 @@ def table(record: dict) -> str:
     return "\n".join(lines)
 
 
+def amg_lines(wall: float, parts: dict) -> list[str]:
+    """The 3D command's parts against one multigrid solve of its K (see :func:`in_process_amg`)."""
+    once = parts["amg_pin_s"] + parts["amg_setup_s"] + parts["amg_solve_s"]
+    lines = [f"One multigrid solve of the same K ({parts['amg_pinned']} pinned), in the same "
+             f"run: pinning {parts['amg_pin_s']:.1f} s, GAMG set-up {parts['amg_setup_s']:.1f} s and CG "
+             f"{parts['amg_solve_s']:.1f} s ({parts['amg_cg_iterations']} iterations), "
+             f"**{once:.1f} s**; `{parts['method']}` took {parts['method_s']:.1f} s "
+             f"({parts['steps']} steps, {parts['cg_iterations']} CG iterations, its hierarchy "
+             f"{parts['hierarchy_s']:.1f} s), **{parts['method_s'] / once:.2f}×** it.", "",
+             "| part (in one process, after the command) | seconds | of the command |",
+             "|---|---:|---:|"]
+    for label, key in (("the model built: meshing and assembly", "build_s"),
+                       ("`signorini.solve`: built again, load matched, solved, judged", "solve_s"),
+                       (f"`{parts['method']}` alone (within the solve)", "method_s"),
+                       ("the error estimate", "estimate_s"),
+                       ("K pinned, and its rigid-body modes", "amg_pin_s"),
+                       ("GAMG: set up the hierarchy of K", "amg_setup_s"),
+                       ("GAMG: CG to pdas-amg's final tolerance", "amg_solve_s")):
+        lines.append(f"| {label} | {parts[key]:.2f} | {100 * parts[key] / wall:.0f} % |")
+    return lines
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--3d", dest="three", action="store_true")
+    parser.add_argument("--parts", choices=["3d-1m"], help="only this case's in-process parts, "
+                        "printed (budget.json is not written)")
     args = parser.parse_args()
+    if args.parts:
+        print(json.dumps(in_process_amg(*CASES[args.parts]), indent=1))
+        return
     out = {"machine": {"system": platform.platform(), "python": platform.python_version(),
                        "processor": platform.processor() or platform.machine(),
                        "cores": os.cpu_count()},
@@ -148,6 +236,8 @@ def main() -> None:
         runs = [whole_process(scene, params) for _ in range(args.repeat)]
         out[case] = {"command": min(runs, key=lambda r: r["wall_s"]),
                      "walls_s": [r["wall_s"] for r in runs]}
+        if case == "3d-1m":
+            out[case]["in_process"] = in_process_amg(scene, params)
     OUT.write_text(json.dumps(out, indent=1) + "\n")
     two = out["2d"]
     once = two["in_process"]["pardiso_factorise_and_solve_s"]

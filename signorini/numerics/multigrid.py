@@ -119,7 +119,8 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
     Eisenstat–Walker forcing term against the first residual, or both); it is
     checked on the recursive residual and confirmed on the true one (CG
     restarts from it at most :data:`MAX_RESTARTS` times). Preconditioned by
-    ``precondition`` restricted to the free dofs. ``weights`` (default one)
+    ``precondition`` restricted to the free dofs (it returns a new array, which CG
+    masks in place; ``K @`` likewise). ``weights`` (default one)
     scale the residual's entries in those norms (rows of other units).
     ``K`` may be anything with ``K @ x`` (e.g. :class:`Bordered`).
     """
@@ -128,7 +129,7 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
 
     def norms(r: np.ndarray) -> tuple[float, float]:
         w = r if weights is None else scaled * r
-        return float(np.linalg.norm(w)), float(np.max(np.abs(w), initial=0.0))
+        return float(np.linalg.norm(w)), max(float(w.max(initial=0.0)), -float(w.min(initial=0.0)))
 
     r = mask * (f - K @ x)
     initial = norms(r)[0]
@@ -137,11 +138,13 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
     for _ in range(MAX_RESTARTS + 1):
         if done(*norms(r), initial):
             break
-        z = mask * precondition(r)
+        z = precondition(r)
+        z *= mask
         p = z.copy()
         rz = float(r @ z)
-        while iterations < max_iter:
-            q = mask * (K @ p)
+        while iterations < max_iter:  # in place where a product would only make a copy
+            q = K @ p
+            q *= mask
             curvature = float(p @ q)
             if not curvature > 0:  # breakdown: nothing left that the free dofs can change
                 break
@@ -151,11 +154,13 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
             iterations += 1
             if done(*norms(r), initial):
                 break
-            z = mask * precondition(r)
+            z = precondition(r)
+            z *= mask
             rz, rz_old = float(r @ z), rz
             if not rz > 0:  # the preconditioned residual vanished: nothing left to correct
                 break
-            p = z + (rz / rz_old) * p
+            p *= rz / rz_old
+            p += z
         r = mask * (f - K @ x)  # the true residual: confirm, or restart from it
         if iterations >= max_iter:
             break

@@ -117,9 +117,10 @@ class GamgHierarchy:
         A = sp.csr_matrix(A)
         A.sort_indices()
         block = block if A.shape[0] % block == 0 else 1
-        self._A = PETSc.Mat().createAIJ(size=A.shape, bsize=block, comm=comm, csr=(
-            A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType), A.data))
-        self._A.assemble()
+        self._A = PETSc.Mat().createAIJWithArrays(A.shape, (
+            A.indptr.astype(PETSc.IntType, copy=False), A.indices.astype(PETSc.IntType, copy=False),
+            np.ascontiguousarray(A.data, dtype=PETSc.ScalarType)), comm=comm)
+        self._A.setBlockSize(block)  # A's arrays not copied: petsc4py holds them for the Mat
         self._A.setOption(PETSc.Mat.Option.SPD, True)
         if modes is not None:
             vectors = []
