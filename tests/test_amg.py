@@ -243,3 +243,35 @@ def test_nodes_touching_with_no_force_end_converged_not_cycling(touching):
     solution = solve(problem, "pdas-amg", tol=1e-8)
     assert solution.status == "converged", solution.message
     assert_agrees(problem, solution, solve(problem, "pdas", tol=1e-8), lam_tol=1e-7)
+
+
+@pytest.mark.parametrize("threads", [2, 3, 7])
+def test_a_product_by_row_blocks_in_threads_is_the_product_to_the_bit(threads):
+    """K @ x split by rows over threads: every row summed as scipy sums it, empty rows included,
+    and the blocks read K's own arrays."""
+    rng = np.random.default_rng(threads)
+    K = sp.random(500, 500, density=0.02, format="csr", random_state=rng)
+    K = sp.csr_matrix(K + sp.diags(np.where(rng.random(500) < 0.9, 1.0, 0.0)))
+    product = multigrid.RowBlocks(K, threads)
+    assert len(product.blocks) == threads
+    assert all(np.shares_memory(rows.data, K.data) for _, _, rows in product.blocks)
+    x = rng.standard_normal(500)
+    assert (product @ x).tobytes() == (K @ x).tobytes()
+
+
+def test_pdas_amg_with_threaded_products_gives_the_same_answer_to_the_bit(problems, monkeypatch):
+    """Large K's products go by row blocks in threads (threaded): the same CG, so the same
+    answer, as with scipy's own product (GAMG: pyamg's set-up draws random vectors)."""
+    pytest.importorskip("petsc4py", reason="PETSc's GAMG needs petsc4py (extra 'petsc')")
+    problem = problems["hertz-sphere-3d"]
+    monkeypatch.setattr(multigrid, "THREADS", 2)
+    monkeypatch.setattr(multigrid, "THREADED_FROM", 10 ** 15)
+    plain = solve(problem, "pdas-amg", amg="petsc")
+    assert not isinstance(amg.PinnedSystem(bound_form(problem)).product, multigrid.RowBlocks)
+    monkeypatch.setattr(multigrid, "THREADED_FROM", 0)
+    assert isinstance(amg.PinnedSystem(bound_form(problem)).product, multigrid.RowBlocks)
+    assert len(amg.PinnedSystem(bound_form(problem)).product.blocks) == 2
+    split = solve(problem, "pdas-amg", amg="petsc")
+    assert split.status == plain.status == "converged"
+    assert split.u.tobytes() == plain.u.tobytes() and split.lam.tobytes() == plain.lam.tobytes()
+    assert split.extras["cg_iterations"] == plain.extras["cg_iterations"]

@@ -22,7 +22,9 @@ CG iterations done in this process, so that tests count work instead of timing i
 
 from __future__ import annotations
 
+import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Callable
 
@@ -37,6 +39,12 @@ AMG_FROM_DOFS = 50_000
 COUNTS = {"hierarchies": 0, "cg_iterations": 0, "cg_solves": 0}
 #: CG restarts from the true residual when the recursive one says done but the true one does not
 MAX_RESTARTS = 4
+#: threads a large product ``K @ x`` is split over (scipy's runs in one and releases the GIL),
+#: and the fewest entries worth splitting (below, starting the threads costs more than it saves)
+THREADS = min(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+              else os.cpu_count() or 1, 8)
+THREADED_FROM = 1_000_000
+_pool: list[ThreadPoolExecutor] = []
 
 
 def pinned_matrix(K: sp.csr_matrix, pinned: np.ndarray) -> sp.csr_matrix:
@@ -79,6 +87,49 @@ class PyamgHierarchy:
 
     def apply(self, r: np.ndarray) -> np.ndarray:
         return self._cycle.matvec(r)
+
+
+class RowBlocks:
+    """``K @ x`` for a vector x, by blocks of K's rows in threads (as many entries in each).
+
+    Each block is a CSR matrix on K's own arrays (set as its attributes: scipy's constructor
+    copies a slice of a much larger array) and each row's sum is scipy's own, so the product is
+    K's to the bit; CG's products with a large K are most of its time besides the
+    preconditioner's.
+    """
+
+    def __init__(self, K: sp.csr_matrix, threads: int | None = None):
+        self.K, self.shape = K, K.shape
+        parts = THREADS if threads is None else threads
+        cuts = np.searchsorted(K.indptr, np.linspace(0, K.nnz, parts + 1)).clip(0, K.shape[0])
+        cuts[0], cuts[-1] = 0, K.shape[0]
+        self.blocks = []
+        for first, last in zip(cuts[:-1], cuts[1:]):
+            start, end = K.indptr[first], K.indptr[last]
+            if last > first:
+                rows = sp.csr_matrix((last - first, K.shape[1]), dtype=K.dtype)
+                rows.data, rows.indices = K.data[start:end], K.indices[start:end]
+                rows.indptr = K.indptr[first:last + 1] - start
+                self.blocks.append((first, last, rows))
+
+    def __matmul__(self, x: np.ndarray) -> np.ndarray:
+        if np.ndim(x) != 1 or len(self.blocks) < 2:
+            return self.K @ x
+        if not _pool:
+            _pool.append(ThreadPoolExecutor(THREADS, thread_name_prefix="signorini-product"))
+        out = np.empty(self.shape[0], dtype=np.result_type(self.K.dtype, x.dtype))
+
+        def product(block) -> None:
+            first, last, rows = block
+            out[first:last] = rows @ x
+
+        list(_pool[0].map(product, self.blocks))
+        return out
+
+
+def threaded(K: sp.csr_matrix) -> sp.csr_matrix | RowBlocks:
+    """K, or its :class:`RowBlocks` when it is large enough and there are threads to use."""
+    return RowBlocks(K) if THREADS > 1 and K.nnz >= THREADED_FROM else K
 
 
 @dataclass

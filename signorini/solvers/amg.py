@@ -57,7 +57,7 @@ from signorini.kkt import certificate
 from signorini.numerics.factor import selection_dofs
 from signorini.numerics.loading import first_contact
 from signorini.numerics.multigrid import (COUNTS, Bordered, PyamgHierarchy, pinned_cg,
-                                          pinned_matrix)
+                                          pinned_matrix, threaded)
 from signorini.numerics.zone import predict_zone
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import pdas, petsc_
@@ -170,14 +170,12 @@ class PinnedSystem:
     """The bound form's K with the prescribed dofs and an active set's bounded dofs pinned."""
 
     def __init__(self, form: BoundForm):
-        self.form = form
-        self.K = sp.csr_matrix(form.K)
+        self.form, self.K, self.f, self.hierarchy = form, sp.csr_matrix(form.K), form.f, None
+        self.product = threaded(self.K)  # K @ x for CG, by rows in threads when K is large
         self.prescribed = form.lower == form.upper
         self.bounded = form.bound_index >= 0
         self.index = np.where(self.bounded, form.bound_index, 0)
         self.coef = form.bound_coef
-        self.f = form.f
-        self.hierarchy = None
 
     def pin(self, active: np.ndarray, d: np.ndarray, x: np.ndarray) -> np.ndarray:
         """Set the pinned values in ``x``; the free mask."""
@@ -243,7 +241,7 @@ class PinnedCG:
             x[targets], pinned[targets] = full[targets], True
         f[pinned] = 0.0
         target = CERTIFICATE_RTOL * max(float(np.linalg.norm(f)), 1e-300)
-        result = pinned_cg(system.K, f, x, ~pinned, system.hierarchy.apply,
+        result = pinned_cg(system.product, f, x, ~pinned, system.hierarchy.apply,
                            lambda r2, rinf, r0: r2 <= target, CG_MAX_ITER)
         self.iterations += result.iterations
         return form.displacement(x)
@@ -393,10 +391,11 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     x = xs[:form.n]
     if opts["warm_start"] is not None and opts["warm_start"].u is not None:
         x[:] = form.T.T @ _embedded(form, opts["warm_start"].u)
-    operator, rhs, free_of, precondition = system.K, form.f, (lambda free: free), hierarchy.apply
+    operator, rhs, precondition = system.product, form.f, hierarchy.apply
+    free_of = lambda free: free  # noqa: E731
     if border is not None:
         xs[-1] = problem.push.scale if opts["push0"] is None else float(opts["push0"])
-        operator = Bordered(system.K, border.g, border.k)
+        operator = Bordered(system.product, border.g, border.k)
         rhs = np.append(border.f0, border.h)
         free_of = lambda free: np.append(free, True)  # noqa: E731
         precondition = border_preconditioner(hierarchy.apply, border)
