@@ -102,7 +102,8 @@ def in_process_amg(scene: str, params: dict) -> dict:
     and one multigrid solve of K: K of the solved problem (at the push found) with the
     prescribed dofs and the answer's active set pinned, a GAMG hierarchy of it set up with
     the package's options (:class:`~signorini.solvers.amg.GamgHierarchy`), and CG
-    (:func:`~signorini.numerics.multigrid.pinned_cg`) from the pinned values and zero
+    (:func:`~signorini.numerics.multigrid.pinned_cg`, with the method's products by K) from the
+    pinned values and zero
     elsewhere to the stationarity residual pdas-amg's final solve stops at
     (``SAFETY · tol ·`` the largest contact force, in the max norm)."""
     import numpy as np
@@ -143,7 +144,7 @@ def in_process_amg(scene: str, params: dict) -> dict:
     parts["amg_setup_s"] = hierarchy.setup_s  # as the method's hierarchy_s: GAMG's set-up
     del pinned
     start = time.perf_counter()
-    solved = pinned_cg(system.K, system.f, x, free, hierarchy.apply,
+    solved = pinned_cg(system.product, system.f, x, free, hierarchy.apply,  # the method's product
                        lambda r2, rinf, r0: rinf <= target, amg.CG_MAX_ITER)
     parts["amg_solve_s"] = time.perf_counter() - start
     parts.update(amg_cg_iterations=solved.iterations, amg_levels=hierarchy.levels[0],
