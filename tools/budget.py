@@ -63,6 +63,26 @@ def whole_process(scene: str, params: dict) -> dict:
             "dofs": result["dofs"], "time": result["time"], "hertz": result.get("hertz")}
 
 
+def built_and_solved(scene: str, params: dict, solved_by: str | None = None, **options):
+    """The first parts of a command in one process, timed: the model built (mesh and assembly),
+    the whole solve through the API (built again, solved, judged) and its estimate; the parts
+    and the result."""
+    import signorini
+    from signorini.scenes.build import build_problem
+
+    start = time.perf_counter()
+    problem = build_problem(scene, params, solved_by=solved_by)
+    parts = {"dofs": problem.n, "build_s": time.perf_counter() - start}
+    del problem
+    start = time.perf_counter()
+    result = signorini.solve(scene, params=params, **options)
+    parts["solve_s"] = time.perf_counter() - start
+    start = time.perf_counter()
+    result.estimate
+    parts["estimate_s"] = time.perf_counter() - start
+    return parts, result
+
+
 def in_process(scene: str, params: dict) -> dict:
     """The command's parts in one process: the model built (mesh and assembly), the whole solve
     through the API (which judges the answer), the estimate, the certificate once more alone
@@ -71,18 +91,8 @@ def in_process(scene: str, params: dict) -> dict:
 
     import signorini
     from signorini.numerics.factor import PardisoFactor
-    from signorini.scenes.build import build_problem
 
-    start = time.perf_counter()
-    problem = build_problem(scene, params)
-    parts = {"dofs": problem.n, "build_s": time.perf_counter() - start}
-    del problem
-    start = time.perf_counter()
-    result = signorini.solve(scene, params=params, keep_factor=True)
-    parts["solve_s"] = time.perf_counter() - start  # built again, solved, judged
-    start = time.perf_counter()
-    result.estimate
-    parts["estimate_s"] = time.perf_counter() - start
+    parts, result = built_and_solved(scene, params, keep_factor=True)
     start = time.perf_counter()  # a copy of the answer: the judged one keeps its certificate
     signorini.certificate(result.problem, dataclasses.replace(result.solution))
     parts["certificate_s"] = time.perf_counter() - start
@@ -103,31 +113,19 @@ def in_process_amg(scene: str, params: dict) -> dict:
     prescribed dofs and the answer's active set pinned, a GAMG hierarchy of it set up with
     the package's options (:class:`~signorini.solvers.amg.GamgHierarchy`), and CG
     (:func:`~signorini.numerics.multigrid.pinned_cg`, with the method's products by K) from the
-    pinned values and zero
-    elsewhere to the stationarity residual pdas-amg's final solve stops at
-    (``SAFETY · tol ·`` the largest contact force, in the max norm)."""
+    pinned values and zero elsewhere to the stationarity residual pdas-amg's final solve stops
+    at (``SAFETY · tol ·`` the largest contact force, in the max norm)."""
     import numpy as np
 
-    import signorini
     from signorini.numerics.multigrid import pinned_cg, pinned_matrix
-    from signorini.scenes.build import build_problem
     from signorini.solvers import amg
     from signorini.solvers.bounds import bound_form
 
-    start = time.perf_counter()
-    problem = build_problem(scene, params, solved_by="auto")  # as the command builds it
-    parts = {"dofs": problem.n, "build_s": time.perf_counter() - start}
-    del problem
-    start = time.perf_counter()
-    result = signorini.solve(scene, params=params)
-    parts["solve_s"] = time.perf_counter() - start  # built again, solved, judged
+    parts, result = built_and_solved(scene, params, solved_by="auto")  # as the command builds it
     extras = result.solution.extras
     parts.update(method=result.method, status=result.status,
                  method_s=extras["method_s"], steps=result.iterations,
                  hierarchy_s=extras["hierarchy_s"], cg_iterations=extras["cg_iterations"])
-    start = time.perf_counter()
-    result.estimate
-    parts["estimate_s"] = time.perf_counter() - start
     problem, lam = result.problem, result.solution.lam
     del result
     system = amg.PinnedSystem(bound_form(problem))
@@ -166,16 +164,13 @@ def table(record: dict) -> str:
              f"{record['repeat']} whole processes: **{wall:.1f} s**, {command['peak_gb']:.2f} GB peak; "
              f"PARDISO's factorisation and one solve of the same K, in the same run: "
              f"**{once:.1f} s**, so the command is **{wall / once:.2f}×** one factorisation.", "",
-             "| part (in one process, after the command) | seconds | of the command |",
-             "|---|---:|---:|"]
-    for label, key in (("the model built: meshing and assembly", "build_s"),
-                       ("`signorini.solve`: built again, load matched, solved, judged", "solve_s"),
-                       ("the certificate, once more alone (the method's factorisation)",
-                        "certificate_s"),
-                       ("the error estimate", "estimate_s"),
-                       ("PARDISO: factorise K", "pardiso_factorise_s"),
-                       ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s")):
-        lines.append(f"| {label} | {parts[key]:.2f} | {100 * parts[key] / wall:.0f} % |")
+             *part_rows(parts, wall, (
+                 (BUILT, "build_s"), (SOLVED, "solve_s"),
+                 ("the certificate, once more alone (the method's factorisation)",
+                  "certificate_s"),
+                 ("the error estimate", "estimate_s"),
+                 ("PARDISO: factorise K", "pardiso_factorise_s"),
+                 ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s")))]
     for case in ("3d", "3d-1m"):
         if case in record:
             three = record[case]["command"]
@@ -198,18 +193,26 @@ def amg_lines(wall: float, parts: dict) -> list[str]:
              f"{parts['amg_solve_s']:.1f} s ({parts['amg_cg_iterations']} iterations), "
              f"**{once:.1f} s**; `{parts['method']}` took {parts['method_s']:.1f} s "
              f"({parts['steps']} steps, {parts['cg_iterations']} CG iterations, its hierarchy "
-             f"{parts['hierarchy_s']:.1f} s), **{parts['method_s'] / once:.2f}×** it.", "",
-             "| part (in one process, after the command) | seconds | of the command |",
-             "|---|---:|---:|"]
-    for label, key in (("the model built: meshing and assembly", "build_s"),
-                       ("`signorini.solve`: built again, load matched, solved, judged", "solve_s"),
-                       (f"`{parts['method']}` alone (within the solve)", "method_s"),
-                       ("the error estimate", "estimate_s"),
-                       ("K pinned, and its rigid-body modes", "amg_pin_s"),
-                       ("GAMG: set up the hierarchy of K", "amg_setup_s"),
-                       ("GAMG: CG to pdas-amg's final tolerance", "amg_solve_s")):
-        lines.append(f"| {label} | {parts[key]:.2f} | {100 * parts[key] / wall:.0f} % |")
-    return lines
+             f"{parts['hierarchy_s']:.1f} s), **{parts['method_s'] / once:.2f}×** it.", ""]
+    return lines + part_rows(parts, wall, (
+        (BUILT, "build_s"), (SOLVED, "solve_s"),
+        (f"`{parts['method']}` alone (within the solve)", "method_s"),
+        ("the error estimate", "estimate_s"),
+        ("K pinned, and its rigid-body modes", "amg_pin_s"),
+        ("GAMG: set up the hierarchy of K", "amg_setup_s"),
+        ("GAMG: CG to pdas-amg's final tolerance", "amg_solve_s")))
+
+
+BUILT = "the model built: meshing and assembly"
+SOLVED = "`signorini.solve`: built again, load matched, solved, judged"
+
+
+def part_rows(parts: dict, wall: float, rows) -> list[str]:
+    """A table of the parts ``rows`` ((label, key) pairs) in seconds and as shares of ``wall``."""
+    return ["| part (in one process, after the command) | seconds | of the command |",
+            "|---|---:|---:|",
+            *(f"| {label} | {parts[key]:.2f} | {100 * parts[key] / wall:.0f} % |"
+              for label, key in rows)]
 
 
 def main() -> None:

@@ -26,6 +26,7 @@ import os
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import cache
 from typing import Callable
 
 import numpy as np
@@ -44,7 +45,6 @@ MAX_RESTARTS = 4
 THREADS = min(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
               else os.cpu_count() or 1, 8)
 THREADED_FROM = 1_000_000
-_pool: list[ThreadPoolExecutor] = []
 
 
 def pinned_matrix(K: sp.csr_matrix, pinned: np.ndarray) -> sp.csr_matrix:
@@ -115,16 +115,20 @@ class RowBlocks:
     def __matmul__(self, x: np.ndarray) -> np.ndarray:
         if np.ndim(x) != 1 or len(self.blocks) < 2:
             return self.K @ x
-        if not _pool:
-            _pool.append(ThreadPoolExecutor(THREADS, thread_name_prefix="signorini-product"))
         out = np.empty(self.shape[0], dtype=np.result_type(self.K.dtype, x.dtype))
 
         def product(block) -> None:
             first, last, rows = block
             out[first:last] = rows @ x
 
-        list(_pool[0].map(product, self.blocks))
+        list(_threads().map(product, self.blocks))
         return out
+
+
+@cache
+def _threads() -> ThreadPoolExecutor:
+    """The threads of :class:`RowBlocks`, started on first use."""
+    return ThreadPoolExecutor(THREADS, thread_name_prefix="signorini-product")
 
 
 def threaded(K: sp.csr_matrix) -> sp.csr_matrix | RowBlocks:
