@@ -31,8 +31,7 @@ from signorini.kkt import Certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem
 from signorini.references import Reference, reference_of, summary_lines
-from signorini import loading
-from signorini.loading import solve as load_control
+from signorini import load_control
 from signorini.scenes import SCENES, SceneFamily, build_problem
 from signorini.scenes.adapt import parse_target
 from signorini.scenes.base import scene_params
@@ -329,7 +328,7 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     :meth:`ContactProblem.from_qp` or :meth:`ContactProblem.load`) or the name
     of a scene (see :func:`scene_families`), built with ``params`` in the
     scene's units. A target load is matched first by load control
-    (:mod:`signorini.loading`). ``method`` is one of :func:`methods` (default
+    (:mod:`signorini.load_control`). ``method`` is one of :func:`methods` (default
     ``auto``: the fastest exact route; the result says which and why): a
     method named here starts cold, or from ``warm_start`` (an earlier
     :class:`Result`), and the iterations it reports are its own;
@@ -344,14 +343,13 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
     Bad input raises :class:`signorini.InputError`; a method that fails
     returns a result whose ``status`` says so.
     """
-    params = scene_params(params)
     adaptive = sorted(set(options) & {"target_error", "max_dofs", "target_on"})
     if adaptive:
         raise InputError(f"{', '.join(adaptive)} steer{'s' * (len(adaptive) == 1)} adaptive "
                          "refinement: call signorini.solve_adaptive(scene, target_error, ...)")
+    request = check_request(method, tol, max_iter, options)  # before the scene is built
     if isinstance(problem, str):
-        check_request(method, tol, max_iter, options)  # bad options fail before the scene is built
-        problem = build_problem(problem, params=params, solved_by=method)
+        problem = build_problem(problem, params=scene_params(params), solved_by=method)
     elif params:
         raise InputError("params= builds a scene by name: give solve('hertz-cylinder', params=...) "
                          "or build the problem with those parameters first")
@@ -359,17 +357,14 @@ def solve(problem: ContactProblem | str, method: str = DEFAULT_METHOD, *, tol: f
         raise InputError(f"problem must be a ContactProblem or a scene name, got "
                          f"{type(problem).__name__}: build one with signorini.build_problem(...) "
                          "or ContactProblem.from_qp(K, f, N, d)")
-    problem, solution = load_control(problem, method, tol=tol, max_iter=max_iter,
-                                     warm_start=warm_start, coarse=coarse_problem,
-                                     keep_factor=keep_factor, **options)
-    log.info("checking the answer: the KKT certificate")
-    return Result(problem, solution, kkt.certificate(problem, solution))
+    return Result(*load_control.solve(problem, request, warm_start=warm_start,
+                                      coarse=coarse_problem, keep_factor=keep_factor))
 
 
 def at_load(problem: ContactProblem) -> ContactProblem:
     """``problem`` at its target load, or itself when it has none: the QP any method (or your
-    own code) can then solve as it is. Load control matches the push (:mod:`signorini.loading`)."""
-    return loading.at_load(problem, coarse_problem)
+    own code) can then solve as it is. Load control matches the push (:mod:`signorini.load_control`)."""
+    return load_control.at_load(problem, coarse_problem)
 
 
 def solve_adaptive(scene: str, target_error: float | str, method: str = DEFAULT_METHOD, *,
@@ -392,15 +387,17 @@ def solve_adaptive(scene: str, target_error: float | str, method: str = DEFAULT_
         raise InputError("adaptive refinement refines a scene's mesh: give the scene by name, "
                          "solve_adaptive('hertz-cylinder', 0.01)")
     params = scene_params(params)
-    check_request(method, tol, max_iter, options)
+    request = check_request(method, tol, max_iter, options)
+    certificates: dict[int, Certificate] = {}
 
-    def solver(problem: ContactProblem):
-        return load_control(problem, method, tol=tol, max_iter=max_iter, coarse=coarse_problem,
-                            **options)
+    def solver(problem: ContactProblem) -> tuple[ContactProblem, ContactSolution]:
+        solved = load_control.solve(problem, request, coarse=coarse_problem)
+        certificates[id(solved.solution)] = solved.certificate
+        return solved.problem, solved.solution
 
     run = adapt(scene, params, parse_target(target_error), solver, max_dofs=max_dofs,
                 quantity=target_on, solved_by=method)
-    result = Result(run.problem, run.solution, kkt.certificate(run.problem, run.solution))
+    result = Result(run.problem, run.solution, certificates[id(run.solution)])
     result._estimate = run.estimate
     return result
 

@@ -34,7 +34,7 @@ from skfem.models.elasticity import lame_parameters
 from signorini.errors import InputError, SolverError
 from signorini.fem.assembly import lame_stiffness
 from signorini.kkt import ACTIVE, WEAK, classify
-from signorini.loading import solve as load_control
+from signorini import load_control
 from signorini.pressure import contact_profile, hertz_fit, hertz_fit_tangent
 from signorini.problem import ContactProblem
 from signorini.scenes import build_problem
@@ -42,6 +42,7 @@ from signorini.scenes.base import scene_params
 from signorini.scenes.build import coarse_problem
 from signorini.numerics.factor import ActiveSetSolver
 from signorini.solution import ContactSolution
+from signorini.solvers.registry import check_request
 
 SIDES = ("auto", "in", "out")
 OUTPUTS = ("total_force", "energy", "displacement", "pressure", "p0", "a")
@@ -367,8 +368,10 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
                          "mesh (R, W, H, refine...) needs a shape derivative, and shape "
                          "derivatives are not provided")
     if isinstance(scene, str):
+        request = check_request(method)  # before the scene is built
         problem = build_problem(scene, params=scene_params(params), solved_by=method)
-        problem, solution = load_control(problem, method, coarse=coarse_problem, keep_factor=True)
+        problem, solution, _ = load_control.solve(problem, request, coarse=coarse_problem,
+                                                  keep_factor=True)
         result = None
     else:
         if params:

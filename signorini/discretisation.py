@@ -55,7 +55,7 @@ class Push:
     ``target`` is the load (dimensionless, full body) the scene asks for, or
     None; ``pending`` says that no push has been matched to it yet: the
     problem is at a nominal push, and load control
-    (:func:`signorini.loading.match`) finds the push whose load is the target.
+    (:func:`signorini.load_control.match`) finds the push whose load is the target.
     The load is the contact resultant along the push, ``μ Σ cᵢ λᵢ`` with ``cᵢ``
     the cosine of candidate i's normal's tilt (``resultant``; None: all 1).
 
@@ -130,7 +130,7 @@ class Discretisation:
     and ``params`` records the scene's parameters as built (for reports and
     rebuilding; code reads the typed fields). ``push``
     says how f, d and the load depend on the prescribed push (load control,
-    :mod:`signorini.loading`), ``predicted_contact`` which candidates the
+    :mod:`signorini.load_control`), ``predicted_contact`` which candidates the
     scene expects in contact (where load control starts), ``watch`` the
     boundary beyond the candidates (see :class:`Watch`).
     """

@@ -184,7 +184,7 @@ class ContactProblem:
     @property
     def pending(self) -> bool:
         """A target load is set and not matched yet: f and d are at a nominal push
-        (:func:`signorini.loading.match` finds the push)."""
+        (:func:`signorini.load_control.match` finds the push)."""
         return self.push is not None and self.push.pending
 
     @property

@@ -1,4 +1,4 @@
-"""Load control (signorini.loading): a target load is matched outside assembly, by one driver.
+"""Load control (signorini.load_control): a target load is matched outside assembly, by one driver.
 
 A scene with a target load P is assembled at a nominal push with the target
 ``pending``; building it factorises nothing. Load control matches it: by

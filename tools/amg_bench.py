@@ -196,13 +196,14 @@ def crossover() -> dict:
 
 def petsc_350k(params: dict = SPHERE_350K, method: str = "pdas-amg") -> dict:
     from signorini.kkt import compare
-    from signorini.loading import solve as load_control
+    from signorini import solve as solve_scene
     from signorini.scenes import build_problem
     from signorini.solvers.registry import solve
 
     problem = build_problem("hertz-sphere-3d", params=params, solved_by=method)
     before = load()
-    problem, ours = load_control(problem, method)  # a target load matched with the answer
+    matched = solve_scene(problem, method)  # a target load matched with the answer
+    problem, ours = matched.problem, matched.solution
     theirs = solve(problem, "petsc-vi")
     agreement = compare(problem, ours, theirs)
     return {"dofs": problem.n, "load_before": before, "load_after": load(), "ours": ours.method,

@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import signorini
-from signorini.loading import counters, spent
+from signorini.load_control import stage
+from signorini.numerics.work import counting
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "derivatives"
@@ -31,15 +32,18 @@ PAGE = ROOT / "docs" / "derivatives.md"
 
 def cost(params: dict) -> dict:
     problem = signorini.build_problem("hertz-cylinder", params=params)
-    start, before = time.perf_counter(), counters()
-    result = signorini.solve(problem)
-    solve_s, solve_work = time.perf_counter() - start, spent(before)
-    start, before = time.perf_counter(), counters()
-    first = signorini.derivative(result, "total_force", "P")
-    first_s, first_work = time.perf_counter() - start, spent(before)
-    start, before = time.perf_counter(), counters()
-    again = signorini.derivative(result, "a", "P")
-    again_s, again_work = time.perf_counter() - start, spent(before)
+    start = time.perf_counter()
+    with counting() as work:
+        result = signorini.solve(problem)
+    solve_s, solve_work = time.perf_counter() - start, stage(work)
+    start = time.perf_counter()
+    with counting() as work:
+        first = signorini.derivative(result, "total_force", "P")
+    first_s, first_work = time.perf_counter() - start, stage(work)
+    start = time.perf_counter()
+    with counting() as work:
+        again = signorini.derivative(result, "a", "P")
+    again_s, again_work = time.perf_counter() - start, stage(work)
     return {"params": params, "dofs": problem.n, "method": result.method, "solve_s": solve_s,
             "solve_work": solve_work, "first_derivative_s": first_s, "first_work": first_work,
             "next_derivative_s": again_s, "next_work": again_work,

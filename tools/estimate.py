@@ -31,10 +31,8 @@ import numpy as np
 
 import signorini
 from signorini.files import atomic_write_text, to_json
-from signorini.loading import solve as load_control
 from signorini.references import reference_of
 from signorini.scenes import SCENES as SCENE_FAMILIES
-from signorini.scenes import coarse_problem
 from signorini.scenes.adapt import solve_adaptive
 from signorini.studies.runner import run_tasks
 from signorini.studies.task import Task
@@ -305,7 +303,8 @@ def adaptive_steps(scene: str, params: dict, target: float, max_dofs: int):
 
     # pdas's default tolerance 1e-9: at 1e-10 the sphere at ν = 0.45 ends `inaccurate` at 66k dofs
     def solver(problem):
-        return load_control(problem, "pdas", tol=1e-9, coarse=coarse_problem)
+        result = signorini.solve(problem, "pdas", tol=1e-9)
+        return result.problem, result.solution
 
     run = solve_adaptive(scene, params, target, solver, max_dofs=max_dofs, on_step=step)
     return steps, run

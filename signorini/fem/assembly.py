@@ -181,7 +181,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
 
     Pure linear algebra: no contact is solved here. A scene with a target
     load gets a problem whose target is pending (``problem.pending``): f and
-    d are at the nominal push, and load control (:mod:`signorini.loading`)
+    d are at the nominal push, and load control (:mod:`signorini.load_control`)
     finds the push whose load is the target, from ``problem.push``.
     """
     start = time.perf_counter()

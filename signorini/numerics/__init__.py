@@ -6,14 +6,14 @@
   linear complementarity problem on it, power iteration for ``λ_max(W)``;
 - :mod:`~signorini.numerics.zone`: exact contact around a predicted contact zone on one
   factorisation (the kernel of the ``nested`` method and of large load targeting);
-- :mod:`~signorini.numerics.loading`: the push that gives a target contact force.
+- :mod:`~signorini.numerics.push`: the push that gives a target contact force.
 - :mod:`~signorini.numerics.multigrid`: algebraic multigrid (pyamg) and CG with pinned dofs,
   the linear algebra of ``pdas-amg``.
 """
 
 from signorini.numerics.factor import ActiveSetSolver, PinnedFactor, available_backends, factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue, solve_lcp
-from signorini.numerics.loading import push_for_load
+from signorini.numerics.push import push_for_load
 from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 

@@ -14,8 +14,8 @@ holds the measurements this module's thresholds were chosen from.
 
 Every factorisation knows the matrix it factorised (``matrix``) and the dofs it
 pinned (``fixed``; none for a plain one), so that the certificate can reuse a
-method's factorisation of the same K; :data:`COUNTS` counts the factorisations
-and back-solves done in this process, so that tests can count what a step costs.
+method's factorisation of the same K; each factorisation and back-solve is counted into the
+stage's :class:`~signorini.numerics.work.Work` record (:mod:`signorini.numerics.work`).
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.errors import BackendNotInstalled, InputError, install_hint
+from signorini.numerics.work import count
 
 log = logging.getLogger(__name__)
 
@@ -38,16 +39,12 @@ _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
 #: the package extra that installs each backend's module (SciPy's SuperLU comes with the package)
 EXTRAS = {"cholmod": "fast", "pardiso": "pardiso"}
 
-#: factorisations (of K, of K with dofs pinned, of a saddle-point matrix) and back-solves
-#: (one per right-hand side) done in this process by every class here: read it before and
-#: after a step to count what the step cost
-COUNTS = {"factorisations": 0, "back_solves": 0}
 NO_DOFS = np.zeros(0, dtype=int)
 
 
 def _count_solve(b: np.ndarray) -> np.ndarray:
-    b = np.asarray(b, dtype=float)  # counted in COUNTS, one per right-hand side
-    COUNTS["back_solves"] += 1 if b.ndim == 1 else b.shape[1]
+    b = np.asarray(b, dtype=float)  # counted, one per right-hand side
+    count("back_solves", 1 if b.ndim == 1 else b.shape[1])
     return b
 
 
@@ -98,7 +95,7 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
 def _factorising(backend: str, K: sp.spmatrix, counted: bool = True) -> None:
     """Say a factorisation of K starts (a progress line) and count it unless ``counted`` is False."""
     log.info("factorising K: %s dofs, %s nonzeros (%s)", f"{K.shape[0]:,}", f"{K.nnz:,}", backend)
-    COUNTS["factorisations"] += counted
+    count("factorisations", int(counted))
 
 
 class Factor:
@@ -269,7 +266,7 @@ class PardisoFactor(Factor):
                 f"({FACTOR_MEMORY_VARIABLE} or MemAvailable): use a method without a "
                 "factorisation (--method pdas-amg, or petsc-vi --opt ksp=gamg), a coarser mesh, or "
                 "for a 3D scene a push (--set delta=...) instead of a target load")
-        COUNTS["factorisations"] += 1
+        count("factorisations")
         solver.set_phase(22)
         solver._call_pardiso(A, rhs)
 
@@ -392,7 +389,7 @@ class SaddlePoint:
         self.active, self.n = active.copy(), K.shape[0]
         self.scale = float(np.mean(np.abs(K.diagonal()))) or 1.0
         system = sp.bmat([[K, self.scale * N_A.T], [self.scale * N_A, None]], format="csc")
-        COUNTS["factorisations"] += 1
+        count("factorisations")
         self._lu = spla.splu(system)
 
     def solve(self, f: np.ndarray, d_A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -16,8 +16,8 @@ Two hierarchies, one interface (``apply(r) -> z``, ``backend``, ``setup_s``):
 :func:`pinned_cg` is preconditioned CG on the free dofs only: the pinned dofs
 keep their values, the preconditioner's output is zeroed on them (so the
 operator CG sees, ``P M P`` on the free subspace, stays SPD whatever pinned
-set the hierarchy was built for). :data:`COUNTS` counts hierarchies built and
-CG iterations done in this process, so that tests count work instead of timing it.
+set the hierarchy was built for). Hierarchies built, CG solves and CG iterations are counted
+into the stage's work record (:mod:`signorini.numerics.work`).
 """
 
 from __future__ import annotations
@@ -32,12 +32,12 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 
+from signorini.numerics.work import count
+
 #: 3D models of at least this many free dofs are solved by multigrid (``auto`` picks pdas-amg when
 #: load control precedes the method, and leaves a pending target load to it): their
 #: factorisations fill in like n^(4/3)
 AMG_FROM_DOFS = 50_000
-#: hierarchies built and CG iterations done in this process (read before and after a step)
-COUNTS = {"hierarchies": 0, "cg_iterations": 0, "cg_solves": 0}
 #: CG restarts from the true residual when the recursive one says done but the true one does not
 MAX_RESTARTS = 4
 #: threads a large product ``K @ x`` is split over (scipy's runs in one and releases the GIL),
@@ -83,7 +83,7 @@ class PyamgHierarchy:
         self._cycle = self._hierarchy.aspreconditioner(cycle="V")
         self.levels = [level.A.shape[0] for level in self._hierarchy.levels]
         self.setup_s = time.perf_counter() - start
-        COUNTS["hierarchies"] += 1
+        count("hierarchies")
 
     def apply(self, r: np.ndarray) -> np.ndarray:
         return self._cycle.matvec(r)
@@ -189,7 +189,7 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
     r = mask * (f - K @ x)
     initial = norms(r)[0]
     iterations = 0
-    COUNTS["cg_solves"] += 1
+    count("cg_solves")
     for _ in range(MAX_RESTARTS + 1):
         if done(*norms(r), initial):
             break
@@ -219,5 +219,5 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
         r = mask * (f - K @ x)  # the true residual: confirm, or restart from it
         if iterations >= max_iter:
             break
-    COUNTS["cg_iterations"] += iterations
+    count("cg_iterations", iterations)
     return CGResult(iterations, initial, *norms(r))

@@ -19,7 +19,7 @@ The loop ends only when every KKT condition holds to round-off, so the
 answer is exact whatever the prediction; a good prediction only makes it
 cheap: one factorisation plus a few dozen back-solves.
 
-With a target load the push ``s`` (see :mod:`signorini.numerics.loading`) joins the
+With a target load the push ``s`` (see :mod:`signorini.numerics.push`) joins the
 band problem as one more unknown, with the total contact force (band forces
 plus core reactions) as one more equation.
 """
@@ -34,7 +34,7 @@ import scipy.sparse as sp
 
 from signorini.numerics.factor import PinnedFactor, Pinning, resolve_backend, selection_dofs
 from signorini.numerics.lcp import solve_lcp
-from signorini.numerics.loading import condensed_pair, push_for_load
+from signorini.numerics.push import condensed_pair, push_for_load
 
 log = logging.getLogger(__name__)
 
@@ -317,7 +317,7 @@ class ZoneSolver:
 
 def _band_push(W: np.ndarray, b: np.ndarray, R: np.ndarray, G: np.ndarray, target: float,
                multiplicity: float) -> tuple[float, np.ndarray]:
-    """The band's share of load targeting: :func:`signorini.numerics.loading.push_for_load`.
+    """The band's share of load targeting: :func:`signorini.numerics.push.push_for_load`.
 
     Band gaps ``Wλ − (s b₁ + b₀) ≥ 0``, forces ``λ ≥ 0``, complementary; the
     load is ``μ (Σλ + Σ core reactions)`` with core reactions ``s R₁ + R₀ + Gλ``

@@ -1,7 +1,7 @@
 """Scene (a family and its parameters, or a TOML file) → assembled :class:`ContactProblem`.
 
 Building solves nothing: a scene with a target load gives a problem whose
-target is pending, matched by load control (:mod:`signorini.loading`).
+target is pending, matched by load control (:mod:`signorini.load_control`).
 :func:`coarse_problem` builds a model of the same scene about 16 times
 coarser, which predicts the contact zone of large models.
 """

@@ -24,7 +24,7 @@ bytes per dof: :data:`BYTES_PER_DOF` with a factorising method;
 :data:`BYTES_PER_DOF_3D_PUSHED` in 3D without one (a prescribed push, or a
 target load that ``pdas-amg`` matches itself: the method ``auto`` picks from
 :data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D dofs, see
-:mod:`signorini.loading`); a 3D factorisation's fill grows like n^⅓ per dof
+:mod:`signorini.load_control`); a 3D factorisation's fill grows like n^⅓ per dof
 from :data:`FILL_GROWS_FROM` dofs on; :data:`NODAL_MEMORY` scales it all when
 the volumetric strain is averaged at the nodes. The constants were chosen
 from measurements (docs/calibration.md).

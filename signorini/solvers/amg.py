@@ -15,7 +15,7 @@ algebraic multigrid given the rigid-body modes as near-null space
   comes from a warm start's forces or from a coarse QP (``coarse``), so that few
   steps remain;
 - a target load that is still pending (``problem.pending``: load control,
-  :mod:`signorini.loading`, leaves it to this method for large 3D models) is
+  :mod:`signorini.load_control`, leaves it to this method: ``Method.matches_load``) is
   matched with the answer: the push is one more unknown of every CG system
   (:class:`LoadBorder`), preconditioned by block elimination
   (:func:`border_preconditioner`), so no factorisation of K is ever made; the
@@ -55,9 +55,10 @@ import scipy.sparse as sp
 from signorini.errors import InputError
 from signorini.kkt import certificate
 from signorini.numerics.factor import selection_dofs
-from signorini.numerics.loading import first_contact
-from signorini.numerics.multigrid import (COUNTS, Bordered, PyamgHierarchy, pinned_cg,
-                                          pinned_matrix, threaded)
+from signorini.numerics.push import first_contact
+from signorini.numerics.multigrid import (Bordered, PyamgHierarchy, pinned_cg, pinned_matrix,
+                                          threaded)
+from signorini.numerics.work import count
 from signorini.numerics.zone import predict_zone
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import pdas, petsc_
@@ -145,7 +146,7 @@ class GamgHierarchy:
         self._x, self._y = self._A.createVecRight(), self._A.createVecLeft()
         self.levels = [int(self._pc.getMGLevels())]
         self.setup_s = time.perf_counter() - start
-        COUNTS["hierarchies"] += 1
+        count("hierarchies")
 
     def apply(self, r: np.ndarray) -> np.ndarray:
         self._x.setArray(r)
@@ -338,7 +339,7 @@ def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.n
         return np.zeros(problem.m, dtype=bool), "none (no prediction)"
     if coarse.pending:
         raise InputError("method 'pdas-amg': option coarse must be a problem at its load (its "
-                         "target is not matched yet: signorini.loading.match(coarse).problem)")
+                         "target is not matched yet: signorini.load_control.match(coarse).problem)")
     solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse, tol=DEFAULT_TOL,
                                                                         amg=opts["amg"])
     if solution.status != "converged":
@@ -384,7 +385,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     if border is not None and not active.any():  # the push needs a contact to hold the body
         active, source = first_contact(problem.d) & system.bounded, "the first point of contact"
     build_time = time.perf_counter() - start
-    counts = dict(COUNTS)
     system.build(active, opts["amg"])
     hierarchy = system.hierarchy
     xs = np.zeros(form.n + 1)  # the unknowns, and the push last (used only with a border)
@@ -473,10 +473,10 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         eta, r0_last = (ETA_MAX, None) if step == 1 else (forcing[0] if forcing else eta,
                                                             result.initial)
         active, final = new_active, False
-    counts = {key: COUNTS[key] - counts[key] for key in COUNTS}
+    cg_iterations = int(sum(history["cg_iterations"]))
     u = form.displacement(x)
-    extras = {"amg": hierarchy.backend, "hierarchies": counts["hierarchies"],
-              "cg_iterations": counts["cg_iterations"], "hierarchy_s": hierarchy.setup_s,
+    extras = {"amg": hierarchy.backend, "hierarchies": 1,
+              "cg_iterations": cg_iterations, "hierarchy_s": hierarchy.setup_s,
               "levels": hierarchy.levels, "first_active": source}
     judged = problem
     if border is not None:
@@ -485,7 +485,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     solution = ContactSolution(
         method="pdas-amg", u=u, lam=lam, status=status,
         message=(f"{message}; first active set from {source}; one {hierarchy.backend} hierarchy "
-                 f"({hierarchy.setup_s:.2f} s), {counts['cg_iterations']} CG iterations"),
+                 f"({hierarchy.setup_s:.2f} s), {cg_iterations} CG iterations"),
         iterations=step, build_time=build_time, solve_time=time.perf_counter() - start - build_time,
         history=history, extras=extras, factor=PinnedCG(judged, system, active))
     return solution
@@ -495,5 +495,6 @@ METHODS = (
     Method(name="pdas-amg", function=solve, family="active set", exact=True,
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
            requires=("pyamg",), extra="", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
-           targets_load=True),
+           matches_load=lambda problem: border_factor(problem) is not None,
+           prediction="active set"),
 )

@@ -1,7 +1,7 @@
 """``auto``: the method picked from the problem's dimension, size, warm start and backends.
 
 - a warm start holding a factorisation of K around the contact zone (load
-  control leaves one, :mod:`signorini.loading`): ``nested``, which reuses
+  control leaves one, :mod:`signorini.load_control`): ``nested``, which reuses
   it and costs back-solves only;
 - 2D and axisymmetric models: ``pdas`` (exact; sparse factorisations of a 2D
   stiffness barely fill in);
@@ -32,7 +32,8 @@ from signorini.solvers.base import Method
 
 #: a 3D model with a mesh and nothing to match (a push) goes to pdas-amg from this many dofs
 PUSHED_AMG_FROM_DOFS = 10_000
-CHOICES = {"pdas": pdas.solve, "pdas-amg": amg.solve, "nested": nested.solve}
+#: the methods auto picks from, by name
+CHOICES = {method.name: method for method in (*pdas.METHODS, *amg.METHODS, *nested.METHODS)}
 
 
 def dimension(problem: ContactProblem) -> int:
@@ -78,7 +79,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     name, why = choose(problem, options, options.get("warm_start"))
     if options.get("warm_start") is None:
         options.pop("warm_start", None)
-    solution = CHOICES[name](problem, tol=tol, max_iter=max_iter, **options)
+    solution = CHOICES[name].function(problem, tol=tol, max_iter=max_iter, **options)
     solution.method = name
     solution.extras["auto"] = why
     solution.message = f"auto picked {why}; {solution.message}"
@@ -89,6 +90,8 @@ METHODS = (
     Method(name="auto", function=solve, family="auto", exact=True,
            summary="picks nested (K factorised by load control), pdas (2D, small 3D) or pdas-amg "
                    "(large 3D) and says why",
-           default_tol=1e-9, targets_load=True,
+           default_tol=1e-9, warm_from_load=True,
+           chooses=lambda problem, options, warm_start: CHOICES[choose(problem, options,
+                                                                       warm_start)[0]],
            options=tuple(sorted(set(pdas.DEFAULTS) | set(amg.DEFAULTS) | set(nested.DEFAULTS)))),
 )

@@ -18,7 +18,7 @@ import numpy as np
 
 from signorini.adequacy import adequacy, warnings
 from signorini.errors import InputError, install_hint
-from signorini.kkt import certificate, shortfall
+from signorini.kkt import Certificate, certificate, shortfall
 from signorini.problem import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.options import Option, check_names, guess_value
 
@@ -52,9 +52,18 @@ class Method:
     for (None: the backend's own settings, the answer held to :data:`DEFAULT_TOL`);
     ``typed_options`` declares their kinds and ranges
     (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
-    refuses a bad value before any work. ``targets_load`` methods take a
-    problem whose target load is pending (``problem.pending``) and match it
-    themselves; any other method gets the problem matched first.
+    refuses a bad value before any work.
+
+    What it offers load control (:mod:`signorini.load_control`), which asks and
+    never branches on a name: ``matches_load(problem)`` says it matches that
+    problem's pending target load itself (``problem.pending``; e.g. the push as
+    a bordered unknown), any other problem is matched first; ``prediction``
+    the kind of prediction of the contact it takes from the scene (``"zone"``:
+    the option ``zone``; ``"active set"``: ``active0``, and ``push0`` for a
+    pending load); ``warm_from_load`` that it takes load control's answer as
+    its warm start (else it starts cold). ``chooses(problem, options,
+    warm_start)`` returns the method it runs instead (a method that picks one),
+    whose capabilities are then the ones asked (:meth:`runs`).
     """
 
     name: str
@@ -68,7 +77,10 @@ class Method:
     default_tol: float | None = None
     options: tuple[str, ...] = field(default=())
     typed_options: Mapping[str, Option] = field(default_factory=dict)
-    targets_load: bool = False
+    matches_load: Callable[[ContactProblem], bool] | None = None
+    prediction: str = ""
+    warm_from_load: bool = False
+    chooses: Callable[..., "Method"] | None = None
 
     @property
     def installed(self) -> bool:
@@ -79,6 +91,15 @@ class Method:
         """The pip command that installs the modules it misses (its extra, or the modules')."""
         missing = [mod for mod in self.requires if importlib.util.find_spec(mod) is None]
         return install_hint(self.extra, missing or self.requires)
+
+    def runs(self, problem: ContactProblem, options: Mapping[str, Any] | None = None,
+             warm_start: Any = None) -> "Method":
+        """The method that runs on ``problem``: this one, or the one it chooses."""
+        return self if self.chooses is None else self.chooses(problem, options or {}, warm_start)
+
+    def matches(self, problem: ContactProblem) -> bool:
+        """It matches ``problem``'s pending target load itself (see ``matches_load``)."""
+        return self.matches_load is not None and bool(self.matches_load(problem))
 
     def check_options(self, given: Mapping[str, Any]) -> dict[str, Any]:
         """``given`` with every declared option checked and converted; InputError otherwise.
@@ -168,9 +189,18 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
     return solution
 
 
-def judge(problem: ContactProblem, solution: ContactSolution,
-          tol: float | None) -> ContactSolution:
-    """Downgrade a claim of convergence that the certificate does not back, or the model cannot.
+def certify(problem: ContactProblem, solution: ContactSolution) -> Certificate:
+    """The certificate of ``solution``; without the duality gap when K is singular (no dual)."""
+    try:
+        return certificate(problem, solution)
+    except np.linalg.LinAlgError:
+        return certificate(problem, solution, duality_gap=False)
+
+
+def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
+          cert: Certificate | None = None) -> ContactSolution:
+    """Downgrade a claim of convergence that the certificate (``cert``, computed here when not
+    given) does not back, or the model cannot.
 
     An answer the certificate accepts becomes ``model_inadequate`` when the
     boundary beyond the contact candidates shows that the contact outgrew
@@ -180,10 +210,7 @@ def judge(problem: ContactProblem, solution: ContactSolution,
     if solution.status != "converged":
         return solution
     accept = acceptance(tol)
-    try:
-        cert = certificate(problem, solution)
-    except np.linalg.LinAlgError:  # K singular: no dual function; judge on the other residuals
-        cert = certificate(problem, solution, duality_gap=False)
+    cert = certify(problem, solution) if cert is None else cert
     reason = shortfall(cert, accept)
     if reason is not None:
         solution.claimed_status = "converged"

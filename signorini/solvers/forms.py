@@ -40,7 +40,8 @@ import scipy.sparse as sp
 
 from signorini.errors import InputError
 from signorini.kkt import ACTIVE, certificate, classify
-from signorini.numerics.factor import COUNTS, ActiveSetSolver, factorize
+from signorini.numerics.factor import ActiveSetSolver, factorize
+from signorini.numerics.work import counting
 from signorini.numerics.lcp import delassus
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers.base import acceptance
@@ -173,34 +174,34 @@ def formulate(problem: ContactProblem, form: str, dense: bool = False,
     form with a ``note`` saying why.
     """
     start = time.perf_counter()
-    before = dict(COUNTS)
-    K = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
-    note = ""
-    if form != "primal":
-        try:
-            factor, u0 = _unconstrained(problem)
-        except np.linalg.LinAlgError as exc:
-            if not fallback:
-                raise np.linalg.LinAlgError(f"form={form!r} needs K⁻¹: {exc}; the primal "
-                                            "form needs none (form=primal)") from exc
-            form, note = "primal", f"the default {form} form needs K⁻¹: {exc}; primal form instead"
-    out: Formulation
-    if form == "primal":
-        out = Formulation(form, K, -problem.f, sp.csc_matrix(problem.N), problem.d.copy())
-    elif form == "shifted":
-        out = Formulation(form, K, np.zeros(problem.n), sp.csc_matrix(problem.N),
-                          problem.d - problem.N @ u0, factor=factor, u0=u0)
-    else:
-        W = delassus(problem.N, factor)
-        b = problem.N @ u0 - problem.d
-        out = Formulation(form, W if dense else sp.csc_matrix(W), -b, factor=factor,
-                          u0=u0, W=W, b=b)
-    out.note = note
-    if dense and sp.issparse(out.P):
-        out.P = out.P.toarray()
-    if dense and out.G is not None:
-        out.G = out.G.toarray()
-    out.work = {key: COUNTS[key] - before[key] for key in COUNTS}
+    with counting() as work:
+        K = sp.csc_matrix(0.5 * (problem.K + problem.K.T))
+        note = ""
+        if form != "primal":
+            try:
+                factor, u0 = _unconstrained(problem)
+            except np.linalg.LinAlgError as exc:
+                if not fallback:
+                    raise np.linalg.LinAlgError(f"form={form!r} needs K⁻¹: {exc}; the primal "
+                                                "form needs none (form=primal)") from exc
+                form, note = "primal", f"the default {form} form needs K⁻¹: {exc}; primal form instead"
+        out: Formulation
+        if form == "primal":
+            out = Formulation(form, K, -problem.f, sp.csc_matrix(problem.N), problem.d.copy())
+        elif form == "shifted":
+            out = Formulation(form, K, np.zeros(problem.n), sp.csc_matrix(problem.N),
+                              problem.d - problem.N @ u0, factor=factor, u0=u0)
+        else:
+            W = delassus(problem.N, factor)
+            b = problem.N @ u0 - problem.d
+            out = Formulation(form, W if dense else sp.csc_matrix(W), -b, factor=factor,
+                              u0=u0, W=W, b=b)
+        out.note = note
+        if dense and sp.issparse(out.P):
+            out.P = out.P.toarray()
+        if dense and out.G is not None:
+            out.G = out.G.toarray()
+    out.work = {"factorisations": work.factorisations, "back_solves": work.back_solves}
     out.seconds = time.perf_counter() - start
     return out
 

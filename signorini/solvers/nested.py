@@ -2,7 +2,7 @@
 
 The prediction is a zone given as the option ``zone`` (``signorini.solve``
 passes the scene's: the analytic contact half-width of its reference, else
-a coarser model's contact zone, see :mod:`signorini.loading`), or the zone
+a coarser model's contact zone, see :mod:`signorini.load_control`), or the zone
 a coarser model of the same QP predicts (option ``coarse``, solved here by
 ``pdas``). :class:`signorini.numerics.zone.ZoneSolver` then pins the
 predicted core, condenses the uncertain band onto a small dense LCP and
@@ -57,7 +57,7 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | N
         return None, ""
     if coarse.pending:
         raise InputError("method 'nested': option coarse must be a problem at its load (its "
-                         "target is not matched yet: signorini.loading.match(coarse).problem)")
+                         "target is not matched yet: signorini.load_control.match(coarse).problem)")
     return zone_from_coarse(problem.contact_points, coarse, opts["neighbours"]), \
         f"coarse model of {coarse.n} dofs"
 
@@ -117,5 +117,5 @@ METHODS = (
     Method(name="nested", function=solve, family="active set", exact=True,
            summary="predicted contact zone (the scene's); one factorisation + exact band LCP",
            default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
-           typed_options=DEFAULTS),
+           typed_options=DEFAULTS, prediction="zone"),
 )

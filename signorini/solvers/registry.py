@@ -15,17 +15,17 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.fingerprint import fingerprint, held_to_problem
-from signorini.numerics.factor import COUNTS
-from signorini.numerics.multigrid import COUNTS as MULTIGRID_COUNTS
+from signorini.kkt import Certificate
+from signorini.numerics.work import counting
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
-from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, check_max_iter, check_tol,
-                                    hold_to_contract, judge)
+from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, certify, check_max_iter,
+                                    check_tol, hold_to_contract, judge)
 
 log = logging.getLogger(__name__)
 
@@ -98,9 +98,17 @@ def _load_user_method(spec: str) -> Method:
 
 
 
+class Request(NamedTuple):
+    """A solve's method, tolerance, iteration limit and options, checked (:func:`check_request`)."""
+
+    method: Method
+    tol: float | None
+    max_iter: int | None
+    options: dict[str, Any]
+
+
 def check_request(method: str, tol: Any = None, max_iter: Any = None,
-                  options: dict[str, Any] | None = None) -> tuple[Method, float | None,
-                                                                  int | None, dict[str, Any]]:
+                  options: dict[str, Any] | None = None) -> Request:
     """The method, tolerance, iteration limit and options of a solve, checked before any work.
 
     InputError for an unknown method, a bad tolerance or limit, an unknown
@@ -114,57 +122,59 @@ def check_request(method: str, tol: Any = None, max_iter: Any = None,
         missing = [m for m in spec.requires if importlib.util.find_spec(m) is None]
         raise BackendNotInstalled(
             f"method {method!r} needs {', '.join(missing)}: {spec.install_hint}")
-    return spec, tol, max_iter, checked
+    return Request(spec, tol, max_iter, checked)
 
 
-def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
-        max_iter: int | None = None, warm_start: WarmStart | None = None, keep_factor: bool = False,
-        **options: Any) -> tuple[ContactProblem, ContactSolution]:
-    """Run ``method`` on ``problem`` and judge its answer: ``(problem solved, solution)``.
+def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | None = None,
+        keep_factor: bool = False) -> tuple[ContactProblem, ContactSolution, Certificate]:
+    """Run the method of ``request`` on ``problem``; its answer judged by its certificate, once:
+    ``(problem solved, solution, certificate)``.
 
     The problem solved is ``problem`` itself, or, for a method that matches
-    a pending target load with the answer (``targets_load``), ``problem``
+    a pending target load with the answer (``Method.matches_load``), ``problem``
     at the push it reports (``solution.extras["push"]``). The method's work
-    (factorisations, back-solves, CG iterations) is counted into
-    ``solution.work["method"]``. ``keep_factor`` keeps the method's last
-    factorisation on the solution after judging (for the answer's derivatives).
-    See :func:`solve`.
+    (factorisations, back-solves, CG iterations) is ``solution.work["method"]``.
+    ``keep_factor`` keeps the method's last factorisation on the solution after
+    judging (for the answer's derivatives). See :func:`solve`.
     """
-    spec, tol, max_iter, options = check_request(method, tol, max_iter, options)
-    if problem.pending and not spec.targets_load:
+    spec, tol, max_iter, options = request
+    method = spec.name
+    if problem.pending and not spec.runs(problem, options, warm_start).matches(problem):
         raise InputError(f"method {method!r} solves the QP as it is, and this problem's target "
                          "load is not matched yet: solve it with signorini.solve (load control "
-                         "finds the push), or match it first with signorini.loading.match")
+                         "finds the push), or match it first with signorini.load_control.match")
     if warm_start is not None:
         if "warm_start" not in spec.options:
             takers = ", ".join(m.name for m in REGISTRY.values() if "warm_start" in m.options)
             raise InputError(f"method {method!r} takes no warm start: give warm_start to one of "
                              f"{takers}")
-        options["warm_start"] = warm_start
+        options = {**options, "warm_start": warm_start}
     log.info("solving %d dofs, %d contact candidates with %s", problem.n, problem.m, method)
-    start, before = time.perf_counter(), dict(COUNTS, **MULTIGRID_COUNTS)
+    start = time.perf_counter()
     held = fingerprint(problem)
-    try:
-        solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
-    except InputError:
-        raise
-    except Exception as exc:  # a backend's own error (e.g. CHOLMOD on a singular K) is a failed run
-        log.warning("method %s raised %s: %s", method, type(exc).__name__, exc)
-        solution = ContactSolution.failure(
-            method, problem, "failed", f"{type(exc).__name__}: {exc}",
-            solve_time=time.perf_counter() - start)
-    except SystemExit as exc:  # a method that exits ends neither the run nor fakes its success
-        solution = ContactSolution.failure(
-            method, problem, "failed", f"the method called sys.exit({exc.code!r})",
-            solve_time=time.perf_counter() - start)
+    with counting() as work:
+        try:
+            solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
+        except InputError:
+            raise
+        except Exception as exc:  # a backend's own error (e.g. CHOLMOD on a singular K) is a failed run
+            log.warning("method %s raised %s: %s", method, type(exc).__name__, exc)
+            solution = ContactSolution.failure(
+                method, problem, "failed", f"{type(exc).__name__}: {exc}",
+                solve_time=time.perf_counter() - start)
+        except SystemExit as exc:  # a method that exits ends neither the run nor fakes its success
+            solution = ContactSolution.failure(
+                method, problem, "failed", f"the method called sys.exit({exc.code!r})",
+                solve_time=time.perf_counter() - start)
     solution = hold_to_contract(problem, method, solution)
     solution = held_to_problem(problem, held, solution, method)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
-    now = dict(COUNTS, **MULTIGRID_COUNTS)
     solution.work["method"] = {"steps": int(solution.iterations), **{
-        key: now[key] - before[key] for key in ("factorisations", "back_solves", "cg_iterations",
-                                                "hierarchies") if now[key] != before[key]}}
+        key: value for key, value in (("factorisations", work.factorisations),
+                                      ("back_solves", work.back_solves),
+                                      ("cg_iterations", work.cg_iterations),
+                                      ("hierarchies", work.hierarchies)) if value}}
     solution.keep_factor = keep_factor
     if "auto" not in solution.extras:  # auto names the method it picked
         solution.method = method
@@ -173,9 +183,10 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
             solution = ContactSolution.failure(method, problem, solution.status if
                                                solution.status != "converged" else "failed",
                                                f"{solution.message}; the target load was not matched")
-            return problem, solution
+            return problem, solution, certify(problem, solution)
         problem = problem.pushed(float(solution.extras["push"]))
-    return problem, judge(problem, solution, tol if tol is not None else spec.default_tol)
+    cert = certify(problem, solution)
+    return problem, judge(problem, solution, tol if tol is not None else spec.default_tol, cert), cert
 
 
 def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
@@ -190,10 +201,12 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     ``failed`` solution; bad input (unknown options, non-positive tolerances)
     raises :class:`InputError`. ``warm_start`` is where the method starts
     (see :class:`signorini.solution.WarmStart`); without it every method
-    starts cold.
+    starts cold. A problem whose target load is pending is matched by
+    :func:`signorini.solve` (load control), not here.
     """
-    return run(problem, method, tol=tol, max_iter=max_iter, warm_start=warm_start, **options)[1]
+    request = check_request(method, tol, max_iter, options)
+    return run(problem, request, warm_start=warm_start)[1]
 
 
-__all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_TOL", "Method", "REGISTRY", "check_request",
-           "get_method", "judge", "methods", "register", "run", "solve"]
+__all__ = ["ACCEPT_FACTOR", "BACKENDS", "DEFAULT_TOL", "Method", "REGISTRY", "Request",
+           "check_request", "get_method", "judge", "methods", "register", "run", "solve"]

@@ -37,7 +37,7 @@ from signorini.fem.model import FlatObstacle
 from signorini.files import atomic_write_bytes
 from signorini.forward_error import refined_on_active_set
 from signorini.kkt import active_set
-from signorini.loading import at_load
+from signorini.load_control import at_load
 from signorini.numerics.factor import factorize
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.problem_files import read_problem

@@ -43,6 +43,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from signorini.api import solve
 from signorini.crosschecking import crosscheck
 from signorini.diagnose import diagnose
 from signorini.errors import InputError
@@ -52,8 +53,6 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics
 from signorini.scenes.block import force_controlled_exact
 from signorini.solvers import cluster
-from signorini.loading import solve as load_control
-from signorini.scenes import coarse_problem
 from signorini.solvers.base import Method
 from signorini.solvers.base import acceptance
 from signorini.solvers.registry import get_method
@@ -220,7 +219,8 @@ def _against_finer(problem: ContactProblem, solution: ContactSolution, task: Tas
     spec = {**task.problem, "params": {**(task.problem.get("params") or {}), "refine": level}}
 
     def make() -> tuple[ContactProblem, ContactSolution]:
-        return load_control(build_spec(spec), how["method"], tol=how.get("tol"), coarse=coarse_problem)
+        result = solve(build_spec(spec), how["method"], tol=how.get("tol"))
+        return result.problem, result.solution
 
     fine, answer = cache.get(_key("finer", spec, how), make)
     if answer.status != "converged":
@@ -236,10 +236,10 @@ def run_on(problem: ContactProblem, task: Task,
     start = time.perf_counter()
     wrapper = "returned"
     try:
-        # the scene's predictions reach the methods that take them (nested, pdas-amg)
-        problem, solution = load_control(problem, task.method, tol=task.tol,
-                                         max_iter=task.max_iter, coarse=coarse_problem,
-                                         **task.options)
+        # as signorini.solve: the scene's predictions reach the methods that take them
+        result = solve(problem, task.method, tol=task.tol, max_iter=task.max_iter,
+                       **task.options)
+        problem, solution = result.problem, result.solution
     except InputError as exc:
         row.update(status="refused", wrapper="input-error", claimed_status="", message=str(exc),
                    time_s=time.perf_counter() - start)

@@ -3,7 +3,7 @@
 For a body pushed by ``s`` times its prescribed displacement, ``b(s) = s b₁ + b₀``
 with ``b₁ = N K⁻¹ f₁ − d₁`` and ``b₀ = P N K⁻¹ f_load − d₀`` (``f_load`` the
 traction of a unit load P on a cut, when the scene loads the body so). Each load level is then a small
-dense problem on the candidates (:func:`signorini.numerics.loading.push_for_load_condensed`)
+dense problem on the candidates (:func:`signorini.numerics.push.push_for_load_condensed`)
 and one back-solve for the displacement.
 
 Every level is judged as ``solve`` judges a method's answer
@@ -27,7 +27,7 @@ from signorini.errors import InputError
 from signorini.forward_error import WithDelassus
 from signorini.kkt import certificate
 from signorini.numerics.lcp import delassus
-from signorini.numerics.loading import push_for_load_condensed
+from signorini.numerics.push import push_for_load_condensed
 from signorini.output.plots import axes as _axes
 from signorini.pressure import compare_hertz, contact_half_width, contact_profile
 from signorini.problem import ContactProblem, ContactSolution

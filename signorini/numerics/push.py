@@ -23,12 +23,10 @@ import scipy.sparse as sp
 
 from signorini.errors import InputError
 from signorini.numerics.factor import ActiveSetSolver
+from signorini.numerics.work import count
 
 log = logging.getLogger(__name__)
 
-
-#: active-set steps of load control done in this process (read before and after a stage)
-COUNTS = {"load_steps": 0}
 
 PairSolve = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 LoadPair = Callable[[np.ndarray], np.ndarray]
@@ -65,7 +63,7 @@ def push_for_load(solve_pair: PairSolve, active: np.ndarray, target: float, load
         raise InputError(f"the target load must be a positive number, got {target!r}")
     seen: set[bytes] = set()
     for step in range(1, max_iter + 1):
-        COUNTS["load_steps"] += 1
+        count("load_steps")
         lam, violation = solve_pair(active)
         per_push, fixed = load(lam)
         if not per_push > 0:

@@ -1,12 +1,12 @@
-"""Load control: the push whose contact force is the target load, around any method.
+"""Load control, and the one pipeline from a checked request to a certified answer.
 
 A scene loaded by a target force P is assembled at a nominal push
 (``problem.pending``). Its load and gaps are affine in the push s,
 ``f(s) = s f₁ + f₀`` and ``d(s) = d₀ + s d₁``, so on a fixed active set the
 answer is affine in s too, and the push whose total contact force
 ``μ Σλ`` equals P solves one scalar equation per active set
-(:func:`signorini.numerics.loading.push_for_load`). This module is the one
-driver that finds it, with one of three strategies:
+(:func:`signorini.numerics.push.push_for_load`). This module is the one
+driver that finds it, whatever the method:
 
 - **zone kernel** (large models whose contact zone can be predicted: from
   the reference's analytic contact width, else from a coarser model of the
@@ -15,15 +15,19 @@ driver that finds it, with one of three strategies:
 - **full active set**: the augmented system ``K u + N_Aᵀλ_A = s f₁ + f₀,
   N_A u = d₀ + s d₁, μ Σλ_A = P``, one factorisation per active-set step,
   from the active set the scene predicts
-  (:func:`signorini.numerics.loading.calibrate_push`);
-- **bordered multigrid**: for ``pdas-amg`` the push is one more unknown of
-  each CG system (:class:`signorini.solvers.amg.LoadBorder`), so no
-  factorisation is ever made (large 3D models).
+  (:func:`signorini.numerics.push.calibrate_push`);
+- **left to the method**, when the method declares that it matches this
+  problem's pending load itself (:attr:`Method.matches_load`, e.g. a bordered
+  load unknown of each CG system: no factorisation is ever made).
 
-Then the method solves the QP at that push. A method named by the caller
-starts cold and the iterations it reports are its own; ``auto`` takes the
-fastest route and is handed what load control learnt as an explicit warm
-start. Every stage's work is in ``solution.work``: ``load control``, the
+:func:`solve` is the pipeline: load control, then the method
+(:func:`signorini.solvers.registry.run`: its answer held to the contract and
+certified once). What a method can use is what it declares on its
+:class:`~signorini.solvers.base.Method`, never its name: the scene's
+``prediction`` of the contact (a zone, or a first active set) and whether it
+takes load control's answer as an explicit warm start (``warm_from_load``);
+a method that does not starts cold and the iterations it reports are its own.
+Every stage's work is in ``solution.work``: ``load control``, the
 ``prediction`` (a coarser model solved to predict the contact) and the
 ``method``.
 """
@@ -32,20 +36,22 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.numerics import factor, loading, multigrid
+from signorini.kkt import Certificate
 from signorini.numerics.factor import FactorTooLarge, selection_dofs
-from signorini.numerics.loading import calibrate_push
+from signorini.numerics.push import calibrate_push
+from signorini.numerics.work import Work, counting
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
                                      zone_around_points)
 from signorini.problem import ContactProblem
 from signorini.references import reference_of
 from signorini.solution import ContactSolution, WarmStart
-from signorini.solvers import amg, auto, registry
+from signorini.solvers import registry
+from signorini.solvers.registry import Request
 
 log = logging.getLogger(__name__)
 
@@ -55,19 +61,6 @@ ZONE_FROM_DOFS = 20_000
 
 #: a function of a problem returning a coarser model of the same scene (or None)
 CoarseModel = Callable[[ContactProblem], "ContactProblem | None"]
-
-
-def counters() -> dict[str, int]:
-    """Every work counter of the package, as it stands now."""
-    return {"steps": loading.COUNTS["load_steps"], **factor.COUNTS,
-            "cg_iterations": multigrid.COUNTS["cg_iterations"],
-            "hierarchies": multigrid.COUNTS["hierarchies"]}
-
-
-def spent(before: dict[str, int]) -> dict[str, int]:
-    """The work done since ``before`` (a :func:`counters` reading), the zero counts left out."""
-    now = counters()
-    return {key: now[key] - before[key] for key in now if now[key] != before[key]}
 
 
 @dataclass
@@ -145,7 +138,12 @@ def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
     """
     if not problem.pending:
         raise InputError("the problem has no target load to match: it is solved as it is")
-    before = counters()
+    with counting() as work:
+        problem, start, how = _matched(problem, zone)
+    return Matched(problem, start, how, stage(work))
+
+
+def _matched(problem: ContactProblem, zone: Zone | None) -> tuple[ContactProblem, WarmStart, str]:
     pu, disc = problem.push, problem.discretisation
     f0 = pu.load * pu.f_load if pu.f_load is not None else None
     if zone is not None and pu.resultant is None:  # the zone kernel sums forces along the push
@@ -155,8 +153,8 @@ def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
                 pu.f1, pu.d0, pu.d1, pu.target, problem.force_multiplicity, zone,
                 f0=np.zeros_like(pu.f1) if f0 is None else f0)
             log.info("load matched on a predicted zone (%s)", final.counts())
-            return Matched(problem.pushed(scale), WarmStart(lam=lam, zone_solver=system, zone=final),
-                           "zone kernel", spent(before))
+            return (problem.pushed(scale), WarmStart(lam=lam, zone_solver=system, zone=final),
+                    "zone kernel")
         except FactorTooLarge:
             raise  # a refusal, not a failed prediction: the full active set would factorise too
         except (ValueError, ArithmeticError) as exc:
@@ -164,8 +162,16 @@ def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
     scale, lam, u = calibrate_push(problem.K, problem.N, pu.f1, pu.d0, pu.d1, pu.target,
                                    problem.force_multiplicity, f0=f0,
                                    start=disc.predicted_contact, weights=pu.resultant)
-    return Matched(problem.pushed(scale), WarmStart(lam=lam, u=u), "full active set",
-                   spent(before))
+    return problem.pushed(scale), WarmStart(lam=lam, u=u), "full active set"
+
+
+def stage(work: Work) -> dict[str, int]:
+    """A stage's work as ``solution.work`` lists it: load control's active-set ``steps``,
+    factorisations, back-solves, CG iterations and hierarchies, the zero counts left out."""
+    counts = {"steps": work.load_steps, "factorisations": work.factorisations,
+              "back_solves": work.back_solves, "cg_iterations": work.cg_iterations,
+              "hierarchies": work.hierarchies}
+    return {key: value for key, value in counts.items() if value}
 
 
 def at_load(problem: ContactProblem, coarse: CoarseModel | None = None) -> ContactProblem:
@@ -176,14 +182,13 @@ def at_load(problem: ContactProblem, coarse: CoarseModel | None = None) -> Conta
     return match(problem, predicted_zone(problem, coarse)).problem
 
 
-def _predictions(problem: ContactProblem, method: str, options: dict[str, Any],
+def _predictions(problem: ContactProblem, kind: str, options: dict[str, Any],
                  coarse: CoarseModel | None, zone: Zone | None = None) -> dict[str, Any]:
-    """What the scene predicts, as the options of a method that takes a prediction (its own
-    options win): ``nested`` a contact zone (``zone`` when load control already predicted it),
-    ``pdas-amg`` a first active set."""
+    """What the scene predicts, as the options of a method that takes a prediction of ``kind``
+    (its own options win): ``zone`` a contact zone (``zone`` when load control already
+    predicted it), ``active set`` a first active set (and, for a pending load, a first push)."""
     given = set(options)
-    if method == "nested" and not given & {"zone", "coarse"} \
-            and selection_dofs(problem.N) is not None:
+    if kind == "zone" and not given & {"zone", "coarse"} and selection_dofs(problem.N) is not None:
         if not options.get("analytic", True):
             zone = None  # the caller asked for no analytic zone: the coarse model's only
         elif zone is None:
@@ -191,7 +196,7 @@ def _predictions(problem: ContactProblem, method: str, options: dict[str, Any],
         if zone is None and coarse is not None:
             zone = coarse_zone(problem, coarse(problem))[0]
         return {"zone": zone} if zone is not None else {}
-    if method == "pdas-amg" and not given & {"active0", "coarse", "warm_start"}:
+    if kind == "active set" and not given & {"active0", "coarse", "warm_start"}:
         a = analytic_extent(problem)  # the candidates inside it: no coarse model to solve
         if a is not None:
             return {"active0": radial_distance(problem.contact_points) < a}
@@ -210,47 +215,53 @@ def _predictions(problem: ContactProblem, method: str, options: dict[str, Any],
     return {}
 
 
-def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = None,
-          max_iter: int | None = None, warm_start: Any = None, coarse: CoarseModel | None = None,
-          keep_factor: bool = False, **options: Any) -> tuple[ContactProblem, ContactSolution]:
-    """Solve ``problem`` with ``method``, matching its target load first when it has one.
+class Solved(NamedTuple):
+    """The problem the answer solves (at the matched push for a target load), the judged
+    answer, and its certificate (computed once)."""
 
-    Returns the problem the answer solves (``problem`` itself, or it at the
-    matched push) and the judged solution. ``coarse`` (from the scene: a
-    coarser model of the same scene) feeds the predictions of the zone kernel,
-    ``nested`` and ``pdas-amg``; ``keep_factor`` keeps the method's last
-    factorisation on the solution (see :func:`signorini.solvers.registry.run`).
+    problem: ContactProblem
+    solution: ContactSolution
+    certificate: Certificate
+
+
+def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
+          coarse: CoarseModel | None = None, keep_factor: bool = False) -> Solved:
+    """Solve ``problem`` as ``request`` (a checked :func:`~signorini.solvers.registry.check_request`)
+    says, matching its target load first when it has one and the method does not.
+
+    ``coarse`` (from the scene: a coarser model of the same scene) feeds the
+    predictions of the zone kernel and of the methods that take one;
+    ``keep_factor`` keeps the method's last factorisation on the solution (see
+    :func:`signorini.solvers.registry.run`).
     """
     start = None if warm_start is None else WarmStart.of(warm_start)
-    name = auto.choose(problem, options, start)[0] if method == "auto" else method
-    bordered = problem.pending and name == "pdas-amg" and amg.border_factor(problem) is not None
+    runs = request.method.runs(problem, request.options, start)  # itself, or the one it picks
     stages: dict[str, dict[str, int]] = {}
-    zone = None
-    if problem.pending and not bordered:
+    zone, matched, options = None, None, request.options
+    if problem.pending and not runs.matches(problem):
         log.info("matching the target load: predicting the contact zone on a coarser model")
-        zone = predicted_zone(problem, coarse)  # predicted once: load control's, and nested's
+        zone = predicted_zone(problem, coarse)  # predicted once: load control's and the method's
         matched = match(problem, zone)
         stages["load control"] = matched.work
         problem = matched.problem
-    if method == "auto" and start is None and "load control" in stages:
-        start = matched.warm_start  # the fastest route: confirm what load control found
-    else:  # a method named by the caller starts cold, from the scene's predictions only
-        before = counters()
-        options = {**_predictions(problem, name, options, coarse, zone), **options}
-        work = spent(before)
-        if work:  # a coarser model solved for its prediction
-            stages["prediction"] = work
-    settled, solution = registry.run(problem, method, tol=tol, max_iter=max_iter,
-                                     warm_start=start, keep_factor=keep_factor, **options)
-    solution.work = {**stages, **solution.work}
-    if "load control" in stages:
-        solution.message += f"; load matched by {matched.how} ({_said(matched.work)})"
-    return settled, solution
+    if matched is not None and start is None and request.method.warm_from_load:
+        start = matched.warm_start  # load control's answer, taken as an explicit warm start
+    elif runs.prediction:  # a method that starts cold, from the scene's predictions only
+        with counting() as work:
+            options = {**_predictions(problem, runs.prediction, options, coarse, zone), **options}
+        if work.as_dict():  # a coarser model solved for its prediction
+            stages["prediction"] = stage(work)
+    solved = Solved(*registry.run(problem, request._replace(options=options), warm_start=start,
+                                  keep_factor=keep_factor))
+    solved.solution.work = {**stages, **solved.solution.work}
+    if matched is not None:
+        solved.solution.message += f"; load matched by {matched.how} ({_said(matched.work)})"
+    return solved
 
 
 def _said(work: dict[str, int]) -> str:
     return ", ".join(f"{value} {key.replace('_', ' ')}" for key, value in work.items()) or "no work"
 
 
-__all__ = ["CoarseModel", "Matched", "ZONE_FROM_DOFS", "analytic_extent", "analytic_zone", "at_load",
-           "coarse_zone", "counters", "match", "predicted_zone", "solve", "spent"]
+__all__ = ["CoarseModel", "Matched", "Solved", "ZONE_FROM_DOFS", "analytic_extent", "analytic_zone",
+           "at_load", "coarse_zone", "match", "predicted_zone", "solve", "stage"]
