@@ -11,10 +11,11 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
-from signorini import loading
+from signorini import load_control
 from signorini.errors import InputError
 from signorini.kkt import certificate, compare
-from signorini.numerics import factor, multigrid
+from signorini.numerics import multigrid
+from signorini.numerics.work import counting
 from signorini.scenes import build_problem
 from signorini.solvers import amg, auto
 from signorini.solvers.bounds import bound_form
@@ -50,28 +51,28 @@ def assert_agrees(problem, first, second, lam_tol=1e-8):
 def test_agrees_with_pdas(problems, name, backend):
     problem = problems[name]
     reference = solve(problem, "pdas")
-    before = dict(multigrid.COUNTS)
-    solution = solve(problem, "pdas-amg", amg=backend)
+    with counting() as work:
+        solution = solve(problem, "pdas-amg", amg=backend)
     assert solution.status == "converged", solution.message
     assert certificate(problem, solution).worst()[1] <= 1e-9
     assert_agrees(problem, solution, reference)
-    assert multigrid.COUNTS["hierarchies"] - before["hierarchies"] == 1
+    assert work.hierarchies == 1
     assert solution.extras["hierarchies"] == 1 and solution.extras["amg"] == backend
 
 
 def test_no_factorisation_and_the_certificate_uses_the_multigrid(problems):
     """Without a coarse model nothing is factorised: not the method, not its certificate."""
     problem = signorini.at_load(build_problem("hertz-sphere-3d", params={"delta": 0.0025}))
-    before = dict(factor.COUNTS)
-    solution = solve(problem, "pdas-amg", amg="pyamg")
-    assert solution.status == "converged"
-    cert = certificate(problem, solution)
+    with counting() as work:
+        solution = solve(problem, "pdas-amg", amg="pyamg")
+        assert solution.status == "converged"
+        cert = certificate(problem, solution)
     assert np.isfinite(cert.duality_gap)
     # the forward error from the multigrid CG: one Newton step (one solve on the pinned active
     # set), no second step to measure round-off with an iterative solve
     assert np.isfinite(cert.force_error) and cert.force_error < 1e-8
     assert np.isnan(cert.force_error_floor) and cert.back_solves == 1
-    assert factor.COUNTS["factorisations"] == before["factorisations"]
+    assert work.factorisations == 0
     assert problem.cached_factor is None
 
 
@@ -79,9 +80,9 @@ def test_cg_iterations_are_counted_and_bounded(problems):
     """The 6,879-dof sphere from an empty active set: 6-7 steps, about 60-90 CG iterations
     (measured with both hierarchies); a loose first solve that lost the prediction took 4x more."""
     problem = problems["hertz-sphere-3d"]
-    before = multigrid.COUNTS["cg_iterations"]
-    solution = solve(problem, "pdas-amg", amg="pyamg")
-    spent = multigrid.COUNTS["cg_iterations"] - before
+    with counting() as work:
+        solution = solve(problem, "pdas-amg", amg="pyamg")
+    spent = work.cg_iterations
     assert solution.extras["cg_iterations"] == sum(solution.history["cg_iterations"])
     assert spent >= solution.extras["cg_iterations"]  # and the certificate's own
     assert solution.extras["cg_iterations"] <= 150, solution.history
@@ -212,7 +213,7 @@ def test_auto_leaves_a_pushed_3d_model_to_pdas_amg_sooner_than_a_load_targeted_o
     assert pushed.n < auto.AMG_FROM_DOFS and loaded.pending
     assert auto.choose(pushed)[0] == "pdas-amg"
     assert auto.choose(loaded)[0] == "pdas"
-    matched = loading.match(loaded)
+    matched = load_control.match(loaded)
     assert auto.choose(matched.problem, (), matched.warm_start)[0] == "pdas"
 
 

@@ -127,12 +127,12 @@ def test_every_result_reports_its_estimate():
 
 def test_the_estimate_solves_nothing():
     """The estimate is local work: no factorisation, no back-solve, no CG (counted, not timed)."""
-    from signorini.loading import counters, spent
+    from signorini.numerics.work import Work, counting
 
     result = signorini.solve("hertz-cylinder")
-    before = counters()
-    estimate(result.problem, result.solution)
-    assert spent(before) == {}
+    with counting() as work:
+        estimate(result.problem, result.solution)
+    assert work == Work()
 
 
 def test_a_uniform_pressure_has_no_pressure_error():

@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 from signorini.cli import main
-from signorini.numerics.factor import COUNTS, FACTOR_MEMORY_VARIABLE, FactorTooLarge
+from signorini.numerics.factor import FACTOR_MEMORY_VARIABLE, FactorTooLarge
+from signorini.numerics.work import counting
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -23,10 +24,9 @@ def test_a_factorisation_over_the_limit_is_refused_before_its_numeric_phase(monk
     factor = PardisoFactor(problem.K)
     assert factor.memory > 8 * problem.K.nnz  # at least K's own values
     monkeypatch.setenv(FACTOR_MEMORY_VARIABLE, f"{0.5 * factor.memory / 1e9}")
-    before = COUNTS["factorisations"]
-    with pytest.raises(FactorTooLarge, match=r"PARDISO's analysis.*pdas-amg"):
+    with counting() as work, pytest.raises(FactorTooLarge, match=r"PARDISO's analysis.*pdas-amg"):
         PardisoFactor(problem.K)
-    assert COUNTS["factorisations"] == before
+    assert work.factorisations == 0
 
 
 def test_the_cli_refuses_in_one_line_and_writes_nothing(monkeypatch, capsys, tmp_path):

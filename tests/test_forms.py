@@ -14,7 +14,7 @@ import pytest
 import signorini
 from signorini.errors import InputError
 from signorini.kkt import compare, force_scale, gap_scale
-from signorini.numerics.factor import COUNTS
+from signorini.numerics.work import Work, counting
 from signorini.problem import ContactSolution
 from signorini.solvers import forms, qp
 from signorini.solvers.registry import get_method, solve
@@ -93,9 +93,9 @@ def test_superlu_on_a_singular_k_is_caught(monkeypatch):
 
 
 def counted(function, *args, **kwargs):
-    before = dict(COUNTS)
-    out = function(*args, **kwargs)
-    return out, {key: COUNTS[key] - before[key] for key in COUNTS}
+    with counting() as work:
+        out = function(*args, **kwargs)
+    return out, {"factorisations": work.factorisations, "back_solves": work.back_solves}
 
 
 @pytest.mark.parametrize("method", ("qp-clarabel", "cvxpy"))
@@ -132,10 +132,9 @@ def test_bad_options_fail_before_any_work(method, options, match):
     problem = signorini.at_load(signorini.build_problem("block"))
     if method == "cvxpy" and "max_dense_dofs" not in options:
         require(method)
-    before = dict(COUNTS)
-    with pytest.raises(InputError, match=match):
+    with counting() as work, pytest.raises(InputError, match=match):
         get_method(method).function(problem, tol=1e-9, **options)
-    assert COUNTS == before
+    assert work == Work()
 
 
 def test_api_and_every_qp_method_take_the_options():

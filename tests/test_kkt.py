@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
-from signorini import kkt, loading
+from signorini import kkt, load_control
 from signorini.kkt import (
     ACTIVE,
     INACTIVE,
@@ -21,7 +21,8 @@ from signorini.kkt import (
     gap_scale,
     primal_dual_gap,
 )
-from signorini.numerics.factor import COUNTS, factorize, selection_dofs
+from signorini.numerics.factor import factorize, selection_dofs
+from signorini.numerics.work import counting
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.scenes import build as scene_build
 from signorini.scenes import build_problem
@@ -322,9 +323,9 @@ def test_a_big_2d_problem_factorises_for_its_certificate_instead_of_cg(hertz, ex
     monkeypatch.setattr(problem_module, "ITERATIVE_ENERGY_FROM", 0)
     monkeypatch.setattr("scipy.sparse.linalg.cg", lambda *a, **k: pytest.fail("CG was used"))
     fresh = hertz.with_data()
-    before = COUNTS["factorisations"]
-    cert = certificate(fresh, exact)
-    assert fresh._factor is not None and COUNTS["factorisations"] == before + 1
+    with counting() as work:
+        cert = certificate(fresh, exact)
+    assert fresh._factor is not None and work.factorisations == 1
     assert np.isfinite(cert.duality_gap) and np.isfinite(cert.force_error)
 
 
@@ -335,7 +336,7 @@ def test_a_big_2d_problem_factorises_for_its_certificate_instead_of_cg(hertz, ex
 def zoned():
     """A cylinder load-targeted on a predicted zone (nested then reuses that factorisation)."""
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(loading, "ZONE_FROM_DOFS", 0)
+        patch.setattr(load_control, "ZONE_FROM_DOFS", 0)
         return signorini.at_load(build_problem("hertz-cylinder",
                                                params={"refine": 1, "n_contact": 24, "grading": 0.4}))
 
@@ -349,9 +350,9 @@ def refuse_the_fallback(monkeypatch):
 
 def spent(step):
     """Factorisations and back-solves ``step()`` performed, and what it returned."""
-    before = dict(COUNTS)
-    out = step()
-    return {name: COUNTS[name] - before[name] for name in COUNTS}, out
+    with counting() as work:
+        out = step()
+    return {"factorisations": work.factorisations, "back_solves": work.back_solves}, out
 
 
 def textbook_gap(problem, u, lam):

@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
-from signorini import loading
+from signorini import load_control
 
 from signorini.fem.assembly import assemble
 from signorini.kkt import certificate, compare
@@ -17,7 +17,7 @@ from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.scenes import build as scenes
 from signorini.scenes import build_problem, coarse_values, get_scene
 from signorini.solvers.registry import solve
-from signorini.loading import analytic_zone
+from signorini.load_control import analytic_zone
 from synthetic import random_problem
 
 MODULES = {"cholmod": "sksparse.cholmod", "pardiso": "pypardiso", "superlu": "scipy"}
@@ -41,7 +41,7 @@ def assert_same_answer(problem, first, second, lam_tol=1e-8):
 def zoned_build(name, **values):
     """build_problem with load targeting on a predicted zone even for a small model."""
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(loading, "ZONE_FROM_DOFS", 0)
+        patch.setattr(load_control, "ZONE_FROM_DOFS", 0)
         return signorini.at_load(build_problem(name, params=values))
 
 
@@ -93,8 +93,6 @@ def test_the_analytic_zone_predicts_the_3d_sphere_by_the_distance_from_the_axis(
 def test_auto_reuses_the_load_targeting_factorisation_of_a_large_3d_model():
     """At 47k dofs the 3D sphere's load is targeted on the analytic zone (one factorisation of
     K); auto then picks nested, which solves on that factorisation by back-solves only."""
-    from signorini.numerics.factor import COUNTS
-
     problem = build_problem("hertz-sphere-3d", params={"refine": 1})
     answer = signorini.solve(problem)
     assert answer.method == "nested" and answer.status == "converged"
@@ -119,7 +117,7 @@ def test_a_wrong_analytic_zone_is_amended_not_trusted():
 
 def test_nested_reuses_the_factorisation_load_control_hands_it():
     problem = build_problem("hertz-cylinder", params={"refine": 1, "n_contact": 24, "grading": 0.4})
-    matched = loading.match(problem, analytic_zone(problem))
+    matched = load_control.match(problem, analytic_zone(problem))
     assert matched.how == "zone kernel" and matched.work["factorisations"] == 1
     system = matched.warm_start.zone_solver
     before = system.factorisations
@@ -168,8 +166,8 @@ def test_the_push_on_a_zone_equals_the_full_active_set_calibration():
     model = family.build(params, set(values))
     nominal = assemble(model)
     assert nominal.reference == "hertz-2d"  # the family's model hands on its reference record
-    full = loading.match(nominal)  # no zone: one factorisation per active-set step
-    zoned = loading.match(nominal, analytic_zone(nominal))
+    full = load_control.match(nominal)  # no zone: one factorisation per active-set step
+    zoned = load_control.match(nominal, analytic_zone(nominal))
     assert full.how == "full active set" and zoned.how == "zone kernel"
     assert zoned.problem.push.scale == pytest.approx(full.problem.push.scale, rel=1e-10)
     assert_same_answer(full.problem, solve(full.problem, "pdas"),

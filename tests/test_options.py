@@ -11,7 +11,7 @@ import pytest
 import signorini
 from signorini.cli import main
 from signorini.errors import InputError
-from signorini.numerics.factor import COUNTS
+from signorini.numerics.work import Work, counting
 from signorini.solvers import condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.options import KINDS, Option
 from signorini.solvers.registry import get_method
@@ -46,10 +46,9 @@ NUMERIC = [(name, _first_numeric(get_method(name)).name) for name in TYPED_METHO
 @pytest.mark.parametrize("name, option", NUMERIC, ids=[f"{n}-{o}" for n, o in NUMERIC])
 def test_a_string_for_a_number_is_refused_before_any_work(name, option):
     problem = signorini.build_problem("block")
-    before = dict(COUNTS)
-    with pytest.raises(InputError, match=f"option {option}='abc' must be"):
+    with counting() as work, pytest.raises(InputError, match=f"option {option}='abc' must be"):
         signorini.solve(problem, name, **{option: "abc"})
-    assert COUNTS == before  # nothing factorised, nothing solved
+    assert work == Work()  # nothing factorised, nothing solved
 
 
 @pytest.mark.parametrize("name", [m for m in TYPED_METHODS if m.startswith("qp-")])

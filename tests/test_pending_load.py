@@ -17,9 +17,9 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
-from signorini import loading
+from signorini import load_control
 from signorini.kkt import certificate, compare
-from signorini.numerics import factor
+from signorini.numerics.work import counting
 from signorini.numerics.multigrid import Bordered
 from signorini.problem import ContactProblem
 from signorini.scenes import build_problem
@@ -32,41 +32,43 @@ SCENE = "hertz-sphere-3d"  # a target load by default (a traction on the cut, on
 PUSHED = {"loading": "displacement"}  # the whole cut pushed: many dofs moving together
 
 
-def factorisations() -> int:
-    return factor.COUNTS["factorisations"]
+def solved(problem, method, **options):
+    """Load control and the method, as signorini.solve runs them: (problem solved, solution)."""
+    result = signorini.solve(problem, method, **options)
+    return result.problem, result.solution
 
 
 @pytest.fixture(scope="module", params=[{}, PUSHED], ids=["traction", "pushed-cut"])
 def pair(request):
     """(pending problem, the same scene matched by factorisation)."""
-    before = factorisations()
-    pending = build_problem(SCENE, params=request.param)
-    assert factorisations() == before, "a problem is built without a factorisation"
-    return pending, loading.at_load(pending)
+    with counting() as work:
+        pending = build_problem(SCENE, params=request.param)
+    assert work.factorisations == 0, "a problem is built without a factorisation"
+    return pending, load_control.at_load(pending)
 
 
 def test_the_target_is_pending_until_matched(pair):
     pending, eager = pair
     assert pending.pending and not eager.pending
     assert pending.push.target == pytest.approx(eager.push.target, rel=1e-12)
-    matched = loading.match(pending)
+    matched = load_control.match(pending)
     assert not matched.problem.pending and matched.work["factorisations"] >= 1
     assert matched.problem.push.scale == pytest.approx(eager.push.scale, rel=1e-9)
     assert np.allclose(matched.problem.f, eager.f, rtol=0, atol=1e-9 * np.abs(eager.f).max())
     with pytest.raises(signorini.InputError, match="no target load to match"):
-        loading.match(matched.problem)
+        load_control.match(matched.problem)
 
 
 def test_pdas_amg_matches_the_load_without_a_factorisation(pair):
     pending, eager = pair
     reference = solve(eager, "pdas")
-    before = factorisations()
-    settled, solution = loading.solve(pending, "pdas-amg")
+    with counting() as work:
+        settled, solution = solved(pending, "pdas-amg")
     assert solution.status == "converged", solution.message
     assert "one more unknown" in solution.message and "load control" not in solution.work
     assert not settled.pending
     # no factorisation of the fine model (its coarse model, if any, is small and counted apart)
-    assert factorisations() - before <= 1
+    assert work.factorisations <= 1
     assert certificate(settled, solution).worst()[1] <= 1e-9
     assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
                                                                       rel=1e-8)
@@ -79,7 +81,7 @@ def test_any_other_method_gets_the_problem_matched_first(pair):
     pending, eager = pair
     with pytest.raises(signorini.InputError, match="not matched yet"):
         solve(pending, "pdas")  # the method alone solves the QP as it is: it refuses
-    settled, solution = loading.solve(pending, "pdas")
+    settled, solution = solved(pending, "pdas")
     assert solution.status == "converged" and not settled.pending
     assert solution.work["load control"]["factorisations"] >= 1
     assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
@@ -109,7 +111,7 @@ def test_a_pending_problem_is_saved_pending(tmp_path, pair):
     pending.save(path)
     loaded = ContactProblem.load(path)
     assert loaded.pending and loaded.push.target == pending.push.target
-    settled, solution = loading.solve(loaded, "pdas")
+    settled, solution = solved(loaded, "pdas")
     assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
                                                                       rel=1e-9)
 
@@ -129,8 +131,8 @@ def test_the_bordered_operator_is_the_bordered_matrix():
                     reason="the petsc backend of pdas-amg needs petsc4py (extra 'petsc')")
 def test_both_multigrids_match_the_load(pair):
     pending, eager = pair
-    first = loading.solve(pending, "pdas-amg", amg="petsc")[1]
-    second = loading.solve(pending, "pdas-amg", amg="pyamg")[1]
+    first = solved(pending, "pdas-amg", amg="petsc")[1]
+    second = solved(pending, "pdas-amg", amg="pyamg")[1]
     assert first.status == second.status == "converged"
     assert compare(eager, first, second).lam_rel <= 1e-7
 
@@ -140,7 +142,7 @@ def test_the_push_as_an_unknown_costs_few_cg_iterations(pair):
     CG iterations stay close to those of the same problem with the push given (counted, not
     timed; measured at 6.9k dofs: 150 against 120 or so)."""
     pending, _ = pair
-    settled, targeted = loading.solve(pending, "pdas-amg")
+    settled, targeted = solved(pending, "pdas-amg")
     given = solve(settled, "pdas-amg")
     assert targeted.status == given.status == "converged"
     assert targeted.extras["cg_iterations"] <= 1.5 * given.extras["cg_iterations"] + 30
@@ -155,10 +157,10 @@ def test_a_push_pdas_amg_cannot_carry_is_matched_before_its_bound_form(pair):
     moved = pending.with_data(push=dataclasses.replace(pending.push, d1=d1),
                               d=pending.push.d0 + pending.push.scale * d1)
     assert moved.pending
-    with pytest.raises(signorini.InputError, match="match the load first"):
+    with pytest.raises(signorini.InputError, match="not matched yet"):
         solve(moved, "pdas-amg")
-    (ours_problem, ours), (their_problem, reference) = (loading.solve(moved, "pdas-amg"),
-                                                        loading.solve(moved, "pdas"))
+    (ours_problem, ours), (their_problem, reference) = (solved(moved, "pdas-amg"),
+                                                        solved(moved, "pdas"))
     assert ours.status == reference.status == "converged"
     assert ours_problem.push.scale == pytest.approx(their_problem.push.scale, rel=1e-9)
     assert compare(their_problem, ours, reference).lam_rel <= 1e-7
