@@ -226,8 +226,9 @@ class Solved(NamedTuple):
 
 def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
           coarse: CoarseModel | None = None, keep_factor: bool = False) -> Solved:
-    """Solve ``problem`` as ``request`` (a checked :func:`~signorini.solvers.registry.check_request`)
-    says, matching its target load first when it has one and the method does not.
+    """Solve ``problem`` as ``request`` says (checked by
+    :func:`~signorini.solvers.registry.check_request`), matching its target load first when it
+    has one and the method does not match it itself.
 
     ``coarse`` (from the scene: a coarser model of the same scene) feeds the
     predictions of the zone kernel and of the methods that take one;
@@ -249,7 +250,7 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
     elif runs.prediction:  # a method that starts cold, from the scene's predictions only
         with counting() as work:
             options = {**_predictions(problem, runs.prediction, options, coarse, zone), **options}
-        if work.as_dict():  # a coarser model solved for its prediction
+        if stage(work):  # a coarser model solved for its prediction
             stages["prediction"] = stage(work)
     solved = Solved(*registry.run(problem, request._replace(options=options), warm_start=start,
                                   keep_factor=keep_factor))

@@ -1,4 +1,4 @@
-"""Work as data: what a stage of a solve did, counted, so that tests count work instead of timing it.
+"""Work as data: what a stage of a solve did, counted (tests count work instead of timing it).
 
 A :class:`Work` record counts factorisations, back-solves (one per right-hand
 side), multigrid hierarchies built, CG solves and iterations, and active-set

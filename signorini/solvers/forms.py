@@ -184,7 +184,8 @@ def formulate(problem: ContactProblem, form: str, dense: bool = False,
                 if not fallback:
                     raise np.linalg.LinAlgError(f"form={form!r} needs K⁻¹: {exc}; the primal "
                                                 "form needs none (form=primal)") from exc
-                form, note = "primal", f"the default {form} form needs K⁻¹: {exc}; primal form instead"
+                note = f"the default {form} form needs K⁻¹: {exc}; primal form instead"
+                form = "primal"
         out: Formulation
         if form == "primal":
             out = Formulation(form, K, -problem.f, sp.csc_matrix(problem.N), problem.d.copy())

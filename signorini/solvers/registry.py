@@ -157,7 +157,7 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
             solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
         except InputError:
             raise
-        except Exception as exc:  # a backend's own error (e.g. CHOLMOD on a singular K) is a failed run
+        except Exception as exc:  # a backend's own error (CHOLMOD on a singular K): a failed run
             log.warning("method %s raised %s: %s", method, type(exc).__name__, exc)
             solution = ContactSolution.failure(
                 method, problem, "failed", f"{type(exc).__name__}: {exc}",
