@@ -16,10 +16,9 @@ algebraic multigrid given the rigid-body modes as near-null space
   steps remain;
 - a target load that is still pending (``problem.pending``: load control,
   :mod:`signorini.load_control`, leaves it to this method: ``Method.matches_load``) is
-  matched with the answer: the push is one more unknown of every CG system
-  (:class:`LoadBorder`), preconditioned by block elimination
-  (:func:`border_preconditioner`), so no factorisation of K is ever made; the
-  push found is ``solution.extras["push"]`` (``push0`` the first guess);
+  matched with the answer: the push is one more unknown of every CG system, preconditioned
+  by block elimination (:mod:`signorini.solvers.load_border`), so no factorisation of K is
+  ever made; the push found is ``solution.extras["push"]`` (``push0`` the first guess);
 - **one hierarchy** is built, for K with the first active set pinned; later
   sets differ in a few rows and CG pays for them in iterations;
 - CG starts from the last step's displacement, and its tolerance follows
@@ -46,7 +45,6 @@ from __future__ import annotations
 import importlib.util
 import logging
 import time
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -56,13 +54,13 @@ from signorini.errors import InputError
 from signorini.kkt import certificate
 from signorini.numerics.factor import selection_dofs
 from signorini.numerics.push import first_contact
-from signorini.numerics.multigrid import (Bordered, PyamgHierarchy, pinned_cg, pinned_matrix,
-                                          threaded)
+from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg, pinned_matrix, threaded
 from signorini.numerics.work import count
 from signorini.numerics.zone import predict_zone
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import pdas, petsc_
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
+from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
 from signorini.solvers.base import Method
 from signorini.solvers.options import positive_number, take_options
 
@@ -248,82 +246,6 @@ class PinnedCG:
         return form.displacement(x)
 
 
-@dataclass
-class LoadBorder:
-    """Load targeting without a factorisation: the push ``s`` as one more unknown.
-
-    The pushed dofs move together, so the load row is parallel to the push's
-    forces, ``ℓ = β f₁``, and the target ``ℓ·u + s·o₁ + o₀ = P`` is the last
-    row of the symmetric system ``[[K, −f₁], [−f₁ᵀ, −o₁/β]] [u; s] = [f₀;
-    −(P − o₀)/β]``: K of the body with the pushed dofs as one more unknown,
-    SPD once the contact holds it (:class:`~signorini.numerics.multigrid.Bordered`).
-    CG preconditions it by block elimination (:func:`border_preconditioner`).
-    Arrays are the bound form's (rotated, full length).
-    """
-
-    g: np.ndarray  # the push's forces f₁
-    k: float  # −o₁/β
-    h: float  # −(P − o₀)/β
-    f0: np.ndarray  # the load that does not move with the push
-    beta: float
-    target: float
-
-
-def border_factor(problem: ContactProblem) -> float | None:
-    """β of :class:`LoadBorder` for a problem whose target load is pending, or None (nothing
-    pending, the pushed dofs do not move together, or the push moves a contact candidate)."""
-    pu = problem.push
-    if not problem.pending or problem.discretisation.load_row is None or np.any(pu.d1 != 0):
-        return None
-    f1, row = pu.f1, problem.discretisation.load_row
-    beta = float(row @ f1) / max(float(f1 @ f1), 1e-300)
-    if not beta or np.linalg.norm(row - beta * f1) > 1e-9 * np.linalg.norm(row):
-        return None
-    return beta if -pu.offset1 / beta > 0 else None
-
-
-def load_border(problem: ContactProblem, form: BoundForm) -> LoadBorder | None:
-    """The border of a problem whose target load is pending (see :func:`border_factor`)."""
-    beta = border_factor(problem)
-    if beta is None:
-        return None
-    pu = problem.push
-    rotate = lambda v: form.T.T @ _embedded(form, v)  # noqa: E731
-    fixed = pu.load * pu.f_load if pu.f_load is not None else np.zeros(problem.n)
-    return LoadBorder(g=rotate(pu.f1), k=-pu.offset1 / beta,
-                      h=-(pu.target - pu.load * pu.offset_load) / beta, f0=rotate(fixed),
-                      beta=beta, target=pu.target)
-
-
-def border_preconditioner(apply, border: LoadBorder):
-    """The multigrid ``M ≈ A⁻¹`` extended to the bordered matrix ``[[A, −g], [−gᵀ, k]]``.
-
-    Block elimination with ``w = −M g`` (one V-cycle, once) and the Schur
-    complement ``S = k − gᵀ M g``: ``P = Z diag(M, 1/S) Zᵀ``, ``Z = [[I, w], [0, 1]]``,
-    symmetric positive definite for any w when S > 0 and the exact inverse
-    when M is. On the default 6.9k-dof sphere it took CG from 146 iterations (the
-    border preconditioned by its diagonal) to 129, with the whole cut pushed from 204
-    to 179, against 106 and 112 with the push given (tests/test_pending_load.py).
-    Should S not be clearly positive (M too far from A⁻¹), the border's diagonal alone.
-    """
-    Mg = apply(border.g)
-    schur = border.k - float(border.g @ Mg)
-    if not schur > 1e-3 * border.k:
-        return lambda r: np.append(apply(r[:-1]), r[-1] / border.k)
-
-    def precondition(r: np.ndarray) -> np.ndarray:
-        t = (r[-1] + float(Mg @ r[:-1])) / schur
-        return np.append(apply(r[:-1]) + Mg * t, t)
-
-    return precondition
-
-
-def _embedded(form: BoundForm, v: np.ndarray) -> np.ndarray:
-    full = np.zeros(form.T.shape[0])
-    full[form.free_dofs] = v
-    return full
-
-
 def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.ndarray, str]:
     """The first active set and where it came from."""
     if opts["active0"] is not None:
@@ -387,18 +309,10 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     build_time = time.perf_counter() - start
     system.build(active, opts["amg"])
     hierarchy = system.hierarchy
-    xs = np.zeros(form.n + 1)  # the unknowns, and the push last (used only with a border)
-    x = xs[:form.n]
+    unknowns = Unknowns(system, border, opts["push0"])
+    x = unknowns.x
     if opts["warm_start"] is not None and opts["warm_start"].u is not None:
-        x[:] = form.T.T @ _embedded(form, opts["warm_start"].u)
-    operator, rhs, precondition = system.product, form.f, hierarchy.apply
-    free_of = lambda free: free  # noqa: E731
-    if border is not None:
-        xs[-1] = problem.push.scale if opts["push0"] is None else float(opts["push0"])
-        operator = Bordered(system.product, border.g, border.k)
-        rhs = np.append(border.f0, border.h)
-        free_of = lambda free: np.append(free, True)  # noqa: E731
-        precondition = border_preconditioner(hierarchy.apply, border)
+        x[:] = rotated(form, opts["warm_start"].u)
     d = problem.d
     floor = 1e-5 * float(np.max(np.abs(problem.f), initial=0.0))
     history: dict[str, list[float]] = {"changes": [], "active": [], "cg_iterations": [],
@@ -421,14 +335,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
                 forcing.append(0.0 if final else _forcing(eta, r0, r0_last))
             return rinf <= target or (not final and r2 <= forcing[0] * r0)
 
-        weights = None
-        if border is not None:  # the load row weighed as its relative error times the force
-            weights = np.ones(form.n + 1)
-            weights[-1] = abs(border.beta) * force / border.target
-        result = pinned_cg(operator, rhs, xs if border is not None else x, free_of(free),
-                           precondition, done, CG_MAX_ITER, weights)
-        if border is not None:
-            system.f = border.f0 + xs[-1] * border.g
+        result = pinned_cg(unknowns.operator, unknowns.rhs, unknowns.values, unknowns.free(free),
+                           unknowns.precondition, done, CG_MAX_ITER, unknowns.weights(force))
+        system.f = unknowns.loaded(system.f)
         lam = system.reactions(x, active)
         new_active = (lam + c * system.violation(x, d) > 0) & system.bounded
         changes = int(np.sum(new_active != active))
@@ -444,8 +353,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             if result.final_inf <= SAFETY * tighten * tol * force:
                 candidate = ContactSolution(method="pdas-amg", u=form.displacement(x), lam=lam,
                                             status="converged")
-                judged = problem.pushed(float(xs[-1])) if border is not None else problem
-                name, worst = certificate(judged, candidate, duality_gap=False).worst()
+                name, worst = certificate(unknowns.at_push(problem), candidate,
+                                          duality_gap=False).worst()
                 if worst <= tol:
                     status = "converged"
                     how = "repeated" if changes == 0 else \
@@ -478,16 +387,15 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     extras = {"amg": hierarchy.backend, "hierarchies": 1,
               "cg_iterations": cg_iterations, "hierarchy_s": hierarchy.setup_s,
               "levels": hierarchy.levels, "first_active": source}
-    judged = problem
-    if border is not None:
-        judged, extras["push"] = problem.pushed(float(xs[-1])), float(xs[-1])
+    if unknowns.push is not None:
+        extras["push"] = unknowns.push
         message += "; the load matched with the push as one more unknown (no factorisation)"
     solution = ContactSolution(
         method="pdas-amg", u=u, lam=lam, status=status,
         message=(f"{message}; first active set from {source}; one {hierarchy.backend} hierarchy "
                  f"({hierarchy.setup_s:.2f} s), {cg_iterations} CG iterations"),
         iterations=step, build_time=build_time, solve_time=time.perf_counter() - start - build_time,
-        history=history, extras=extras, factor=PinnedCG(judged, system, active))
+        history=history, extras=extras, factor=PinnedCG(unknowns.at_push(problem), system, active))
     return solution
 
 
