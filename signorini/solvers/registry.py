@@ -178,6 +178,7 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
     solution.keep_factor = keep_factor
     if "auto" not in solution.extras:  # auto names the method it picked
         solution.method = method
+    log.info("checking the answer: the KKT certificate")
     if problem.pending:
         if "push" not in solution.extras:
             solution = ContactSolution.failure(method, problem, solution.status if
