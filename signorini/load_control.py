@@ -44,7 +44,7 @@ from signorini.errors import InputError
 from signorini.kkt import Certificate
 from signorini.numerics.factor import FactorTooLarge, selection_dofs
 from signorini.numerics.push import calibrate_push
-from signorini.numerics.work import Work, counting
+from signorini.numerics.work import counting
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
                                      zone_around_points)
 from signorini.problem import ContactProblem
@@ -140,7 +140,7 @@ def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
         raise InputError("the problem has no target load to match: it is solved as it is")
     with counting() as work:
         problem, start, how = _matched(problem, zone)
-    return Matched(problem, start, how, stage(work))
+    return Matched(problem, start, how, work.listed())
 
 
 def _matched(problem: ContactProblem, zone: Zone | None) -> tuple[ContactProblem, WarmStart, str]:
@@ -163,15 +163,6 @@ def _matched(problem: ContactProblem, zone: Zone | None) -> tuple[ContactProblem
                                    problem.force_multiplicity, f0=f0,
                                    start=disc.predicted_contact, weights=pu.resultant)
     return problem.pushed(scale), WarmStart(lam=lam, u=u), "full active set"
-
-
-def stage(work: Work) -> dict[str, int]:
-    """A stage's work as ``solution.work`` lists it: load control's active-set ``steps``,
-    factorisations, back-solves, CG iterations and hierarchies, the zero counts left out."""
-    counts = {"steps": work.load_steps, "factorisations": work.factorisations,
-              "back_solves": work.back_solves, "cg_iterations": work.cg_iterations,
-              "hierarchies": work.hierarchies}
-    return {key: value for key, value in counts.items() if value}
 
 
 def at_load(problem: ContactProblem, coarse: CoarseModel | None = None) -> ContactProblem:
@@ -250,8 +241,8 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
     elif runs.prediction:  # a method that starts cold, from the scene's predictions only
         with counting() as work:
             options = {**_predictions(problem, runs.prediction, options, coarse, zone), **options}
-        if stage(work):  # a coarser model solved for its prediction
-            stages["prediction"] = stage(work)
+        if work.listed():  # a coarser model solved for its prediction
+            stages["prediction"] = work.listed()
     solved = Solved(*registry.run(problem, request._replace(options=options), warm_start=start,
                                   keep_factor=keep_factor))
     solved.solution.work = {**stages, **solved.solution.work}
@@ -265,4 +256,4 @@ def _said(work: dict[str, int]) -> str:
 
 
 __all__ = ["CoarseModel", "Matched", "Solved", "ZONE_FROM_DOFS", "analytic_extent", "analytic_zone",
-           "at_load", "coarse_zone", "match", "predicted_zone", "solve", "stage"]
+           "at_load", "coarse_zone", "match", "predicted_zone", "solve"]

@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 import signorini
-from signorini.load_control import stage
 from signorini.numerics.work import counting
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,15 +34,15 @@ def cost(params: dict) -> dict:
     start = time.perf_counter()
     with counting() as work:
         result = signorini.solve(problem)
-    solve_s, solve_work = time.perf_counter() - start, stage(work)
+    solve_s, solve_work = time.perf_counter() - start, work.listed()
     start = time.perf_counter()
     with counting() as work:
         first = signorini.derivative(result, "total_force", "P")
-    first_s, first_work = time.perf_counter() - start, stage(work)
+    first_s, first_work = time.perf_counter() - start, work.listed()
     start = time.perf_counter()
     with counting() as work:
         again = signorini.derivative(result, "a", "P")
-    again_s, again_work = time.perf_counter() - start, stage(work)
+    again_s, again_work = time.perf_counter() - start, work.listed()
     return {"params": params, "dofs": problem.n, "method": result.method, "solve_s": solve_s,
             "solve_work": solve_work, "first_derivative_s": first_s, "first_work": first_work,
             "next_derivative_s": again_s, "next_work": again_work,

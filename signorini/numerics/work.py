@@ -35,8 +35,19 @@ class Work:
     load_steps: int = 0
 
     def as_dict(self) -> dict[str, int]:
-        """The counts that are not zero, by name (the shape of ``solution.work``'s stages)."""
+        """The counts that are not zero, by name."""
         return {name: value for name, value in asdict(self).items() if value}
+
+    def listed(self, steps: int | None = None) -> dict[str, int]:
+        """The stage as ``solution.work`` lists it: its ``steps`` (given, else load control's
+        active-set steps when there were any), factorisations, back-solves, CG iterations and
+        hierarchies, the zero counts left out."""
+        counts = {"factorisations": self.factorisations, "back_solves": self.back_solves,
+                  "cg_iterations": self.cg_iterations, "hierarchies": self.hierarchies}
+        listed = {key: value for key, value in counts.items() if value}
+        if steps is None and not self.load_steps:
+            return listed
+        return {"steps": self.load_steps if steps is None else steps, **listed}
 
 
 _OPEN: ContextVar[tuple[Work, ...]] = ContextVar("signorini_work", default=())

@@ -170,11 +170,7 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
     solution = held_to_problem(problem, held, solution, method)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
-    solution.work["method"] = {"steps": int(solution.iterations), **{
-        key: value for key, value in (("factorisations", work.factorisations),
-                                      ("back_solves", work.back_solves),
-                                      ("cg_iterations", work.cg_iterations),
-                                      ("hierarchies", work.hierarchies)) if value}}
+    solution.work["method"] = work.listed(steps=int(solution.iterations))
     solution.keep_factor = keep_factor
     if "auto" not in solution.extras:  # auto names the method it picked
         solution.method = method
