@@ -89,6 +89,6 @@ METHODS = (
     Method(name="auto", function=solve, family="auto", exact=True,
            summary="picks nested (K factorised by load control), pdas (2D, small 3D) or pdas-amg "
                    "(large 3D) and says why",
-           default_tol=1e-9, targets_load=True,
+           targets_load=True,
            options=tuple(sorted(set(pdas.DEFAULTS) | set(amg.DEFAULTS) | set(nested.DEFAULTS)))),
 )

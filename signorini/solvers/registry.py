@@ -24,8 +24,10 @@ from signorini.numerics.multigrid import COUNTS as MULTIGRID_COUNTS
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
+from signorini.scales import Scales
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, check_max_iter, check_tol,
                                     hold_to_contract, judge)
+from signorini.solvers.conditioning import in_problem_units, scaled_view
 
 log = logging.getLogger(__name__)
 
@@ -94,7 +96,7 @@ def _load_user_method(spec: str) -> Method:
     if not callable(func):
         raise InputError(f"method {spec!r}: module {module_name!r} has no function {attr!r}")
     return Method(name=spec, function=func, summary=(func.__doc__ or "").strip().split("\n")[0],
-                  family="user")
+                  family="user", scaled=False)
 
 
 
@@ -143,9 +145,11 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
         options["warm_start"] = warm_start
     log.info("solving %d dofs, %d contact candidates with %s", problem.n, problem.m, method)
     start, before = time.perf_counter(), dict(COUNTS, **MULTIGRID_COUNTS)
-    held = fingerprint(problem)
+    tol, max_iter = spec.defaults_for(tol, max_iter)
+    given, units = scaled_view(problem, options) if spec.scaled else (problem, Scales())
+    held = fingerprint(given)
     try:
-        solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
+        solution = spec.function(given, tol=tol, max_iter=max_iter, **options)
     except InputError:
         raise
     except Exception as exc:  # a backend's own error (e.g. CHOLMOD on a singular K) is a failed run
@@ -157,8 +161,8 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
         solution = ContactSolution.failure(
             method, problem, "failed", f"the method called sys.exit({exc.code!r})",
             solve_time=time.perf_counter() - start)
-    solution = hold_to_contract(problem, method, solution)
-    solution = held_to_problem(problem, held, solution, method)
+    solution = hold_to_contract(given, method, solution)
+    solution = in_problem_units(problem, held_to_problem(given, held, solution, method), units)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
     now = dict(COUNTS, **MULTIGRID_COUNTS)
@@ -175,7 +179,7 @@ def run(problem: ContactProblem, method: str = "pdas", *, tol: float | None = No
                                                f"{solution.message}; the target load was not matched")
             return problem, solution
         problem = problem.pushed(float(solution.extras["push"]))
-    return problem, judge(problem, solution, tol if tol is not None else spec.default_tol)
+    return problem, judge(problem, solution, tol)
 
 
 def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,
