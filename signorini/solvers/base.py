@@ -20,7 +20,7 @@ from signorini.adequacy import adequacy, warnings
 from signorini.errors import InputError, install_hint
 from signorini.kkt import certificate, shortfall
 from signorini.problem import STATUSES, ContactProblem, ContactSolution
-from signorini.solvers.defaults import DEFAULT_TOL, Defaults, defaults_of, resolved
+from signorini.solvers.defaults import DEFAULT_TOL, MIN_TOL, Defaults, defaults_of, resolved
 from signorini.solvers.options import Option, check_names, guess_value
 
 SolverFunction = Callable[..., ContactSolution]
@@ -114,8 +114,6 @@ class Method:
                 for name, text in texts.items()}
 
 
-#: relative KKT residuals cannot be certified below a few hundred times double precision's ε
-MIN_TOL = 1e-14
 
 
 def check_tol(tol: Any, name: str = "tol") -> float | None:

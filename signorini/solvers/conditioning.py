@@ -7,7 +7,9 @@ a view with ``K̂ = K/k``, ``f̂ = f/(kU)``, ``d̂ = d/U`` and ``ŵ = w/W``
 (:func:`signorini.scales.qp_scales` chooses k, U and W), whose ``scales`` say how to go
 back, and its answer is mapped back (``u = U û``, ``λ = kU λ̂``) before it is judged. The
 view is made per run and never stored on the problem. A problem a model made
-dimensionless already (its ``scales`` are not the identity: a scene's) is its own view.
+dimensionless already (its ``scales`` are not the identity: a scene's), or whose numbers are of
+order one already (every scale within a factor :data:`ORDER_ONE` of 1), is its own view:
+scaling it would change its round-off and nothing else.
 """
 
 from __future__ import annotations
@@ -21,7 +23,10 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.scales import Scales, qp_scales
 from signorini.solution import WarmStart
 
-__all__ = ["UnitsFactor", "in_problem_units", "scaled_view"]
+__all__ = ["ORDER_ONE", "UnitsFactor", "in_problem_units", "scaled_view"]
+
+#: a scale within this factor of 1 is of order one
+ORDER_ONE = 10.0
 
 
 def scaled_view(problem: ContactProblem, options: dict[str, Any]) -> tuple[ContactProblem, Scales]:
@@ -30,6 +35,8 @@ def scaled_view(problem: ContactProblem, options: dict[str, Any]) -> tuple[Conta
     if problem.scales != Scales():
         return problem, Scales()
     s = qp_scales(problem.K, problem.f, problem.d, problem.weights)
+    if all(1 / ORDER_ONE <= value <= ORDER_ONE for value in (s.displacement, s.force, s.weight)):
+        return problem, Scales()
     view = dataclasses.replace(
         problem, K=problem.K * (s.displacement / s.force), f=problem.f / s.force,
         d=problem.d / s.displacement, scales=s,

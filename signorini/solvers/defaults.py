@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["DEFAULT_TOL", "Defaults", "TABLE", "defaults_of", "resolved"]
+__all__ = ["DEFAULT_TOL", "EXACT_TOL", "MIN_TOL", "Defaults", "TABLE", "defaults_of", "resolved"]
 
 #: the package's default relative KKT tolerance: what :func:`signorini.crosscheck` asks every
 #: method for, what a user's method is handed when nobody names one, and what an answer is
@@ -20,6 +20,10 @@ DEFAULT_TOL = 1e-8
 #: what an exact method (its answer exact up to round-off once its active set is found) is held
 #: to: one digit tighter than an iterative method is asked for
 EXACT_TOL = 1e-9
+
+#: relative KKT residuals cannot be certified below a few hundred times double precision's ε:
+#: the smallest tol a method may be asked for
+MIN_TOL = 1e-14
 
 
 @dataclass(frozen=True)
