@@ -2,8 +2,12 @@
 
 ``solve(problem, *, tol=None, max_iter=None, **options) -> ContactSolution``
 
-``tol=None`` means the method's own default tolerance (for QP backends: the
-backend's defaults, untouched). Unknown options raise :class:`InputError`.
+A ``tol`` or ``max_iter`` not asked for is the method's row of
+:mod:`signorini.solvers.defaults` (None for a QP backend: its own settings,
+untouched), which :func:`run` hands every method as numbers. A ``scaled`` method
+gets a view of the problem in units of order one
+(:mod:`signorini.solvers.conditioning`); a user's method gets the problem as
+given. Unknown options raise :class:`InputError`.
 """
 
 from __future__ import annotations
