@@ -26,9 +26,9 @@ from signorini.fingerprint import fingerprint, held_to_problem
 from signorini.numerics.factor import COUNTS
 from signorini.numerics.multigrid import COUNTS as MULTIGRID_COUNTS
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.scales import Scales
 from signorini.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
-from signorini.scales import Scales
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, check_max_iter, check_tol,
                                     hold_to_contract, judge)
 from signorini.solvers.conditioning import in_problem_units, scaled_view
