@@ -5,8 +5,9 @@ K, the complementarity problem ``λ ≥ 0, Wλ − b ≥ 0, λ·(Wλ − b) = 0`
 ``b = N K⁻¹ f − d`` is solved exactly on it (primal-dual active set on the
 dense matrix, least-index pivoting should it cycle), and ``u = K⁻¹(f − Nᵀλ)``
 is one more back-solve; the LCP stops when its active set repeats or its answer meets the
-bounds to ``tol`` (:func:`signorini.numerics.lcp.solve_lcp`). Cost: one factorisation, m + 2 back-solves and dense
-m × m work; only for problems with few contact candidates (memory m²).
+bounds to ``tol`` (:func:`signorini.numerics.lcp.solve_lcp`). Cost: one factorisation,
+m + 2 back-solves and dense m × m work; only for problems with few contact candidates
+(memory m²).
 """
 
 from __future__ import annotations
