@@ -116,14 +116,17 @@ def test_a_user_method_through_the_cli_gets_the_users_qp_and_numbers(tmp_path, m
 
 def default_tolerance_literals(path: Path) -> list[str]:
     """Where ``path`` writes a default tolerance or iteration limit as a number: a default
-    of a ``tol``/``max_iter`` parameter, a ``…TOL``/``MAX_ITER`` name bound to a number, a
-    ``default_tol=`` keyword, or ``tol = <number> if tol is None else tol``."""
+    of a ``tol``/``max_iter`` parameter, a ``…TOL``/``MAX_ITER`` name bound to a number (or a
+    dict of numbers), a ``default_tol=`` keyword, ``tol=``/``max_iter=`` given a number in a
+    call, or ``tol = <number> if tol is None else tol``."""
     tree = ast.parse(path.read_text())
     found = []
 
     def numeric(node) -> bool:
         if isinstance(node, ast.IfExp):
             return numeric(node.body) or numeric(node.orelse)
+        if isinstance(node, ast.Dict):
+            return any(numeric(value) for value in node.values)
         if isinstance(node, ast.UnaryOp):
             return numeric(node.operand)
         return isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) \
@@ -142,8 +145,9 @@ def default_tolerance_literals(path: Path) -> list[str]:
                 if (name.endswith("_TOL") or name in ("TOL", "MAX_ITER", "tol", "max_iter")) \
                         and numeric(node.value):
                     found.append(f"{name} = … (line {node.lineno})")
-        elif isinstance(node, ast.keyword) and node.arg == "default_tol":
-            found.append("default_tol=…")
+        elif isinstance(node, ast.keyword) and (node.arg == "default_tol" or (
+                node.arg in ("tol", "max_iter") and numeric(node.value))):
+            found.append(f"{node.arg}=… in a call")
     return found
 
 
@@ -156,9 +160,11 @@ def test_no_default_tolerance_outside_the_table():
 
 def test_the_scan_finds_a_default_tolerance(tmp_path):
     planted = tmp_path / "planted.py"
-    planted.write_text("DEFAULT_TOL = 1e-9\n\ndef solve(problem, *, tol=1e-9, max_iter=None):\n"
-                       "    tol = 1e-9 if tol is None else tol\n")
-    assert len(default_tolerance_literals(planted)) == 3
+    planted.write_text("DEFAULT_TOL = 1e-9\nMAX_ITER = {'a': 20}\n\n"
+                       "def solve(problem, *, tol=1e-9, max_iter=None):\n"
+                       "    tol = 1e-9 if tol is None else tol\n"
+                       "    return run(problem, max_iter=200 if max_iter is None else max_iter)\n")
+    assert len(default_tolerance_literals(planted)) == 5
 
 
 def test_every_registered_method_has_a_row():
@@ -254,3 +260,10 @@ def test_a_file_saved_scaled_by_an_older_version_loads_in_the_users_units(tmp_pa
     np.testing.assert_allclose(problem.d, D, rtol=1e-15)
     fresh = signorini.solve(signorini.ContactProblem.from_qp(K, F, N, D), "pdas")
     np.testing.assert_allclose(signorini.solve(problem, "pdas").force, fresh.force, rtol=1e-12)
+
+
+def test_the_docs_show_the_table():
+    text = (Path(__file__).resolve().parents[1] / "docs" / "methods.md").read_text()
+    for key, row in TABLE.items():
+        tol = "its backend" if row.tol is None else f"{row.tol:g}"
+        assert f"| `{key}` | {tol} |" in text, key
