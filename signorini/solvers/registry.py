@@ -6,7 +6,7 @@ A ``tol`` or ``max_iter`` not asked for is the method's row of
 :mod:`signorini.solvers.defaults` (None for a QP backend: its own settings,
 untouched), which :func:`run` hands every method as numbers. A ``scaled`` method
 gets a view of the problem in units of order one
-(:mod:`signorini.solvers.conditioning`); a user's method gets the problem as
+(:func:`signorini.scales.scaled_view`); a user's method gets the problem as
 given. Unknown options raise :class:`InputError`.
 """
 
@@ -26,12 +26,11 @@ from signorini.fingerprint import fingerprint, held_to_problem
 from signorini.numerics.factor import COUNTS
 from signorini.numerics.multigrid import COUNTS as MULTIGRID_COUNTS
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.scales import Scales
+from signorini.scales import Scales, in_problem_units, scaled_view
 from signorini.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, check_max_iter, check_tol,
                                     hold_to_contract, judge)
-from signorini.solvers.conditioning import in_problem_units, scaled_view
 
 log = logging.getLogger(__name__)
 
