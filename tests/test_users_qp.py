@@ -203,6 +203,14 @@ def test_from_qp_refuses_nan_contact_points():
         signorini.ContactProblem.from_qp(K[:2, :2], F[:2], N[:, :2], D, contact_points=points)
 
 
+def test_a_problem_file_with_nan_contact_points_exits_2(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    np.savez("nan_points.npz", K=K, f=F, N=N, d=D, contact_points=[[0.0, 0.0], [np.nan, 1.0]])
+    assert main(["solve", "nan_points.npz"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "contact_points row 1" in err
+
+
 def rewritten(tmp_path: Path, change) -> Path:
     """A file ``ContactProblem.save`` wrote, with one array changed by ``change(arrays)``."""
     path = tmp_path / "saved.npz"
