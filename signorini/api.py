@@ -9,9 +9,10 @@ A :class:`Result` gives every quantity in the units of the problem's input
 (SI if the scene's parameters are SI): ``force`` in N (N/m per unit thickness
 in 2D, N per radian in axisymmetric models), ``pressure`` in Pa, ``gap`` and
 ``displacement`` in m; a QP of your own (:meth:`ContactProblem.from_qp`) answers in
-your units (``result.u`` is your unknown, ``result.force`` your λ). The solver's own
-vectors ``result.solution.u`` and ``result.solution.lam`` are dimensionless (see
-:class:`signorini.problem.Scales`).
+your units (``result.u`` is your unknown, ``result.force`` your λ). The answer's own
+vectors ``result.solution.u`` and ``result.solution.lam`` are in the problem's arrays' units:
+a scene's are dimensionless (see :class:`signorini.problem.Scales`), a ``from_qp`` problem's
+are yours.
 ``Result.to_dict()`` is the JSON that ``signorini solve --json`` writes.
 """
 
@@ -406,8 +407,8 @@ def certificate(problem: ContactProblem, solution: ContactSolution | None = None
                 u: Any = None, force: Any = None, duality_gap: bool = True) -> Certificate:
     """The relative KKT residuals of an answer ``(u, λ)`` of ``problem`` (:class:`Certificate`).
 
-    Give the answer as a ``solution`` (a :class:`ContactSolution` in the
-    problem's own, dimensionless arrays: ``result.solution``), or as arrays in
+    Give the answer as a ``solution`` (a :class:`ContactSolution` in the units of the
+    problem's own arrays: ``result.solution``), or as arrays in
     your units: ``u`` the QP's unknown (n entries, as ``Result.u``) and
     ``force`` the contact forces λ (m entries, as ``Result.force``); they are
     scaled by ``problem.scales`` as every method's answer is.

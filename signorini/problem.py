@@ -8,41 +8,38 @@ The problem is one convex QP::
 with KKT conditions ``K u − f + Nᵀ λ = 0``, ``N u ≤ d``, ``λ ≥ 0``,
 ``λᵢ (N u − d)ᵢ = 0``. ``λ`` is the nodal contact force (compressive positive).
 
-All arrays held by :class:`ContactProblem` are dimensionless; :class:`Scales`
-turns them back into physical units.
+A QP given as arrays (:meth:`ContactProblem.from_qp`) is held in the units it
+was given (identity :class:`Scales`); a scene's is dimensionless, and its
+:class:`Scales` turn it back into physical units.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import io
-import json
-import logging
 import os
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import MeshTet, MeshTri
 
 from signorini.discretisation import Discretisation, Push, ReferenceData, Watch
 from signorini.errors import InputError
-from signorini.files import atomic_write_bytes
 from signorini.numerics.arrays import (
     multiplicity_argument,
     points_argument,
     sparse_argument,
+    symmetric_argument,
     vector_argument,
 )
 from signorini.numerics.factor import factorize
-from signorini.scales import Scales, qp_scales
+from signorini import saved_problem
+from signorini.scales import Scales
 from signorini.solution import STATUSES, ContactSolution
 
-log = logging.getLogger(__name__)
 
 __all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Discretisation", "Push", "ReferenceData",
-           "Scales", "Watch", "qp_scales"]
+           "Scales", "Watch"]
 
 #: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
 ITERATIVE_ENERGY_FROM = 300_000
@@ -52,7 +49,7 @@ ITERATIVE_ENERGY_MAX_ITER = 20_000
 
 @dataclass
 class ContactProblem:
-    """The QP ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` (dimensionless), and what its rows mean.
+    """The QP ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` in its ``scales``' units, and what its rows mean.
 
     Attributes
     ----------
@@ -128,28 +125,18 @@ class ContactProblem:
         positions; there is no analytic reference to compare with. Shapes
         and values are checked (InputError names the array and the fix).
 
-        The arrays are scaled as a scene's are (:func:`qp_scales`), so that
-        every method sees numbers of order one whatever your units; the
-        problem keeps the scaled arrays and their :class:`Scales`, and a
-        :class:`signorini.Result` gives every output back in your units
-        (``result.u`` is your unknown, ``result.force`` your λ). Contact
-        points keep your units (``scales.length`` is 1).
+        The problem holds your arrays (as CSR and float arrays, the same
+        values) and its ``scales`` are the identity: ``.K``, ``.f``, ``.N``,
+        ``.d`` and :meth:`qp` are what you passed, a method of your own is
+        handed them, and a :class:`signorini.Result` answers in your units.
+        A built-in method that needs numbers of order one works on a scaled
+        view of its own (:func:`signorini.scales.scaled_view`).
         """
-        K = sparse_argument(K, "K")
-        n = K.shape[0]
-        if K.shape[0] != K.shape[1]:
-            raise InputError(f"K must be square, got shape {K.shape}")
-        if n and abs(K - K.T).max() > 1e-10 * abs(K).max():
-            raise InputError("K must be symmetric: pass the stiffness matrix itself, or ½(K + Kᵀ)")
+        K = symmetric_argument(sparse_argument(K, "K"))
         N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")
-        given = cls(K=K, f=f, N=N, d=d, weights=weights,
-                    contact_points=points_argument(contact_points, N),
-                    force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
-        scales = qp_scales(given.K, given.f, given.d, given.weights)
-        return dataclasses.replace(
-            given, K=given.K * (scales.displacement / scales.force), f=given.f / scales.force,
-            d=given.d / scales.displacement, scales=scales,
-            weights=None if given.weights is None else given.weights / scales.weight)
+        return cls(K=K, f=f, N=N, d=d, weights=weights,
+                   contact_points=points_argument(contact_points, N),
+                   force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
 
     # -- what the discretisation says (neutral values for a QP given as arrays) ---------------
     scene = property(lambda self: self.name, doc="The scene's name (``name``).")
@@ -225,9 +212,11 @@ class ContactProblem:
         return full
 
     def qp(self) -> tuple[sp.csr_matrix, np.ndarray, sp.csr_matrix, np.ndarray]:
-        """``(K, f, N, d)`` in the problem's own units (its :class:`Scales` undone): for
-        :meth:`from_qp`, the arrays you gave; the problem itself keeps them dimensionless."""
+        """``(K, f, N, d)`` in the problem's physical units (its :class:`Scales` undone): for
+        :meth:`from_qp`, the arrays you gave, themselves; a scene keeps them dimensionless."""
         s = self.scales
+        if s == Scales():
+            return self.K, self.f, self.N, self.d
         return (self.K * (s.force / s.displacement), self.f * s.force, self.N,
                 self.d * s.displacement)
 
@@ -342,83 +331,12 @@ class ContactProblem:
     def save(self, path: str | os.PathLike) -> None:
         """Store the arrays of this problem (and its mesh) in ``path`` (.npz), atomically.
 
-        :meth:`load` gives it back (the cached factorisation is not stored).
+        :meth:`load` gives it back (the cached factorisation is not stored); the format is
+        :mod:`signorini.saved_problem`'s.
         """
-        K, N = self.K.tocsr(), self.N.tocsr()
-        arrays = dict(
-            K_data=K.data, K_indices=K.indices, K_indptr=K.indptr, N_data=N.data,
-            N_indices=N.indices, N_indptr=N.indptr, shape=np.array([self.n, self.m]), f=self.f,
-            d=self.d, weights=self.weights if self.weights is not None else np.zeros(0),
-            contact_points=self.contact_points)
-        meta: dict[str, Any] = {"scene": self.name, "force_multiplicity": self.force_multiplicity,
-                                "scales": vars(self.scales), "discretisation": None}
-        disc = self.discretisation
-        if disc is not None:
-            arrays.update(free_dofs=disc.free_dofs, prescribed=disc.prescribed,
-                          load_row=disc.load_row if disc.load_row is not None else np.zeros(0))
-            if disc.mesh is not None:  # node blocks and rigid modes for the petsc methods
-                arrays.update(mesh_p=disc.mesh.p, mesh_t=disc.mesh.t)
-            pu = disc.push
-            if pu is not None:
-                arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
-                if pu.f_load is not None:
-                    arrays.update(push_f_load=pu.f_load)
-            meta["discretisation"] = {
-                "load_offset": disc.load_offset, "E": disc.E, "nu": disc.nu,
-                "volumetric": disc.volumetric, "axisymmetric": disc.axisymmetric,
-                "reference": None if disc.reference is None else dataclasses.asdict(disc.reference),
-                "params": disc.params, "assemble_s": disc.assemble_s,
-                "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
-                                                 "offset_load": pu.offset_load, "load": pu.load,
-                                                 "target": pu.target, "pending": pu.pending,
-                                                 "delta": pu.delta, "P": pu.P}}
-        arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
-        buffer = io.BytesIO()
-        np.savez(buffer, **arrays)
-        atomic_write_bytes(path, buffer.getvalue())
+        saved_problem.save(self, path)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "ContactProblem":
-        """The problem :meth:`save` stored in ``path``."""
-        z = np.load(path)
-        meta = json.loads(bytes(z["meta"]).decode())
-        n, m = (int(v) for v in z["shape"])
-        discretisation = None
-        about = meta.get("discretisation")
-        if about is not None:
-            push = None
-            if about["push"] is not None:
-                p = about["push"]
-                push = Push(z["push_f1"], z["push_d0"], z["push_d1"], p["offset1"], p["scale"],
-                            z["push_f_load"] if "push_f_load" in z else None, p["offset_load"],
-                            p["load"], p["target"], p["pending"],
-                            z["push_resultant"] if "push_resultant" in z else None,
-                            p.get("delta"), p.get("P"))
-            mesh = None
-            if "mesh_p" in z:
-                kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
-                mesh = kind(z["mesh_p"], z["mesh_t"])
-            discretisation = Discretisation(
-                mesh=mesh, free_dofs=z["free_dofs"], prescribed=z["prescribed"],
-                load_row=z["load_row"] if z["load_row"].size else None,
-                load_offset=about["load_offset"], E=about["E"], nu=about["nu"],
-                volumetric=about["volumetric"], axisymmetric=about["axisymmetric"],
-                reference=_reference_data(about["reference"]), params=about["params"], push=push,
-                assemble_s=about["assemble_s"])
-        return cls(
-            K=sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]), shape=(n, n)),
-            f=z["f"], N=sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
-            d=z["d"], weights=z["weights"] if z["weights"].size else None,
-            contact_points=z["contact_points"], force_multiplicity=meta["force_multiplicity"],
-            scales=Scales(**meta["scales"]), name=meta["scene"], discretisation=discretisation)
-
-
-def _reference_data(stored: Any) -> ReferenceData | None:
-    """The reference record :meth:`ContactProblem.save` stored; a file that stored the name
-    alone (an older version) has no record to compare with: rebuild it from its scene."""
-    if isinstance(stored, dict):
-        return ReferenceData(**stored)
-    if stored:
-        log.warning("the stored problem names its reference %r without the record it reads: "
-                    "rebuild the problem from its scene to compare with the reference", stored)
-    return None
+        """The problem :meth:`save` stored in ``path`` (a QP given as arrays in its own units)."""
+        return saved_problem.load(path, cls)

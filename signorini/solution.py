@@ -50,10 +50,11 @@ class ContactSolution:
     :func:`signorini.solvers.registry.solve` enforces this). ``history`` maps a name to
     one value per iteration (``kkt``, ``primal``, ``dual``...).
 
-    ``u`` and ``lam`` are in the problem's units, which are dimensionless for
-    a scene built with ``nondimensionalise=True`` (the default): multiply by
-    ``problem.scales`` or read :class:`signorini.api.Result`, which gives
-    displacements, gaps, forces and pressures in the scene's own units.
+    ``u`` and ``lam`` are in the units of the problem's arrays: dimensionless for
+    a scene built with ``nondimensionalise=True`` (the default; multiply by
+    ``problem.scales``), the user's own for a QP given as arrays; a
+    :class:`signorini.api.Result` gives displacements, gaps, forces and
+    pressures in the problem's physical units.
     """
 
     method: str

@@ -1,4 +1,4 @@
-"""A QP of your own in any units: ``ContactProblem.from_qp`` scales it as a scene is scaled.
+"""A QP of your own in any units: ``ContactProblem.from_qp`` keeps it; methods see it scaled.
 
 The user's problem is built here with scikit-fem, as a user would: half a block (symmetry
 plane x = 0) pressed by a prescribed displacement of its top onto a rigid cylinder, condensed
@@ -16,7 +16,8 @@ from skfem import Basis, ElementTriP1, ElementVector, MeshTri, asm, condense
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 import signorini
-from signorini.solvers.registry import get_method
+from signorini.solvers.base import Method
+from signorini.solvers.registry import REGISTRY, get_method
 
 #: the routes the problem statement names, in their default forms
 ROUTES = ("qp-osqp", "qp-clarabel", "cvxpy", "uzawa", "uzawa-nesterov", "pdas")
@@ -118,19 +119,44 @@ def test_outputs_are_in_the_users_units_and_meet_the_users_kkt():
         np.testing.assert_allclose(result.total_force / (E * length), base.total_force / (E0 * L0), rtol=1e-8)
 
 
-def test_the_problem_a_method_sees_is_of_order_one():
-    for _, length, E in UNITS:
-        problem, _ = user_problem(length, E)
-        assert np.mean(problem.K.diagonal()) == pytest.approx(1.0)
-        assert 0.1 <= max(np.abs(problem.d).max(), np.abs(problem.f).max()) <= 10
-        assert np.mean(problem.weights) == pytest.approx(1.0)
+def test_the_problem_a_built_in_method_sees_is_of_order_one():
+    """The problem holds the user's arrays; a built-in method is handed a scaled view of them,
+    made per run (the problem keeps no scaled copy)."""
+    from signorini.solvers.registry import register
+
+    seen = []
+
+    def spy(problem, *, tol, max_iter, **options):
+        seen.append(problem)
+        return get_method("pdas").function(problem, tol=tol, max_iter=max_iter)
+
+    spec = register(Method(name="spy-of-order-one", function=spy, summary="records its problem",
+                           family="active set"))
+    try:
+        for _, length, E in UNITS:
+            problem, (K, f, N, d) = user_problem(length, E)
+            assert problem.K is not None and (problem.K != sp.csr_matrix(K)).nnz == 0
+            assert problem.scales == signorini.Scales()
+            result = signorini.solve(problem, spec.name, tol=TOL)
+            view = seen[-1]
+            assert view is not problem and result.converged
+            assert np.mean(view.K.diagonal()) == pytest.approx(1.0)
+            assert 0.1 <= max(np.abs(view.d).max(), np.abs(view.f).max()) <= 10
+            assert np.mean(view.weights) == pytest.approx(1.0)
+            # the answer is mapped back: the user's own KKT conditions hold
+            assert np.max(np.abs(K @ result.u - f + N.T @ result.force)) <= \
+                1e-9 * np.max(np.abs(N.T @ result.force))
+    finally:
+        REGISTRY.pop(spec.name)
 
 
-def test_scales_survive_save_and_load(tmp_path):
-    problem, _ = user_problem(1.0, 2.1e5)
+def test_the_qp_survives_save_and_load(tmp_path):
+    problem, (K, f, N, d) = user_problem(1.0, 2.1e5)
     problem.save(tmp_path / "p.npz")
     again = signorini.ContactProblem.load(tmp_path / "p.npz")
-    assert again.scales == problem.scales
+    assert again.scales == problem.scales == signorini.Scales()
+    assert np.array_equal(again.f, f) and np.array_equal(again.d, d)
+    assert (again.K != K).nnz == 0 and (again.N != N).nnz == 0
     first, second = signorini.solve(problem, "pdas"), signorini.solve(again, "pdas")
     np.testing.assert_allclose(second.force, first.force)
 

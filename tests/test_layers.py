@@ -36,7 +36,7 @@ LAYERS = {
     "errors": 0, "files": 0,
     "numerics": 1,
     "problem": 2, "problem_files": 2, "discretisation": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
-    "adequacy": 2, "forward_error": 2, "fingerprint": 2, "scales": 2,
+    "adequacy": 2, "forward_error": 2, "fingerprint": 2, "scales": 2, "saved_problem": 2,
     "fem": 2,
     "solvers": 3,
     "load_control": 4,

@@ -42,6 +42,8 @@ def _refuse_complex_or_none(value: Any, name: str) -> None:
 
 def sparse_argument(value: Any, name: str) -> sp.csr_matrix:
     """``value`` (a SciPy sparse matrix or a 2D array of numbers) as CSR floats, or InputError."""
+    if value is None:
+        raise InputError(f"{name} is None: give a sparse matrix or a 2D array of numbers")
     _refuse_complex_or_none(value, name)
     try:
         matrix = sp.csr_matrix(value, dtype=float)
@@ -51,6 +53,20 @@ def sparse_argument(value: Any, name: str) -> sp.csr_matrix:
     if matrix.ndim != 2:
         raise InputError(f"{name} must be two-dimensional, got shape {matrix.shape}")
     return matrix
+
+
+#: K is symmetric when ``|K − Kᵀ|`` is at most this fraction of its largest entry
+SYMMETRY_RTOL = 1e-10
+
+
+def symmetric_argument(K: sp.csr_matrix, name: str = "K") -> sp.csr_matrix:
+    """``K`` when it is square and symmetric (to :data:`SYMMETRY_RTOL`), or InputError naming it."""
+    if K.shape[0] != K.shape[1]:
+        raise InputError(f"{name} must be square, got shape {K.shape}")
+    if K.shape[0] and abs(K - K.T).max() > SYMMETRY_RTOL * abs(K).max():
+        raise InputError(f"{name} must be symmetric: pass the stiffness matrix itself, or "
+                         f"½({name} + {name}ᵀ)")
+    return K
 
 
 def vector_argument(value: Any, name: str) -> np.ndarray:
@@ -107,6 +123,10 @@ def points_argument(value: Any, N: sp.csr_matrix) -> np.ndarray:
     if points.ndim != 2 or points.shape[0] != m or points.shape[1] not in (2, 3):
         raise InputError(f"contact_points must have shape ({m}, 2) or ({m}, 3), one row per "
                          f"candidate, got {points.shape}")
+    if not np.all(np.isfinite(points)):
+        row = int(np.flatnonzero(~np.all(np.isfinite(points), axis=1))[0])
+        raise InputError(f"contact_points row {row} is {points[row].tolist()}: give finite "
+                         "coordinates for every candidate, or leave contact_points out")
     dim = dimension_of(N)
     if dim is not None and points.shape[1] != dim:
         raise InputError(f"contact_points have {points.shape[1]} columns but N's rows are those of a "

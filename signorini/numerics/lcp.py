@@ -41,14 +41,26 @@ def delassus(N: sp.csr_matrix, factor, block: int | None = None) -> np.ndarray:
     return 0.5 * (W + W.T)
 
 
+def _slack(lam: np.ndarray, gap: np.ndarray, b: np.ndarray) -> float:
+    """How far ``(λ, g)`` is from ``λ ≥ 0, g ≥ 0``, relative to ``‖λ‖∞`` and ``‖b‖∞``."""
+    def worst(x: np.ndarray, scale: float) -> float:
+        return float(np.max(-x, initial=0.0)) / (scale if scale > 0 else 1.0)
+
+    return max(worst(lam, float(np.max(np.abs(lam), initial=0.0))),
+               worst(gap, float(np.max(np.abs(b), initial=0.0))))
+
+
 def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
-              lam0: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+              lam0: np.ndarray | None = None, tol: float = 0.0) -> tuple[np.ndarray, int]:
     """Primal-dual active set on ``min ½λᵀWλ − bᵀλ, λ ≥ 0``.
 
     The active set is ``A = {i : λᵢ − gᵢ > 0}`` with ``g = Wλ − b``; on A the
     gap is closed (``W_AA λ_A = b_A``), off A the force is zero. Stops when A
-    repeats; returns ``(λ, iterations)``, or raises ``ArithmeticError`` when
-    the active set keeps changing for ``max_iter`` steps.
+    repeats, or sooner when the answer on A meets the other conditions to
+    ``tol`` (no force below ``−tol·‖λ‖∞``, no gap below ``−tol·‖b‖∞``: A
+    repeating is this test at ``tol = 0``); returns ``(λ, iterations)``, or
+    raises ``ArithmeticError`` when the active set keeps changing for
+    ``max_iter`` steps.
     """
     m = len(b)
     lam = np.zeros(m) if lam0 is None else np.maximum(lam0, 0.0)
@@ -57,7 +69,8 @@ def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
     for iteration in range(1, max_iter + 1):
         gap = W @ lam - b
         new_active = (lam - gap) > 0
-        if active is not None and np.array_equal(new_active, active):
+        if active is not None and (np.array_equal(new_active, active) or _slack(
+                lam, gap, b) <= tol):
             return lam, iteration - 1
         if new_active.tobytes() in seen:
             lam, steps = least_index_lcp(W, b)

@@ -62,12 +62,11 @@ from signorini.solvers import pdas, petsc_
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
 from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
 from signorini.solvers.base import Method
+from signorini.solvers.defaults import resolved
 from signorini.solvers.options import positive_number, take_options
 
 log = logging.getLogger(__name__)
 
-DEFAULT_TOL = 1e-9
-MAX_ITER = 50
 AMG_CHOICES = ("auto", "petsc", "pyamg")
 DEFAULTS = {"amg": "auto", "c": 1.0, "active0": None, "coarse": None, "callback": None,
             "warm_start": None, "push0": None}
@@ -262,7 +261,7 @@ def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.n
     if coarse.pending:
         raise InputError("method 'pdas-amg': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
-    solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse, tol=DEFAULT_TOL,
+    solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse,
                                                                         amg=opts["amg"])
     if solution.status != "converged":
         return np.zeros(problem.m, dtype=bool), "none (the coarse model did not solve)"
@@ -289,8 +288,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         raise InputError(f"method 'pdas-amg': option amg={opts['amg']!r} is not one of "
                          f"{', '.join(AMG_CHOICES)}")
     c = positive_number("pdas-amg", "c", opts["c"])
-    tol = DEFAULT_TOL if tol is None else tol
-    max_iter = MAX_ITER if max_iter is None else int(max_iter)
+    tol, max_iter = resolved("pdas-amg", "active set", tol, max_iter)
     start = time.perf_counter()
     if problem.pending and border_factor(problem) is None:
         raise InputError("method 'pdas-amg': the push of this problem does not move one rigid "
@@ -402,7 +400,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="pdas-amg", function=solve, family="active set", exact=True,
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
-           requires=("pyamg",), extra="", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
+           requires=("pyamg",), extra="", options=tuple(DEFAULTS),
            matches_load=lambda problem: border_factor(problem) is not None,
            prediction="active set"),
 )

@@ -20,14 +20,11 @@ from signorini.adequacy import adequacy, warnings
 from signorini.errors import InputError, install_hint
 from signorini.kkt import Certificate, certificate, shortfall
 from signorini.problem import STATUSES, ContactProblem, ContactSolution
+from signorini.solvers.defaults import DEFAULT_TOL, MIN_TOL, Defaults, defaults_of, resolved
 from signorini.solvers.options import Option, check_names, guess_value
 
 SolverFunction = Callable[..., ContactSolution]
 
-#: the package's default relative KKT tolerance: what :func:`signorini.crosscheck` asks every
-#: method for, and what an answer is held to when neither the caller nor the method names a
-#: tolerance (a QP backend run at its own settings)
-DEFAULT_TOL = 1e-8
 #: a claim of success is accepted when every relative KKT residual is at most
 #: ``ACCEPT_FACTOR × tol`` (:func:`acceptance`): success means what qpbenchmark means by it,
 #: the residuals under the tolerance
@@ -48,8 +45,8 @@ class Method:
     pip extra that installs them. ``dense`` methods build dense matrices and
     refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
     answer up to round-off when they converge. ``options`` names the options
-    it takes; ``default_tol`` is the tolerance it runs at and is held to when none is asked
-    for (None: the backend's own settings, the answer held to :data:`DEFAULT_TOL`);
+    it takes; its :attr:`defaults` (the row of :mod:`signorini.solvers.defaults`) are the
+    tolerance it runs at and is held to when none is asked for and its iteration limit;
     ``typed_options`` declares their kinds and ranges
     (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
     refuses a bad value before any work.
@@ -63,7 +60,10 @@ class Method:
     pending load); ``warm_from_load`` that it takes load control's answer as
     its warm start (else it starts cold). ``chooses(problem, options,
     warm_start)`` returns the method it runs instead (a method that picks one),
-    whose capabilities are then the ones asked (:meth:`runs`).
+    whose capabilities are then the ones asked (:meth:`runs`). A ``scaled`` method is
+    handed a view of the problem in units that make its numbers of order one (its answer
+    mapped back to the problem's units before it is judged); a method that is not scaled (a
+    user's) is handed the problem as it was given.
     """
 
     name: str
@@ -74,13 +74,26 @@ class Method:
     dense: bool = False
     exact: bool = False
     family: str = ""
-    default_tol: float | None = None
     options: tuple[str, ...] = field(default=())
     typed_options: Mapping[str, Option] = field(default_factory=dict)
     matches_load: Callable[[ContactProblem], bool] | None = None
     prediction: str = ""
     warm_from_load: bool = False
     chooses: Callable[..., "Method"] | None = None
+    scaled: bool = True
+
+    @property
+    def defaults(self) -> Defaults:
+        """Its default tolerance and iteration limit, and why."""
+        return defaults_of(self.name, self.family)
+
+    @property
+    def default_tol(self) -> float | None:
+        return self.defaults.tol
+
+    def defaults_for(self, tol: float | None, max_iter: int | None) -> tuple[float | None, int | None]:
+        """``(tol, max_iter)`` as asked, each one not asked for from its :attr:`defaults`."""
+        return resolved(self.name, self.family, tol, max_iter)
 
     @property
     def installed(self) -> bool:
@@ -122,8 +135,6 @@ class Method:
                 for name, text in texts.items()}
 
 
-#: relative KKT residuals cannot be certified below a few hundred times double precision's ε
-MIN_TOL = 1e-14
 
 
 def check_tol(tol: Any, name: str = "tol") -> float | None:

@@ -4,8 +4,10 @@
 K, the complementarity problem ``λ ≥ 0, Wλ − b ≥ 0, λ·(Wλ − b) = 0`` with
 ``b = N K⁻¹ f − d`` is solved exactly on it (primal-dual active set on the
 dense matrix, least-index pivoting should it cycle), and ``u = K⁻¹(f − Nᵀλ)``
-is one more back-solve. Cost: one factorisation, m + 2 back-solves and dense
-m × m work; only for problems with few contact candidates (memory m²).
+is one more back-solve; the LCP stops when its active set repeats or its answer meets the
+bounds to ``tol`` (:func:`signorini.numerics.lcp.solve_lcp`). Cost: one factorisation,
+m + 2 back-solves and dense m × m work; only for problems with few contact candidates
+(memory m²).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
+from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 DEFAULTS = declare(
@@ -39,7 +42,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     W = delassus(problem.N, factor, block=None if opts["block"] is None else int(opts["block"]))
     b = problem.N @ factor.solve(problem.f) - problem.d
     build_time = time.perf_counter() - start
-    lam, steps = solve_lcp(W, b, max_iter=200 if max_iter is None else int(max_iter))
+    tol, max_iter = resolved("condensed", "active set", tol, max_iter)
+    lam, steps = solve_lcp(W, b, max_iter=max_iter, tol=tol)
     u = factor.solve(problem.f - problem.N.T @ lam)
     return ContactSolution(
         method="condensed", u=u, lam=lam, status="converged",
@@ -53,5 +57,5 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="condensed", function=solve, family="active set", exact=True,
            summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
-           default_tol=1e-9, options=tuple(DEFAULTS), typed_options=DEFAULTS),
+           options=tuple(DEFAULTS), typed_options=DEFAULTS),
 )

@@ -32,11 +32,11 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.solution import WarmStart
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
+from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 log = logging.getLogger(__name__)
 
-DEFAULT_TOL = 1e-9
 DEFAULTS = declare(
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)),
     Option("coarse", "object", types=(ContactProblem,)), Option("zone", "object", types=(Zone,)),
@@ -44,7 +44,8 @@ DEFAULTS = declare(
     Option("warm_start", "object", types=(WarmStart,)))
 
 
-def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | None, str]:
+def _prediction(problem: ContactProblem, opts: dict[str, Any],
+                tol: float) -> tuple[Zone | None, str]:
     """The predicted zone and where it came from (None when there is none)."""
     if opts["zone"] is not None:
         zone = opts["zone"]
@@ -58,16 +59,17 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any]) -> tuple[Zone | N
     if coarse.pending:
         raise InputError("method 'nested': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
-    return zone_from_coarse(problem.contact_points, coarse, opts["neighbours"]), \
+    return zone_from_coarse(problem.contact_points, coarse, opts["neighbours"], tol), \
         f"coarse model of {coarse.n} dofs"
 
 
-def zone_from_coarse(points: np.ndarray, coarse: ContactProblem,
-                     neighbours: int | None = None) -> Zone | None:
+def zone_from_coarse(points: np.ndarray, coarse: ContactProblem, neighbours: int | None = None,
+                     tol: float | None = None) -> Zone | None:
     """The zone at ``points`` predicted by the coarse model ``coarse`` (solved by ``pdas``);
     None when that does not converge."""
     try:
-        solution = judge(coarse, pdas.solve(coarse), DEFAULT_TOL)
+        tol = resolved("nested", "active set", tol, None)[0]
+        solution = judge(coarse, pdas.solve(coarse, tol=tol), tol)
     except Exception as exc:  # noqa: BLE001 - any failure of the coarse solve: no prediction
         log.info("the coarse model did not solve (%s): no prediction", exc)
         return None
@@ -80,6 +82,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
           **options: Any) -> ContactSolution:
     """Exact contact from a coarse model's contact zone on one factorisation."""
     opts = take_options("nested", options, DEFAULTS)
+    tol, max_iter = resolved("nested", "active set", tol, max_iter)
     start = time.perf_counter()
     warm = opts["warm_start"]
     system = None if warm is None else warm.zone_solver
@@ -90,7 +93,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         if selection_dofs(problem.N) is None:
             zone, source = None, ""
         else:
-            zone, source = _prediction(problem, opts)
+            zone, source = _prediction(problem, opts, tol)
     if zone is None:
         solution = pdas.solve(problem, tol=tol, max_iter=max_iter)
         solution.method = "nested"
@@ -116,6 +119,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="nested", function=solve, family="active set", exact=True,
            summary="predicted contact zone (the scene's); one factorisation + exact band LCP",
-           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
+           options=tuple(DEFAULTS),
            typed_options=DEFAULTS, prediction="zone"),
 )

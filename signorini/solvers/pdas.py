@@ -11,7 +11,12 @@ for CHOLMOD reuses one symbolic analysis for every step)::
     [ K    N_Aᵀ ] [ u   ]   [ f   ]
     [ N_A  0    ] [ λ_A ] = [ d_A ],   λ_I = 0.
 
-It stops when A repeats; the answer is then exact up to round-off. PDAS can
+It stops when A repeats; the answer is then exact up to round-off. ``tol`` is the
+accuracy the answer is held to: it stops one solve sooner when the answer on A already
+meets the remaining conditions to ``tol`` (no force on A below ``−tol`` times the force
+scale, no penetration off A beyond ``tol`` times the gap scale, as :mod:`signorini.kkt`
+measures them; stationarity and the closed gaps on A hold exactly). A repeating is this
+test at ``tol = 0``. PDAS can
 cycle through active sets when W is not an M-matrix; a set seen before (but
 not the last one) is a cycle, and the method then finishes on the condensed
 LCP with Murty's least-index pivoting, which terminates for SPD W. After the
@@ -33,13 +38,14 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.kkt import gap_scale
+from signorini.kkt import force_scale, gap_scale
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import ActiveSetSolver, factorize
 from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.solution import WarmStart
 from signorini.solvers.base import Method
+from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 log = logging.getLogger(__name__)
@@ -48,7 +54,6 @@ DEFAULTS = declare(
     Option("c", "positive", 1.0), Option("lam0", "vector"), Option("callback", "callable"),
     Option("warm_start", "object", types=(WarmStart,)),
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)))
-MAX_ITER = 100
 
 
 def _finish_condensed(problem: ContactProblem, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
@@ -65,7 +70,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     """Semismooth Newton / PDAS on the full saddle-point system (one sparse LU per step)."""
     opts = take_options("pdas", options, DEFAULTS)
     c = opts["c"]
-    max_iter = MAX_ITER if max_iter is None else int(max_iter)
+    tol, max_iter = resolved("pdas", "active set", tol, max_iter)
     start = time.perf_counter()
     system = ActiveSetSolver(problem.K, problem.N, opts["backend"])
     warm = opts["warm_start"]
@@ -100,6 +105,14 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             message = f"active set of {int(active.sum())} nodes repeated after {iteration - 1} steps"
             iteration -= 1
             break
+        slack = max(history["primal"][-1],
+                    float(np.max(-lam, initial=0.0)) / force_scale(problem, lam, u))
+        if active is not None and slack <= tol:
+            status = "converged"
+            message = (f"active set of {int(active.sum())} nodes after {iteration - 1} steps: "
+                       f"its answer meets the bounds to {slack:.1e} ≤ tol {tol:.0e}")
+            iteration -= 1
+            break
         if new_active.tobytes() in seen:
             u, lam, steps = _finish_condensed(problem, lam)
             status = "converged"
@@ -120,5 +133,5 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="pdas", function=solve, family="active set", exact=True,
            summary="primal-dual active set / semismooth Newton, exact when it converges",
-           default_tol=1e-9, options=tuple(DEFAULTS), typed_options=DEFAULTS),
+           options=tuple(DEFAULTS), typed_options=DEFAULTS),
 )

@@ -40,6 +40,7 @@ from signorini.problem import ContactProblem, ContactSolution
 from signorini.solvers import cluster
 from signorini.solvers.base import Method
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
+from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 KSP_CHOICES = ("auto", "mumps", "gamg")
@@ -50,8 +51,6 @@ GAMG_FROM_DOFS = 20_000
 #: PETSc type of each method
 KINDS = {"petsc-vi": ("snes", "vinewtonrsls"), "petsc-tron": ("tao", "tron"),
          "petsc-gpcg": ("tao", "gpcg")}
-MAX_ITER = {"snes": 200, "tao": 2000}
-DEFAULT_TOL = 1e-9
 #: how far below the requested tolerance PETSc's own stopping test is set
 SAFETY = 1e-5
 #: SNES-VI's stationarity target relative to the requested tolerance
@@ -336,7 +335,7 @@ def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: in
            options: dict[str, Any]) -> ContactSolution:
     opts = take_options(method, options, DEFAULTS)
     kind, petsc_type = KINDS[method]
-    tol = DEFAULT_TOL if tol is None else tol
+    tol, max_iter = resolved(method, "petsc", tol, max_iter)
     ksp = opts["ksp"]
     start = time.perf_counter()
     try:
@@ -351,7 +350,7 @@ def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: in
     job = {"run": f"{__name__}:solve_piece", "n": form.n, "block": form.block,
            "kind": (kind, petsc_type), "ksp": ksp, "tol": tol,
            "f_norm": float(np.linalg.norm(form.f)),
-           "max_iter": MAX_ITER[kind] if max_iter is None else max_iter,
+           "max_iter": max_iter,
            "petsc_options": opts["petsc_options"]}
     parts = pieces(form, ranks, x0, gamg=ksp == "gamg")
     build_time = time.perf_counter() - start
@@ -402,6 +401,6 @@ SUMMARIES = {
 METHODS = tuple(
     Method(name=name, function=_make(name), summary=SUMMARIES[name],
            requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
-           exact=name == "petsc-vi", default_tol=DEFAULT_TOL, options=tuple(DEFAULTS),
+           exact=name == "petsc-vi", options=tuple(DEFAULTS),
            typed_options=DEFAULTS)
     for name in KINDS)

@@ -2,8 +2,12 @@
 
 ``solve(problem, *, tol=None, max_iter=None, **options) -> ContactSolution``
 
-``tol=None`` means the method's own default tolerance (for QP backends: the
-backend's defaults, untouched). Unknown options raise :class:`InputError`.
+A ``tol`` or ``max_iter`` not asked for is the method's row of
+:mod:`signorini.solvers.defaults` (None for a QP backend: its own settings,
+untouched), which :func:`run` hands every method as numbers. A ``scaled`` method
+gets a view of the problem in units of order one
+(:func:`signorini.scales.scaled_view`); a user's method gets the problem as
+given. Unknown options raise :class:`InputError`.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from signorini.fingerprint import fingerprint, held_to_problem
 from signorini.kkt import Certificate
 from signorini.numerics.work import counting
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.scales import Scales, in_problem_units, scaled_view
 from signorini.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, certify, check_max_iter,
@@ -94,7 +99,7 @@ def _load_user_method(spec: str) -> Method:
     if not callable(func):
         raise InputError(f"method {spec!r}: module {module_name!r} has no function {attr!r}")
     return Method(name=spec, function=func, summary=(func.__doc__ or "").strip().split("\n")[0],
-                  family="user")
+                  family="user", scaled=False)
 
 
 
@@ -151,10 +156,12 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
         options = {**options, "warm_start": warm_start}
     log.info("solving %d dofs, %d contact candidates with %s", problem.n, problem.m, method)
     start = time.perf_counter()
-    held = fingerprint(problem)
+    tol, max_iter = spec.defaults_for(tol, max_iter)
+    given, units = scaled_view(problem, options) if spec.scaled else (problem, Scales())
+    held = fingerprint(given)
     with counting() as work:
         try:
-            solution = spec.function(problem, tol=tol, max_iter=max_iter, **options)
+            solution = spec.function(given, tol=tol, max_iter=max_iter, **options)
         except InputError:
             raise
         except Exception as exc:  # a backend's own error (CHOLMOD on a singular K): a failed run
@@ -166,8 +173,8 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
             solution = ContactSolution.failure(
                 method, problem, "failed", f"the method called sys.exit({exc.code!r})",
                 solve_time=time.perf_counter() - start)
-    solution = hold_to_contract(problem, method, solution)
-    solution = held_to_problem(problem, held, solution, method)
+    solution = hold_to_contract(given, method, solution)
+    solution = in_problem_units(problem, held_to_problem(given, held, solution, method), units)
     # the method's own wall time; judging below (the certificate factorises K) is not the method's
     solution.extras["method_s"] = time.perf_counter() - start
     solution.work["method"] = work.listed(steps=int(solution.iterations))
@@ -183,7 +190,7 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
             return problem, solution, certify(problem, solution)
         problem = problem.pushed(float(solution.extras["push"]))
     cert = certify(problem, solution)
-    return problem, judge(problem, solution, tol if tol is not None else spec.default_tol, cert), cert
+    return problem, judge(problem, solution, tol, cert), cert
 
 
 def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = None,

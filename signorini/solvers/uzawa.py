@@ -43,7 +43,8 @@ from signorini.errors import InputError
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.base import DEFAULT_TOL, Method
+from signorini.solvers.base import Method
+from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 DEFAULTS = declare(
@@ -58,7 +59,6 @@ NESTEROV_DEFAULTS = {**DEFAULTS, "step_fraction": Option("step_fraction", "posit
                                             choices=("none", "nesterov"))}
 DELASSUS_MAX_CANDIDATES = 2000
 RATE_WINDOW = 20
-MAX_ITER = 50_000
 #: stop when the estimated distance to the fixed point is below this fraction of tol ‖λ‖:
 #: at 1 the forward error of λ came out 1.0001–1.0015 × tol on Hertz's cylinder
 DISTANCE_MARGIN = 0.5
@@ -128,8 +128,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     """The paper's Uzawa iteration with one factorisation of K (optionally accelerated)."""
     opts = take_options(_name, options, _defaults)
     accelerated = opts["acceleration"] == "nesterov"
-    tol = DEFAULT_TOL if tol is None else tol
-    max_iter = MAX_ITER if max_iter is None else int(max_iter)
+    tol, max_iter = resolved(_name, "dual", tol, max_iter)
     start = time.perf_counter()
     factor = factorize(problem.K)
     choice, normal_displacement, apply_W = _operator(problem, factor, opts["operator"])
@@ -224,9 +223,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="uzawa", function=solve, family="dual", exact=False,
            summary="the paper's Uzawa iteration: projected gradient ascent on the dual",
-           default_tol=DEFAULT_TOL, options=tuple(DEFAULTS), typed_options=DEFAULTS),
+           options=tuple(DEFAULTS), typed_options=DEFAULTS),
     Method(name="uzawa-nesterov", function=solve_nesterov, family="dual", exact=False,
            summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
-           default_tol=DEFAULT_TOL, options=tuple(NESTEROV_DEFAULTS),
+           options=tuple(NESTEROV_DEFAULTS),
            typed_options=NESTEROV_DEFAULTS),
 )
