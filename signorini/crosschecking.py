@@ -165,10 +165,11 @@ class CrossCheck:
 
     @property
     def failures(self) -> list[str]:
-        """What fails the check, one line each: a method that did not converge, a pair that
-        disagrees (methods in ``allowed`` left out)."""
-        said = [f"{run.method} {run.status}" for run in self.runs
-                if run.status != "converged" and run.method not in self.allowed]
+        """What fails the check, one line each: a method that did not converge (with its message
+        when it failed: an exception and its line), a pair that disagrees (``allowed`` left out)."""
+        said = [f"{run.method} {run.status}" + (f" ({run.message})" if run.status == "failed"
+                                                  and run.message else "")
+                for run in self.runs if run.status != "converged" and run.method not in self.allowed]
         said += [f"{pair.first} ~ {pair.second} disagree" for pair in self.disagreements
                  if pair.first not in self.allowed and pair.second not in self.allowed]
         return said
@@ -230,7 +231,8 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     Parameters
     ----------
     problem : a :class:`ContactProblem`, or a scene name or ``.toml`` file built with ``params``.
-    methods : method names (default :data:`DEFAULT_METHODS`); ``module:function`` for your own.
+    methods : method names (default :data:`DEFAULT_METHODS`); for your own, ``module:function``
+        or the function itself (known by its name).
     tol : the relative KKT tolerance every method is asked for (default
         :data:`signorini.DEFAULT_TOL`; ``None`` leaves each method its own default).
     options : per-method options, ``{"qp-cvxpy": {"solver": "OSQP"}}``; a method
@@ -256,8 +258,7 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
         raise InputError(f"methods must be a list of names, got the string {methods!r}: "
                          f"write methods=[{methods!r}, 'pdas']")
     names = list(DEFAULT_METHODS if methods is None else methods)
-    for name in names:
-        get_method(name)  # an unknown name fails here, before any work
+    names = [get_method(name).name for name in names]  # an unknown one fails here, before work
     if len(names) < 2:
         raise InputError(f"a cross-check compares at least two methods, got {names}: "
                          "name two or more (--method uzawa --method pdas)")

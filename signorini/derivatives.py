@@ -100,8 +100,7 @@ class Sensitivity:
     """
 
     def __init__(self, problem: ContactProblem, solution: ContactSolution, factor: Any = None):
-        if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
-            raise SolverError("the answer is not finite: it has no derivative")
+        exact_answer(solution)
         self.problem, self.solution = problem, solution
         labels = classify(problem, solution)
         self.strong = labels == ACTIVE
@@ -152,6 +151,16 @@ class Sensitivity:
         return gf, np.where(active, gd, 0.0)
 
 
+def exact_answer(solution: ContactSolution) -> None:
+    """SolverError unless ``solution`` is converged and finite: only an exact answer has a
+    derivative (a ``max_iter`` answer's active set may not be the answer's)."""
+    if solution.status != "converged":
+        raise SolverError(f"the answer is {solution.status} ({solution.message}): only an exact "
+                          "answer has a derivative; solve to convergence first")
+    if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
+        raise SolverError("the answer is not finite: it has no derivative")
+
+
 def _side(side: str, allowed: tuple[str, ...]) -> str:
     if side not in allowed:
         raise InputError(f"side must be one of {', '.join(allowed)}, got {side!r}")
@@ -161,7 +170,13 @@ def _side(side: str, allowed: tuple[str, ...]) -> str:
 def _vector(value: Any, size: int, name: str, unit: float) -> np.ndarray:
     if value is None:
         return np.zeros(size)
-    array = np.asarray(value, dtype=float)
+    try:
+        array = np.asarray(value)
+    except ValueError:  # a ragged list
+        array = np.asarray(None)
+    if array.dtype.kind not in "biuf":
+        raise InputError(f"{name} must be {size} real numbers, got {str(value)[:60]}")
+    array = array.astype(float)
     if array.shape != (size,):
         raise InputError(f"{name} must have shape ({size},), got {array.shape}")
     if not np.all(np.isfinite(array)):
@@ -329,8 +344,8 @@ def outputs(problem: ContactProblem, solution: ContactSolution, output: str, at:
     if output == "displacement":
         if at is None or disc is None or disc.mesh is None:
             raise InputError("output 'displacement' needs a point: at=(x, y) in the scene's units")
-        point = np.asarray(at, dtype=float) / s.length
         mesh = disc.mesh
+        point = _point(at, mesh.p.shape[0]) / s.length
         node = int(np.argmin(np.linalg.norm(mesh.p - point[:, None], axis=0)))
         dofs = np.arange(mesh.p.shape[0]) + mesh.p.shape[0] * node
         value = problem.expand(solution.u)[dofs] * s.displacement
@@ -340,6 +355,17 @@ def outputs(problem: ContactProblem, solution: ContactSolution, output: str, at:
         full[disc.free_dofs] = du
         return value, full[dofs] * s.displacement
     raise InputError(f"output must be one of {', '.join(OUTPUTS)}, got {output!r}")
+
+
+def _point(at: Any, dim: int) -> np.ndarray:
+    try:
+        point = np.asarray(at, dtype=float)
+    except (TypeError, ValueError):
+        point = np.full(dim + 1, np.nan)
+    if point.shape != (dim,) or not np.all(np.isfinite(point)):
+        raise InputError(f"at must be a point of {dim} finite coordinates in the scene's units, "
+                         f"e.g. at=({', '.join(['0.0'] * dim)}), got {at!r}")
+    return point
 
 
 def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | None = None,
@@ -374,9 +400,7 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
         if params:
             raise InputError("params= builds a scene by name; a Result is differentiated as solved")
         problem, solution, result = scene.problem, scene.solution, scene
-    if solution.status != "converged":
-        raise SolverError(f"the answer is {solution.status} ({solution.message}): only an exact "
-                          "answer has a derivative")
+    exact_answer(solution)
     delta = change(problem, solution, wrt)
     sensitivity = Sensitivity(problem, solution, solution.factor) if result is None else result.sensitivity
     tangent = scene_tangent(sensitivity, delta)

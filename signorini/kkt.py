@@ -151,7 +151,7 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     """Relative KKT residuals of ``solution`` for ``problem`` (see :class:`Certificate`).
 
     ``duality_gap=False`` leaves out what needs K⁻¹: the duality gap and the
-    forward error (for a singular K).
+    forward error (left out too, NaN, when K cannot be factorised).
 
     The result is kept on the solution (for these same arrays, problem and
     options): judging a solution and then reporting it costs one evaluation.
@@ -168,7 +168,10 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     kept = getattr(solution, "_certificate", None)
     if kept is not None and kept[0] == key:
         return kept[1]
-    cert = _certificate(problem, solution, duality_gap)
+    try:
+        cert = _certificate(problem, solution, duality_gap)
+    except np.linalg.LinAlgError:  # K singular or indefinite: no dual function, no Newton step
+        cert = _certificate(problem, solution, False)
     solution._certificate = (key, cert)
     return cert
 
