@@ -23,20 +23,17 @@ from typing import Any
 
 import numpy as np
 
-from signorini import derivatives
+from signorini import derivatives, kkt, loading
 from signorini.errors import InputError
 from signorini.fem.estimate import ErrorEstimate, estimate
-from signorini import kkt
 from signorini.kkt import Certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem
 from signorini.references import Reference, reference_of, summary_lines
-from signorini import loading
 from signorini.loading import solve as load_control
 from signorini.scenes import SCENES, SceneFamily, build_problem
-from signorini.scenes.adapt import parse_target
+from signorini.scenes.adapt import parse_target, solve_adaptive as adapt
 from signorini.scenes.base import scene_params
-from signorini.scenes.adapt import solve_adaptive as adapt
 from signorini.scenes.build import coarse_problem
 from signorini.numerics.arrays import vector_argument
 from signorini.solution import ContactSolution
@@ -93,6 +90,12 @@ class Result:
     problem: ContactProblem
     solution: ContactSolution
     certificate: Certificate
+
+    def __repr__(self) -> str:  # a line, not the arrays
+        name, worst = self.certificate.worst()
+        return (f"Result({self.solution.method!r}: {self.status}, {self.solution.iterations} "
+                f"iterations, {self.problem.n} dofs, {self.problem.m} candidates, worst KKT "
+                f"{name} {worst:.1e})")
 
     # -- the method's verdict --------------------------------------------------------------
     @property

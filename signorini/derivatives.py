@@ -25,7 +25,7 @@ from node to node), so it has no derivative; the fitted ``a`` is smooth.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -37,6 +37,7 @@ from signorini.kkt import ACTIVE, WEAK, classify
 from signorini.loading import solve as load_control
 from signorini.pressure import contact_profile, hertz_fit, hertz_fit_tangent
 from signorini.problem import ContactProblem
+from signorini.reprs import short_repr
 from signorini.scenes import build_problem
 from signorini.scenes.base import scene_params
 from signorini.scenes.build import coarse_problem
@@ -61,6 +62,7 @@ class Tangent:
     dforce: np.ndarray
     weakly_active: np.ndarray
     pressed: np.ndarray
+    __repr__ = short_repr
 
     def __iter__(self):
         return iter((self.du, self.dforce))
@@ -82,6 +84,7 @@ class Cotangent:
     gd: np.ndarray
     weakly_active: np.ndarray
     side: str
+    __repr__ = short_repr
 
     def __iter__(self):
         return iter((self.gf, self.gd))
@@ -238,7 +241,8 @@ class SceneDerivative:
     value: Any
     derivative: Any
     weakly_active: np.ndarray
-    result: Any = None
+    result: Any = field(default=None, repr=False)
+    __repr__ = short_repr
 
 
 def _load_controlled(problem: ContactProblem) -> bool:

@@ -287,11 +287,12 @@ FORCE_SHORTFALL = {
 }
 
 
-def shortfall(cert: Certificate, accept: float) -> str | None:
+def shortfall(cert: Certificate, accept: float,
+              advice: str = "tighten the tolerance or use an exact method (pdas)") -> str | None:
     """Why ``cert`` does not back a claim of convergence at ``accept`` (None when it does).
 
     What the forward error says about the contact force comes first (see
-    :data:`FORCE_SHORTFALL`); then the worst of the other residuals.
+    :data:`FORCE_SHORTFALL`); then the worst of the other residuals, with ``advice``.
     """
     name, worst = cert.worst()
     if np.isfinite(worst) and worst <= accept:
@@ -310,8 +311,7 @@ def shortfall(cert: Certificate, accept: float) -> str | None:
     name = max(others, key=others.get)
     if not np.isfinite(others[name]) or others[name] > accept:
         said.append(f"the method claimed success but the KKT certificate's {name} residual is "
-                    f"{others[name]:.1e} > {accept:.0e}: tighten the tolerance or use an exact "
-                    "method (pdas)")
+                    f"{others[name]:.1e} > {accept:.0e}" + (f": {advice}" if advice else ""))
     return "; ".join(said)
 
 
@@ -431,13 +431,15 @@ def classify(problem: ContactProblem, solution: ContactSolution,
     weakly active when both are at most ``weak_tol`` (it touches with zero
     force, so its membership of the active set is not determined); otherwise
     it is active when ``λ̃ > g̃`` and inactive when not. For an exact solution
-    one of the two is zero; for an inexact one the larger decides.
+    one of the two is zero; for an inexact one the larger decides. A candidate that
+    penetrates by more than ``weak_tol`` is never weak (with no force: inactive).
     """
     u, lam = solution.u, solution.lam
     lam_n = np.maximum(lam, 0.0) / force_scale(problem, lam, u)
     gap_n = np.maximum(problem.gap(u), 0.0) / gap_scale(problem, u)
     labels = np.where(lam_n > gap_n, ACTIVE, INACTIVE).astype(object)
-    labels[(lam_n <= weak_tol) & (gap_n <= weak_tol)] = WEAK
+    inside = np.maximum(-problem.gap(u), 0.0) / gap_scale(problem, u)  # a penetration: not weak
+    labels[(lam_n <= weak_tol) & (gap_n <= weak_tol) & (inside <= weak_tol)] = WEAK
     return labels
 
 

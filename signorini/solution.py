@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.reprs import short_repr
 
 #: the statuses a :class:`ContactSolution` can carry
 STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed",
@@ -88,6 +89,7 @@ class ContactSolution:
     #: the work of every stage that ran, by stage ("method", "load control"): active-set or
     #: load-control steps, factorisations, back-solves, CG iterations
     work: dict[str, dict[str, int]] = field(default_factory=dict)
+    __repr__ = short_repr
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:

@@ -17,6 +17,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from signorini.adequacy import adequacy, warnings
+from signorini.diagnose import explain
 from signorini.errors import InputError, install_hint
 from signorini.kkt import certificate, shortfall
 from signorini.problem import STATUSES, ContactProblem, ContactSolution
@@ -187,7 +188,10 @@ def judge(problem: ContactProblem, solution: ContactSolution,
     accept = acceptance(tol)
     cert = certificate(problem, solution)  # K singular: judged on the residuals but the gap
     reason = shortfall(cert, accept)
-    if reason is not None:
+    if reason is not None:  # which candidates fail and how, with the advice that fits
+        by_constraint = explain(problem, solution, accept)
+        if by_constraint is not None:
+            reason = f"{shortfall(cert, accept, advice='')}: {by_constraint}"
         solution.claimed_status = "converged"
         solution.status = "inaccurate"
         solution.message = f"{solution.message}; {reason}".lstrip("; ")
