@@ -93,9 +93,8 @@ class Result:
 
     def __repr__(self) -> str:  # a line, not the arrays
         name, worst = self.certificate.worst()
-        return (f"Result({self.solution.method!r}: {self.status}, {self.solution.iterations} "
-                f"iterations, {self.problem.n} dofs, {self.problem.m} candidates, worst KKT "
-                f"{name} {worst:.1e})")
+        return (f"Result({self.method!r}: {self.status}, {self.iterations} iterations, "
+                f"{self.problem.n} dofs, {self.problem.m} candidates, worst KKT {name} {worst:.1e})")
 
     # -- the method's verdict --------------------------------------------------------------
     @property
@@ -137,25 +136,12 @@ class Result:
             self._profile = contact_profile(self.problem, self.solution)
         return self._profile
 
-    @property
-    def x(self) -> np.ndarray:
-        return self.profile.x
-
-    @property
-    def gap(self) -> np.ndarray:
-        return self.profile.gap
-
-    @property
-    def force(self) -> np.ndarray:
-        return self.profile.force
-
-    @property
-    def pressure(self) -> np.ndarray:
-        return self.profile.pressure
-
-    @property
-    def active(self) -> np.ndarray:
-        return self.profile.active
+    # the profile's arrays, one entry per candidate (see the class's docstring)
+    x = property(lambda self: self.profile.x)
+    gap = property(lambda self: self.profile.gap)
+    force = property(lambda self: self.profile.force)
+    pressure = property(lambda self: self.profile.pressure)
+    active = property(lambda self: self.profile.active)
 
     @property
     def total_force(self) -> float:

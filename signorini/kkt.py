@@ -131,11 +131,9 @@ class Certificate:
     def worst(self) -> tuple[str, float]:
         """The largest residual and its name."""
         items = {k: v for k, v in self.residuals().items() if not np.isnan(v)}
-        name = max(items, key=lambda k: items[k])
-        return name, items[name]
+        return max(items.items(), key=lambda item: item[1])
 
-    def as_dict(self) -> dict[str, float]:
-        return self.residuals()
+    as_dict = residuals
 
     def passed(self, tol: float) -> bool:
         """Every residual and error is finite and at most ``tol``: the answer is certified at
@@ -374,9 +372,7 @@ def _pinned_rows(problem: ContactProblem, factor) -> tuple[np.ndarray, np.ndarra
     row_of = np.full(problem.n, -1)
     row_of[dofs] = np.arange(problem.m)
     rows = row_of[fixed]
-    if np.any(rows < 0):
-        return None
-    return rows, np.asarray(problem.N[rows, fixed]).ravel()
+    return None if np.any(rows < 0) else (rows, np.asarray(problem.N[rows, fixed]).ravel())
 
 
 def _same_matrix(K, other) -> bool:
@@ -431,15 +427,14 @@ def classify(problem: ContactProblem, solution: ContactSolution,
     weakly active when both are at most ``weak_tol`` (it touches with zero
     force, so its membership of the active set is not determined); otherwise
     it is active when ``λ̃ > g̃`` and inactive when not. For an exact solution
-    one of the two is zero; for an inexact one the larger decides. A candidate that
-    penetrates by more than ``weak_tol`` is never weak (with no force: inactive).
+    one of the two is zero; for an inexact one the larger decides. One that penetrates
+    by more than ``weak_tol`` is never weak (with no force: inactive).
     """
     u, lam = solution.u, solution.lam
     lam_n = np.maximum(lam, 0.0) / force_scale(problem, lam, u)
-    gap_n = np.maximum(problem.gap(u), 0.0) / gap_scale(problem, u)
-    labels = np.where(lam_n > gap_n, ACTIVE, INACTIVE).astype(object)
-    inside = np.maximum(-problem.gap(u), 0.0) / gap_scale(problem, u)  # a penetration: not weak
-    labels[(lam_n <= weak_tol) & (gap_n <= weak_tol) & (inside <= weak_tol)] = WEAK
+    gap = problem.gap(u) / gap_scale(problem, u)
+    labels = np.where(lam_n > np.maximum(gap, 0.0), ACTIVE, INACTIVE).astype(object)
+    labels[(lam_n <= weak_tol) & (np.abs(gap) <= weak_tol)] = WEAK
     return labels
 
 

@@ -41,7 +41,7 @@ LAYERS = {
     "solvers": 3,
     "loading": 4,
     "scenes": 5,
-    "api": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "": 6,
+    "api": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "scene_derivatives": 6, "": 6,
     "studies": 7, "output": 7,
     "cli": 8,
 }
