@@ -82,7 +82,7 @@ class Result:
 
     Attributes that hold arrays are per contact candidate, in the order of
     ``problem.N``'s rows: ``x`` (horizontal distance from the first point of
-    contact, or the radius; NaN when the problem has no geometry), ``gap``,
+    contact, or the radius; signed for a plane QP given as arrays; NaN without geometry), ``gap``,
     ``force`` (the nodal contact force λ), ``pressure`` (λ over the lumped
     boundary weight; NaN when the problem has no weights) and ``active``.
     """
