@@ -48,7 +48,7 @@ def test_an_indefinite_k_ends_failed_in_a_crosscheck_as_in_a_solve():
 @pytest.mark.parametrize("method", ["qp-osqp", "qp-clarabel", "uzawa"])
 @pytest.mark.parametrize("max_iter", [1e20, MAX_ITER + 1, 2 ** 63])
 def test_max_iter_beyond_a_backends_counter_names_max_iter(method, max_iter):
-    with pytest.raises(InputError, match=f"max_iter must be an integer from 1 to {MAX_ITER}"):
+    with pytest.raises(InputError, match=f"max_iter must be a positive integer up to {MAX_ITER}"):
         signorini.solve("block", method, max_iter=max_iter)
 
 

@@ -130,8 +130,8 @@ def check_max_iter(max_iter: Any) -> int | None:
     ok = ok or (isinstance(max_iter, (float, np.floating)) and np.isfinite(max_iter)
                 and float(max_iter).is_integer())
     if not ok or not 1 <= max_iter <= MAX_ITER:
-        raise InputError(f"max_iter must be an integer from 1 to {MAX_ITER} (2³¹ − 1, what every "
-                         f"backend takes), got {max_iter!r}")
+        raise InputError(f"max_iter must be a positive integer up to {MAX_ITER} (2³¹ − 1, what "
+                         f"every backend's counter holds), got {max_iter!r}")
     return int(max_iter)
 
 
