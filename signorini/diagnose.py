@@ -139,8 +139,8 @@ def violations(problem: ContactProblem, solution: ContactSolution,
     lam_norm = float(np.max(np.abs(lam), initial=0.0))
     scale = max(float(np.max(np.abs(NT_lam), initial=0.0)), force if force > lam_norm else 0.0)
     residual = np.abs(problem.K @ u - problem.f + NT_lam) / (scale or 1.0)
-    on_rows = np.array([residual[N.indices[N.indptr[i]:N.indptr[i + 1]]].max(initial=0.0)
-                        for i in range(problem.m)])
+    on_rows = sp.csr_matrix((residual[N.indices], N.indices, N.indptr),
+                            shape=N.shape).max(axis=1).toarray().ravel()
     sizes = {"penetration": violation / length, "tension": -lam / force,
              "complementarity": np.abs(lam * violation) / (force * length),
              "stationarity": on_rows}
