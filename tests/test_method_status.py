@@ -58,3 +58,16 @@ def test_a_warm_start_from_another_problem_names_warm_start():
         signorini.solve("block", "pdas", params={"nx": 6}, warm_start=earlier)
     with pytest.raises(InputError, match="warm_start must be an earlier Result"):
         signorini.solve("block", "pdas", warm_start=[0.0])
+
+
+def test_an_unbounded_dual_within_the_step_bound_says_infeasible_not_lower_rho():
+    problem = signorini.ContactProblem.from_qp(K, F, np.array(ROWS[3][1]), np.array(ROWS[3][2]))
+    result = signorini.solve(problem, "uzawa-nesterov")
+    assert result.status == "diverged", result.message
+    assert "infeasible" in result.message and "lower rho" not in result.message
+
+
+def test_a_builtin_methods_failure_names_the_packages_line_not_a_librarys():
+    problem = signorini.ContactProblem.from_qp(K, F, np.array(ROWS[1][1]), np.array(ROWS[1][2]))
+    result = signorini.solve(problem, "pdas")
+    assert result.status == "failed" and "signorini" in result.message.rsplit(" at ", 1)[-1]

@@ -26,10 +26,10 @@ from signorini.solvers.base import Method
 
 #: the forms a user method is named in, for every message about one
 FORMS = "--method module:function or --method path/to/file.py:function"
-#: where the package and the Python installation live: frames there are not the user's code
-_NOT_YOURS = tuple(str(Path(p).resolve()) for p in {
-    str(Path(__file__).resolve().parents[1]), *(sysconfig.get_paths()[k] for k in
-                                                ("stdlib", "platstdlib", "purelib", "platlib"))})
+#: the package's folder, and where the Python installation lives: frames there are not the user's
+_PACKAGE = str(Path(__file__).resolve().parents[1])
+_INSTALLED = tuple(str(Path(sysconfig.get_paths()[k]).resolve())
+                   for k in ("stdlib", "platstdlib", "purelib", "platlib"))
 
 
 def load(spec: str) -> Method:
@@ -89,21 +89,19 @@ def _method(name: str, function: Callable[..., Any]) -> Method:
                   summary=(getattr(function, "__doc__", None) or "").strip().split("\n")[0])
 
 
-def _yours(filename: str) -> bool:
-    if filename.startswith("<"):
-        return False
+def _under(filename: str, roots: tuple[str, ...]) -> bool:
     path = str(Path(filename).resolve())
-    return not any(path == root or path.startswith(root + os.sep) for root in _NOT_YOURS)
+    return any(path == root or path.startswith(root + os.sep) for root in roots)
 
 
 def where(tb: TracebackType | None) -> str:
-    """`` at file:line`` of the innermost frame of ``tb`` in the user's code (else the
-    innermost frame), or "" without a traceback."""
-    frames = traceback.extract_tb(tb)
-    if not frames:
-        return ""
-    frame = next((f for f in reversed(frames) if _yours(f.filename)), frames[-1])
-    return f" at {frame.filename}:{frame.lineno}"
+    """`` at file:line`` of the innermost frame of ``tb`` in the user's code, else in the
+    package's own (a built-in method's line, not a library's), else ""."""
+    frames = [f for f in traceback.extract_tb(tb) if not f.filename.startswith("<")]
+    yours = [f for f in frames if not _under(f.filename, (_PACKAGE, *_INSTALLED))]
+    ours = [f for f in frames if _under(f.filename, (_PACKAGE,))]
+    frame = (yours or ours or [None])[-1]
+    return "" if frame is None else f" at {frame.filename}:{frame.lineno}"
 
 
 def raised(exc: BaseException) -> tuple[str, str]:

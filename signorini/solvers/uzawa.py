@@ -223,9 +223,12 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             limit = divergence_factor * size
         if not np.isfinite(size) or (limit is not None and size > limit):
             status = "diverged"
+            why = (f"ρ = {rho * own:.3g} exceeds 2/λ_max(W) = {2 * own / lam_max:.3g}; lower "
+                   "rho or step_fraction" if rho * lam_max >= 2.0 else
+                   f"ρ = {rho * own:.3g} is within the step bound, so the dual is unbounded: no u "
+                   "satisfies N u ≤ d (the constraints are infeasible); check N and d")
             message = (f"|λ| grew beyond {divergence_factor:.0e} × its first value at "
-                       f"iteration {iteration}: ρ = {rho * own:.3g} exceeds 2/λ_max(W) = "
-                       f"{2 * own / lam_max:.3g}; lower rho or step_fraction")
+                       f"iteration {iteration}: {why}")
             break
     # the step bounds: FISTA needs ρ ≤ 1/λ_max(W), plain Uzawa ρ < 2/λ_max(W)
     nesterov = opts["acceleration"] == "nesterov"
