@@ -325,3 +325,9 @@ def test_the_python_api_takes_a_function_wherever_it_takes_a_name(user_file):
     assert [run.method for run in check.runs] == ["honest", "pdas", "returns_none"]
     assert check.runs[0].status == "converged" and check.runs[2].status == "failed"
     assert "returns_none failed" in "; ".join(check.failures)
+
+
+def test_what_a_method_wrote_is_shown_when_it_fails_in_a_study(tmp_path, method_folder):
+    found = _command(tmp_path, "validate", "--case", "block", "--method",
+                     f"{method_folder / 'debugged.py'}:crashes", "--out", str(tmp_path / "out"))
+    assert "mine: starting on" in found.stderr and "a word on stderr" in found.stderr, found.stderr

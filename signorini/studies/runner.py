@@ -369,6 +369,9 @@ def run_tasks(tasks: Sequence[Task], *, isolate: bool = True, time_limit: float 
     try:
         for index, task in enumerate(tasks, start=1):
             row = worker.run(task) if worker is not None else _run_here(task, cache)
+            if worker is not None and ":" in task.method and worker.output.strip() \
+                    and row.get("status") != "converged":  # what a user's method wrote, shown
+                log.warning("method %s wrote:\n%s", task.method, worker.output.rstrip())
             row = {k: (float("nan") if v is None and k in NUMERIC else v) for k, v in row.items()}
             rows.append(row)
             if progress is not None:
