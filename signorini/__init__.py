@@ -29,7 +29,7 @@ from signorini.api import (
     solve_adaptive,
 )
 from signorini.crosschecking import CrossCheck, crosscheck
-from signorini.derivatives import derivative
+from signorini.scene_derivatives import derivative
 from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
 from signorini.kkt import Certificate
 from signorini.problem import ContactProblem, ContactSolution, Discretisation, Scales

@@ -24,19 +24,17 @@ from typing import Any
 
 import numpy as np
 
-from signorini import derivatives
+from signorini import derivatives, kkt, loading
 from signorini.errors import InputError
 from signorini.fem.estimate import ErrorEstimate, estimate
-from signorini import kkt
 from signorini.kkt import Certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem
 from signorini.references import Reference, reference_of, summary_lines
 from signorini import load_control
 from signorini.scenes import SCENES, SceneFamily, build_problem
-from signorini.scenes.adapt import parse_target
+from signorini.scenes.adapt import parse_target, solve_adaptive as adapt
 from signorini.scenes.base import scene_params
-from signorini.scenes.adapt import solve_adaptive as adapt
 from signorini.scenes.build import coarse_problem
 from signorini.numerics.arrays import vector_argument
 from signorini.solution import ContactSolution
@@ -85,7 +83,7 @@ class Result:
 
     Attributes that hold arrays are per contact candidate, in the order of
     ``problem.N``'s rows: ``x`` (horizontal distance from the first point of
-    contact, or the radius; NaN when the problem has no geometry), ``gap``,
+    contact, or the radius; signed for a plane QP given as arrays; NaN without geometry), ``gap``,
     ``force`` (the nodal contact force λ), ``pressure`` (λ over the lumped
     boundary weight; NaN when the problem has no weights) and ``active``.
     """
@@ -93,6 +91,11 @@ class Result:
     problem: ContactProblem
     solution: ContactSolution
     certificate: Certificate
+
+    def __repr__(self) -> str:  # a line, not the arrays
+        name, worst = self.certificate.worst()
+        return (f"Result({self.method!r}: {self.status}, {self.iterations} iterations, "
+                f"{self.problem.n} dofs, {self.problem.m} candidates, worst KKT {name} {worst:.1e})")
 
     # -- the method's verdict --------------------------------------------------------------
     @property
@@ -134,25 +137,12 @@ class Result:
             self._profile = contact_profile(self.problem, self.solution)
         return self._profile
 
-    @property
-    def x(self) -> np.ndarray:
-        return self.profile.x
-
-    @property
-    def gap(self) -> np.ndarray:
-        return self.profile.gap
-
-    @property
-    def force(self) -> np.ndarray:
-        return self.profile.force
-
-    @property
-    def pressure(self) -> np.ndarray:
-        return self.profile.pressure
-
-    @property
-    def active(self) -> np.ndarray:
-        return self.profile.active
+    # the profile's arrays, one entry per candidate (see the class's docstring)
+    x = property(lambda self: self.profile.x)
+    gap = property(lambda self: self.profile.gap)
+    force = property(lambda self: self.profile.force)
+    pressure = property(lambda self: self.profile.pressure)
+    active = property(lambda self: self.profile.active)
 
     @property
     def total_force(self) -> float:

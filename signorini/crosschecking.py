@@ -46,8 +46,9 @@ from typing import Any
 import numpy as np
 
 from signorini.api import SCHEMA_VERSION, Result, build_problem, record_units, solve
+from signorini.crosscheck_tables import render, render_candidates, render_markdown
 from signorini.errors import BackendNotInstalled, InputError
-from signorini.kkt import ACTIVE, WEAK_TOL, classify, compare
+from signorini.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify, compare
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.references import reference_metrics, reference_of
 from signorini.solvers.base import DEFAULT_TOL, check_tol
@@ -165,10 +166,11 @@ class CrossCheck:
 
     @property
     def failures(self) -> list[str]:
-        """What fails the check, one line each: a method that did not converge, a pair that
-        disagrees (methods in ``allowed`` left out)."""
-        said = [f"{run.method} {run.status}" for run in self.runs
-                if run.status != "converged" and run.method not in self.allowed]
+        """What fails the check, one line each: a method that did not converge (with its message
+        when it failed: an exception and its line), a pair that disagrees (``allowed`` left out)."""
+        said = [f"{run.method} {run.status}" + (f" ({run.message})" if run.status == "failed"
+                                                  and run.message else "")
+                for run in self.runs if run.status != "converged" and run.method not in self.allowed]
         said += [f"{pair.first} ~ {pair.second} disagree" for pair in self.disagreements
                  if pair.first not in self.allowed and pair.second not in self.allowed]
         return said
@@ -188,11 +190,14 @@ class CrossCheck:
                 "passed": self.passed, "failures": self.failures, "allowed": list(self.allowed),
                 "reference_method": self.reference_method, "polish": self.polish,
                 "methods": [run.as_dict() for run in self.runs],
-                "pairs": [pair.as_dict() for pair in self.pairs]}
+                "pairs": [pair.as_dict() for pair in self.pairs],
+                "candidates": candidate_rows(problem, self.results, self.tol)}
 
-    def summary(self) -> str:
-        """The printed tables (what ``signorini crosscheck`` shows)."""
-        return render(self.to_dict())
+    def summary(self, verbose: bool = False) -> str:
+        """The printed tables (what ``signorini crosscheck`` shows; ``verbose``: with ``-v``,
+        also the table per candidate)."""
+        record = self.to_dict()
+        return render(record) + ("\n\n" + render_candidates(record) if verbose else "")
 
     def markdown(self) -> str:
         """The same tables in Markdown (``signorini crosscheck --md``)."""
@@ -230,7 +235,8 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     Parameters
     ----------
     problem : a :class:`ContactProblem`, or a scene name or ``.toml`` file built with ``params``.
-    methods : method names (default :data:`DEFAULT_METHODS`); ``module:function`` for your own.
+    methods : method names (default :data:`DEFAULT_METHODS`); for your own, ``module:function``
+        or the function itself (known by its name).
     tol : the relative KKT tolerance every method is asked for (default
         :data:`signorini.DEFAULT_TOL`; ``None`` leaves each method its own default).
     options : per-method options, ``{"qp-cvxpy": {"solver": "OSQP"}}``; a method
@@ -256,8 +262,7 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
         raise InputError(f"methods must be a list of names, got the string {methods!r}: "
                          f"write methods=[{methods!r}, 'pdas']")
     names = list(DEFAULT_METHODS if methods is None else methods)
-    for name in names:
-        get_method(name)  # an unknown name fails here, before any work
+    names = [get_method(name).name for name in names]  # an unknown one fails here, before work
     if len(names) < 2:
         raise InputError(f"a cross-check compares at least two methods, got {names}: "
                          "name two or more (--method uzawa --method pdas)")
@@ -330,6 +335,22 @@ def _raw(name: str, options: dict[str, Any]) -> dict[str, Any]:
     return options
 
 
+def candidate_rows(problem: ContactProblem, results: dict[str, Result],
+                   tol: float) -> list[dict[str, Any]]:
+    """Per candidate: its index, point, and each method's gap (``d − Nu``: > 0 apart, < 0
+    penetrating), λ and classification (:func:`signorini.kkt.classify`, weak below
+    ``max(WEAK_TOL, tol)``; ``penetrating`` an inactive one inside the obstacle), in the user's units."""
+    labels = {name: classify(problem, result.solution, max(WEAK_TOL, tol))
+              for name, result in results.items()}
+    points = problem.contact_points * problem.scales.length
+    return [{"index": i, "point": None if np.isnan(points[i]).any() else points[i].tolist(),
+             "gap": {name: float(result.gap[i]) for name, result in results.items()},
+             "lam": {name: float(result.force[i]) for name, result in results.items()},
+             "class": {name: "penetrating" if labels[name][i] == INACTIVE and result.gap[i] < 0
+                       else str(labels[name][i]) for name, result in results.items()}}
+            for i in range(problem.m)]
+
+
 def _reference_method(names: list[str], results: dict[str, Result]) -> str:
     """pdas when it converged, else the first exact method that did ("" for none)."""
     done = [name for name in names if name in results and results[name].converged]
@@ -343,112 +364,5 @@ def _against(problem: ContactProblem, reference: Result, result: Result) -> tupl
     return found.lam_rel, found.misclassified
 
 
-# --- the tables ---------------------------------------------------------------------------------
-
-REFERENCE_COLUMNS = (("p0_rel", "p0 err"), ("a_rel", "a err"), ("pressure_l2_rel", "L2 err"),
-                     ("pressure_max_rel", "p max err"))
-
-
-def _num(value: Any, spec: str = ".1e") -> str:
-    if value is None or (isinstance(value, float) and not np.isfinite(value)):
-        return "–"
-    return format(value, spec)
-
-
-def _said(run: dict[str, Any]) -> str:
-    if run["claimed_status"] != run["status"]:
-        return f"{run['claimed_status']} → {run['status']}"
-    return run["status"]
-
-
-def _count(value: Any) -> str:
-    return "–" if value is None or value < 0 else str(value)
-
-
-def _polished(run: dict[str, Any]) -> str:
-    if run.get("polished_status") is None:
-        return "–"
-    return f"{_num(run.get('polished_lam_ref'))} ({run['polished_status']})"
-
-
-def _form(run: dict[str, Any]) -> str:
-    polish = {None: "", True: ", polished", False: ", raw (polish did not help)"}[run["polished"]]
-    return (run["form"] or "–") + polish
-
-
-def _tables(record: dict[str, Any]) -> tuple[str, list[str], list[list[str]], list[str],
-                                              list[list[str]]]:
-    """The title and the two tables (methods, pairs) as header and rows of strings."""
-    title = (f"cross-check of {record['scene'] or 'a problem'}: {record['dofs']:,} dofs, "
-             f"{record['contact_candidates']:,} contact candidates, tol {record['tol']:.0e}")
-    present = [(key, label) for key, label in REFERENCE_COLUMNS
-               if any(key in run["reference"] for run in record["methods"])]
-    ref = record.get("reference_method") or "reference"
-    head = ["method", "said → certificate", "form", "worst KKT", f"λ vs {ref}", "active",
-            "apart", "iterations", "time s"]
-    polish = record.get("polish", False)
-    head += [f"polished λ vs {ref}"] * polish + [label for _, label in present]
-    rows = []
-    for run in record["methods"]:
-        row = [run["method"] + " (allowed)" * bool(run.get("allowed")), _said(run), _form(run),
-               f"{_num(run['kkt_worst'])} {run['kkt_worst_name']}".strip(),
-               _num(run.get("lam_ref")), _count(run.get("active")), _count(run.get("apart_ref")),
-               str(run["iterations"]), _num(run["time_s"], ".2f")]
-        if polish:
-            row.append(_polished(run))
-        row += [_num(run["reference"].get(key), ".2e") for key, _ in present]
-        rows.append(row)
-    pair_head = ["pair", "λ rel", "u rel", "nodes apart", "weak", "limit", "verdict"]
-    pair_rows = [[f"{p['first']} ~ {p['second']}", _num(p["lam_rel"]), _num(p["u_rel"]),
-                  str(p["apart"]), str(p["weak"]), _num(p["limit"]), p["verdict"]]
-                 for p in record["pairs"]]
-    return title, head, rows, pair_head, pair_rows
-
-
-def _plain(head: list[str], rows: list[list[str]]) -> list[str]:
-    widths = [max(len(x) for x in column) for column in zip(head, *rows)]
-    return ["  ".join(x.ljust(w) for x, w in zip(line, widths)).rstrip() for line in [head, *rows]]
-
-
-def _verdict_line(record: dict[str, Any]) -> str:
-    allowed = [r["method"] for r in record["methods"] if r.get("allowed")]
-    let = f" (allowed through: {', '.join(allowed)})" if allowed else ""
-    if record["failures"]:
-        return (f"FAILED: {'; '.join(record['failures'])}{let}. A method fails when it does not "
-                f"converge at tol; a pair when both said converged and they differ beyond "
-                f"{record['agree_factor']:.0e} × tol or classify nodes apart")
-    judged = sum(p["judged"] for p in record["pairs"])
-    return (f"passed: every method converged and every judged pair agrees ({judged} of "
-            f"{len(record['pairs'])} pairs said converged on both sides){let}")
-
-
-def render(record: dict[str, Any]) -> str:
-    """The cross-check record as plain-text tables (see :meth:`CrossCheck.to_dict`)."""
-    title, head, rows, pair_head, pair_rows = _tables(record)
-    return "\n".join([title, "", *_plain(head, rows), "", *_plain(pair_head, pair_rows), "",
-                      _verdict_line(record)])
-
-
-def _md(head: list[str], rows: list[list[str]]) -> list[str]:
-    return ["| " + " | ".join(head) + " |", "|" + "---|" * len(head),
-            *("| " + " | ".join(x.replace("|", "\\|") for x in row) + " |" for row in rows)]
-
-
-def render_markdown(record: dict[str, Any]) -> str:
-    """The cross-check record as Markdown."""
-    title, head, rows, pair_head, pair_rows = _tables(record)
-    params = ", ".join(f"{k}={v}" for k, v in record["params"].items()) or "defaults"
-    notes = (f"Parameters: {params}. Each method's own answer is judged (polish "
-             f"{'shown as an extra column' if record.get('polish') else 'off'}); λ vs "
-             f"{record.get('reference_method') or 'the reference'} is λ's relative distance to "
-             f"that answer, apart the nodes classified apart from it. "
-             f"A pair is judged when both methods said `converged` "
-             f"(their own claim); it disagrees when a node is active in one answer and "
-             f"inactive in the other (weakly active nodes apart: force and gap both within "
-             f"max(1e-6, tol)), or λ or u differ by more than {record['agree_factor']:.0e} × tol.")
-    return "\n".join([f"# {title}", "", notes, "", *_md(head, rows), "", *_md(pair_head, pair_rows),
-                      "", _verdict_line(record), ""])
-
-
 __all__ = ["AGREE_FACTOR", "DEFAULT_METHODS", "CrossCheck", "MethodRun", "Pair",
-           "agreement", "crosscheck", "render", "render_markdown"]
+           "agreement", "candidate_rows", "crosscheck", "render", "render_markdown"]

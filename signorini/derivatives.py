@@ -15,12 +15,8 @@ the directional derivative along ``+(df, dd)`` (a node presses when its gap
 would close, and lets go when its force would turn negative), ``"in"`` and
 ``"out"`` keep every weak node in or out of A; every answer lists the weak nodes.
 
-:func:`derivative` differentiates a scene's physical outputs (total force,
-energy, the displacement at a point, nodal pressures, Hertz's fitted p₀ and
-a) with respect to E, ν, the load P or push δ and the obstacle's position,
-all of which enter K, f and d analytically, on the scene's mesh as built.
-The discrete contact width is piecewise constant in these data (it jumps
-from node to node), so it has no derivative; the fitted ``a`` is smooth.
+:mod:`signorini.scene_derivatives` differentiates a scene's physical outputs with respect
+to its parameters on this system.
 """
 
 from __future__ import annotations
@@ -29,24 +25,15 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from skfem.models.elasticity import lame_parameters
 
 from signorini.errors import InputError, SolverError
-from signorini.fem.assembly import lame_stiffness
 from signorini.kkt import ACTIVE, WEAK, classify
-from signorini import load_control
-from signorini.pressure import contact_profile, hertz_fit, hertz_fit_tangent
-from signorini.problem import ContactProblem
-from signorini.scenes import build_problem
-from signorini.scenes.base import scene_params
-from signorini.scenes.build import coarse_problem
 from signorini.numerics.factor import ActiveSetSolver
+from signorini.problem import ContactProblem
+from signorini.reprs import short_repr
 from signorini.solution import ContactSolution
-from signorini.solvers.registry import check_request
 
 SIDES = ("auto", "in", "out")
-OUTPUTS = ("total_force", "energy", "displacement", "pressure", "p0", "a")
-PARAMETERS = ("E", "nu", "P", "delta", "obstacle")
 
 
 @dataclass(frozen=True)
@@ -62,6 +49,7 @@ class Tangent:
     dforce: np.ndarray
     weakly_active: np.ndarray
     pressed: np.ndarray
+    __repr__ = short_repr
 
     def __iter__(self):
         return iter((self.du, self.dforce))
@@ -83,6 +71,7 @@ class Cotangent:
     gd: np.ndarray
     weakly_active: np.ndarray
     side: str
+    __repr__ = short_repr
 
     def __iter__(self):
         return iter((self.gf, self.gd))
@@ -101,8 +90,7 @@ class Sensitivity:
     """
 
     def __init__(self, problem: ContactProblem, solution: ContactSolution, factor: Any = None):
-        if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
-            raise SolverError("the answer is not finite: it has no derivative")
+        exact_answer(solution)
         self.problem, self.solution = problem, solution
         labels = classify(problem, solution)
         self.strong = labels == ACTIVE
@@ -153,6 +141,16 @@ class Sensitivity:
         return gf, np.where(active, gd, 0.0)
 
 
+def exact_answer(solution: ContactSolution) -> None:
+    """SolverError unless ``solution`` is converged and finite: only an exact answer has a
+    derivative (a ``max_iter`` answer's active set may not be the answer's)."""
+    if solution.status != "converged":
+        raise SolverError(f"the answer is {solution.status} ({solution.message}): only an exact "
+                          "answer has a derivative; solve to convergence first")
+    if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
+        raise SolverError("the answer is not finite: it has no derivative")
+
+
 def _side(side: str, allowed: tuple[str, ...]) -> str:
     if side not in allowed:
         raise InputError(f"side must be one of {', '.join(allowed)}, got {side!r}")
@@ -162,7 +160,13 @@ def _side(side: str, allowed: tuple[str, ...]) -> str:
 def _vector(value: Any, size: int, name: str, unit: float) -> np.ndarray:
     if value is None:
         return np.zeros(size)
-    array = np.asarray(value, dtype=float)
+    try:
+        array = np.asarray(value)
+    except ValueError:  # a ragged list
+        array = np.asarray(None)
+    if array.dtype.kind not in "biuf":
+        raise InputError(f"{name} must be {size} real numbers, got {str(value)[:60]}")
+    array = array.astype(float)
     if array.shape != (size,):
         raise InputError(f"{name} must have shape ({size},), got {array.shape}")
     if not np.all(np.isfinite(array)):
@@ -192,200 +196,4 @@ def vjp(sensitivity: Sensitivity, gu: Any = None, gforce: Any = None, side: str 
     return Cotangent(gf / s.force, gd / s.displacement, sensitivity.weak, side)
 
 
-# -- scene parameters ------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Change:
-    """How the QP's data move per unit of one parameter (problem's units).
-
-    ``Ku`` is ``dK u`` (the stiffness's change applied to the answer), ``f``
-    and ``d`` the changes of the load and gaps, ``target`` of the target load.
-    """
-
-    Ku: np.ndarray
-    f: np.ndarray
-    d: np.ndarray
-    target: float = 0.0
-
-
-@dataclass(frozen=True)
-class SceneDerivative:
-    """``d output / d wrt`` of one scene, in the scene's units, at ``value`` of the output.
-
-    ``derivative`` is a number, or an array for ``pressure`` (per candidate)
-    and ``displacement`` (per component). ``weakly_active`` lists candidates
-    touching with zero force (the derivative is then one-sided: for an
-    increase of the parameter).
-    """
-
-    output: str
-    wrt: str
-    value: Any
-    derivative: Any
-    weakly_active: np.ndarray
-    result: Any = None
-
-
-def _load_controlled(problem: ContactProblem) -> bool:
-    return problem.push is not None and problem.push.target is not None
-
-
-def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Change:
-    """The change of K, f, d and the target load per unit of the scene parameter ``wrt``."""
-    disc, push, s = problem.discretisation, problem.push, problem.scales
-    if disc is None or push is None:
-        raise InputError("derivatives with respect to scene parameters need a scene "
-                         "(a problem from ContactProblem.from_qp has none): use Result.jvp")
-    zero_n, zero_m = np.zeros(problem.n), np.zeros(problem.m)
-    u = solution.u
-    lift = push.scale * push.f1  # the load the prescribed push puts on the free dofs
-    if wrt == "E":  # K ∝ E, and so is the lift of the prescribed push
-        return Change(problem.K @ u / disc.E, lift / disc.E, zero_m)
-    if wrt == "nu":
-        return _poisson_change(problem, u)
-    if wrt == "P":
-        if not _load_controlled(problem):
-            raise InputError(f"{problem.scene or 'this scene'} is loaded by a prescribed push, not "
-                             "a target load: differentiate with respect to delta")
-        return Change(zero_n, zero_n, zero_m, target=1.0 / s.force)
-    if wrt == "delta":
-        if _load_controlled(problem):
-            raise InputError(f"{problem.scene or 'this scene'} is loaded by a target load P, which "
-                             "sets the push: differentiate with respect to P (or build the scene "
-                             "with delta=)")
-        if push.delta is None:
-            raise InputError(f"{problem.scene or 'this scene'} names no push delta to differentiate "
-                             "with respect to: build it from a scene with a delta parameter")
-        ratio = push.scale / push.delta  # the push moves in proportion to delta
-        return Change(zero_n, push.f1 * ratio, push.d1 * ratio)
-    if wrt == "obstacle":  # towards the body along the load axis: each gap shrinks by cᵢ
-        tilt = np.ones(problem.m) if push.resultant is None else push.resultant
-        return Change(zero_n, zero_n, -tilt / s.displacement)
-    raise InputError(f"wrt must be one of {', '.join(PARAMETERS)}, got {wrt!r}")
-
-
-def _poisson_change(problem: ContactProblem, u: np.ndarray) -> Change:
-    """∂K/∂ν from K's two Lamé parts, ``∂K/∂ν = E (∂Λ/∂ν K_Λ + ∂μ/∂ν K_μ)`` (exact)."""
-    disc, s = problem.discretisation, problem.scales
-    nu, k = disc.nu, 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
-    E = disc.E * s.displacement * s.length ** k / s.force  # E in the problem's units
-    lame = (1 + 2 * nu ** 2) / ((1 + nu) * (1 - 2 * nu)) ** 2, -0.5 / (1 + nu) ** 2
-    dK = lame_stiffness(disc.mesh, E * lame[0], E * lame[1], axisymmetric=disc.axisymmetric,
-                        volumetric=disc.volumetric)
-    free = disc.free_dofs
-    on_free, prescribed = np.zeros(disc.prescribed.size), disc.prescribed.copy()
-    on_free[free] = u
-    prescribed[free] = 0.0
-    return Change((dK @ on_free)[free], -(dK @ prescribed)[free], np.zeros(problem.m))
-
-
-def scene_tangent(sensitivity: Sensitivity, delta: Change) -> tuple[np.ndarray, np.ndarray, float]:
-    """``(du, dλ, ds)`` for a change of the data; a load-controlled problem keeps its load
-    ``μ Σ cᵢ λᵢ`` at the target by moving its push s (one more right-hand side)."""
-    problem = sensitivity.problem
-    push = problem.push
-    f, d = delta.f - delta.Ku, delta.d
-    if not _load_controlled(problem):
-        du, dlam, _ = sensitivity.tangent(f, d)
-        return du, dlam, 0.0
-    tilt = np.ones(problem.m) if push.resultant is None else push.resultant
-    du, dlam, _ = sensitivity.tangent(np.column_stack([f, push.f1]), np.column_stack([d, push.d1]),
-                                      side="out" if sensitivity.weak.size else "auto")
-    load = problem.force_multiplicity * (tilt @ dlam)
-    ds = (delta.target - load[0]) / load[1]
-    return du[:, 0] + ds * du[:, 1], dlam[:, 0] + ds * dlam[:, 1], float(ds)
-
-
-def outputs(problem: ContactProblem, solution: ContactSolution, output: str, at: Any = None,
-            tangent: tuple[np.ndarray, np.ndarray, float] | None = None,
-            delta: Change | None = None) -> tuple[Any, Any]:
-    """``(value, derivative)`` of one physical output (the derivative None without a tangent)."""
-    s, disc = problem.scales, problem.discretisation
-    profile = contact_profile(problem, solution)
-    du, dlam, ds = tangent if tangent is not None else (None, None, 0.0)
-    if output == "total_force":
-        slope = None if du is None else problem.total_contact_force(dlam) * s.force
-        return profile.total_force, slope
-    if output == "pressure":
-        unit = s.force / (problem.weights * s.weight)
-        return profile.pressure, None if du is None else dlam * unit
-    if output in ("p0", "a"):
-        which = 0 if output == "p0" else 1
-        value = hertz_fit(profile.x, profile.pressure, profile.active)[which]
-        if du is None:
-            return value, None
-        dpressure = dlam * s.force / (problem.weights * s.weight)
-        return value, hertz_fit_tangent(profile.x, profile.pressure, profile.active, dpressure)[which]
-    if output == "energy":
-        u, lam = solution.u, solution.lam
-        value = problem.energy(u) * s.force * s.displacement
-        if du is None:
-            return value, None
-        push = problem.push
-        f = delta.f + (ds * push.f1 if push is not None else 0.0)
-        d = delta.d + (ds * push.d1 if push is not None else 0.0)
-        slope = 0.5 * u @ delta.Ku - f @ u - lam @ d  # the envelope theorem
-        return value, slope * s.force * s.displacement
-    if output == "displacement":
-        if at is None or disc is None or disc.mesh is None:
-            raise InputError("output 'displacement' needs a point: at=(x, y) in the scene's units")
-        point = np.asarray(at, dtype=float) / s.length
-        mesh = disc.mesh
-        node = int(np.argmin(np.linalg.norm(mesh.p - point[:, None], axis=0)))
-        dofs = np.arange(mesh.p.shape[0]) + mesh.p.shape[0] * node
-        value = problem.expand(solution.u)[dofs] * s.displacement
-        if du is None:
-            return value, None
-        full = disc.prescribed * (ds / disc.push.scale if disc.push is not None else 0.0)
-        full[disc.free_dofs] = du
-        return value, full[dofs] * s.displacement
-    raise InputError(f"output must be one of {', '.join(OUTPUTS)}, got {output!r}")
-
-
-def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | None = None,
-               method: str = "auto", at: Any = None) -> SceneDerivative:
-    """``d output / d wrt`` of a scene's answer, exactly, on the scene's mesh.
-
-    ``scene`` is a scene's name (built with ``params`` and solved with
-    ``method``) or a converged :class:`signorini.Result`. ``output`` is one of
-    ``total_force``, ``energy`` (the optimal ½uᵀKu − fᵀu), ``displacement``
-    (at the mesh node nearest ``at``), ``pressure`` (nodal), ``p0`` and ``a``
-    (Hertz's profile fitted to the pressures, :func:`signorini.pressure.hertz_fit`);
-    ``wrt`` one of ``E``, ``nu``, ``P`` (a load-controlled scene's target
-    load), ``delta`` (a push-controlled scene's push) and ``obstacle`` (the
-    obstacle's position along the load axis, towards the body). A parameter
-    that moves the mesh is refused: shape derivatives are not provided.
-    Cost: the solve, then two back-solves, with the method's factorisation
-    when it pins the final active set (``pdas``), else one factorisation of
-    the active-set system (K with the active dofs pinned) first.
-    """
-    if output not in OUTPUTS:
-        raise InputError(f"output must be one of {', '.join(OUTPUTS)}, got {output!r}")
-    if wrt not in PARAMETERS:
-        raise InputError(f"the derivative with respect to {wrt!r} is not provided: {', '.join(PARAMETERS)} "
-                         "enter K, f and d analytically; a parameter that moves or rebuilds the "
-                         "mesh (R, W, H, refine...) needs a shape derivative, and shape "
-                         "derivatives are not provided")
-    if isinstance(scene, str):
-        request = check_request(method)  # before the scene is built
-        problem = build_problem(scene, params=scene_params(params), solved_by=method)
-        problem, solution, _ = load_control.solve(problem, request, coarse=coarse_problem,
-                                                  keep_factor=True)
-        result = None
-    else:
-        if params:
-            raise InputError("params= builds a scene by name; a Result is differentiated as solved")
-        problem, solution, result = scene.problem, scene.solution, scene
-    if solution.status != "converged":
-        raise SolverError(f"the answer is {solution.status} ({solution.message}): only an exact "
-                          "answer has a derivative")
-    delta = change(problem, solution, wrt)
-    sensitivity = Sensitivity(problem, solution, solution.factor) if result is None else result.sensitivity
-    tangent = scene_tangent(sensitivity, delta)
-    value, slope = outputs(problem, solution, output, at, tangent, delta)
-    return SceneDerivative(output, wrt, value, slope, sensitivity.weak, result)
-
-
-__all__ = ["Cotangent", "OUTPUTS", "PARAMETERS", "SIDES", "SceneDerivative", "Sensitivity",
-           "Tangent", "derivative", "jvp", "vjp"]
+__all__ = ["Cotangent", "SIDES", "Sensitivity", "Tangent", "exact_answer", "jvp", "vjp"]

@@ -118,6 +118,16 @@ def _unit_solutions(solve: Callable, dofs: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
+def _inverse(S: np.ndarray) -> np.ndarray | None:
+    """``S⁻¹`` of a small dense border, or None when S is singular (rows of N on the active
+    set that are zero, repeated or dependent: their forces are not unique)."""
+    try:
+        inverse = np.linalg.inv(S)
+    except np.linalg.LinAlgError:
+        return None
+    return inverse if np.all(np.isfinite(inverse)) else None
+
+
 def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.ndarray,
                    coef: np.ndarray):
     """``M⁻¹`` on the rows ``dofs`` (coefficients ``coef``) from a factor pinning ``fixed``.
@@ -136,7 +146,9 @@ def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.
 
     B, Z = _blocks(lambda j: _unit_solutions(solve, border[j], n), k, n,
                    lambda Z: np.vstack([(K @ Z)[Q], Z[P]]))
-    lu = np.linalg.inv(B) if k else None  # k ≤ MAX_BORDER, dense and small
+    lu = _inverse(B) if k else None  # k ≤ MAX_BORDER, dense and small
+    if k and lu is None:
+        return None, k
 
     def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         value = np.zeros(n)
@@ -184,7 +196,9 @@ def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.nd
         S = offered.delassus[np.ix_(rows, rows)]
     else:
         S, Z = _blocks(lambda j: solve(NT[:, j].toarray()), k, K.shape[0], lambda Z: N_A @ Z)
-    lu = np.linalg.inv(S) if k else None
+    lu = _inverse(S) if k else None
+    if k and lu is None:  # dependent active rows: λ on them is not unique
+        return None, k
 
     def apply(r: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         x0 = solve(-r)
@@ -200,13 +214,14 @@ def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.nd
 
 def _system(K: sp.spmatrix, N: sp.csr_matrix, rows: np.ndarray, solve: _Counted):
     """``(r, g) ↦ M⁻¹(−r, −g)`` on the rows ``rows`` by the factorisation behind ``solve``
-    (pinned or plain); None when it cannot (more than :data:`MAX_BORDER` rows to border, or a
-    pinned factorisation while the rows of N do not each bound one dof)."""
+    (pinned or plain); None when it cannot (more than :data:`MAX_BORDER` rows to border, rows
+    that are dependent, or a pinned factorisation while the rows of N do not each bound one dof)."""
     fixed = np.asarray(solve.factor.fixed, dtype=int)
     if not fixed.size:
         return _schur_system(K, solve, N, rows)[0] if rows.size <= MAX_BORDER else None
     dofs = selection_dofs(N)
-    if dofs is None or np.setxor1d(dofs[rows], fixed).size > MAX_BORDER:
+    if dofs is None or np.unique(dofs[rows]).size < rows.size \
+            or np.setxor1d(dofs[rows], fixed).size > MAX_BORDER:
         return None
     return _pinned_system(K, solve, fixed, dofs[rows], np.asarray(N[rows, dofs[rows]]).ravel())[0]
 
@@ -258,6 +273,9 @@ def refined_on_active_set(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np
     ld = np.longdouble
     rows = np.flatnonzero(active)
     apply = _system(K, N, rows, _Counted(factor))
+    if apply is None:
+        raise np.linalg.LinAlgError("no Newton step on this active set: its rows of N are "
+                                    "dependent, or too many to border")
     K_l, N_l = K.astype(ld), N[rows].astype(ld)
     f_l, d_l = f.astype(ld), d[rows].astype(ld)
     x, mu = u.astype(ld), lam[rows].astype(ld)

@@ -131,11 +131,9 @@ class Certificate:
     def worst(self) -> tuple[str, float]:
         """The largest residual and its name."""
         items = {k: v for k, v in self.residuals().items() if not np.isnan(v)}
-        name = max(items, key=lambda k: items[k])
-        return name, items[name]
+        return max(items.items(), key=lambda item: item[1])
 
-    def as_dict(self) -> dict[str, float]:
-        return self.residuals()
+    as_dict = residuals
 
     def passed(self, tol: float) -> bool:
         """Every residual and error is finite and at most ``tol``: the answer is certified at
@@ -151,7 +149,7 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     """Relative KKT residuals of ``solution`` for ``problem`` (see :class:`Certificate`).
 
     ``duality_gap=False`` leaves out what needs K⁻¹: the duality gap and the
-    forward error (for a singular K).
+    forward error (left out too, NaN, when K cannot be factorised).
 
     The result is kept on the solution (for these same arrays, problem and
     options): judging a solution and then reporting it costs one evaluation.
@@ -168,7 +166,10 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     kept = getattr(solution, "_certificate", None)
     if kept is not None and kept[0] == key:
         return kept[1]
-    cert = _certificate(problem, solution, duality_gap)
+    try:
+        cert = _certificate(problem, solution, duality_gap)
+    except np.linalg.LinAlgError:  # K singular or indefinite: no dual function, no Newton step
+        cert = _certificate(problem, solution, False)
     solution._certificate = (key, cert)
     return cert
 
@@ -284,11 +285,12 @@ FORCE_SHORTFALL = {
 }
 
 
-def shortfall(cert: Certificate, accept: float) -> str | None:
+def shortfall(cert: Certificate, accept: float,
+              advice: str = "tighten the tolerance or use an exact method (pdas)") -> str | None:
     """Why ``cert`` does not back a claim of convergence at ``accept`` (None when it does).
 
     What the forward error says about the contact force comes first (see
-    :data:`FORCE_SHORTFALL`); then the worst of the other residuals.
+    :data:`FORCE_SHORTFALL`); then the worst of the other residuals, with ``advice``.
     """
     name, worst = cert.worst()
     if np.isfinite(worst) and worst <= accept:
@@ -307,8 +309,7 @@ def shortfall(cert: Certificate, accept: float) -> str | None:
     name = max(others, key=others.get)
     if not np.isfinite(others[name]) or others[name] > accept:
         said.append(f"the method claimed success but the KKT certificate's {name} residual is "
-                    f"{others[name]:.1e} > {accept:.0e}: tighten the tolerance or use an exact "
-                    "method (pdas)")
+                    f"{others[name]:.1e} > {accept:.0e}" + (f": {advice}" if advice else ""))
     return "; ".join(said)
 
 
@@ -371,9 +372,7 @@ def _pinned_rows(problem: ContactProblem, factor) -> tuple[np.ndarray, np.ndarra
     row_of = np.full(problem.n, -1)
     row_of[dofs] = np.arange(problem.m)
     rows = row_of[fixed]
-    if np.any(rows < 0):
-        return None
-    return rows, np.asarray(problem.N[rows, fixed]).ravel()
+    return None if np.any(rows < 0) else (rows, np.asarray(problem.N[rows, fixed]).ravel())
 
 
 def _same_matrix(K, other) -> bool:
@@ -428,13 +427,14 @@ def classify(problem: ContactProblem, solution: ContactSolution,
     weakly active when both are at most ``weak_tol`` (it touches with zero
     force, so its membership of the active set is not determined); otherwise
     it is active when ``λ̃ > g̃`` and inactive when not. For an exact solution
-    one of the two is zero; for an inexact one the larger decides.
+    one of the two is zero; for an inexact one the larger decides. One that penetrates
+    by more than ``weak_tol`` is never weak (with no force: inactive).
     """
     u, lam = solution.u, solution.lam
     lam_n = np.maximum(lam, 0.0) / force_scale(problem, lam, u)
-    gap_n = np.maximum(problem.gap(u), 0.0) / gap_scale(problem, u)
-    labels = np.where(lam_n > gap_n, ACTIVE, INACTIVE).astype(object)
-    labels[(lam_n <= weak_tol) & (gap_n <= weak_tol)] = WEAK
+    gap = problem.gap(u) / gap_scale(problem, u)
+    labels = np.where(lam_n > np.maximum(gap, 0.0), ACTIVE, INACTIVE).astype(object)
+    labels[(lam_n <= weak_tol) & (np.abs(gap) <= weak_tol)] = WEAK
     return labels
 
 

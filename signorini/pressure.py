@@ -25,14 +25,15 @@ from signorini.analytic import (
 )
 from signorini.kkt import ACTIVE, classify
 from signorini.problem import ContactProblem, ContactSolution
+from signorini.reprs import short_repr
 
 
 @dataclass(frozen=True)
 class ContactProfile:
     """The contact state at the candidates, in physical units, sorted along the surface.
 
-    ``x`` is the horizontal distance from the first point of contact (the
-    radius from the axis in axisymmetric and 3D models), ``gap``
+    ``x`` is the horizontal distance from the first point of contact (the radius in axisymmetric
+    and 3D models; x as given, signed, for a plane QP given as arrays), ``gap``
     the remaining gap ``d − Nu``, ``force`` the nodal force λ, ``pressure``
     ``λ / w``; ``total_force`` is the load of the full body (per unit thickness
     in 2D) and ``applied_load`` the same load measured as the reaction on the
@@ -48,9 +49,9 @@ class ContactProfile:
     total_force: float
     applied_load: float
 
+    __repr__ = short_repr
     def as_dict(self) -> dict:
-        return {"x": self.x.tolist(), "gap": self.gap.tolist(), "force": self.force.tolist(),
-                "pressure": self.pressure.tolist(), "active": self.active.tolist()}
+        return {key: getattr(self, key).tolist() for key in ("x", "gap", "force", "pressure", "active")}
 
 
 def contact_profile(problem: ContactProblem, solution: ContactSolution) -> ContactProfile:
@@ -59,7 +60,7 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
     force = solution.lam * s.force
     labels = classify(problem, solution)
     return ContactProfile(
-        x=radial_distance(problem.contact_points) * s.length,
+        x=radial_distance(problem.contact_points, signed=problem.mesh is None) * s.length,
         gap=problem.gap(solution.u) * s.displacement,
         force=force,
         pressure=(force / (problem.weights * s.weight) if problem.weights is not None
@@ -231,9 +232,7 @@ class UniformComparison:
     pressure_ref: float
     pressure_max_rel: float
     force_balance: float
-
-    def as_dict(self) -> dict[str, float]:
-        return asdict(self)
+    as_dict = asdict
 
 
 def compare_uniform(problem: ContactProblem, solution: ContactSolution) -> UniformComparison:
@@ -251,14 +250,15 @@ def compare_uniform(problem: ContactProblem, solution: ContactSolution) -> Unifo
 # --- Hertz's sphere: axisymmetric (r, z) and 3D models (Johnson 1985, §4.2) -------------------
 
 
-def radial_distance(points: np.ndarray) -> np.ndarray:
+def radial_distance(points: np.ndarray, signed: bool = False) -> np.ndarray:
     """Horizontal distance from the vertical axis through the first point of contact.
 
-    ``points`` is (k, 2) for an axisymmetric (r, z) model, where it is r, or
-    (k, 3) for a 3D model with z vertical, where it is ``√(x² + y²)``.
+    ``points`` is (k, 2) for a plane or axisymmetric (r, z) model, where it is |x| (or x
+    itself, ``signed``), or (k, 3) for a 3D model with z vertical, where it is ``√(x² + y²)``.
     """
     points = np.asarray(points, dtype=float)
-    return np.abs(points[:, 0]) if points.shape[1] == 2 else np.hypot(points[:, 0], points[:, 1])
+    x = points[:, 0] if signed or points.shape[1] == 3 else np.abs(points[:, 0])
+    return x if points.shape[1] == 2 else np.hypot(x, points[:, 1])
 
 
 def _sub_profile(profile: ContactProfile, order: np.ndarray, x: np.ndarray) -> ContactProfile:

@@ -7,6 +7,9 @@ from typing import Any
 
 import numpy as np
 
+from signorini.errors import InputError
+from signorini.reprs import short_repr
+
 #: the statuses a :class:`ContactSolution` can carry
 STATUSES = ("converged", "inaccurate", "max_iter", "diverged", "infeasible", "failed",
             "model_inadequate")
@@ -36,9 +39,18 @@ class WarmStart:
             return earlier
         solution = getattr(earlier, "solution", earlier)
         if not isinstance(solution, ContactSolution):
-            raise TypeError(f"warm_start must be an earlier Result, ContactSolution or WarmStart, "
-                            f"got {type(earlier).__name__}")
+            raise InputError(f"warm_start must be an earlier Result, ContactSolution or "
+                             f"WarmStart, got {type(earlier).__name__}")
         return cls(lam=solution.lam, u=solution.u)
+
+    def check_fits(self, n: int, m: int) -> "WarmStart":
+        """Itself, when its ``u`` has ``n`` entries and its ``lam`` ``m``; InputError otherwise."""
+        for name, value, size in (("u", self.u, n), ("lam", self.lam, m)):
+            if value is not None and np.shape(value) != (size,):
+                raise InputError(f"warm_start: its {name} has shape {np.shape(value)} and this "
+                                 f"problem needs ({size},): start from an answer of this problem "
+                                 "(the same mesh and candidates), or give no warm_start")
+        return self
 
 
 @dataclass
@@ -78,6 +90,7 @@ class ContactSolution:
     #: the work of every stage that ran, by stage ("method", "load control"): active-set or
     #: load-control steps, factorisations, back-solves, CG iterations
     work: dict[str, dict[str, int]] = field(default_factory=dict)
+    __repr__ = short_repr
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:

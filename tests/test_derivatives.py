@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import signorini
+from signorini.errors import InputError
 from signorini.numerics.work import counting
 
 
@@ -180,3 +181,28 @@ def test_a_weakly_active_node_makes_the_derivative_one_sided():
                                                                                 side="out")
     assert not np.allclose(inside.dforce, outside.dforce)
     assert np.all(tangent.dforce >= -1e-12 * np.max(np.abs(tangent.dforce)))
+
+
+@pytest.mark.parametrize("df, said", [([1j, 0], "df must be"), ("abc", "df must be"),
+                                      ([[1.0], [2.0, 3.0]], "df must be")])
+def test_a_change_that_is_not_real_numbers_names_its_argument(results, df, said):
+    with pytest.raises(InputError, match=said):
+        results["block"].jvp(df=df)
+    full = np.full(results["block"].problem.n, 1j)  # complex of the right size: not cast to real
+    with pytest.raises(InputError, match="df must be"):
+        results["block"].jvp(df=full)
+
+
+def test_an_answer_that_did_not_converge_has_no_derivative_by_any_door():
+    stopped = signorini.solve("block", "uzawa", max_iter=2)
+    assert stopped.status == "max_iter"
+    for door in (lambda: stopped.jvp(), lambda: stopped.vjp(),
+                 lambda: signorini.derivative(stopped, "total_force", "E")):
+        with pytest.raises(signorini.errors.SolverError, match="only an exact answer"):
+            door()
+
+
+@pytest.mark.parametrize("at", [(float("nan"), 0.0), (0.0,), (1.0, 2.0, 3.0), "here"])
+def test_a_point_that_is_not_one_names_at(results, at):
+    with pytest.raises(InputError, match="at must be a point of 2 finite coordinates"):
+        signorini.derivative(results["block"], "displacement", "E", at=at)

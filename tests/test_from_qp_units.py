@@ -186,3 +186,15 @@ def test_a_certificate_refuses_bad_input(call, words):
     result = signorini.solve(problem, "pdas")
     with pytest.raises(signorini.InputError, match=words):
         call(problem, result)
+
+
+def test_contact_coordinates_of_a_users_qp_keep_their_sign():
+    """Points given on x < 0 come back as given (a scene's x stays its distance from the axis)."""
+    K, f, N, d, weights, points = half_block(1.0, 2.1e5, refine=2)
+    mirrored = points * np.array([-1.0, 1.0])
+    problem = signorini.ContactProblem.from_qp(K, f, N, d, weights=weights, contact_points=mirrored)
+    result = signorini.solve(problem, "pdas")
+    np.testing.assert_array_equal(result.x, mirrored[:, 0])
+    assert result.to_dict()["contact"]["x"] == mirrored[:, 0].tolist() and result.x.min() < 0
+    scene = signorini.solve("hertz-cylinder", "pdas")
+    assert scene.x.min() >= 0.0

@@ -94,7 +94,10 @@ def test_near_incompressible_forces_are_not_certified(near_half, method, tol):
     accept = tol or registry.get_method(method).default_tol
     error = lam_error(solution, reference_lam(near_half))
     assert error > 100 * accept
-    assert solution.status == "inaccurate" and solution.claimed_status == "converged"
+    if method.startswith("uzawa"):  # its stopping test asks the certificate: it says so itself
+        assert solution.status in ("inaccurate", "max_iter") and solution.claimed_status == ""
+    else:
+        assert solution.status == "inaccurate" and solution.claimed_status == "converged"
     assert "the contact force is not certified" in solution.message
     assert "ill-conditioned" in solution.message or "Newton step" in solution.message
     cert = certificate(near_half, solution)

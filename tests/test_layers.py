@@ -2,7 +2,7 @@
 
 Layers, low to high (a module may import its own layer and the layers below):
 
-0. ``errors``, ``files``                 exceptions, atomic writes
+0. ``errors``, ``files``, ``reprs``     exceptions, atomic writes, short reprs
 1. ``numerics``                          factorisations, dense LCP, zone kernel, the push kernel
 2. ``problem``, ``problem_files``, ``discretisation``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
 3. ``solvers``                           the registry collects each backend's METHODS
@@ -33,7 +33,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
 
 LAYERS = {
-    "errors": 0, "files": 0,
+    "errors": 0, "files": 0, "reprs": 0,
     "numerics": 1,
     "problem": 2, "problem_files": 2, "discretisation": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
     "adequacy": 2, "forward_error": 2, "fingerprint": 2, "scales": 2, "saved_problem": 2,
@@ -41,7 +41,7 @@ LAYERS = {
     "solvers": 3,
     "load_control": 4,
     "scenes": 5,
-    "api": 6, "crosschecking": 6, "derivatives": 6, "": 6,
+    "api": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "scene_derivatives": 6, "": 6,
     "studies": 7, "output": 7,
     "cli": 8,
 }

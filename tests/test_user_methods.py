@@ -214,3 +214,120 @@ def test_a_bad_time_limit_is_one_line_exit_2(capsys, tmp_path, monkeypatch, argv
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1 and "--time-limit" in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+# -- your own method, debuggable ------------------------------------------------------------
+
+SIBLING = "def compare(a, b):\n    return a < b\n"
+DEBUGGED = textwrap.dedent("""
+    import os
+    import subprocess
+    import sys
+
+    from helper import compare
+    from signorini.solvers.pdas import solve as pdas
+
+
+    def crashes(problem, **options):
+        print("mine: starting on", problem.n, "dofs")
+        print("mine: a word on stderr", file=sys.stderr)
+        return compare(None, 1)
+
+
+    def forks(problem, **options):
+        child = subprocess.Popen(["sleep", "60"])
+        with open(os.environ["CHILD_PID_FILE"], "w") as file:
+            file.write(str(child.pid))
+        return pdas(problem)
+""")
+
+
+@pytest.fixture
+def method_folder(tmp_path):
+    """A method file beside the module it imports, and a working folder elsewhere."""
+    folder = tmp_path / "methods"
+    folder.mkdir()
+    (folder / "helper.py").write_text(SIBLING)
+    (folder / "debugged.py").write_text(DEBUGGED)
+    (tmp_path / "work").mkdir()
+    return folder
+
+
+def _command(tmp_path, *argv, **env):
+    import os
+    import subprocess
+    import sys
+
+    environment = {**os.environ, **env}
+    environment.pop("PYTHONSAFEPATH", None)
+    return subprocess.run([sys.executable, "-m", "signorini.cli", *argv], cwd=tmp_path / "work",
+                          capture_output=True, text=True, env=environment, timeout=300)
+
+
+def test_a_raising_method_is_shown_with_its_line_and_with_v_its_traceback(tmp_path, method_folder):
+    method = f"{method_folder / 'debugged.py'}:crashes"
+    quiet = _command(tmp_path, "solve", "block", "--method", method)
+    helper = f"{method_folder / 'helper.py'}:2"
+    assert quiet.returncode == 1, quiet.stderr
+    assert "TypeError: '<' not supported" in quiet.stdout and helper in quiet.stdout, quiet.stdout
+    assert "Traceback" not in quiet.stderr
+    # what it wrote on stdout and stderr is shown when it failed
+    assert "mine: starting on 544 dofs" in quiet.stderr and "a word on stderr" in quiet.stderr
+    loud = _command(tmp_path, "-v", "solve", "block", "--method", method)
+    assert "Traceback" in loud.stderr, loud.stderr
+    assert f'File "{method_folder / "debugged.py"}", line 13, in crashes' in loud.stderr
+    assert f'File "{method_folder / "helper.py"}", line 2, in compare' in loud.stderr
+
+
+def test_a_method_that_raises_in_a_crosscheck_is_shown_with_its_line(tmp_path, method_folder):
+    found = _command(tmp_path, "crosscheck", "block", "--method",
+                     f"{method_folder / 'debugged.py'}:crashes", "--method", "pdas")
+    assert found.returncode == 1
+    assert "TypeError: '<' not supported" in found.stdout, found.stdout
+    assert f"{method_folder / 'helper.py'}:2" in found.stdout
+
+
+@pytest.mark.parametrize("limit", [[], ["--time-limit", "60"]], ids=["no limit", "time limit"])
+def test_what_a_method_forks_ends_with_the_command(tmp_path, method_folder, limit):
+    psutil = pytest.importorskip("psutil", reason="psutil tells a live process from a zombie")
+    pid_file = tmp_path / "child.pid"
+    done = _command(tmp_path, "solve", "block", "--method",
+                    f"{method_folder / 'debugged.py'}:forks", *limit, CHILD_PID_FILE=str(pid_file))
+    assert done.returncode == 0, done.stdout + done.stderr
+    pid = int(pid_file.read_text())
+    try:
+        alive = psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        alive = False
+    if alive:
+        psutil.Process(pid).kill()
+    assert not alive, f"the method's child {pid} outlived the command"
+
+
+@pytest.mark.parametrize("spec, words", [(":", ["names no module or file", "module:function"]),
+                                         ("mine.py:", ["names no function", "file.py:function"]),
+                                         (":solve", ["names no module or file"])])
+def test_a_method_spec_without_a_part_names_method_and_its_forms(spec, words):
+    with pytest.raises(InputError) as info:
+        signorini.solve("block", spec)
+    for word in ["--method", *words]:
+        assert word in str(info.value), str(info.value)
+
+
+def test_the_python_api_takes_a_function_wherever_it_takes_a_name(user_file):
+    from signorini.solvers.registry import get_method
+
+    honest, returns_none = (get_method(f"mine.py:{name}").function
+                            for name in ("honest", "returns_none"))
+    result = signorini.solve("block", method=honest)
+    assert result.status == "converged" and result.solution.method == "honest"
+    check = signorini.crosscheck("block", [honest, "pdas", returns_none])
+    assert [run.method for run in check.runs] == ["honest", "pdas", "returns_none"]
+    assert check.runs[0].status == "converged" and check.runs[2].status == "failed"
+    assert "returns_none failed" in "; ".join(check.failures)
+
+
+def test_what_a_method_wrote_is_shown_when_it_fails_in_a_study(tmp_path, method_folder):
+    found = _command(tmp_path, "validate", "--case", "block", "--method",
+                     f"{method_folder / 'debugged.py'}:crashes", "--out", str(tmp_path / "out"))
+    assert "mine: starting on" in found.stderr and "a word on stderr" in found.stderr, found.stderr

@@ -47,7 +47,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
             if path is not None:
                 write_output(path, texts[flag])
     if STDOUT not in outputs.values():
-        print(check.summary())
+        print(check.summary(verbose=args.verbose))
     return 0 if check.passed else EXIT_FAILED
 
 

@@ -17,6 +17,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from signorini.adequacy import adequacy, warnings
+from signorini.diagnose import explain
 from signorini.errors import InputError, install_hint
 from signorini.kkt import Certificate, certificate, shortfall
 from signorini.problem import STATUSES, ContactProblem, ContactSolution
@@ -150,14 +151,19 @@ def check_tol(tol: Any, name: str = "tol") -> float | None:
     return float(tol)
 
 
+#: the largest iteration limit: every backend's counter holds it (a C int)
+MAX_ITER = 2 ** 31 - 1
+
+
 def check_max_iter(max_iter: Any) -> int | None:
     if max_iter is None:
         return None
     ok = isinstance(max_iter, (int, np.integer)) and not isinstance(max_iter, bool)
     ok = ok or (isinstance(max_iter, (float, np.floating)) and np.isfinite(max_iter)
                 and float(max_iter).is_integer())
-    if not ok or max_iter < 1:
-        raise InputError(f"max_iter must be a positive integer, got {max_iter!r}")
+    if not ok or not 1 <= max_iter <= MAX_ITER:
+        raise InputError(f"max_iter must be a positive integer up to {MAX_ITER} (2³¹ − 1, what "
+                         f"every backend's counter holds), got {max_iter!r}")
     return int(max_iter)
 
 
@@ -223,7 +229,10 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
     accept = acceptance(tol)
     cert = certify(problem, solution) if cert is None else cert
     reason = shortfall(cert, accept)
-    if reason is not None:
+    if reason is not None:  # which candidates fail and how, with the advice that fits
+        by_constraint = explain(problem, solution, accept)
+        if by_constraint is not None:
+            reason = f"{shortfall(cert, accept, advice='')}: {by_constraint}"
         solution.claimed_status = "converged"
         solution.status = "inaccurate"
         solution.message = f"{solution.message}; {reason}".lstrip("; ")

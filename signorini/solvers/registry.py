@@ -12,14 +12,10 @@ given. Unknown options raise :class:`InputError`.
 
 from __future__ import annotations
 
-import importlib
 import importlib.util
 import logging
-import os
-import sys
 import time
-from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, Callable, NamedTuple
 
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.fingerprint import fingerprint, held_to_problem
@@ -28,7 +24,7 @@ from signorini.numerics.work import counting
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.scales import Scales, in_problem_units, scaled_view
 from signorini.solution import WarmStart
-from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
+from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, user, uzawa
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, certify, check_max_iter,
                                     check_tol, hold_to_contract, judge)
 
@@ -47,15 +43,26 @@ def register(method: Method) -> Method:
     return method
 
 
-def get_method(name: str) -> Method:
-    """Look a method up by name; unknown names list the known ones."""
+#: the callables given as methods in this process, by the name they are known by
+CALLABLES: dict[str, Method] = {}
+
+
+def get_method(name: str | Callable[..., Any]) -> Method:
+    """Look a method up by name, or take a callable as a method; unknown names list the known ones.
+
+    A callable is known afterwards by its name (:func:`signorini.solvers.user.of_callable`).
+    """
+    if callable(name) and not isinstance(name, str):
+        method = user.of_callable(name, {**CALLABLES, **REGISTRY})
+        CALLABLES[method.name] = method
+        return method
     if not isinstance(name, str):
-        raise InputError(f"method must be a name (a string), got {type(name).__name__}: "
+        raise InputError(f"method must be a name or a function, got {type(name).__name__}: "
                          f"e.g. method='pdas'")
-    if name in REGISTRY:
-        return REGISTRY[name]
+    if name in REGISTRY or name in CALLABLES:
+        return REGISTRY.get(name) or CALLABLES[name]
     if ":" in name:
-        return _load_user_method(name)
+        return user.load(name)
     known = ", ".join(sorted(REGISTRY))
     raise InputError(f"unknown method {name!r}: choose --method from {known}")
 
@@ -64,43 +71,6 @@ def methods(installed_only: bool = False) -> list[Method]:
     """Every registered method, sorted by name."""
     out = sorted(REGISTRY.values(), key=lambda m: m.name)
     return [m for m in out if m.installed] if installed_only else out
-
-
-def _load_user_method(spec: str) -> Method:
-    """``module:function`` or ``path/to/file.py:function``: a user solver with the standard signature.
-
-    A module is looked up on ``sys.path`` and then in the current directory.
-    """
-    module_name, _, attr = spec.rpartition(":")
-    try:
-        if module_name.endswith(".py"):
-            path = Path(module_name)
-            if not path.is_file():
-                raise ImportError(f"no file {module_name}")
-            loader_spec = importlib.util.spec_from_file_location(path.stem, path)
-            module = importlib.util.module_from_spec(loader_spec)
-            loader_spec.loader.exec_module(module)
-        else:
-            if os.getcwd() not in sys.path:
-                sys.path.append(os.getcwd())
-            module = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise InputError(f"method {spec!r}: cannot import module {module_name!r} ({exc}); "
-                         "give --method module:function or path/to/file.py:function") from exc
-    except SyntaxError as exc:
-        raise InputError(f"method {spec!r}: {exc.filename or module_name}, line {exc.lineno}: "
-                         f"syntax error ({exc.msg}): fix the file") from None
-    except (Exception, SystemExit) as exc:  # the user's module failed while it was imported
-        what = f"sys.exit({exc.code!r})" if isinstance(exc, SystemExit) else \
-            f"{type(exc).__name__}: {exc}"
-        raise InputError(f"method {spec!r}: importing {module_name!r} failed ({what}): "
-                         "fix the module so that it imports") from None
-    func = getattr(module, attr, None)
-    if not callable(func):
-        raise InputError(f"method {spec!r}: module {module_name!r} has no function {attr!r}")
-    return Method(name=spec, function=func, summary=(func.__doc__ or "").strip().split("\n")[0],
-                  family="user", scaled=False)
-
 
 
 class Request(NamedTuple):
@@ -143,7 +113,7 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
     judging (for the answer's derivatives). See :func:`solve`.
     """
     spec, tol, max_iter, options = request
-    method = spec.name
+    method = spec.name  # a callable given as the method is known by its name
     if problem.pending and not spec.runs(problem, options, warm_start).matches(problem):
         raise InputError(f"method {method!r} solves the QP as it is, and this problem's target "
                          "load is not matched yet: solve it with signorini.solve (load control "
@@ -153,7 +123,8 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
             takers = ", ".join(m.name for m in REGISTRY.values() if "warm_start" in m.options)
             raise InputError(f"method {method!r} takes no warm start: give warm_start to one of "
                              f"{takers}")
-        options = {**options, "warm_start": warm_start}
+        fits = WarmStart.of(warm_start).check_fits(problem.n, problem.m)
+        options = {**options, "warm_start": fits}
     log.info("solving %d dofs, %d contact candidates with %s", problem.n, problem.m, method)
     start = time.perf_counter()
     tol, max_iter = spec.defaults_for(tol, max_iter)
@@ -165,10 +136,12 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
         except InputError:
             raise
         except Exception as exc:  # a backend's own error (CHOLMOD on a singular K): a failed run
-            log.warning("method %s raised %s: %s", method, type(exc).__name__, exc)
-            solution = ContactSolution.failure(
-                method, problem, "failed", f"{type(exc).__name__}: {exc}",
-                solve_time=time.perf_counter() - start)
+            said, trace = user.raised(exc)
+            log.warning("method %s raised %s", method, said)
+            log.info("the traceback of method %s:\n%s", method, trace)
+            solution = ContactSolution.failure(method, problem, "failed", said,
+                                               solve_time=time.perf_counter() - start)
+            solution.extras["traceback"] = trace
         except SystemExit as exc:  # a method that exits ends neither the run nor fakes its success
             solution = ContactSolution.failure(
                 method, problem, "failed", f"the method called sys.exit({exc.code!r})",

@@ -15,7 +15,11 @@ observed contraction of the steps, ``‖Δλ‖ q / (1 − q)``, is below
 ``DISTANCE_MARGIN · tol ‖λ‖`` (the paper's own test is on ``‖Δλ‖``; without the
 factor ``q / (1 − q)`` it stops far from the answer when the dual is
 ill-conditioned; the margin because that estimate lands on the tolerance itself,
-and the certificate's forward error of λ then just above it).
+and the certificate's forward error of λ then just above it) — and the KKT
+certificate, with the method's factorisation and W, backs the answer at ``tol``.
+When it does not (the estimate is a heuristic, and FISTA's steps do not contract
+evenly), the margin is halved and the iteration goes on: the method stops
+certified, or at ``max_iter`` saying why.
 
 With ``operator="delassus"`` (the default when m ≤ 2000) the m × m matrix
 ``W`` is formed once by m back-solves and each iteration costs a dense
@@ -40,10 +44,12 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.forward_error import WithDelassus
+from signorini.kkt import certificate, shortfall
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
 from signorini.problem import ContactProblem, ContactSolution
-from signorini.solvers.base import Method
+from signorini.solvers.base import Method, acceptance
 from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
 
@@ -112,7 +118,16 @@ def _operator(problem: ContactProblem, factor, choice: str):
         return choice, normal_displacement, None
     W = delassus(problem.N, factor)
     free = problem.N @ factor.solve(problem.f)
-    return choice, (lambda lam: free - W @ lam), (lambda x: W @ x)
+    return choice, (lambda lam: free - W @ lam), W
+
+
+def _uncertified(problem: ContactProblem, lam: np.ndarray, u: np.ndarray, factor,
+                 W: np.ndarray | None, tol: float) -> str | None:
+    """Why the certificate (:func:`signorini.kkt.certificate`, with this factorisation and W)
+    does not back ``(u, λ)`` at ``tol``; None when it does."""
+    offered = factor if W is None else WithDelassus(factor, problem.N, W)
+    candidate = ContactSolution("uzawa", u, lam, "converged", factor=offered)
+    return shortfall(certificate(problem, candidate), acceptance(tol))
 
 
 def solve_nesterov(problem: ContactProblem, *, tol: float | None = None,
@@ -131,7 +146,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     tol, max_iter = resolved(_name, "dual", tol, max_iter)
     start = time.perf_counter()
     factor = factorize(problem.K)
-    choice, normal_displacement, apply_W = _operator(problem, factor, opts["operator"])
+    choice, normal_displacement, W = _operator(problem, factor, opts["operator"])
+    apply_W = None if W is None else (lambda x: W @ x)
 
     def displacement(lam: np.ndarray) -> np.ndarray:
         return factor.solve(problem.f - problem.N.T @ lam)
@@ -157,13 +173,14 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     iteration = 0
     u_norm = float(np.max(np.abs(displacement(lam))))  # refreshed before convergence is declared
     lam_prev, Nu_prev, momentum, restarts = lam, None, 1.0, 0
+    margin, doubt = DISTANCE_MARGIN, None  # the stop estimate's margin, what the certificate said
     for iteration in range(1, max_iter + 1):
         Nu = normal_displacement(lam)
         violation = Nu - problem.d
         primal, natural = dual_residuals(problem, violation, Nu, lam, u_norm)
         kkt = max(primal, natural)
         lam_norm = float(np.max(lam)) or 1.0
-        if kkt <= tol and _distance_estimate(history["step"]) <= DISTANCE_MARGIN * tol * lam_norm:
+        if kkt <= tol and _distance_estimate(history["step"]) <= margin * tol * lam_norm:
             u_norm = float(np.max(np.abs(displacement(lam))))
             primal, natural = dual_residuals(problem, violation, Nu, lam, u_norm)
             kkt = max(primal, natural)
@@ -171,9 +188,15 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         history["natural"].append(natural)
         if opts["callback"] is not None:
             opts["callback"](iteration, lam, displacement)
-        if kkt <= tol and _distance_estimate(history["step"]) <= DISTANCE_MARGIN * tol * lam_norm:
-            status, message = "converged", f"KKT residual {kkt:.1e} ≤ {tol:.0e} ({choice} operator)"
-            break
+        if kkt <= tol and _distance_estimate(history["step"]) <= margin * tol * lam_norm:
+            doubt = _uncertified(problem, lam, displacement(lam), factor, W, tol)
+            if doubt is None:
+                status, message = "converged", f"KKT residual {kkt:.1e} ≤ {tol:.0e} ({choice} operator)"
+                break
+            if history["step"] and history["step"][-1] == 0.0:  # λ no longer moves: say why
+                status, message = "inaccurate", f"λ stopped moving uncertified: {doubt}"
+                break
+            margin /= 2  # the estimate of the distance was short: ask it for more
         if accelerated and Nu_prev is not None:
             # FISTA: a projected gradient step from y = λ + β(λ − λ_prev); N u(y) is affine in y
             next_momentum = 0.5 * (1.0 + np.sqrt(1.0 + 4.0 * momentum ** 2))
@@ -199,14 +222,19 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
             limit = divergence_factor * size
         if not np.isfinite(size) or (limit is not None and size > limit):
             status = "diverged"
+            why = (f"ρ = {rho * own:.3g} exceeds 2/λ_max(W) = {2 * own / lam_max:.3g}; lower "
+                   "rho or step_fraction" if rho * lam_max >= 2.0 else
+                   f"ρ = {rho * own:.3g} is within the step bound, so the dual is unbounded: no u "
+                   "satisfies N u ≤ d (the constraints are infeasible); check N and d")
             message = (f"|λ| grew beyond {divergence_factor:.0e} × its first value at "
-                       f"iteration {iteration}: ρ = {rho * own:.3g} exceeds 2/λ_max(W) = "
-                       f"{2 * own / lam_max:.3g}; lower rho or step_fraction")
+                       f"iteration {iteration}: {why}")
             break
     # the step bounds: FISTA needs ρ ≤ 1/λ_max(W), plain Uzawa ρ < 2/λ_max(W)
     nesterov = opts["acceleration"] == "nesterov"
     bound = 1.0 if nesterov else 2.0
     beyond = rho * lam_max > bound * (1 + 1e-9) if nesterov else rho * lam_max >= bound
+    if status == "max_iter" and doubt is not None:
+        message += f"; its own stopping test held but the certificate did not: {doubt}"
     if status == "max_iter" and beyond:
         message += (f"; ρ·λ_max(W) = {rho * lam_max:.2f} {'>' if nesterov else '≥'} {bound:g}, "
                     "beyond the convergence bound: lower rho or step_fraction")

@@ -123,7 +123,7 @@ def answer_record(solution: ContactSolution) -> dict[str, Any]:
             "claimed_status": solution.claimed_status, "message": solution.message,
             "iterations": int(solution.iterations), "build_time": solution.build_time,
             "solve_time": solution.solve_time, "u": solution.u.tolist(),
-            "lam": solution.lam.tolist()}
+            "lam": solution.lam.tolist(), "traceback": solution.extras.get("traceback", "")}
 
 
 def answer_from(record: dict[str, Any]) -> ContactSolution:
@@ -132,7 +132,9 @@ def answer_from(record: dict[str, Any]) -> ContactSolution:
                            lam=np.array(record["lam"], dtype=float), status=record["status"],
                            message=record["message"], iterations=record["iterations"],
                            build_time=record["build_time"], solve_time=record["solve_time"],
-                           claimed_status=record["claimed_status"])
+                           claimed_status=record["claimed_status"],
+                           extras={"traceback": record["traceback"]} if record.get("traceback")
+                           else {})
 
 
 def forward_error(problem: ContactProblem, reference: ContactSolution,

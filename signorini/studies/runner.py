@@ -32,12 +32,10 @@ restarted and the study goes on. A ``fresh`` task gets a process of its own
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import logging
 import os
 import sys
-import tempfile
 import time
 from typing import Any, Callable, Sequence
 
@@ -57,7 +55,6 @@ from signorini.solvers.base import Method
 from signorini.solvers.base import acceptance
 from signorini.solvers.registry import get_method
 from signorini.studies.measures import (
-    answer_from,
     answer_record,
     bound_at_solution,
     certificate_of,
@@ -86,7 +83,7 @@ from signorini.studies.task import (
     task_row,
     verdict,
 )
-from signorini.studies.worker import Worker, die_with_parent
+from signorini.studies.worker import Worker, die_with_parent, in_worker, solve_within
 
 log = logging.getLogger(__name__)
 
@@ -108,7 +105,7 @@ EXTRA_STATUSES = ("built", "checked", "ran", "refused", "input-error", "raised",
 
 __all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "COMMAND", "CROSSCHECK", "DEFAULT_TIME_LIMIT",
            "EXTRA_STATUSES", "ITERATION_CAPS", "MEASURES", "NEAR_FACTOR", "NUMERIC", "Row", "Task",
-           "Worker", "in_worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "task_row"]
+           "Worker", "in_worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "solve_within", "task_row"]
 #: the verdicts on a row (the name the tests know)
 _verdict = verdict
 
@@ -361,47 +358,6 @@ def _run_here(task: Task, cache: _Cache) -> Row:
         return failed_row(task, exc)
 
 
-def solve_within(problem: ContactProblem, spec: dict[str, Any], method: str, time_limit: float, *,
-                 tol: float | None = None, max_iter: int | None = None,
-                 options: dict[str, Any] | None = None) -> ContactSolution:
-    """One solve in a worker process of its own, stopped after ``time_limit`` seconds.
-
-    ``spec`` describes ``problem`` (:func:`~signorini.studies.problems.build_spec`)
-    so that the worker can build it again. Returns the package's answer, judged
-    in the worker, or a ``failed`` solution saying that the run was stopped or
-    that the worker died (a method that hangs or ends the process costs its
-    limit, not the run); InputError when the worker refused the input.
-    """
-    task = Task(axis="solve", case=str(spec.get("scene", spec["kind"])), value="", problem=spec,
-                method=method, tol=tol, max_iter=max_iter, options=dict(options or {}),
-                reference={"kind": "none"}, measure=("answer",), fresh=True)
-    row = Worker(time_limit).run(task)
-    if row.get("wrapper") == "input-error":
-        raise InputError(row.get("message", "the worker refused the input"))
-    if "answer" in row:
-        return answer_from(row["answer"])
-    return ContactSolution.failure(method, problem, "failed",
-                                   row.get("message") or f"the run ended {row.get('status')}")
-
-
-def in_worker(method: Method, time_limit: float = float("inf")) -> Method:
-    """``method`` run in a worker process of its own on a stored copy of each problem.
-
-    Whatever the method does to its process (ends it, closes stdout, prints,
-    changes the working folder) costs its run only: the answer is then a
-    ``failed`` solution saying so.
-    """
-    def function(problem: ContactProblem, *, tol: float | None = None,
-                 max_iter: int | None = None, **options: Any) -> ContactSolution:
-        with tempfile.TemporaryDirectory(prefix="signorini-") as folder:
-            path = os.path.join(folder, "problem.npz")
-            problem.save(path)
-            return solve_within(problem, {"kind": "stored", "path": path}, method.name,
-                                time_limit, tol=tol, max_iter=max_iter, options=options)
-
-    return dataclasses.replace(method, function=function)
-
-
 def run_tasks(tasks: Sequence[Task], *, isolate: bool = True, time_limit: float = DEFAULT_TIME_LIMIT,
               progress: Callable[[int, int, Task, Row], None] | None = None) -> list[Row]:
     """Run ``tasks`` in order: in a worker process with a time limit, or in this process.
@@ -414,6 +370,9 @@ def run_tasks(tasks: Sequence[Task], *, isolate: bool = True, time_limit: float 
     try:
         for index, task in enumerate(tasks, start=1):
             row = worker.run(task) if worker is not None else _run_here(task, cache)
+            if worker is not None and ":" in task.method and worker.output.strip() \
+                    and row.get("status") != "converged":  # what a user's method wrote, shown
+                log.warning("method %s wrote:\n%s", task.method, worker.output.rstrip())
             row = {k: (float("nan") if v is None and k in NUMERIC else v) for k, v in row.items()}
             rows.append(row)
             if progress is not None:

@@ -2,11 +2,15 @@
 
 The child runs :func:`signorini.studies.runner.serve_worker`; a task that
 takes longer than the limit, or a child that dies, costs one row and a new child.
+Each child leads a process group of its own, killed whole when the child is stopped:
+what a method started ends with it. :func:`solve_within` is one solve in a child of its
+own (a user's method: its traceback and what it wrote come back to be shown).
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import logging
 import os
@@ -17,15 +21,21 @@ import sys
 import tempfile
 import time
 import weakref
+from typing import Any
 
 from signorini.errors import InputError
 from signorini.files import plain
+from signorini.problem import ContactProblem, ContactSolution
+from signorini.solvers.base import Method
 from signorini.solvers import cluster
+from signorini.studies.measures import answer_from
 from signorini.studies.task import DEFAULT_TIME_LIMIT, Row, Task, task_row, verdict
 
 log = logging.getLogger(__name__)
 #: the workers of this process that may have a child running (see :func:`stop_all`)
 _LIVE: "weakref.WeakSet[Worker]" = weakref.WeakSet()
+#: the most of a task's output kept to be shown (its last bytes)
+OUTPUT_KEPT = 1 << 16
 
 
 def stop_all() -> None:
@@ -61,6 +71,9 @@ class Worker:
         self._stderr = None
         self._buffer = b""
         self._ranks = 1
+        self._written = 0
+        #: what the last task wrote on stdout and stderr (a method's prints, its warnings)
+        self.output = ""
 
     def _start(self, ranks: int) -> None:
         command = [sys.executable, "-c",
@@ -86,11 +99,10 @@ class Worker:
                     self._proc.wait(timeout=grace)
             except (OSError, subprocess.TimeoutExpired):
                 pass
-            if self._proc.poll() is None:
-                try:
-                    os.killpg(self._proc.pid, signal.SIGKILL)
-                except ProcessLookupError:
-                    pass
+            # the whole process group, also when the worker ended by itself: what a method
+            # started (a forked child, a shell) ends with it
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(self._proc.pid, signal.SIGKILL)
             self._proc.wait()
             try:
                 self._proc.stdout.close()
@@ -101,12 +113,22 @@ class Worker:
             self._stderr.close()
             self._stderr = None
 
-    def _last_error_line(self) -> str:
+    def _written_since(self, start: int) -> str:
+        """What the child wrote from byte ``start`` on (read without moving the offset the
+        child writes at)."""
         if self._stderr is None:
             return ""
-        self._stderr.seek(0)
-        lines = self._stderr.read().decode(errors="replace").strip().splitlines()
+        fd = self._stderr.fileno()
+        size = os.fstat(fd).st_size
+        start = max(start, size - OUTPUT_KEPT)
+        return os.pread(fd, size - start, start).decode(errors="replace") if size > start else ""
+
+    def _last_error_line(self) -> str:
+        lines = self._written_since(0).strip().splitlines()
         return lines[-1] if lines else ""
+
+    def _task_output(self) -> None:
+        self.output = self._written_since(self._written)
 
     def run(self, task: Task) -> Row:
         """The row of ``task``, or a ``timeout``/``crashed`` row.
@@ -128,6 +150,7 @@ class Worker:
                 self._start(task.ranks)
             except InputError as exc:  # no mpirun, or more ranks than cores
                 return self._lost(task, "input-error", str(exc))
+        self._written = os.fstat(self._stderr.fileno()).st_size
         try:
             self._proc.stdin.write((json.dumps(plain(task.as_dict())) + "\n").encode())
             self._proc.stdin.flush()
@@ -154,12 +177,15 @@ class Worker:
             except ValueError:  # not a row: something else printed under mpirun
                 log.debug("worker output: %s", line[:200])
                 continue
+            self._task_output()
             if task.fresh:
                 self.stop()
             return row
 
     def _lost(self, task: Task, status: str, message: str = "") -> Row:
         detail = self._last_error_line() if status == "crashed" else ""
+        if self._stderr is not None:
+            self._task_output()
         self.stop(grace=0.0)
         if not message:
             message = (f"no answer within {self.time_limit:g} s: the run was stopped"
@@ -169,3 +195,52 @@ class Worker:
                   message=message,
                   time_s=self.time_limit if status == "timeout" else float("nan"))
         return verdict(row, task)
+
+
+def solve_within(problem: ContactProblem, spec: dict[str, Any], method: str, time_limit: float, *,
+                 tol: float | None = None, max_iter: int | None = None,
+                 options: dict[str, Any] | None = None) -> ContactSolution:
+    """One solve in a worker process of its own, stopped after ``time_limit`` seconds.
+
+    ``spec`` describes ``problem`` (:func:`~signorini.studies.problems.build_spec`)
+    so that the worker can build it again. Returns the package's answer, judged
+    in the worker, or a ``failed`` solution saying that the run was stopped or
+    that the worker died (a method that hangs or ends the process costs its
+    limit, not the run); InputError when the worker refused the input.
+    """
+    task = Task(axis="solve", case=str(spec.get("scene", spec["kind"])), value="", problem=spec,
+                method=method, tol=tol, max_iter=max_iter, options=dict(options or {}),
+                reference={"kind": "none"}, measure=("answer",), fresh=True)
+    worker = Worker(time_limit)
+    row = worker.run(task)
+    if row.get("wrapper") == "input-error":
+        raise InputError(row.get("message", "the worker refused the input"))
+    solution = answer_from(row["answer"]) if "answer" in row else ContactSolution.failure(
+        method, problem, "failed", row.get("message") or f"the run ended {row.get('status')}")
+    if "traceback" in solution.extras:  # shown with -v, as for a method run in this process
+        log.info("the traceback of method %s:\n%s", method, solution.extras["traceback"])
+    if worker.output.strip():  # what the method printed: shown when it failed, else with -v
+        log.log(logging.INFO if solution.status == "converged" else logging.WARNING,
+                "method %s wrote:\n%s", method, worker.output.rstrip())
+    return solution
+
+
+def in_worker(method: Method, time_limit: float = float("inf")) -> Method:
+    """``method`` run in a worker process of its own on a stored copy of each problem.
+
+    Whatever the method does to its process (ends it, closes stdout, prints,
+    changes the working folder) costs its run only: the answer is then a
+    ``failed`` solution saying so.
+    """
+    def function(problem: ContactProblem, *, tol: float | None = None,
+                 max_iter: int | None = None, **options: Any) -> ContactSolution:
+        with tempfile.TemporaryDirectory(prefix="signorini-") as folder:
+            path = os.path.join(folder, "problem.npz")
+            problem.save(path)
+            return solve_within(problem, {"kind": "stored", "path": path}, method.name,
+                                time_limit, tol=tol, max_iter=max_iter, options=options)
+
+    return dataclasses.replace(method, function=function)
+
+
+__all__ = ["OUTPUT_KEPT", "Worker", "die_with_parent", "in_worker", "solve_within", "stop_all"]
