@@ -24,14 +24,13 @@ from typing import Any
 
 import numpy as np
 
-from signorini import derivatives, kkt, loading
+from signorini import derivatives, kkt, load_control
 from signorini.errors import InputError
 from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.kkt import Certificate
 from signorini.pressure import ContactProfile, contact_profile, load_resultant
 from signorini.problem import ContactProblem
 from signorini.references import Reference, reference_of, summary_lines
-from signorini import load_control
 from signorini.scenes import SCENES, SceneFamily, build_problem
 from signorini.scenes.adapt import parse_target, solve_adaptive as adapt
 from signorini.scenes.base import scene_params
