@@ -41,7 +41,7 @@ from signorini.scenes.base import (VOLUMETRIC, Param, SceneFamily, at_least, len
                                    poisson_ratio, positive)
 from signorini.scenes.size import CountedSize
 
-__all__ = ["FAMILY", "patch_pressure"]
+__all__ = ["FAMILY", "compliance", "patch_pressure"]
 
 #: the analytic reference (signorini.references) this family's problems compare with
 REFERENCE = "uniform"
