@@ -30,7 +30,11 @@ RECORD_PARAMS = {"hertz-2d": {"R": "R"}, "hertz-3d": {"R": "R"}, "reverse-hertz"
                  "punch": {"a": "a", "corner_radius": "corner_radius"}, "uniform": {"H": "H"}}
 #: the records of two-body families, from their parameters
 TWO_BODIES = {"two-block-patch": lambda p: {"H": p["H1"] + p["H2"],
-                                            "E_star": (p["H1"] + p["H2"]) / compliance(p)}}
+                                            "E_star": (p["H1"] + p["H2"]) / compliance(p)},
+              "hertz-two-cylinders": lambda p: {
+                  "R": 1.0 / (1.0 / p["R1"] + 1.0 / p["R2"]),
+                  "E_star": 1.0 / (1.0 / contact_modulus(p["E1"], p["nu1"])
+                                   + 1.0 / contact_modulus(p["E2"], p["nu2"]))}}
 #: coarse meshes, so that building every family stays quick
 COARSE = {"punch": {"n_contact": 16, "grading": 0.6}, "reverse-hertz": {"n_contact": 16, "grading": 0.6},
           "hertz-sphere-3d": {"n_contact": 4, "grading": 1.0}}

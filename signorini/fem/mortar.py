@@ -15,7 +15,10 @@ keeps the package's one sign convention and ``λ ≥ 0`` is compressive.
   function ψₛ and integrated over the slave face, ∫ ψₛ [(u¹ − u²)·n − g] ds ≤ 0.
   Each master segment is projected onto each slave segment along the slave
   normal; on each overlap piece a two-point Gauss rule is exact (the integrands
-  are quadratic in the slave coordinate). ``Dₛₖ = ∫ ψₛ φ¹ₖ``,
+  are quadratic in the slave coordinate), and n is the master segment's normal
+  reversed, as node-to-segment takes it (on curved faces the direction of the
+  rows is then the same in both, and the rows of a body on a flat are those of
+  a rigid flat's). ``Dₛₖ = ∫ ψₛ φ¹ₖ``,
   ``Mₛⱼ = ∫ ψₛ φ²ⱼ`` and the weighted gap ``g̃ₛ = ∫ ψₛ g``. The standard basis
   ψₛ = φₛ has D lumped to ``diag(∫ φₛ)``; the dual (biorthogonal) basis
   ψₛ = 2φₛ − φₒ on each slave segment (o the segment's other node) has
@@ -61,7 +64,8 @@ GAUSS_WEIGHTS = 0.5 * np.polynomial.legendre.leggauss(2)[1]
 class Face:
     """A P1 boundary face in 2D: its nodes, their coordinates, segments and outward normals.
 
-    ``nodes`` (k,) are the mesh's node numbers, ``points`` (2, k) their
+    ``nodes`` (k,) are the mesh's node numbers (in order along the face when it is one open
+    chain of segments, else by number), ``points`` (2, k) their
     coordinates, ``segments`` (2, e) index ``nodes`` and ``normals`` (2, e)
     are the segments' outward unit normals (out of the body).
     """
@@ -78,7 +82,9 @@ class Face:
         if mesh.p.shape[0] != 2 or facets.size == 0:
             raise InputError("a contact face needs boundary facets (edges) of a 2D mesh")
         ends = mesh.facets[:, facets]
-        nodes, local = np.unique(ends, return_inverse=True)
+        nodes = _along(ends)
+        local = np.searchsorted(np.sort(nodes), ends)
+        local = np.argsort(nodes)[local]
         tangent = mesh.p[:, ends[1]] - mesh.p[:, ends[0]]
         normal = np.array([tangent[1], -tangent[0]])
         inside = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
@@ -96,6 +102,23 @@ class Face:
         """Lumped weights ``∫ φₛ ds`` of the face's nodes (k,): half of each segment to each end."""
         return np.bincount(self.segments.ravel(), np.tile(0.5 * self.lengths, 2),
                            minlength=self.nodes.size)
+
+
+def _along(ends: np.ndarray) -> np.ndarray:
+    """The nodes of segments ``ends`` (2, e) in order along them when they make one open chain
+    (from the end with the smaller node number), else sorted by number."""
+    nodes, counts = np.unique(ends, return_counts=True)
+    if nodes.size != ends.shape[1] + 1 or np.count_nonzero(counts == 1) != 2 or counts.max() > 2:
+        return nodes
+    neighbours: dict[int, list[int]] = {int(n): [] for n in nodes}
+    for a, b in ends.T:
+        neighbours[int(a)].append(int(b))
+        neighbours[int(b)].append(int(a))
+    chain = [int(nodes[counts == 1][0])]
+    while len(chain) < nodes.size:
+        step = [n for n in neighbours[chain[-1]] if len(chain) < 2 or n != chain[-2]]
+        chain.append(step[0])
+    return np.array(chain)
 
 
 @dataclass(frozen=True)
@@ -228,7 +251,8 @@ def mortar(slave: Face, master: Face, basis: str = "dual") -> Coupling:
 
     Segment to segment on the slave face: each master segment that faces a
     slave segment (opposite normals) is projected onto it along the slave
-    normal, the overlap is integrated by two Gauss points, and ``Dₛₖ``,
+    normal, the overlap is integrated by two Gauss points with n the master
+    segment's normal reversed, and ``Dₛₖ``,
     ``Mₛⱼ``, ``g̃ₛ`` and ``wₛ = ∫ φₛ ds`` accumulate over the overlaps with
     ψₛ the ``basis`` ("dual": biorthogonal, "standard": ψₛ = φₛ with D lumped).
     Slave nodes the master face does not reach get no row.
@@ -260,18 +284,19 @@ def mortar(slave: Face, master: Face, basis: str = "dual") -> Coupling:
         psi = _multiplier(eta, basis)
         y0, y1 = master_ends[:, 0, pieces][..., None], master_ends[:, 1, pieces][..., None]
         across = (y0 + xi * (y1 - y0) - (x0[:, None, None] + eta * t[:, None, None]))
-        g = np.einsum("i,ipq->pq", n, across)  # normal distance from slave to master
+        normal = -master.normals[:, pieces]  # (2, p): the master's normal, as node-to-segment
+        g = np.einsum("ip,ipq->pq", normal, across)  # normal distance from slave to master
         slave_pair, master_pair = np.array([a, b]), master.segments[:, pieces]  # (2,), (2, p)
         mm = np.einsum("ipq,jpq,pq->ijp", psi, phi_m, dw)  # ∫ψᵢ φ²ⱼ on each piece
-        if basis == "standard":
-            dd = np.diag(np.einsum("ipq,pq->i", phi_s, dw))  # lumped: ∫ φᵢ on the diagonal
+        if basis == "standard":  # lumped: ∫ φᵢ on the diagonal
+            dd = np.einsum("ik,ipq,pq->ikp", np.eye(2), phi_s, dw)
         else:
-            dd = np.einsum("ipq,kpq,pq->ik", psi, phi_s, dw)
-        add_d(slave_pair[:, None], slave_pair[None, :], dd)
+            dd = np.einsum("ipq,kpq,pq->ikp", psi, phi_s, dw)
+        add_d(slave_pair[:, None], slave_pair[None, :], dd.sum(axis=2))
         add_m(slave_pair[:, None, None], master_pair[None], mm)
         for c in range(2):
-            add_sr(slave_pair[:, None], 2 * slave_pair[None, :] + c, dd * n[c])
-            add_mr(slave_pair[:, None, None], 2 * master_pair[None] + c, -mm * n[c])
+            add_sr(slave_pair[:, None, None], 2 * slave_pair[None, :, None] + c, dd * normal[c])
+            add_mr(slave_pair[:, None, None], 2 * master_pair[None] + c, -mm * normal[c])
         np.add.at(gap, slave_pair, np.einsum("ipq,pq,pq->i", psi, g, dw))
         np.add.at(weights, slave_pair, np.einsum("ipq,pq->i", phi_s, dw))
     coupling = Coupling(kind="mortar" if basis == "dual" else "mortar-standard",

@@ -87,6 +87,7 @@ def _check_held(body: Body, which: str) -> None:
 def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar", *,
                         length_scale: float, force_multiplicity: float = 1.0,
                         reference: ReferenceData | None = None, params: dict[str, Any] | None = None,
+                        target_load: float | None = None, predicted: Any = None,
                         nondimensionalise: bool = True) -> ContactProblem:
     """The contact QP of two bodies: ``K = diag(K¹, K²)``, f, N, d, weights, points, scales.
 
@@ -96,6 +97,11 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     as :func:`signorini.fem.assembly.assemble` makes them: lengths by
     ``length_scale``, displacements by the largest prescribed one, stresses
     by the pair's contact modulus E* (:func:`series_modulus`).
+
+    ``target_load`` (the full pair, scene units) leaves the problem pending:
+    load control scales the prescribed push until the contact resultant along
+    y is that load; ``predicted(points)`` says which slave nodes (physical
+    coordinates, (k, 2)) the scene expects in contact, where load control starts.
     """
     start = time.perf_counter()
     _check_held(slave, "slave")
@@ -140,16 +146,23 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     offset = float(load_full[fixed] @ u_D)
     pushed = [-v for body in (slave, master) for c, nodes, v in body.dirichlet
               if c == 1 and np.isin(nodes, body.load_nodes).any()]
-    push = Push(f1=f, d0=d0, d1=d1, offset1=offset, scale=1.0,
-                delta=max(pushed) if pushed else None)
+    points = mesh.p[:, slave_face.nodes[coupling.slave]].T
+    # each row's share of the resultant along y: the y-part of its slave normal, reversed
+    resultant = -np.asarray(N_full[:, dof_table[1, slave_face.nodes]].sum(axis=1)).ravel()
+    target = None if target_load is None else target_load / (stress * U)
+    push = Push(f1=f, d0=d0, d1=d1, offset1=offset, scale=1.0, target=target,
+                pending=target is not None,
+                resultant=None if np.all(resultant == 1.0) else resultant,
+                delta=max(pushed) if pushed else None, P=target_load)
     discretisation_record = Discretisation(
         mesh=mesh, free_dofs=free, prescribed=prescribed, load_row=load_full[free],
         load_offset=offset, E=float(slave.E), nu=float(slave.nu),
         volumetric=resolve(slave.volumetric, slave.nu), reference=reference,
-        params=dict(params or {}, discretisation=discretisation), push=push)
+        params=dict(params or {}, discretisation=discretisation), push=push,
+        predicted_contact=None if predicted is None else np.asarray(predicted(points * L)))
     problem = ContactProblem(
         K=K_II, f=f, N=N_full[:, free].tocsr(), d=d0 + d1, weights=coupling.weights / L,
-        contact_points=mesh.p[:, slave_face.nodes[coupling.slave]].T,
+        contact_points=points,
         force_multiplicity=force_multiplicity,
         scales=Scales(length=L, displacement=U, force=stress * U, weight=L),
         discretisation=discretisation_record)
@@ -171,6 +184,8 @@ class TwoBodyModel:
     force_multiplicity: float = 1.0
     reference: ReferenceData | None = None
     params: dict[str, Any] = field(default_factory=dict)
+    target_load: float | None = None
+    predicted: Any = None
 
     def assemble(self, nondimensionalise: bool = True) -> ContactProblem:
         """The model's contact QP (:func:`assemble_two_bodies`)."""
@@ -178,4 +193,5 @@ class TwoBodyModel:
                                    length_scale=self.length_scale,
                                    force_multiplicity=self.force_multiplicity,
                                    reference=self.reference, params=self.params,
+                                   target_load=self.target_load, predicted=self.predicted,
                                    nondimensionalise=nondimensionalise)

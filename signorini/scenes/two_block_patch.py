@@ -41,20 +41,31 @@ from signorini.scenes.base import (VOLUMETRIC, Param, SceneFamily, at_least, len
                                    poisson_ratio, positive)
 from signorini.scenes.size import CountedSize
 
-__all__ = ["FAMILY", "compliance", "patch_pressure"]
+__all__ = ["DISCRETISATION", "FAMILY", "compliance", "materials", "patch_pressure"]
 
 #: the analytic reference (signorini.references) this family's problems compare with
 REFERENCE = "uniform"
+
+#: how the two contact faces are coupled (signorini.fem.mortar)
+DISCRETISATION = Param("discretisation", "mortar", "mortar: dual (biorthogonal) mortar; "
+                       "mortar-standard: standard mortar, D lumped; nts: node-to-segment, one pass",
+                       kind=str, check=one_of(*DISCRETISATIONS))
+
+
+def materials(first: str, second: str) -> tuple[Param, ...]:
+    """The parameters E1, nu1 of the body named ``first`` and E2, nu2 of ``second``."""
+    return tuple(Param(f"{name}{k}", default, f"{what} of the {body}", check=check)
+                 for k, body in ((1, first), (2, second))
+                 for name, default, what, check in (("E", 1.0, "Young's modulus", positive),
+                                                    ("nu", 0.3, "Poisson's ratio", poisson_ratio)))
+
 
 PARAMS = (
     Param("W", 1.0, "width of both blocks (x = 0 is a symmetry plane of a pair 2W wide)",
           check=length),
     Param("H1", 1.0, "height of the lower block", check=length),
     Param("H2", 1.0, "height of the upper block", check=length),
-    Param("E1", 1.0, "Young's modulus of the lower block", check=positive),
-    Param("nu1", 0.3, "Poisson's ratio of the lower block", check=poisson_ratio),
-    Param("E2", 1.0, "Young's modulus of the upper block", check=positive),
-    Param("nu2", 0.3, "Poisson's ratio of the upper block", check=poisson_ratio),
+    *materials("lower block", "upper block"),
     VOLUMETRIC,
     Param("delta", None, "prescribed downward displacement of the upper block's top (default "
           "0.01 · (H1 + H2); exclusive with p)", check=positive),
@@ -65,9 +76,7 @@ PARAMS = (
     Param("mesh_ratio", 1.7, "elements along the upper (slave) face over the lower (master) "
           "face's: non-matching unless an integer ratio", check=lambda r: None if 1e-3 <= r <= 1e3
           else "in [0.001, 1000]"),
-    Param("discretisation", "mortar", "mortar: dual (biorthogonal) mortar; mortar-standard: "
-          "standard mortar, D lumped; nts: node-to-segment, one pass", kind=str,
-          check=one_of(*DISCRETISATIONS)),
+    DISCRETISATION,
 )
 
 
