@@ -1,6 +1,6 @@
 """Two elastic bodies: the contact patch test and Hertz between two cylinders, per discretisation.
 
-    .venv/bin/python tools/two_bodies.py      # about a minute; writes docs/two-bodies/runs.json
+    .venv/bin/python tools/two_bodies.py      # about three minutes; writes docs/two-bodies/runs.json
 
 Every run is a task of the studies' runner (signorini.studies.runner): pdas (at tol 1e-10 on
 the blocks, 1e-8 on the cylinders: ``CYLINDERS_TOL``) on the scene as signorini.solve builds
@@ -10,8 +10,10 @@ it, measured against the scene's reference.
   H2 = 0.7 above), for each contact discretisation and mesh ratio: the largest relative
   error of the nodal pressures λ/w against the uniform δ / (H1/E1* + H2/E2*).
 - ``cylinders``: hertz-two-cylinders on its default mesh, for equal cylinders, for two
-  materials and radii, and for a stiff large lower cylinder (E2 = 10⁶, R2 = 10³) beside
-  hertz-cylinder (loading=displacement, the same cut pushed flat) at the same load P.
+  materials and radii (also in SI units), and for a stiff large lower cylinder (E2 = 10⁶,
+  R2 = 10³) beside hertz-cylinder at the same load P.
+- ``dissimilar``: equal radii and ν, E1/E2 = 1, 3 and 1/3, on the default mesh and on one
+  twice as fine across the contact.
 
 docs/two-bodies.md quotes the tables that ``tables`` renders from the JSON.
 """
@@ -35,7 +37,11 @@ PATCH = {"E2": 3.0, "nu2": 0.2, "H2": 0.7}
 #: hertz-cylinder's default load (a/R = 0.05, E = 1, ν = 0.3), given to both scenes as P
 RIGID_P = hertz_cylinder_load(0.05, 1.0, contact_modulus(1.0, 0.3))
 PAIRS = {"equal": {}, "different": {"E2": 3.0, "nu2": 0.2, "R2": 2.0},
+         "steel on aluminium, SI": {"E1": 2.1e11, "E2": 7e10, "nu2": 0.33, "R1": 0.01, "R2": 0.02},
          "stiff and large": {"E2": 1e6, "R2": 1e3, "P": RIGID_P}}
+#: E1/E2 (equal radii and ν) on the default mesh and on one twice as fine across the contact
+STIFFNESS_RATIOS = (1.0, 3.0, 1 / 3)
+MESHES = ((40, 0.15), (80, 0.075))
 TIME_LIMIT = 300.0
 #: the certificate's tolerance for the cylinders: the stiff pair's K spans a stiffness contrast of
 #: 10⁶ on elements from 10⁻³ to 250, and its stationarity residual stays near 3e-9 (round-off)
@@ -50,8 +56,11 @@ def cases() -> list[dict]:
              "label": name, "tol": CYLINDERS_TOL, "params": {**params, "discretisation": d}}
             for name, params in PAIRS.items() for d in ("mortar", "nts")]
     out.append({"table": "cylinders", "scene": "hertz-cylinder", "discretisation": "rigid flat",
-                "label": "stiff and large", "tol": CYLINDERS_TOL,
-                "params": {"loading": "displacement", "P": RIGID_P}})
+                "label": "stiff and large", "tol": CYLINDERS_TOL, "params": {"P": RIGID_P}})
+    out += [{"table": "dissimilar", "scene": "hertz-two-cylinders", "discretisation": "mortar",
+             "label": f"{ratio:.3g}", "tol": CYLINDERS_TOL,
+             "params": {"E1": ratio, "n_contact": n_contact, "grading": grading}}
+            for ratio in STIFFNESS_RATIOS for n_contact, grading in MESHES]
     return out
 
 
@@ -87,19 +96,33 @@ def tables(rows: list[dict]) -> dict[str, str]:
         lines.append(f"| {label} | {group['mortar']['dofs']:,} | " + " | ".join(
             f"{group[d]['reference']['pressure_max_rel']:.1e}" for d in DISCRETISATIONS) + " |")
     out = {"patch": "\n".join(lines)}
-    lines = ["| cylinders | scene | discretisation | dofs | a / a_Hertz − 1 | p₀ / p₀,Hertz − 1 | "
-             "a against hertz-cylinder | p₀ against hertz-cylinder |", "|---|---|---|---:|---:|---:|---:|---:|"]
+    lines = ["| cylinders | scene | discretisation | dofs | status | a / a_Hertz − 1 | "
+             "p₀ / p₀,Hertz − 1 | a against hertz-cylinder | p₀ against hertz-cylinder |",
+             "|---|---|---|---:|---|---:|---:|---:|---:|"]
     cylinders = [r for r in rows if r["table"] == "cylinders"]
     rigid = next(r["reference"] for r in cylinders if r["scene"] == "hertz-cylinder")
     for r in cylinders:
         h = r["reference"]
-        against = (f"{100 * (h['a'] / rigid['a'] - 1):+.3f} % | {100 * (h['p0'] / rigid['p0'] - 1):+.3f} %"
+        against = (f"{_pct(h['a'] / rigid['a'] - 1)} | {_pct(h['p0'] / rigid['p0'] - 1)}"
                    if r["label"] == "stiff and large" else "| ").strip()
         lines.append(f"| {r['label']} | {r['scene']} | {r['discretisation']} | {r['dofs']:,} | "
-                     f"{100 * (h['a'] / h['a_ref'] - 1):+.3f} % | "
-                     f"{100 * (h['p0'] / h['p0_ref'] - 1):+.3f} % | {against} |")
+                     f"{r['status']} | {_pct(h['a'] / h['a_ref'] - 1)} | "
+                     f"{_pct(h['p0'] / h['p0_ref'] - 1)} | {against} |")
     out["cylinders"] = "\n".join(lines)
+    lines = ["| E1 / E2 | " + " | ".join(f"n_contact = {n}: dofs, a, p₀" for n, _ in MESHES) + " |",
+             "|---:|" + "---|" * len(MESHES)]
+    dissimilar = [r for r in rows if r["table"] == "dissimilar"]
+    for label in dict.fromkeys(r["label"] for r in dissimilar):
+        cells = [f"{r['dofs']:,}: {_pct(r['reference']['a'] / r['reference']['a_ref'] - 1)}, "
+                 f"{_pct(r['reference']['p0'] / r['reference']['p0_ref'] - 1)}"
+                 for r in dissimilar if r["label"] == label]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    out["dissimilar"] = "\n".join(lines)
     return out
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:+.3f} %"
 
 
 def load() -> list[dict]:

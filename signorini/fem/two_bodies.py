@@ -48,7 +48,10 @@ class Body:
     ``contact_facets`` the boundary facets of its contact face, ``load_nodes``
     the nodes whose y-reactions make up the applied load (a push towards the
     other body is positive; empty for none), ``volumetric`` how K integrates
-    the volumetric strain (:mod:`signorini.fem.volumetric`).
+    the volumetric strain (:mod:`signorini.fem.volumetric`). ``traction`` is
+    ``(facets, direction)``: a cut loaded by a uniform traction along y
+    (direction −1 down, +1 up) whose total is the pair's target load, as
+    Hertz's theory loads a body (None: no traction).
     """
 
     mesh: Any
@@ -58,6 +61,7 @@ class Body:
     contact_facets: np.ndarray
     load_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     volumetric: str = "auto"
+    traction: tuple[np.ndarray, float] | None = None
 
     def stiffness(self, mesh: Any, stress: float) -> sp.csr_matrix:
         """K of the whole body on ``mesh`` (its nodes scaled), E in units of ``stress``."""
@@ -140,18 +144,26 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     K_free = K_full[free]
     K_II, K_ID = K_free[:, free], K_free[:, fixed]
     u_D = prescribed[fixed]
-    f = -(K_ID @ u_D)
+    f1 = -(K_ID @ u_D)
     d0 = coupling.gap / U
     d1 = -(N_full[:, fixed] @ u_D)
-    offset = float(load_full[fixed] @ u_D)
+    offset1 = float(load_full[fixed] @ u_D)
+    target = None if target_load is None else target_load / (stress * U)
+    f_load, offset_load = _cut_traction((slave, master), (0, first), L, dof_table, load_dofs,
+                                        force_multiplicity)
+    if f_load is not None and target is None:
+        raise InputError("a load applied on a cut needs a target load: give P (or a_over_R)")
+    load = 0.0 if f_load is None else target
+    f = f1 + (0.0 if f_load is None else load * f_load[free])
+    offset = offset1 + load * offset_load
     pushed = [-v for body in (slave, master) for c, nodes, v in body.dirichlet
               if c == 1 and np.isin(nodes, body.load_nodes).any()]
     points = mesh.p[:, slave_face.nodes[coupling.slave]].T
     # each row's share of the resultant along y: the y-part of its slave normal, reversed
     resultant = -np.asarray(N_full[:, dof_table[1, slave_face.nodes]].sum(axis=1)).ravel()
-    target = None if target_load is None else target_load / (stress * U)
-    push = Push(f1=f, d0=d0, d1=d1, offset1=offset, scale=1.0, target=target,
-                pending=target is not None,
+    push = Push(f1=f1, d0=d0, d1=d1, offset1=offset1, scale=1.0,
+                f_load=None if f_load is None else f_load[free], offset_load=offset_load,
+                load=load, target=target, pending=target is not None,
                 resultant=None if np.all(resultant == 1.0) else resultant,
                 delta=max(pushed) if pushed else None, P=target_load)
     discretisation_record = Discretisation(
@@ -170,6 +182,31 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     log.info("assembled two bodies: %d free dofs, %d %s rows in %.2f s", problem.n, problem.m,
              discretisation, discretisation_record.assemble_s)
     return problem
+
+
+def _cut_traction(bodies: tuple[Body, Body], offsets: tuple[int, int], L: float,
+                  dof_table: np.ndarray, load_dofs: np.ndarray,
+                  multiplicity: float) -> tuple[np.ndarray | None, float]:
+    """Nodal forces of the bodies' cut tractions per unit load of the full pair (None: no cut
+    is loaded), and the part of the applied load the load dofs' reactions do not see.
+
+    Each cut's uniform traction is ``1 / (μ A)`` along its direction, A the cut's length; its
+    consistent nodal forces are the lumped weights times it (exact for P1).
+    """
+    f_load = np.zeros(dof_table.size)
+    offset_load, loaded = 0.0, False
+    for body, first in zip(bodies, offsets):
+        if body.traction is None:
+            continue
+        facets, direction = body.traction
+        cut = Face.of(MeshTri(body.mesh.p / L, body.mesh.t), facets)
+        weights = cut.weights()
+        dofs = dof_table[1, cut.nodes + first]
+        f_load[dofs] = direction * weights / (multiplicity * weights.sum())
+        loaded = True
+        if len(body.load_nodes):  # the traction on the loaded body's other nodes
+            offset_load += multiplicity * direction * f_load[dofs[~np.isin(dofs, load_dofs)]].sum()
+    return (f_load if loaded else None), offset_load
 
 
 @dataclass(frozen=True)

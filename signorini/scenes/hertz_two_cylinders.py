@@ -5,11 +5,14 @@ centre (0, R1), the lower one (R2, E2, ν2) the quarter above its centre
 (0, −R2); they first touch at the origin. Each is meshed as
 ``hertz-cylinder`` meshes its disc (graded towards the contact, ``n_contact``
 elements across the expected half-width), so the two contact faces do not
-match. The cuts x = 0 are symmetry planes (``u_x = 0``); the lower disc's cut
-through its centre is held (``u_y = 0``) and the upper disc's is pushed down
-flat (``hertz-cylinder``'s ``loading=displacement``), by δ given or by the
-push whose contact resultant is the load P (load control). The upper disc's
-arc is the slave face.
+match. The cuts x = 0 are symmetry planes (``u_x = 0``). By default
+(``loading=traction``, as ``hertz-cylinder``) each disc's cut through its
+centre carries a uniform traction towards the other whose total is the load
+P; the lower centre node is held and the upper one pushed down by δ, which
+load control adjusts until the contact resultant is P (the centre nodes then
+carry no force: they only remove the rigid translations). With
+``loading=displacement``, or a prescribed ``delta``, the lower cut is held
+and the upper cut pushed down flat. The upper disc's arc is the slave face.
 
 Two-body Hertz (Johnson 1985, §4.2): ``1/E* = (1 − ν1²)/E1 + (1 − ν2²)/E2``,
 ``1/R* = 1/R1 + 1/R2``, ``a = √(4PR*/(πE*))`` and ``p₀ = 2P/(πa)``; the
@@ -28,7 +31,7 @@ from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus
-from signorini.scenes.base import (MESHER, VOLUMETRIC, Param, SceneFamily, checked_ratio,
+from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Param, SceneFamily, checked_ratio,
                                    contact_ratio, length, positive)
 from signorini.scenes.hertz_cylinder import PARAMS as CYLINDER_PARAMS
 from signorini.scenes.hertz_cylinder import SIZE as ONE_DISC
@@ -61,6 +64,7 @@ PARAMS = (
           check=positive),
     *(ONE_CYLINDER[name] for name in ("n_contact", "grading", "candidates")),
     DISCRETISATION,
+    LOADING,
     MESHER,
 )
 
@@ -94,16 +98,19 @@ def _disc(p: dict[str, Any], radius: float, a: float, extent: float) -> GradedDi
                                mesher=p["mesher"])
 
 
-def _body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str,
-          mirrored: bool) -> Body:
-    """One cylinder: its quarter disc (mirrored below y = 0 for the lower one) held on its cuts."""
+def _body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str, upper: bool,
+          traction: bool) -> Body:
+    """One cylinder: its quarter disc (mirrored below y = 0 for the lower one) held on its axis,
+    its cut pushed by ``push`` (the lower one's: held), whole or at its centre node under a
+    traction towards the other cylinder."""
     mesh = disc.mesh
-    if mirrored:
+    if not upper:
         mesh = type(mesh)(mesh.p * np.array([[1.0], [-1.0]]), mesh.t[[0, 2, 1]])
-    face = facets_on(mesh, disc.candidates)
-    return Body(mesh=mesh, E=E, nu=nu, dirichlet=[(0, disc.axis, 0.0), (1, disc.top, -push)],
-                contact_facets=face, load_nodes=disc.top if push else np.zeros(0, dtype=int),
-                volumetric=volumetric)
+    held = np.array([disc.centre]) if traction else disc.top
+    return Body(mesh=mesh, E=E, nu=nu, dirichlet=[(0, disc.axis, 0.0), (1, held, -push)],
+                contact_facets=facets_on(mesh, disc.candidates),
+                load_nodes=held if upper else np.zeros(0, dtype=int), volumetric=volumetric,
+                traction=(facets_on(mesh, disc.top), -1.0 if upper else 1.0) if traction else None)
 
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
@@ -114,10 +121,11 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
     delta_nominal = delta if delta is not None else a * a / R
     upper = _disc(p, p["R1"], a, p["candidates"])
     lower = _disc(p, p["R2"], a, MASTER_REACH * p["candidates"])
+    traction = target is not None and p["loading"] == "traction"
     params = dict(p, P=target, delta=delta_nominal, a_over_R=a / R if target is not None else None)
     return TwoBodyModel(
-        slave=_body(upper, p["E1"], p["nu1"], delta_nominal, p["volumetric"], False),
-        master=_body(lower, p["E2"], p["nu2"], 0.0, p["volumetric"], True),
+        slave=_body(upper, p["E1"], p["nu1"], delta_nominal, p["volumetric"], True, traction),
+        master=_body(lower, p["E2"], p["nu2"], 0.0, p["volumetric"], False, traction),
         discretisation=p["discretisation"], length_scale=R, force_multiplicity=2.0,
         reference=ReferenceData(REFERENCE, E_star=E_star, R=R), params=params,
         target_load=target, predicted=lambda points: points[:, 0] < a)
