@@ -39,3 +39,24 @@ def test_a_stiff_large_lower_cylinder_approaches_the_rigid_flat(loading):
     # (Hertz itself moves by 0.05 % between the two: 1/R* = 1.001 here)
     assert abs(two.a / one.a - 1) < 5e-4 and abs(two.p0 / one.p0 - 1) < 5e-4
     assert two.a_ref / one.a_ref == pytest.approx((1 / 1.001) ** 0.5, rel=1e-5)  # E* by 1e-6
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("params, limit", [
+    ({}, 5e-4),  # two equal cylinders, the scene's defaults
+    ({"E1": 2.1e11, "nu1": 0.3, "R1": 0.01, "E2": 7e10, "nu2": 0.33, "R2": 0.02}, 1e-3),  # SI
+], ids=["defaults", "steel-on-aluminium-SI"])
+def test_the_default_mesh_meets_two_body_hertz(params, limit):
+    result = signorini.solve("hertz-two-cylinders", "pdas", params=params)
+    assert result.converged and result.problem.n <= 20_000
+    c = result.comparison
+    assert abs(c.a / c.a_ref - 1) < limit and abs(c.p0 / c.p0_ref - 1) < limit
+
+
+def test_the_rows_follow_the_normal_asked_for():
+    vertical, master = (signorini.build_problem("hertz-two-cylinders",
+                                                params={**COARSE, "normal": normal})
+                        for normal in ("vertical", "master"))
+    for problem, tilted in ((vertical, False), (master, True)):
+        x_dofs = problem.discretisation.free_dofs % 2 == 0  # dofs interleaved by node: x even
+        assert (abs(problem.N[:, x_dofs]).max() > 1e-3) == tilted

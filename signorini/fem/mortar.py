@@ -128,7 +128,7 @@ class Coupling:
     ``slave`` (m,) indexes the slave face's nodes of the rows; ``D`` (m, k¹)
     and ``M`` (m, k²) are the scalar coupling matrices; ``slave_rows``
     (m, 2k¹) and ``master_rows`` (m, 2k²) the rows on the faces' dofs
-    (node-major, x then y: ``D n`` and ``−M n`` with each segment's normal);
+    (node-major, x then y: ``D n`` and ``−M n``, n the master segment's normal reversed);
     ``gap`` the (weighted) initial gaps and ``weights`` ``∫ φₛ ds``.
     """
 
@@ -207,20 +207,28 @@ def _vector(scalar: sp.csr_matrix, normal: np.ndarray) -> sp.csr_matrix:
                          shape=(scalar.shape[0], 2 * scalar.shape[1]))
 
 
-def node_to_segment(slave: Face, master: Face) -> Coupling:
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The 2D cross product ``a₀b₁ − a₁b₀`` of vectors along the first axis (broadcast)."""
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def node_to_segment(slave: Face, master: Face, direction: np.ndarray | None = None) -> Coupling:
     """One-pass node-to-segment rows: each slave node projected on the master face.
 
-    Slave node s is projected along each master segment's normal (the
-    orthogonal projection onto its line, ξ in [0, 1]); the nearest such point
-    is its partner ξₛ. Its row is ``n`` on u¹ₛ and ``−φⱼ(ξₛ) n`` on the master
-    segment's two nodes, with ``n = −n²`` (the master's outward normal
-    reversed), and its gap ``gₛ = (xₛ − x²(ξₛ))·n²``. Slave nodes that project
-    on no master segment get no row. Weights are the slave face's lumped ``∫ φₛ ds``.
+    Slave node s is projected along each master segment's normal n² (or along
+    the fixed ``direction``, the slave's outward normal, when given) onto the
+    segment's line, ξ in [0, 1]; the nearest such point is its partner ξₛ. Its
+    row is ``n`` on u¹ₛ and ``−φⱼ(ξₛ) n`` on the master segment's two nodes,
+    with ``n = −n²`` (or ``direction``), and its gap ``gₛ = (x²(ξₛ) − xₛ)·n``.
+    Slave nodes that project on no master segment get no row. Weights are the
+    slave face's lumped ``∫ φₛ ds``.
     """
     ends = master.points[:, master.segments]  # (2, 2, e)
     tangent = ends[:, 1] - ends[:, 0]
-    xi = np.einsum("ise,ie->se", slave.points[:, :, None] - ends[:, 0][:, None, :], tangent)
-    xi /= np.einsum("ie,ie->e", tangent, tangent)
+    along = -master.normals if direction is None else np.asarray(direction, float)[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):  # a segment along the direction: no ξ
+        xi = _cross(slave.points[:, :, None] - ends[:, 0][:, None, :], along[:, None, :])
+        xi /= _cross(tangent, along)[None, :]
     on_segment = (xi >= -END_TOLERANCE) & (xi <= 1.0 + END_TOLERANCE)
     xi = np.clip(xi, 0.0, 1.0)
     foot = ends[:, 0][:, None, :] + xi[None] * tangent[:, None, :]  # (2, k, e)
@@ -229,8 +237,8 @@ def node_to_segment(slave: Face, master: Face) -> Coupling:
     keep = np.isfinite(distance[np.arange(slave.nodes.size), nearest])
     k = np.arange(slave.nodes.size)
     xi_s = xi[k, nearest]
-    normal = -master.normals[:, nearest]  # the slave's outward normal: towards the master
-    gap = np.einsum("ik,ik->k", slave.points - foot[:, k, nearest], -normal)
+    normal = along[:, nearest] if direction is None else along[:, [0] * k.size]  # towards the master
+    gap = np.einsum("ik,ik->k", foot[:, k, nearest] - slave.points, normal)
     add_m, build_m = _triplets((slave.nodes.size, master.nodes.size))
     add_m(k[:, None], master.segments[:, nearest].T, np.stack([1.0 - xi_s, xi_s], axis=1))
     D = sp.identity(slave.nodes.size, format="csr")
@@ -246,7 +254,8 @@ def _multiplier(eta: np.ndarray, basis: str) -> np.ndarray:
     return phi if basis == "standard" else 2.0 * phi - phi[::-1]
 
 
-def mortar(slave: Face, master: Face, basis: str = "dual") -> Coupling:
+def mortar(slave: Face, master: Face, basis: str = "dual",
+           direction: np.ndarray | None = None) -> Coupling:
     """Mortar rows: ``D n`` on the slave nodes, ``−M n`` on the master nodes, gap ``g̃``.
 
     Segment to segment on the slave face: each master segment that faces a
@@ -270,7 +279,9 @@ def mortar(slave: Face, master: Face, basis: str = "dual") -> Coupling:
                                  slave.points[:, slave.segments[1]].T, slave.normals.T):
         t = x1 - x0
         h2 = t @ t
-        eta_ends = np.einsum("i,ise->se", t, master_ends - x0[:, None, None]) / h2  # (2, e²)
+        along = n if direction is None else np.asarray(direction, dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):  # along the direction: no piece
+            eta_ends = _cross(master_ends - x0[:, None, None], along) / _cross(t, along)  # (2, e²)
         lo = np.clip(eta_ends.min(axis=0), 0.0, 1.0)
         hi = np.clip(eta_ends.max(axis=0), 0.0, 1.0)
         pieces = np.flatnonzero((hi - lo > END_TOLERANCE) & (n @ master.normals < 0.0))
@@ -284,7 +295,8 @@ def mortar(slave: Face, master: Face, basis: str = "dual") -> Coupling:
         psi = _multiplier(eta, basis)
         y0, y1 = master_ends[:, 0, pieces][..., None], master_ends[:, 1, pieces][..., None]
         across = (y0 + xi * (y1 - y0) - (x0[:, None, None] + eta * t[:, None, None]))
-        normal = -master.normals[:, pieces]  # (2, p): the master's normal, as node-to-segment
+        normal = (-master.normals[:, pieces] if direction is None  # (2, p): as node-to-segment
+                  else np.repeat(np.asarray(direction, dtype=float)[:, None], pieces.size, axis=1))
         g = np.einsum("ip,ipq->pq", normal, across)  # normal distance from slave to master
         slave_pair, master_pair = np.array([a, b]), master.segments[:, pieces]  # (2,), (2, p)
         mm = np.einsum("ipq,jpq,pq->ijp", psi, phi_m, dw)  # ∫ψᵢ φ²ⱼ on each piece
@@ -305,10 +317,13 @@ def mortar(slave: Face, master: Face, basis: str = "dual") -> Coupling:
     return _kept(coupling, weights > 0)
 
 
-def couple(slave: Face, master: Face, discretisation: str = "mortar") -> Coupling:
-    """The rows of ``discretisation`` (one of :data:`DISCRETISATIONS`), unscaled."""
+def couple(slave: Face, master: Face, discretisation: str = "mortar",
+           direction: np.ndarray | None = None) -> Coupling:
+    """The rows of ``discretisation`` (one of :data:`DISCRETISATIONS`), unscaled; with a fixed
+    ``direction`` (the slave's outward unit normal) every row and projection takes it."""
     if discretisation == "nts":
-        return node_to_segment(slave, master)
+        return node_to_segment(slave, master, direction)
     if discretisation in ("mortar", "mortar-standard"):
-        return mortar(slave, master, "dual" if discretisation == "mortar" else "standard")
+        return mortar(slave, master, "dual" if discretisation == "mortar" else "standard",
+                      direction)
     raise InputError(f"discretisation={discretisation!r} must be one of {', '.join(DISCRETISATIONS)}")

@@ -92,6 +92,7 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
                         length_scale: float, force_multiplicity: float = 1.0,
                         reference: ReferenceData | None = None, params: dict[str, Any] | None = None,
                         target_load: float | None = None, predicted: Any = None,
+                        direction: np.ndarray | None = None,
                         nondimensionalise: bool = True) -> ContactProblem:
     """The contact QP of two bodies: ``K = diag(K¹, K²)``, f, N, d, weights, points, scales.
 
@@ -106,6 +107,9 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     load control scales the prescribed push until the contact resultant along
     y is that load; ``predicted(points)`` says which slave nodes (physical
     coordinates, (k, 2)) the scene expects in contact, where load control starts.
+    ``direction`` fixes the rows' normal (the slave's outward unit normal, e.g.
+    the common normal at the first point of contact, along which Hertz's
+    theory measures the gap); None: each master segment's normal.
     """
     start = time.perf_counter()
     _check_held(slave, "slave")
@@ -134,7 +138,7 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
 
     slave_face = Face.of(slave.mesh, slave.contact_facets)
     master_face = Face.of(master.mesh, master.contact_facets)
-    coupling = couple(slave_face, master_face, discretisation).scaled()
+    coupling = couple(slave_face, master_face, discretisation, direction).scaled()
     N_full = coupling.rows(dof_table[:, slave_face.nodes], dof_table[:, master_face.nodes + first],
                            n_full)
     load_dofs = np.concatenate([dof_table[1, slave.load_nodes],
@@ -223,6 +227,7 @@ class TwoBodyModel:
     params: dict[str, Any] = field(default_factory=dict)
     target_load: float | None = None
     predicted: Any = None
+    direction: np.ndarray | None = None
 
     def assemble(self, nondimensionalise: bool = True) -> ContactProblem:
         """The model's contact QP (:func:`assemble_two_bodies`)."""
@@ -231,4 +236,5 @@ class TwoBodyModel:
                                    force_multiplicity=self.force_multiplicity,
                                    reference=self.reference, params=self.params,
                                    target_load=self.target_load, predicted=self.predicted,
+                                   direction=self.direction,
                                    nondimensionalise=nondimensionalise)
