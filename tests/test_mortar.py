@@ -100,3 +100,12 @@ def test_faces_that_do_not_face_each_other_are_refused():
         mortar(slave, master)
     with pytest.raises(InputError, match="discretisation"):
         couple(slave, master, "segment-to-segment")
+
+
+def test_a_face_lists_its_nodes_in_order_along_it():
+    grid = MeshTri.init_tensor(np.linspace(0.0, 1.0, 7), np.linspace(0.0, 1.0, 3))
+    order = np.random.default_rng(6).permutation(grid.p.shape[1])  # nodes numbered at random
+    mesh = MeshTri(grid.p[:, order], np.argsort(order)[grid.t])
+    face = Face.of(mesh, facets_on(mesh, np.flatnonzero(np.isclose(mesh.p[1], 0.0))))
+    assert np.all(np.diff(face.points[0]) > 0) or np.all(np.diff(face.points[0]) < 0)
+    np.testing.assert_allclose(face.normals, [[0.0] * 6, [-1.0] * 6], atol=1e-15)  # outward

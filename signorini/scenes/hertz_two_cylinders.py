@@ -69,11 +69,9 @@ PARAMS = (
     *(dataclasses.replace(ONE_CYLINDER[name], default=default)
       for name, default in (("n_contact", 48), ("grading", 0.12), ("candidates", 2.0))),
     DISCRETISATION,
-    Param("normal", "vertical", "the rows' normal: vertical, the common normal at the first point "
-          "of contact, along which Hertz's theory measures the gap; master: each master segment's "
-          "own (the tangential displacements then enter the rows: with unlike materials about "
-          "0.15 % off Hertz at a/R* = 0.05, docs/two-bodies.md)", kind=str,
-          check=one_of("vertical", "master")),
+    Param("normal", "vertical", "the rows' normal: vertical (Hertz's gap, along the common normal "
+          "at the first point of contact) or master (each master segment's: docs/two-bodies.md)",
+          kind=str, check=one_of("vertical", "master")),
     LOADING,
     MESHER,
 )
