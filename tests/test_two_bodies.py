@@ -100,3 +100,8 @@ def test_the_two_body_problem_has_one_mesh_of_both_bodies():
 def test_the_cli_solves_the_patch_scene(capsys):
     assert main(["solve", "two-block-patch", "--set", "discretisation=nts"]) == 0
     assert "converged" in capsys.readouterr().out
+
+
+def test_adaptive_refinement_refuses_two_bodies_in_one_line():
+    with pytest.raises(InputError, match="of two bodies: .*mesh parameters"):
+        signorini.solve_adaptive("two-block-patch", 0.01)
