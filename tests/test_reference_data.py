@@ -22,11 +22,19 @@ from signorini.problem import ContactProblem
 from signorini.references import REFERENCES
 from signorini.scenes import SCENES, build_problem, register, unregister
 from signorini.scenes.block import FAMILY as BLOCK
+from signorini.scenes.two_block_patch import compliance
 from signorini.solvers.registry import solve
 
 #: the parameters each reference's record holds, by record field
 RECORD_PARAMS = {"hertz-2d": {"R": "R"}, "hertz-3d": {"R": "R"}, "reverse-hertz": {"R": "R"},
                  "punch": {"a": "a", "corner_radius": "corner_radius"}, "uniform": {"H": "H"}}
+#: the records of two-body families, from their parameters
+TWO_BODIES = {"two-block-patch": lambda p: {"H": p["H1"] + p["H2"],
+                                            "E_star": (p["H1"] + p["H2"]) / compliance(p)},
+              "hertz-two-cylinders": lambda p: {
+                  "R": 1.0 / (1.0 / p["R1"] + 1.0 / p["R2"]),
+                  "E_star": 1.0 / (1.0 / contact_modulus(p["E1"], p["nu1"])
+                                   + 1.0 / contact_modulus(p["E2"], p["nu2"]))}}
 #: coarse meshes, so that building every family stays quick
 COARSE = {"punch": {"n_contact": 16, "grading": 0.6}, "reverse-hertz": {"n_contact": 16, "grading": 0.6},
           "hertz-sphere-3d": {"n_contact": 4, "grading": 1.0}}
@@ -38,9 +46,14 @@ def test_every_family_hands_its_reference_the_record_of_its_parameters(name):
     record = problem.reference_data
     assert record.name == problem.reference == SCENES[name].reference
     assert record.name in REFERENCES
-    assert record.E_star == contact_modulus(problem.params["E"], problem.params["nu"])
-    for field, param in RECORD_PARAMS[record.name].items():
-        assert getattr(record, field) == problem.params[param]
+    p = problem.params
+    if name in TWO_BODIES:  # the pair's record: both bodies' compliances in series
+        for field, value in TWO_BODIES[name](p).items():
+            assert getattr(record, field) == pytest.approx(value, rel=1e-15)
+    else:
+        assert record.E_star == contact_modulus(p["E"], p["nu"])
+        for field, param in RECORD_PARAMS[record.name].items():
+            assert getattr(record, field) == p[param]
     # the push carries the scene's δ and target P, as the parameters report them
     assert problem.push.delta == problem.params["delta"]
     assert problem.push.P == problem.params.get("P")

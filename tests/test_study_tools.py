@@ -113,3 +113,15 @@ def test_a_whole_command_past_its_limit_is_stopped():
     amg = tool("amg_bench")
     run = amg.timed(["-c", "import time; time.sleep(60)"], timeout=1.0)
     assert run["returncode"] is None and run["said"] == "timed out" and run["record"] is None
+
+
+def test_a_two_body_case_is_the_public_solve_of_its_scene():
+    two_bodies = tool("two_bodies")
+    case = next(c for c in two_bodies.cases() if c["table"] == "patch" and c["label"] == "1.7"
+                and c["discretisation"] == "nts")
+    row = two_bodies.run([case])[0]
+    direct = signorini.solve("two-block-patch", "pdas", tol=case["tol"], params=case["params"])
+    assert row["status"] == direct.status == "converged" and row["dofs"] == direct.problem.n
+    assert row["reference"]["pressure_max_rel"] == pytest.approx(
+        direct.comparison.pressure_max_rel, rel=1e-9)
+    assert row["reference"]["pressure_max_rel"] > 1e-6  # node-to-segment fails the patch test

@@ -177,8 +177,7 @@ def _rebuild(family, params: dict[str, Any], given: set[str], mesh: Any,
     return model
 
 
-def _contact_extent(model: SceneModel, problem: ContactProblem,
-                    solution: ContactSolution) -> float | None:
+def _contact_extent(model: SceneModel, problem: ContactProblem, solution: ContactSolution) -> float | None:
     """How far the contact reached (physical x of the last candidate with a force)."""
     if not np.all(np.isfinite(solution.lam)) or not np.any(solution.lam > 0):
         return None
@@ -278,9 +277,10 @@ def _steeper_than_measured(scene: _Scene) -> str:
 
 
 def _checked(scene: _Scene) -> _Scene:
-    if scene.model.mesh.p.shape[0] != 2 or not hasattr(scene.model.mesh, "refined"):
-        raise InputError(f"scene {scene.name!r} is 3D: target error refines 2D and axisymmetric "
-                         "scenes (marked triangles); refine a 3D scene uniformly with --set refine=N")
+    if (mesh := getattr(scene.model, "mesh", None)) is None or not hasattr(mesh, "refined") or mesh.dim() > 2:
+        raise InputError(f"scene {scene.name!r} is {'3D' if mesh is not None else 'of two bodies'}: "
+                         "target error refines one body in 2D or axisymmetric (marked triangles); refine "
+                         "the others by their mesh parameters (3D uniformly with --set refine=N)")
     return scene
 
 

@@ -13,6 +13,7 @@ from typing import Any
 
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
+from signorini.fem.two_bodies import TwoBodyModel
 from signorini.numerics.arrays import flag_argument
 from signorini.problem import ContactProblem, Scales
 from signorini.problem_files import is_problem_file, read_problem
@@ -106,6 +107,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
                          f"hands on {model.reference!r}: give its SceneModel "
                          f"reference=ReferenceData({declared!r}, ...) with the fields that "
                          "reference reads (signorini.problem.ReferenceData)")
-    problem = assemble(model, nondimensionalise=nondimensionalise)
+    problem = (model.assemble(nondimensionalise) if isinstance(model, TwoBodyModel)
+               else assemble(model, nondimensionalise=nondimensionalise))
     problem.name = name
     return problem

@@ -1,0 +1,329 @@
+"""Two P1 boundary faces in 2D coupled by contact rows: node-to-segment or mortar.
+
+The slave face Γ¹ and the master face Γ² are chains of straight segments
+(plane strain). Each slave node s gets one row of the contact constraint
+
+    Σₖ Dₛₖ nₛ·u¹ₖ − Σⱼ Mₛⱼ nₛ·u²ⱼ ≤ gₛ,
+
+with n the slave's outward normal (towards the master), so that ``N u ≤ d``
+keeps the package's one sign convention and ``λ ≥ 0`` is compressive.
+
+- **Node-to-segment** (one pass, :func:`node_to_segment`): the slave node is
+  projected along the master segment's normal onto the master face at ξₛ;
+  D = I, Mₛⱼ = φⱼ(ξₛ) and gₛ the normal distance to the projection.
+- **Mortar** (:func:`mortar`): the same constraint weighted by a multiplier
+  function ψₛ and integrated over the slave face, ∫ ψₛ [(u¹ − u²)·n − g] ds ≤ 0.
+  Each master segment is projected onto each slave segment along the slave
+  normal; on each overlap piece a two-point Gauss rule is exact (the integrands
+  are quadratic in the slave coordinate), and n is the master segment's normal
+  reversed, as node-to-segment takes it (on curved faces the direction of the
+  rows is then the same in both, and the rows of a body on a flat are those of
+  a rigid flat's). ``Dₛₖ = ∫ ψₛ φ¹ₖ``,
+  ``Mₛⱼ = ∫ ψₛ φ²ⱼ`` and the weighted gap ``g̃ₛ = ∫ ψₛ g``. The standard basis
+  ψₛ = φₛ has D lumped to ``diag(∫ φₛ)``; the dual (biorthogonal) basis
+  ψₛ = 2φₛ − φₒ on each slave segment (o the segment's other node) has
+  ``∫ ψₛ φₖ = δₛₖ ∫ φₛ``, so D is diagonal without lumping.
+
+The weight of a row is ``wₛ = ∫ φₛ ds`` over the part of the slave face the
+rows cover; :meth:`Coupling.scaled` divides each row and its gap by its own
+coefficient ``Dₛₛ`` (1 for node-to-segment, ``wₛ`` for mortar), so that the
+multiplier λₛ of a scaled row is a nodal force and ``λₛ / wₛ`` the contact
+pressure. On matching meshes the scaled dual mortar rows are the
+node-to-segment rows (node to node).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from signorini.errors import InputError
+
+log = logging.getLogger(__name__)
+
+__all__ = ["DISCRETISATIONS", "Coupling", "Face", "couple", "mortar", "node_to_segment"]
+
+#: the contact discretisations between two faces: dual mortar, standard (lumped) mortar,
+#: node-to-segment
+DISCRETISATIONS = ("mortar", "mortar-standard", "nts")
+
+#: a projection this far outside a segment (in its own parameter) still lands on it
+END_TOLERANCE = 1e-9
+
+#: Gauss-Legendre points and weights on [0, 1]: two points integrate cubics exactly
+GAUSS_POINTS = 0.5 + 0.5 * np.polynomial.legendre.leggauss(2)[0]
+GAUSS_WEIGHTS = 0.5 * np.polynomial.legendre.leggauss(2)[1]
+
+
+@dataclass(frozen=True)
+class Face:
+    """A P1 boundary face in 2D: its nodes, their coordinates, segments and outward normals.
+
+    ``nodes`` (k,) are the mesh's node numbers (in order along the face when it is one open
+    chain of segments, else by number), ``points`` (2, k) their
+    coordinates, ``segments`` (2, e) index ``nodes`` and ``normals`` (2, e)
+    are the segments' outward unit normals (out of the body).
+    """
+
+    nodes: np.ndarray
+    points: np.ndarray
+    segments: np.ndarray
+    normals: np.ndarray
+
+    @classmethod
+    def of(cls, mesh: Any, facets: np.ndarray) -> "Face":
+        """The face made of the boundary ``facets`` of a triangle ``mesh``."""
+        facets = np.asarray(facets, dtype=int)
+        if mesh.p.shape[0] != 2 or facets.size == 0:
+            raise InputError("a contact face needs boundary facets (edges) of a 2D mesh")
+        ends = mesh.facets[:, facets]
+        nodes = _along(ends)
+        local = np.searchsorted(np.sort(nodes), ends)
+        local = np.argsort(nodes)[local]
+        tangent = mesh.p[:, ends[1]] - mesh.p[:, ends[0]]
+        normal = np.array([tangent[1], -tangent[0]])
+        inside = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
+        outward = np.sign(np.einsum("ij,ij->j", normal, mesh.p[:, ends].mean(axis=1) - inside))
+        return cls(nodes=nodes, points=mesh.p[:, nodes], segments=local.reshape(ends.shape),
+                   normals=normal * outward / np.linalg.norm(normal, axis=0))
+
+    @property
+    def lengths(self) -> np.ndarray:
+        """The segments' lengths (e,)."""
+        ends = self.points[:, self.segments]
+        return np.linalg.norm(ends[:, 1] - ends[:, 0], axis=0)
+
+    def weights(self) -> np.ndarray:
+        """Lumped weights ``∫ φₛ ds`` of the face's nodes (k,): half of each segment to each end."""
+        return np.bincount(self.segments.ravel(), np.tile(0.5 * self.lengths, 2),
+                           minlength=self.nodes.size)
+
+
+def _along(ends: np.ndarray) -> np.ndarray:
+    """The nodes of segments ``ends`` (2, e) in order along them when they make one open chain
+    (from the end with the smaller node number), else sorted by number."""
+    nodes, counts = np.unique(ends, return_counts=True)
+    if nodes.size != ends.shape[1] + 1 or np.count_nonzero(counts == 1) != 2 or counts.max() > 2:
+        return nodes
+    neighbours: dict[int, list[int]] = {int(n): [] for n in nodes}
+    for a, b in ends.T:
+        neighbours[int(a)].append(int(b))
+        neighbours[int(b)].append(int(a))
+    chain = [int(nodes[counts == 1][0])]
+    while len(chain) < nodes.size:
+        step = [n for n in neighbours[chain[-1]] if len(chain) < 2 or n != chain[-2]]
+        chain.append(step[0])
+    return np.array(chain)
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """The contact rows between a slave and a master face, one per slave node that has one.
+
+    ``slave`` (m,) indexes the slave face's nodes of the rows; ``D`` (m, k¹)
+    and ``M`` (m, k²) are the scalar coupling matrices; ``slave_rows``
+    (m, 2k¹) and ``master_rows`` (m, 2k²) the rows on the faces' dofs
+    (node-major, x then y: ``D n`` and ``−M n``, n the master segment's normal reversed);
+    ``gap`` the (weighted) initial gaps and ``weights`` ``∫ φₛ ds``.
+    """
+
+    kind: str
+    slave: np.ndarray
+    D: sp.csr_matrix
+    M: sp.csr_matrix
+    slave_rows: sp.csr_matrix
+    master_rows: sp.csr_matrix
+    gap: np.ndarray
+    weights: np.ndarray
+
+    @property
+    def m(self) -> int:
+        """The number of rows."""
+        return self.slave.size
+
+    def scaled(self) -> "Coupling":
+        """Each row and its gap divided by its slave node's own coefficient ``Dₛₛ`` (1 for
+        node-to-segment, ``∫ φₛ ds`` for mortar): λ is then a nodal force, λ / w a pressure."""
+        own = np.asarray(self.D[np.arange(self.m), self.slave]).ravel()
+        inverse = sp.diags(1.0 / own)
+        return dataclasses.replace(
+            self, D=(inverse @ self.D).tocsr(), M=(inverse @ self.M).tocsr(),
+            slave_rows=(inverse @ self.slave_rows).tocsr(),
+            master_rows=(inverse @ self.master_rows).tocsr(), gap=self.gap / own)
+
+    def rows(self, slave_dofs: np.ndarray, master_dofs: np.ndarray, n: int) -> sp.csr_matrix:
+        """The rows on a global dof vector of size ``n``: ``slave_dofs`` (2, k¹) and
+        ``master_dofs`` (2, k²) are the faces' nodes' (x, y) dofs in it."""
+        local = sp.hstack([self.slave_rows, self.master_rows]).tocoo()
+        places = np.concatenate([slave_dofs.T.ravel(), master_dofs.T.ravel()])
+        return sp.csr_matrix((local.data, (local.row, places[local.col])), shape=(self.m, n))
+
+
+def _triplets(shape: tuple[int, int]):
+    """A sparse matrix built from (row, column, value) lists, summed where they repeat."""
+    rows: list[np.ndarray] = []
+    cols: list[np.ndarray] = []
+    vals: list[np.ndarray] = []
+
+    def add(r, c, v) -> None:
+        r, c, v = np.broadcast_arrays(r, c, v)
+        rows.append(r.ravel())
+        cols.append(c.ravel())
+        vals.append(v.ravel())
+
+    def build() -> sp.csr_matrix:
+        if not rows:
+            return sp.csr_matrix(shape)
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                             shape=shape)
+
+    return add, build
+
+
+def _kept(coupling: Coupling, keep: np.ndarray) -> Coupling:
+    """The rows ``keep`` of ``coupling`` (slave nodes the master face does not reach dropped)."""
+    if not keep.any():
+        raise InputError("no slave node faces the master face: check the two contact faces "
+                         "(their facets and which body is the slave)")
+    dropped = int((~keep).sum())
+    if dropped:
+        log.info("%d slave nodes beyond the master face have no contact row", dropped)
+    return Coupling(kind=coupling.kind, slave=coupling.slave[keep], D=coupling.D[keep],
+                    M=coupling.M[keep], slave_rows=coupling.slave_rows[keep],
+                    master_rows=coupling.master_rows[keep], gap=coupling.gap[keep],
+                    weights=coupling.weights[keep])
+
+
+def _vector(scalar: sp.csr_matrix, normal: np.ndarray) -> sp.csr_matrix:
+    """Rows ``Σₖ Sₛₖ n`` on node-major (x, y) dofs, one normal (2, m) per row."""
+    coo = scalar.tocoo()
+    data = np.concatenate([coo.data * normal[0, coo.row], coo.data * normal[1, coo.row]])
+    return sp.csr_matrix((data, (np.tile(coo.row, 2), np.concatenate([2 * coo.col, 2 * coo.col + 1]))),
+                         shape=(scalar.shape[0], 2 * scalar.shape[1]))
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The 2D cross product ``a₀b₁ − a₁b₀`` of vectors along the first axis (broadcast)."""
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def node_to_segment(slave: Face, master: Face, direction: np.ndarray | None = None) -> Coupling:
+    """One-pass node-to-segment rows: each slave node projected on the master face.
+
+    Slave node s is projected along each master segment's normal n² (or along
+    the fixed ``direction``, the slave's outward normal, when given) onto the
+    segment's line, ξ in [0, 1]; the nearest such point is its partner ξₛ. Its
+    row is ``n`` on u¹ₛ and ``−φⱼ(ξₛ) n`` on the master segment's two nodes,
+    with ``n = −n²`` (or ``direction``), and its gap ``gₛ = (x²(ξₛ) − xₛ)·n``.
+    Slave nodes that project on no master segment get no row. Weights are the
+    slave face's lumped ``∫ φₛ ds``.
+    """
+    ends = master.points[:, master.segments]  # (2, 2, e)
+    tangent = ends[:, 1] - ends[:, 0]
+    along = -master.normals if direction is None else np.asarray(direction, float)[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):  # a segment along the direction: no ξ
+        xi = _cross(slave.points[:, :, None] - ends[:, 0][:, None, :], along[:, None, :])
+        xi /= _cross(tangent, along)[None, :]
+    on_segment = (xi >= -END_TOLERANCE) & (xi <= 1.0 + END_TOLERANCE)
+    xi = np.clip(xi, 0.0, 1.0)
+    foot = ends[:, 0][:, None, :] + xi[None] * tangent[:, None, :]  # (2, k, e)
+    distance = np.where(on_segment, np.linalg.norm(slave.points[:, :, None] - foot, axis=0), np.inf)
+    nearest = np.argmin(distance, axis=1)
+    keep = np.isfinite(distance[np.arange(slave.nodes.size), nearest])
+    k = np.arange(slave.nodes.size)
+    xi_s = xi[k, nearest]
+    normal = along[:, nearest] if direction is None else along[:, [0] * k.size]  # towards the master
+    gap = np.einsum("ik,ik->k", foot[:, k, nearest] - slave.points, normal)
+    add_m, build_m = _triplets((slave.nodes.size, master.nodes.size))
+    add_m(k[:, None], master.segments[:, nearest].T, np.stack([1.0 - xi_s, xi_s], axis=1))
+    D = sp.identity(slave.nodes.size, format="csr")
+    M = build_m()
+    coupling = Coupling(kind="nts", slave=k, D=D, M=M, slave_rows=_vector(D, normal),
+                        master_rows=-_vector(M, normal), gap=gap, weights=slave.weights())
+    return _kept(coupling, keep)
+
+
+def _multiplier(eta: np.ndarray, basis: str) -> np.ndarray:
+    """ψ of a slave segment's two nodes at its coordinates ``eta`` (2, ...): standard or dual."""
+    phi = np.stack([1.0 - eta, eta])
+    return phi if basis == "standard" else 2.0 * phi - phi[::-1]
+
+
+def mortar(slave: Face, master: Face, basis: str = "dual",
+           direction: np.ndarray | None = None) -> Coupling:
+    """Mortar rows: ``D n`` on the slave nodes, ``−M n`` on the master nodes, gap ``g̃``.
+
+    Segment to segment on the slave face: each master segment that faces a
+    slave segment (opposite normals) is projected onto it along the slave
+    normal, the overlap is integrated by two Gauss points with n the master
+    segment's normal reversed, and ``Dₛₖ``,
+    ``Mₛⱼ``, ``g̃ₛ`` and ``wₛ = ∫ φₛ ds`` accumulate over the overlaps with
+    ψₛ the ``basis`` ("dual": biorthogonal, "standard": ψₛ = φₛ with D lumped).
+    Slave nodes the master face does not reach get no row.
+    """
+    if basis not in ("dual", "standard"):
+        raise InputError(f"mortar basis={basis!r} must be 'dual' or 'standard'")
+    ks, km = slave.nodes.size, master.nodes.size
+    add_d, build_d = _triplets((ks, ks))
+    add_m, build_m = _triplets((ks, km))
+    add_sr, build_sr = _triplets((ks, 2 * ks))
+    add_mr, build_mr = _triplets((ks, 2 * km))
+    gap, weights = np.zeros(ks), np.zeros(ks)
+    master_ends = master.points[:, master.segments]  # (2, 2, e²)
+    for (a, b), x0, x1, n in zip(slave.segments.T, slave.points[:, slave.segments[0]].T,
+                                 slave.points[:, slave.segments[1]].T, slave.normals.T):
+        t = x1 - x0
+        h2 = t @ t
+        along = n if direction is None else np.asarray(direction, dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):  # along the direction: no piece
+            eta_ends = _cross(master_ends - x0[:, None, None], along) / _cross(t, along)  # (2, e²)
+        lo = np.clip(eta_ends.min(axis=0), 0.0, 1.0)
+        hi = np.clip(eta_ends.max(axis=0), 0.0, 1.0)
+        pieces = np.flatnonzero((hi - lo > END_TOLERANCE) & (n @ master.normals < 0.0))
+        if pieces.size == 0:
+            continue
+        eta = lo[pieces, None] + (hi - lo)[pieces, None] * GAUSS_POINTS  # (p, q)
+        dw = (hi - lo)[pieces, None] * GAUSS_WEIGHTS * np.sqrt(h2)  # ds of each point
+        xi = (eta - eta_ends[0, pieces, None]) / (eta_ends[1, pieces, None] - eta_ends[0, pieces, None])
+        phi_s = np.stack([1.0 - eta, eta])  # (2, p, q)
+        phi_m = np.stack([1.0 - xi, xi])
+        psi = _multiplier(eta, basis)
+        y0, y1 = master_ends[:, 0, pieces][..., None], master_ends[:, 1, pieces][..., None]
+        across = (y0 + xi * (y1 - y0) - (x0[:, None, None] + eta * t[:, None, None]))
+        normal = (-master.normals[:, pieces] if direction is None  # (2, p): as node-to-segment
+                  else np.repeat(np.asarray(direction, dtype=float)[:, None], pieces.size, axis=1))
+        g = np.einsum("ip,ipq->pq", normal, across)  # normal distance from slave to master
+        slave_pair, master_pair = np.array([a, b]), master.segments[:, pieces]  # (2,), (2, p)
+        mm = np.einsum("ipq,jpq,pq->ijp", psi, phi_m, dw)  # ∫ψᵢ φ²ⱼ on each piece
+        if basis == "standard":  # lumped: ∫ φᵢ on the diagonal
+            dd = np.einsum("ik,ipq,pq->ikp", np.eye(2), phi_s, dw)
+        else:
+            dd = np.einsum("ipq,kpq,pq->ikp", psi, phi_s, dw)
+        add_d(slave_pair[:, None], slave_pair[None, :], dd.sum(axis=2))
+        add_m(slave_pair[:, None, None], master_pair[None], mm)
+        for c in range(2):
+            add_sr(slave_pair[:, None, None], 2 * slave_pair[None, :, None] + c, dd * normal[c])
+            add_mr(slave_pair[:, None, None], 2 * master_pair[None] + c, -mm * normal[c])
+        np.add.at(gap, slave_pair, np.einsum("ipq,pq,pq->i", psi, g, dw))
+        np.add.at(weights, slave_pair, np.einsum("ipq,pq->i", phi_s, dw))
+    coupling = Coupling(kind="mortar" if basis == "dual" else "mortar-standard",
+                        slave=np.arange(ks), D=build_d(), M=build_m(), slave_rows=build_sr(),
+                        master_rows=build_mr(), gap=gap, weights=weights)
+    return _kept(coupling, weights > 0)
+
+
+def couple(slave: Face, master: Face, discretisation: str = "mortar",
+           direction: np.ndarray | None = None) -> Coupling:
+    """The rows of ``discretisation`` (one of :data:`DISCRETISATIONS`), unscaled; with a fixed
+    ``direction`` (the slave's outward unit normal) every row and projection takes it."""
+    if discretisation == "nts":
+        return node_to_segment(slave, master, direction)
+    if discretisation in ("mortar", "mortar-standard"):
+        return mortar(slave, master, "dual" if discretisation == "mortar" else "standard",
+                      direction)
+    raise InputError(f"discretisation={discretisation!r} must be one of {', '.join(DISCRETISATIONS)}")

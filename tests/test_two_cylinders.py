@@ -1,0 +1,62 @@
+"""Hertz between two elastic cylinders (hertz-two-cylinders): the pair's reference and the rigid limit."""
+
+import pytest
+
+import signorini
+from signorini.analytic import hertz_cylinder_load
+from signorini.scenes.hertz_two_cylinders import FAMILY, pair_radius
+
+#: coarse meshes, so that each solve takes about a second
+COARSE = {"n_contact": 16, "grading": 0.4}
+
+
+def test_the_reference_is_hertz_with_the_pair_s_modulus_and_radius():
+    params = {"E1": 2.0, "nu1": 0.25, "E2": 3.0, "nu2": 0.2, "R1": 1.0, "R2": 2.0}
+    model = FAMILY.build(FAMILY.parse({**COARSE, **params}))
+    assert model.reference.R == pytest.approx(1.0 / (1.0 / 1.0 + 1.0 / 2.0), rel=1e-15)
+    assert model.reference.E_star == pytest.approx(1.0 / ((1 - 0.25 ** 2) / 2.0 + (1 - 0.2 ** 2) / 3.0),
+                                                   rel=1e-15)
+    assert pair_radius(FAMILY.parse(params)) == model.reference.R
+
+
+@pytest.mark.parametrize("discretisation", ["mortar", "nts"])
+def test_two_cylinders_of_different_materials_and_radii_meet_two_body_hertz(discretisation):
+    params = {**COARSE, "E2": 3.0, "nu2": 0.2, "R2": 2.0, "discretisation": discretisation}
+    result = signorini.solve("hertz-two-cylinders", "pdas", params=params)
+    assert result.converged
+    c = result.comparison  # against a and p0 of the pair's E* and R* at the load carried
+    assert abs(c.a / c.a_ref - 1) < 5e-3 and abs(c.p0 / c.p0_ref - 1) < 5e-3
+    assert result.applied_load == pytest.approx(result.problem.push.P, rel=1e-8)  # load control
+
+
+@pytest.mark.parametrize("loading", ["traction", "displacement"])
+def test_a_stiff_large_lower_cylinder_approaches_the_rigid_flat(loading):
+    P = hertz_cylinder_load(0.05, 1.0, 1.0 / (1 - 0.3 ** 2))
+    one = signorini.solve("hertz-cylinder", "pdas",
+                          params={**COARSE, "loading": loading, "P": P}).comparison
+    two = signorini.solve("hertz-two-cylinders", "pdas",
+                          params={**COARSE, "loading": loading, "E2": 1e6, "R2": 1e3, "P": P}).comparison
+    # (Hertz itself moves by 0.05 % between the two: 1/R* = 1.001 here)
+    assert abs(two.a / one.a - 1) < 5e-4 and abs(two.p0 / one.p0 - 1) < 5e-4
+    assert two.a_ref / one.a_ref == pytest.approx((1 / 1.001) ** 0.5, rel=1e-5)  # E* by 1e-6
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("params, limit", [
+    ({}, 5e-4),  # two equal cylinders, the scene's defaults
+    ({"E1": 2.1e11, "nu1": 0.3, "R1": 0.01, "E2": 7e10, "nu2": 0.33, "R2": 0.02}, 1e-3),  # SI
+], ids=["defaults", "steel-on-aluminium-SI"])
+def test_the_default_mesh_meets_two_body_hertz(params, limit):
+    result = signorini.solve("hertz-two-cylinders", "pdas", params=params)
+    assert result.converged and result.problem.n <= 20_000
+    c = result.comparison
+    assert abs(c.a / c.a_ref - 1) < limit and abs(c.p0 / c.p0_ref - 1) < limit
+
+
+def test_the_rows_follow_the_normal_asked_for():
+    vertical, master = (signorini.build_problem("hertz-two-cylinders",
+                                                params={**COARSE, "normal": normal})
+                        for normal in ("vertical", "master"))
+    for problem, tilted in ((vertical, False), (master, True)):
+        x_dofs = problem.discretisation.free_dofs % 2 == 0  # dofs interleaved by node: x even
+        assert (abs(problem.N[:, x_dofs]).max() > 1e-3) == tilted
