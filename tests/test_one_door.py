@@ -19,8 +19,8 @@ import signorini
 
 ROOT = os.path.dirname(signorini.__file__)
 #: package files a solve enters: a scene with a target load, and a QP given as arrays
-SCENE_FILES = 32
-QP_FILES = 14
+SCENE_FILES = 34
+QP_FILES = 16
 
 
 def traced(step):
