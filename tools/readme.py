@@ -22,6 +22,7 @@ import budget  # noqa: E402  (tools/budget.py: the 10⁶-dof command against one
 import derivatives as derivative_cost  # noqa: E402  (tools/derivatives.py: a derivative against the solve)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 import mesher_compare  # noqa: E402  (tools/mesher_compare.py: the Hertz discs' three meshers)
+import mesher_front  # noqa: E402  (tools/mesher_front.py: accuracy against time per mesher)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 import startup  # noqa: E402  (tools/startup.py: whole-process time before the contact)
 
@@ -159,7 +160,9 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
         return {"mesher-first": mesher_compare.table(first),
                 "mesher-first-summary": mesher_compare.summary(first),
                 "mesher-runs": mesher_compare.table(rows), "mesher-summary": mesher_compare.summary(rows),
-                "mesher-load": mesher_compare.machine_load()}
+                "mesher-load": mesher_compare.machine_load(),
+                "mesher-front": mesher_front.table(mesher_front.load()),
+                "mesher-front-load": mesher_front.machine_load()}
     raise ValueError(f"no generated blocks for {document}")
 
 
