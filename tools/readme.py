@@ -139,7 +139,10 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
         peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
         triangle = peer_table(json.loads((ROOT / "docs" / "peer-triangle" / "peer.json")
                                          .read_text())["rows"])  # --set mesher=triangle
+        two = peer_table(json.loads((ROOT / "docs" / "peer-two" / "peer.json").read_text())["rows"])
         return {"peer-runs": "\n".join(peer[:peer.index("")]),
+                "peer-two-runs": "\n".join(two[:two.index("")]),  # hertz-two-cylinders
+                "peer-two-summary": "\n".join(two[two.index("") + 1:]),
                 "peer-summary": "\n".join(peer[peer.index("") + 1:]),
                 "peer-triangle-runs": "\n".join(triangle[:triangle.index("")]),
                 "peer-triangle-summary": "\n".join(triangle[triangle.index("") + 1:]),
