@@ -440,6 +440,7 @@ def test_getfem_solves_two_cylinders_on_non_matching_meshes():
                           capture_output=True, text=True, timeout=300, check=True)
     record = json.loads(done.stdout.strip().splitlines()[-1])
     assert record["converged"] and record["dofs"] > 1000
+    assert record["master_nodes"] > 0 and record["facing_nodes"] <= 1  # the meshes do not match
     assert abs(record["p0_rel"]) < 0.01 and abs(record["a_rel"]) < 0.01
     # the vertical part of forces along the master's normal, taken on the undeformed arc
     assert record["total_force"] == pytest.approx(record["load"], rel=1e-5)
@@ -499,3 +500,26 @@ def test_docs_peer_two_bodies_reading_is_the_committed_run():
     one = json.loads((root / "docs" / "peer" / "peer.json").read_text())["rows"]
     assert worst(next(r for r in one if r["scene"] == "hertz-cylinder" and r["code"] == "getfem"
                       and r["rung"] == 0)) < 0.001
+
+
+def test_docs_peer_two_bodies_matching_reading_is_the_committed_run():
+    """docs/peer-two/master-ratio.json: GetFEM within 0.05 % on every rung where the meshes match
+    (every slave node facing a master node), farther and closing in as the mesh is refined where
+    they do not (the first point of contact alone facing one)."""
+    root = Path(__file__).resolve().parents[1]
+    rows = json.loads((root / "docs" / "peer-two" / "master-ratio.json").read_text())["rows"]
+    page = (root / "docs" / "peer.md").read_text()
+    matching = [r for r in rows if r["master_ratio"] == 1.0]
+    apart = [r for r in rows if r["master_ratio"] != 1.0]
+    assert len(matching) == len(apart) == 4 and all(r["converged"] for r in rows)
+    assert all(r["facing_nodes"] == r["contact_nodes"] for r in matching)
+    assert all(r["facing_nodes"] == 1 for r in apart)
+    worst = [max(abs(r["p0_rel"]), abs(r["a_rel"])) for r in apart]
+    assert all(max(abs(r["p0_rel"]), abs(r["a_rel"])) < 0.0005 for r in matching)
+    assert all(a > b for a, b in zip(worst, worst[1:])) and min(worst) > 0.0005
+    assert "within 0.05 % of Hertz from its coarsest rung on" in page and "within 0.05 % on\n  every rung" in page
+    # the non-matching rows are the committed peer run's GetFEM rows
+    peer_rows = json.loads((root / "docs" / "peer-two" / "peer.json").read_text())["rows"]
+    theirs = [r for r in peer_rows if r["code"] == "getfem"]
+    assert [r["dofs"] for r in apart] == [r["dofs"] for r in theirs]
+    assert [r["p0_rel"] for r in apart] == pytest.approx([r["p0_rel"] for r in theirs], rel=1e-9)

@@ -32,11 +32,13 @@ not match. Solved in units of R1 and E1 by ``Model.solve`` (MUMPS), Newton
 starting from the upper body pushed down rigidly by a²/R*.
 
 Output, one JSON line on stdout, with the keys of ``getfem_hertz.py``'s: dofs
-(both bodies' displacement dofs), slave nodes, p0 and a from the same fit of
-the slave's nodal pressures λᵢ/wᵢ (wᵢ = ∫ φᵢ ds on the slave arc; λᵢ acts along
-the master's normal), the total vertical contact force of the full cylinders,
-Hertz's values, Newton's iterations, the phase timings and, with ``repeat``,
-every solve's wall time.
+(both bodies' displacement dofs), slave and master nodes, the slave nodes that
+face a master node at the same x (on non-matching meshes the first point of
+contact alone; all of them when the meshes match: R1 = R2 and ``master_ratio``
+1), p0 and a from the same fit of the slave's nodal pressures λᵢ/wᵢ (wᵢ = ∫ φᵢ
+ds on the slave arc; λᵢ acts along the master's normal), the total vertical
+contact force of the full cylinders, Hertz's values, Newton's iterations, the
+phase timings and, with ``repeat``, every solve's wall time.
 """
 
 from __future__ import annotations
@@ -157,6 +159,8 @@ def solve(q):
     # the slave node's place on the master arc (the undeformed circle; the displacements are small)
     vertical = np.sqrt(1.0 - np.minimum(nodes[0] / R2, 1.0) ** 2)
     p0, a_fit, n_active = fit_hertz(nodes[0], pressure)
+    master = fems[1].basic_dof_nodes(fems[1].basic_dof_on_region(ARC)[::2])
+    apart = np.abs(nodes[0][:, None] - master[0]).min(axis=1)  # across the gap, along x
     P_ref, p0_ref, _, _ = two_body_hertz(q["R1"], q["R2"], q["E1"], q["nu1"], q["E2"], q["nu2"],
                                          a * length)
     times["post_s"] = time.perf_counter() - tic
@@ -164,6 +168,7 @@ def solve(q):
         "code": "getfem", "scene": "two-cylinders", "params": q,
         "dofs": int(fems[0].nbdof() + fems[1].nbdof()), "nodes": int(n_upper + n_lower),
         "contact_nodes": int(slave.size // 2), "active_nodes": n_active,
+        "master_nodes": int(master.shape[1]), "facing_nodes": int((apart < 1e-9 * a).sum()),
         "newton_iterations": int(iterations), "converged": bool(converged),
         "p0": p0 * stress, "a": a_fit * length, "p0_ref": p0_ref, "a_ref": a * length,
         "load": P_ref, "total_force": float(2.0 * (lam * vertical).sum()) * stress * length,

@@ -17,7 +17,8 @@ import numpy as np
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output import plots
 
-__all__ = ["MEASURES", "NAMES", "TARGETS", "at_accuracy", "peer_figure", "peer_table", "write_peer"]
+__all__ = ["MEASURES", "NAMES", "TARGETS", "at_accuracy", "matching_table", "peer_figure", "peer_table",
+           "write_peer"]
 
 #: accuracies at which the report compares the codes' fastest runs: p₀ and a within 0.3 % and 0.1 %
 TARGETS = (0.003, 0.001)
@@ -149,3 +150,14 @@ def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
     atomic_write_text(paths["md"], "\n".join(head + peer_table(rows) + [
         "", "![time against accuracy, whole process and in process](peer.png)", ""]))
     return paths
+
+
+def matching_table(rows: list[dict[str, Any]]) -> list[str]:
+    """GetFEM's two-body rungs on matching and non-matching meshes (``master_ratio`` 1 against
+    another), from the script's records: docs/peer-two/master-ratio.json."""
+    lines = ["| h at the contact | master / slave size | dofs | slave nodes facing a master node "
+             "| p₀ − Hertz | a − Hertz | Newton steps |", "|---|---:|---:|---:|---:|---:|---:|"]
+    lines += [f"| {r['h_contact']} | {r['master_ratio']:g} | {r['dofs']:,} | {r['facing_nodes']} of "
+              f"{r['contact_nodes']} | {_pct(r['p0_rel'])} | {_pct(r['a_rel'])} | {r['newton_iterations']} |"
+              for r in rows]
+    return lines
