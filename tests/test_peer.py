@@ -352,3 +352,174 @@ def test_docs_peer_triangle_reading_is_the_committed_run():
         assert all(worst(triangle, scene, n) < worst(relaxed, scene, n) for n in coarse)
     assert all(worst(triangle, "hertz-cylinder", n) > worst(relaxed, "hertz-cylinder", n)
                for n in (40, 80))
+
+
+# ---- two bodies: hertz-two-cylinders, GetFEM's contact between non-matching meshes ----
+
+TWO = "hertz-two-cylinders"
+#: different cylinders in SI units: steel on a larger aluminium cylinder
+SI_PAIR = {"R1": 0.01, "R2": 0.025, "E1": 2.1e11, "nu1": 0.3, "E2": 7e10, "nu2": 0.33, "a_over_R": 0.05}
+
+
+def load_two_body_script(monkeypatch):
+    """The two-body GetFEM script as a module (it imports the one-body script beside it)."""
+    path = peer.SCRIPT.parent / "getfem_two_cylinders.py"
+    monkeypatch.syspath_prepend(str(path.parent))
+    spec = importlib.util.spec_from_file_location("getfem_two_cylinders", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_two_body_ladder_gives_each_code_its_own_meshes_and_the_scene_s_parameters():
+    points = peer.ladder([TWO], None, {"E2": "3", "mesher": "triangle"})
+    theirs = [p for p in points if p.code == "getfem"]
+    ours = [p for p in points if p.code == "signorini"]
+    assert len(theirs) == len(ours) == 4 and [p.rung for p in ours] == [0, 1, 2, 3]
+    # GetFEM refines at the contact, the package its n_contact; both finer rung after rung
+    assert all(a.mesh["h_contact"] > b.mesh["h_contact"] for a, b in zip(theirs, theirs[1:]))
+    assert all(a.mesh["n_contact"] < b.mesh["n_contact"] for a, b in zip(ours, ours[1:]))
+    # the two-body script takes no scene key; both codes take the scene's materials and radii
+    assert all("scene" not in p.given and p.given["E2"] == 3.0 and p.given["R1"] == 1.0 for p in theirs)
+    assert all("mesher" not in p.given for p in theirs)
+    assert "E2=3.0" in ours[0].settings and "mesher=triangle" in ours[0].settings
+    # the one-body default leaves the two-body scene out (it has a --scene of its own)
+    assert TWO in peer.SCENES and TWO not in peer.ONE_BODY
+
+
+@pytest.mark.parametrize("scenes, sizes, given, word", [
+    ([TWO], None, {"R": "2"}, "--set R is not shared by both codes on hertz-two-cylinders"),
+    (["hertz-cylinder"], None, {"E1": "2"}, "--set E1 is not shared by both codes on hertz-cylinder"),
+    ([TWO], [4], {}, "0..3"),
+    (["hertz-cylinder"], [4], {}, None),
+])
+def test_the_two_body_ladder_refuses_what_it_does_not_share(scenes, sizes, given, word):
+    if word is None:
+        assert len(peer.ladder(scenes, sizes, given)) == 2
+        return
+    from signorini.errors import InputError
+
+    with pytest.raises(InputError, match=word.replace(".", r"\.")):
+        peer.ladder(scenes, sizes, given)
+
+
+def test_two_body_hertz_is_the_scene_s_and_the_script_s(monkeypatch):
+    """One reference for the pair: the peer's, the scene's load and the GetFEM script's agree."""
+    from signorini.scenes.hertz_two_cylinders import FAMILY
+    from signorini.studies.peer_cases import hertz_reference
+
+    script = load_two_body_script(monkeypatch)
+    for pair in (peer.ladder([TWO], [0], {})[0].params, SI_PAIR):
+        P, p0, a = hertz_reference(TWO, **pair)
+        scene = {param.name: param.default for param in FAMILY.params}
+        assert FAMILY.loads({**scene, **pair}, {"a_over_R"})[0] == pytest.approx(P, rel=1e-14)
+        theirs = script.two_body_hertz(*(pair[k] for k in ("R1", "R2", "E1", "nu1", "E2", "nu2")), a)
+        assert theirs[:2] == pytest.approx((P, p0), rel=1e-14)
+    assert script.fit_hertz.__module__ == "getfem_hertz"  # the one fit, reused by the two-body script
+
+
+def test_the_package_s_two_body_row_is_fitted_against_two_body_hertz():
+    """The package's side of the two-body case through the peer's own runner: its nodal
+    pressures on the slave arc, fitted as GetFEM's are, within 0.5 % of two-body Hertz."""
+    (point,) = [p for p in peer.ladder([TWO], [0], {}) if p.code == "signorini"]
+    peer.run_point(point, python=peer.system_python(), command=peer.our_command(), timeout=300)
+    row = point.row
+    assert row["status"] == "converged", row["message"]
+    assert abs(row["p0_rel"]) < 0.005 and abs(row["a_rel"]) < 0.005
+    assert abs(row["force_rel"]) < 1e-9 and row["active_nodes"] < row["contact_nodes"]
+    assert row["a_ref"] == pytest.approx(0.05 * 0.5)  # a/R* with R* = 1/2 for two unit cylinders
+
+
+@pytest.mark.usefixtures("getfem")
+def test_getfem_solves_two_cylinders_on_non_matching_meshes():
+    """GetFEM's nodal contact between non-matching meshes, two different cylinders in SI units,
+    a coarse mesh: converged, within 1 % of two-body Hertz, its contact force the load."""
+    script = peer.SCRIPT.parent / "getfem_two_cylinders.py"
+    given = {**SI_PAIR, "h_contact": 1 / 16}
+    done = subprocess.run([peer.system_python(), str(script), json.dumps(given)],
+                          capture_output=True, text=True, timeout=300, check=True)
+    record = json.loads(done.stdout.strip().splitlines()[-1])
+    assert record["converged"] and record["dofs"] > 1000
+    assert record["master_nodes"] > 0 and record["facing_nodes"] <= 1  # the meshes do not match
+    assert abs(record["p0_rel"]) < 0.01 and abs(record["a_rel"]) < 0.01
+    # the vertical part of forces along the master's normal, taken on the undeformed arc
+    assert record["total_force"] == pytest.approx(record["load"], rel=1e-5)
+    P, p0, a = peer.hertz_reference(TWO, **SI_PAIR)
+    assert (record["load"], record["p0_ref"], record["a_ref"]) == pytest.approx((P, p0, a), rel=1e-12)
+    assert peer.fit_hertz(record["x"], record["pressure"])[:2] == pytest.approx(
+        (record["p0"], record["a"]), rel=1e-12)
+
+
+def test_docs_peer_two_bodies_table_is_the_committed_run():
+    """docs/peer-two/peer.json: every rung of both codes converged, the same scene and load, the
+    dofs growing up the ladders, both codes within 0.3 % of two-body Hertz at their finest rung."""
+    root = Path(__file__).resolve().parents[1]
+    record = json.loads((root / "docs" / "peer-two" / "peer.json").read_text())
+    rows = record["rows"]
+    assert {r["scene"] for r in rows} == {TWO} and all(r["status"] == "converged" for r in rows)
+    assert record["load_average"]["before"] and record["in_process"] >= 1
+    P, _, _ = peer.hertz_reference(TWO, **peer.ladder([TWO], [0], {})[0].params)
+    for code in peer.NAMES:
+        mine = sorted((r for r in rows if r["code"] == code), key=lambda r: r["rung"])
+        assert len(mine) == 4 and all(r["load"] == pytest.approx(P, rel=1e-12) for r in mine)
+        assert all(a["dofs"] < b["dofs"] for a, b in zip(mine, mine[1:]))
+        assert max(abs(mine[-1]["p0_rel"]), abs(mine[-1]["a_rel"])) < 0.003
+    table = peer.peer_table(rows)
+    assert sum(line.startswith(f"| {TWO} | ") for line in table) == len(rows) + 2 * len(peer.TARGETS)
+
+
+def test_docs_peer_two_bodies_reading_is_the_committed_run():
+    """docs/peer.md's reading of docs/peer-two: the package closer rung for rung and faster at both
+    accuracies by both measures; GetFEM's a too wide on every rung, faster on its coarse meshes;
+    the numbers the prose quotes (the load average, dofs, the coarsest rungs)."""
+    root = Path(__file__).resolve().parents[1]
+    record = json.loads((root / "docs" / "peer-two" / "peer.json").read_text())
+    rows, page = record["rows"], (root / "docs" / "peer.md").read_text()
+
+    def worst(r):
+        return max(abs(r["p0_rel"]), abs(r["a_rel"]))
+
+    theirs, ours = (sorted((r for r in rows if r["code"] == code), key=lambda r: r["rung"])
+                    for code in ("getfem", "signorini"))
+    assert all(worst(o) < worst(t) for o, t in zip(ours, theirs))
+    for target in peer.TARGETS:
+        for by in ("wall_s", "in_process_s"):
+            best = peer.at_accuracy(rows, TWO, target, by)
+            assert best["signorini"][by] < best["getfem"][by]
+            assert f"{best['signorini']['dofs']:,} dofs" in page and f"{best['getfem']['dofs']:,}" in page
+    assert worst(ours[0]) < 0.003 < worst(theirs[0])
+    assert all(t["a_rel"] > abs(t["p0_rel"]) for t in theirs)
+    assert all(a["a_rel"] > b["a_rel"] for a, b in zip(theirs, theirs[1:]))
+    assert f"+{100 * theirs[0]['a_rel']:.2f} % on its coarsest" in page
+    assert theirs[0]["wall_s"] < ours[0]["wall_s"]
+    assert (f"{theirs[0]['wall_s']:.2f} s as a whole\n  process at {theirs[0]['dofs']:,} dofs against "
+            f"the package's {ours[0]['wall_s']:.2f} s at {ours[0]['dofs']:,}") in page
+    before, after = record["load_average"]["before"][0], record["load_average"]["after"][0]
+    assert f"load average was\n{before:.1f} before the run and {after:.1f} after" in page
+    # on one body, GetFEM's coarsest cylinder mesh was within 0.1 %
+    one = json.loads((root / "docs" / "peer" / "peer.json").read_text())["rows"]
+    assert worst(next(r for r in one if r["scene"] == "hertz-cylinder" and r["code"] == "getfem"
+                      and r["rung"] == 0)) < 0.001
+
+
+def test_docs_peer_two_bodies_matching_reading_is_the_committed_run():
+    """docs/peer-two/master-ratio.json: GetFEM within 0.05 % on every rung where the meshes match
+    (every slave node facing a master node), farther and closing in as the mesh is refined where
+    they do not (the first point of contact alone facing one)."""
+    root = Path(__file__).resolve().parents[1]
+    rows = json.loads((root / "docs" / "peer-two" / "master-ratio.json").read_text())["rows"]
+    page = (root / "docs" / "peer.md").read_text()
+    matching = [r for r in rows if r["master_ratio"] == 1.0]
+    apart = [r for r in rows if r["master_ratio"] != 1.0]
+    assert len(matching) == len(apart) == 4 and all(r["converged"] for r in rows)
+    assert all(r["facing_nodes"] == r["contact_nodes"] for r in matching)
+    assert all(r["facing_nodes"] == 1 for r in apart)
+    worst = [max(abs(r["p0_rel"]), abs(r["a_rel"])) for r in apart]
+    assert all(max(abs(r["p0_rel"]), abs(r["a_rel"])) < 0.0005 for r in matching)
+    assert all(a > b for a, b in zip(worst, worst[1:])) and min(worst) > 0.0005
+    assert "within 0.05 % of Hertz from its coarsest rung on" in page and "within 0.05 % on\n  every rung" in page
+    # the non-matching rows are the committed peer run's GetFEM rows
+    peer_rows = json.loads((root / "docs" / "peer-two" / "peer.json").read_text())["rows"]
+    theirs = [r for r in peer_rows if r["code"] == "getfem"]
+    assert [r["dofs"] for r in apart] == [r["dofs"] for r in theirs]
+    assert [r["p0_rel"] for r in apart] == pytest.approx([r["p0_rel"] for r in theirs], rel=1e-9)

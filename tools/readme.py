@@ -28,7 +28,7 @@ import startup  # noqa: E402  (tools/startup.py: whole-process time before the c
 
 from signorini.files import atomic_write_text  # noqa: E402
 from signorini.output.report import readme_validation  # noqa: E402
-from signorini.studies.peer import peer_table  # noqa: E402
+from signorini.studies.peer_report import matching_table, peer_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results.md"          # validation, accuracy on demand, GetFEM, the atlas
@@ -140,7 +140,12 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
         peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
         triangle = peer_table(json.loads((ROOT / "docs" / "peer-triangle" / "peer.json")
                                          .read_text())["rows"])  # --set mesher=triangle
+        two = peer_table(json.loads((ROOT / "docs" / "peer-two" / "peer.json").read_text())["rows"])
         return {"peer-runs": "\n".join(peer[:peer.index("")]),
+                "peer-two-runs": "\n".join(two[:two.index("")]),  # hertz-two-cylinders
+                "peer-two-summary": "\n".join(two[two.index("") + 1:]),
+                "peer-two-matching": "\n".join(matching_table(json.loads(
+                    (ROOT / "docs" / "peer-two" / "master-ratio.json").read_text())["rows"])),
                 "peer-summary": "\n".join(peer[peer.index("") + 1:]),
                 "peer-triangle-runs": "\n".join(triangle[:triangle.index("")]),
                 "peer-triangle-summary": "\n".join(triangle[triangle.index("") + 1:]),

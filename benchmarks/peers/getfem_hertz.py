@@ -138,6 +138,17 @@ def mesh_quarter_disc(R, a, q):
     return points, triangles
 
 
+def newton(md, name, dofs, push, q):
+    """``Model.solve`` from the variable ``name`` (``dofs`` of a 2D field) pushed down rigidly by
+    ``push`` (0: from zero); Newton's iterations and whether it converged."""
+    if push:
+        start = np.zeros(dofs)
+        start[1::2] = -push
+        md.set_variable(name, start)
+    return md.solve("max_res", q["max_res"], "max_iter", 100, "lsearch", q["lsearch"],
+                    "lsolver", q["lsolver"])
+
+
 def solve(q):
     """Mesh, assemble, solve and fit one point (getfem and gmsh imported already by :func:`main`)."""
     import getfem as gf
@@ -193,12 +204,8 @@ def solve(q):
     times["setup_s"] = time.perf_counter() - tic
 
     tic = time.perf_counter()
-    if q["start"] == "hertz":  # start from a rigid push by Hertz's approach a²/R
-        start = np.zeros(mfu.nbdof())
-        start[1::2] = -a ** 2 / R
-        md.set_variable("u", start)
-    iterations, converged = md.solve("max_res", q["max_res"], "max_iter", 100, "lsearch", q["lsearch"],
-                                     "lsolver", q["lsolver"])
+    # start from a rigid push by Hertz's approach a²/R
+    iterations, converged = newton(md, "u", mfu.nbdof(), a ** 2 / R if q["start"] == "hertz" else 0.0, q)
     times["solve_s"] = time.perf_counter() - tic
 
     tic = time.perf_counter()
@@ -228,20 +235,21 @@ def solve(q):
     }
 
 
-def main(argv):
+def main(argv, solve=solve, defaults=DEFAULTS, name="getfem_hertz"):
     """Solve the point of ``argv[1]`` ``repeat`` times in this process; print the last record.
 
     ``time.import_s`` is the start-up to getfem and gmsh imported, ``time.total_s`` the
     whole script to its output; ``runs_s`` holds each solve's wall time (mesh, assembly,
     solve and fit: everything after the imports), the first a warm-up when there are several.
+    ``solve``, ``defaults`` and ``name`` are another script's (the two-body one's) when it runs.
     """
     given = json.loads(argv[1]) if len(argv) > 1 else {}
-    unknown = sorted(set(given) - set(DEFAULTS))
+    unknown = sorted(set(given) - set(defaults))
     if unknown:
-        raise SystemExit(f"getfem_hertz: unknown parameters {unknown}; known: {sorted(DEFAULTS)}")
-    q = {**DEFAULTS, **given}
+        raise SystemExit(f"{name}: unknown parameters {unknown}; known: {sorted(defaults)}")
+    q = {**defaults, **given}
     if not (isinstance(q["repeat"], int) and q["repeat"] >= 1):
-        raise SystemExit(f"getfem_hertz: repeat {q['repeat']!r} must be a whole number >= 1")
+        raise SystemExit(f"{name}: repeat {q['repeat']!r} must be a whole number >= 1")
     import getfem  # noqa: F401  (imported before any solve is timed)
     import gmsh  # noqa: F401
 

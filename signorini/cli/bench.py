@@ -18,7 +18,7 @@ def _bench_peer(args: argparse.Namespace) -> int:
     from signorini.output.report import provenance  # as above
     from signorini.studies import peer  # as above
 
-    points = peer.ladder([args.scene] if args.scene else list(peer.SCENES),
+    points = peer.ladder([args.scene] if args.scene else list(peer.ONE_BODY),
                          None if args.sizes is None else _sizes(args.sizes, ""), pairs(args.set, "--set"))
     out = out_folder(args.out or "peer-report")
     missing = peer.getfem_missing()
@@ -145,11 +145,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def add_parsers(sub) -> None:
     """Register ``bench``."""
     bench = sub.add_parser("bench", help="benchmark methods × sizes × tolerances (resumable CSV)")
-    bench.add_argument("--scene", help="default hertz-cylinder (with --peer: both Hertz scenes)")
+    bench.add_argument("--scene", help="default hertz-cylinder (with --peer: hertz-cylinder and "
+                       "hertz-sphere; or hertz-two-cylinders)")
     bench.add_argument("--problem", metavar="FILE", help="benchmark on a problem file of yours "
                        f"instead of a scene: {PROBLEM_FILES}")
     bench.add_argument("--sizes", help="refinement levels, e.g. 0,1,2 (default 0,1; with --peer: "
-                       "rungs of the peer ladder 0..4, default all)")
+                       "rungs of the peer ladder 0..4, 0..3 for hertz-two-cylinders; default all)")
     bench.add_argument("--peer", choices=["getfem"], help="the Hertz scenes by GetFEM (system "
                        "python3-getfem) and this package side by side: accuracy, whole-process time")
     bench.add_argument("--repeat", type=int, default=5,

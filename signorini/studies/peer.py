@@ -1,10 +1,11 @@
-"""A peer, side by side: Hertz's cylinder and sphere by GetFEM and by this package.
+"""A peer, side by side: Hertz's cylinder, sphere and two cylinders by GetFEM and by this package.
 
 ``signorini bench --peer getfem``. GetFEM runs in the system Python (Debian's
-``python3-getfem`` and ``python3-gmsh``) through our own script,
-``benchmarks/peers/getfem_hertz.py`` in a checkout of the repository (:data:`SCRIPT`;
-not part of the installed package); this package runs as ``signorini solve SCENE
---json -``. Each point is timed two ways:
+``python3-getfem`` and ``python3-gmsh``) through our own scripts,
+``benchmarks/peers/getfem_hertz.py`` (one body on a rigid flat) and
+``getfem_two_cylinders.py`` (two bodies, non-matching meshes) in a checkout of the
+repository (:mod:`signorini.studies.peer_cases`; not part of the installed
+package); this package runs as ``signorini solve SCENE --json -``. Each point is timed two ways:
 
 - whole process: each code in its own process, timed from start to exit
   (interpreter, imports, meshing, assembly, solve, output), ``repeat`` runs
@@ -18,10 +19,8 @@ not part of the installed package); this package runs as ``signorini solve SCENE
 Both codes' p₀ and a come from the same least-squares fit (:func:`fit_hertz`)
 of their nodal pressures, and are compared with Hertz's values for the applied load.
 
-The ladders differ by code: GetFEM refines its gmsh size field at the contact
-(``h_contact``, a fraction of a), this package its scene parameters
-(``n_contact``, ``refine``; ``grading`` the scene's default). Each ladder spans
-about 2k to 60k dofs; the chart puts both on the same axes (accuracy and time).
+The ladders (:mod:`signorini.studies.peer_cases`) differ by code; the report
+(:mod:`signorini.studies.peer_report`) puts both on the same axes, accuracy and time.
 """
 
 from __future__ import annotations
@@ -38,39 +37,19 @@ from typing import Any, Callable
 import numpy as np
 
 import signorini
-from signorini.analytic import (contact_modulus, hertz_cylinder_load, hertz_cylinder_peak,
-                                hertz_sphere_load, hertz_sphere_peak)
-from signorini.errors import InputError
-from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-from signorini.output import plots
 from signorini.pressure import hertz_fit
-from signorini.scenes.meshing import MESHERS
+from signorini.studies.peer_cases import CASES, ONE_BODY, SCENES, hertz_reference, ladder_of
+from signorini.studies.peer_report import NAMES, TARGETS, at_accuracy, peer_table, write_peer
 
-#: the standalone GetFEM script, run by the system Python: in the repository's checkout,
-#: beside the package's source tree (an installed package has none)
-SCRIPT = Path(signorini.__file__).parents[1] / "benchmarks" / "peers" / "getfem_hertz.py"
+__all__ = ["NAMES", "ONE_BODY", "SCENES", "SCRIPT", "TARGETS", "Point", "at_accuracy", "fit_hertz",
+           "getfem_missing", "ladder", "our_command", "peer_table", "run_peer", "solve_repeatedly",
+           "system_python", "time_in_process", "write_peer"]
+
+#: the one-body GetFEM script (the two-body one beside it: :data:`signorini.studies.peer_cases.CASES`)
+SCRIPT = CASES["hertz-cylinder"].path
 #: the interpreter that has GetFEM (override with SIGNORINI_GETFEM_PYTHON)
 SYSTEM_PYTHON = "/usr/bin/python3"
 INSTALL = "apt-get install python3-getfem python3-gmsh"
-#: the package's scene and the script's name for it
-SCENES = {"hertz-cylinder": "cylinder", "hertz-sphere": "sphere"}
-#: parameters both codes take (passed to the script and as --set to the package)
-SHARED = ("R", "E", "nu", "a_over_R")
-#: parameters only the package takes, added to each of its rungs (e.g. --set mesher=triangle)
-OURS_ONLY = ("mesher",)
-DEFAULTS = {"R": 1.0, "E": 1.0, "nu": 0.3, "a_over_R": 0.05}
-#: GetFEM's ladder: the element size at the contact, a fraction of a
-GETFEM_LADDER = ({"h_contact": 1 / 16}, {"h_contact": 1 / 24}, {"h_contact": 1 / 40},
-                 {"h_contact": 1 / 64}, {"h_contact": 1 / 112})
-#: this package's ladder per scene (the grading is the scene's default)
-OUR_LADDER = {
-    "hertz-cylinder": ({"n_contact": 10}, {"n_contact": 20}, {"n_contact": 40},
-                       {"n_contact": 80}, {"n_contact": 80, "refine": 1}),
-    "hertz-sphere": ({"n_contact": 12}, {"n_contact": 25}, {"n_contact": 50},
-                     {"n_contact": 100}, {"n_contact": 100, "refine": 1}),
-}
-#: accuracies at which the report compares the codes' fastest runs: p₀ and a within 0.3 % and 0.1 %
-TARGETS = (0.003, 0.001)
 
 
 def fit_hertz(x, p, rel: float = 1e-9) -> tuple[float, float, int]:
@@ -86,18 +65,6 @@ def fit_hertz(x, p, rel: float = 1e-9) -> tuple[float, float, int]:
     active = p > rel * p.max()
     p0, a = hertz_fit(x, p, active)
     return p0, a, int(active.sum())
-
-
-def hertz_reference(scene: str, *, R: float, E: float, nu: float,
-                    a_over_R: float) -> tuple[float, float, float]:
-    """(load P, p0, a) of Hertz's solution for ``a_over_R`` (P per unit thickness for the cylinder)."""
-    a = a_over_R * R
-    E_star = contact_modulus(E, nu)
-    if scene == "hertz-cylinder":
-        P = hertz_cylinder_load(a, R, E_star)
-        return P, hertz_cylinder_peak(P, a), a
-    P = hertz_sphere_load(a, R, E_star)
-    return P, hertz_sphere_peak(P, a), a
 
 
 def system_python() -> str:
@@ -147,7 +114,8 @@ class Point:
     def given(self) -> dict[str, Any]:
         """The point's parameters as its code takes them (the script's JSON, the scene's --set)."""
         if self.code == "getfem":
-            return {**self.params, **self.mesh, "scene": SCENES[self.scene]}
+            name = CASES[self.scene].name  # the one-body script's scene key
+            return {**self.params, **self.mesh, **({"scene": name} if name else {})}
         return {**self.params, **self.mesh}
 
     @property
@@ -199,7 +167,7 @@ def run_point(point: Point, *, python: str, command: list[str], timeout: float) 
     import json
 
     if point.code == "getfem":
-        argv = [python, str(SCRIPT), json.dumps(point.given)]
+        argv = [python, str(CASES[point.scene].path), json.dumps(point.given)]
     else:
         argv = [*command, "solve", point.scene, "--json", "-"]
         argv += point.settings
@@ -263,7 +231,7 @@ def time_in_process(point: Point, solves: int, *, python: str, timeout: float) -
     import json
 
     if point.code == "getfem":
-        argv = [python, str(SCRIPT), json.dumps({**point.given, "repeat": solves})]
+        argv = [python, str(CASES[point.scene].path), json.dumps({**point.given, "repeat": solves})]
     else:
         argv = [sys.executable, "-c", IN_PROCESS,
                 json.dumps({"scene": point.scene, "params": point.given, "repeat": solves})]
@@ -282,30 +250,12 @@ def time_in_process(point: Point, solves: int, *, python: str, timeout: float) -
 
 
 def ladder(scenes: list[str], sizes: list[int] | None,
-           params: dict[str, float]) -> list[Point]:
-    """The points to run: per scene, both codes at the chosen rungs (default: every rung)."""
-    unknown = [s for s in scenes if s not in SCENES]
-    if unknown:
-        raise InputError(f"--scene {unknown[0]!r} has no peer model: choose from {', '.join(SCENES)}")
-    extra = sorted(set(params) - set(SHARED) - set(OURS_ONLY))
-    if extra:
-        raise InputError(f"--set {extra[0]} is not shared by both codes: the peer benchmark "
-                         f"takes {', '.join(SHARED)}, and mesher for the package alone")
-    ours = {k: v for k, v in params.items() if k in OURS_ONLY}
-    if "mesher" in ours and ours["mesher"] not in MESHERS:
-        raise InputError(f"--set mesher={ours['mesher']} is not a mesher of the Hertz discs: "
-                         f"choose one of {', '.join(MESHERS)}")
-    params = {k: v for k, v in params.items() if k not in OURS_ONLY}
-    rungs = range(len(GETFEM_LADDER)) if sizes is None else sizes
-    bad = [i for i in rungs if not 0 <= i < len(GETFEM_LADDER)]
-    if bad:
-        raise InputError(f"--sizes {bad[0]} is not a rung of the peer ladder: give numbers in "
-                         f"0..{len(GETFEM_LADDER) - 1}")
-    values = {**DEFAULTS, **{k: float(v) for k, v in params.items()}}
-    return [Point(scene, code, i, dict(mesh), values)
-            for scene in scenes for i in rungs
-            for code, mesh in (("getfem", GETFEM_LADDER[i]),
-                               ("signorini", {**OUR_LADDER[scene][i], **ours}))]
+           params: dict[str, Any]) -> list[Point]:
+    """The points to run: per scene, both codes at the chosen rungs (default: every rung;
+    :func:`signorini.studies.peer_cases.ladder_of` checks the choice)."""
+    return [Point(scene, code, i, mesh, values)
+            for scene, i, theirs, ours, values in ladder_of(scenes, sizes, params)
+            for code, mesh in (("getfem", theirs), ("signorini", ours))]
 
 
 def run_peer(points: list[Point], *, repeat: int = 5, in_process: int = 5, timeout: float = 600.0,
@@ -342,131 +292,3 @@ def _in_process(point: Point) -> dict[str, Any]:
     after = point.solves[1:]
     fields = {"in_process_runs_s": list(point.solves), "in_process_s": min(after) if after else None}
     return {**fields, "in_process_message": point.solves_message} if point.solves_message else fields
-
-
-def _pct(value: Any) -> str:
-    return "–" if value is None or not np.isfinite(value) else f"{100 * value:+.3f} %"
-
-
-def _error(row: dict[str, Any]) -> float:
-    """The larger of the p₀ and a errors (inf when the run gave none)."""
-    worst = max(abs(row.get("p0_rel", math.nan)), abs(row.get("a_rel", math.nan)))
-    return worst if np.isfinite(worst) else math.inf
-
-
-NAMES = {"getfem": "GetFEM", "signorini": "signorini"}
-#: the two measures of time: a row's key and its name in the tables
-MEASURES = {"wall_s": "whole process", "in_process_s": "in process"}
-
-
-def _seconds(value: Any) -> str:
-    return "–" if value is None else f"{value:.2f}"
-
-
-def at_accuracy(rows: list[dict[str, Any]], scene: str, target: float,
-                by: str = "wall_s") -> dict[str, dict | None]:
-    """Per code, its fastest run by the time ``by`` (a key of :data:`MEASURES`) with p₀ and a
-    both within ``target`` of Hertz; rows without that time (not measured) are left out."""
-    best: dict[str, dict | None] = {}
-    for code in NAMES:
-        good = [r for r in rows if r["scene"] == scene and r["code"] == code and r.get(by) is not None
-                and r["status"] == "converged" and _error(r) <= target]
-        best[code] = min(good, key=lambda r: r[by]) if good else None
-    return best
-
-
-def _fastest_cells(rows: list[dict[str, Any]], scene: str, target: float, by: str) -> list[str]:
-    """The summary's cells for one scene, target and measure: each code's fastest run ("–" for a
-    code whose runs carry no such time) and the ratio of their times."""
-    best = at_accuracy(rows, scene, target, by)
-    measured = {r["code"] for r in rows if r["scene"] == scene and r.get(by) is not None}
-    cells = [f"{r['dofs']:,} dofs, {r[by]:.2f} s" if r else "not reached" if code in measured else "–"
-             for code, r in best.items()]
-    ratio = f"{best['signorini'][by] / best['getfem'][by]:.2f}" if all(best.values()) else "–"
-    return [*cells, ratio]
-
-
-def peer_table(rows: list[dict[str, Any]]) -> list[str]:
-    """The Markdown tables: every run, then both codes at the target accuracies by each measure
-    of time the runs carry (whole process always, in process when it was measured)."""
-    lines = ["| scene | code | mesh | dofs | contact nodes (active) | p₀ − Hertz | a − Hertz "
-             "| force − P | whole process [s] | in process [s] | inside [s] | status |",
-             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
-    for r in rows:
-        lines.append(
-            f"| {r['scene']} | {NAMES[r['code']]} | {r['mesh']} | {r.get('dofs', 0):,} "
-            f"| {r.get('contact_nodes', '–')} ({r.get('active_nodes', '–')}) | {_pct(r.get('p0_rel'))} "
-            f"| {_pct(r.get('a_rel'))} | {_pct(r.get('force_rel'))} | {r['wall_s']:.2f} "
-            f"| {_seconds(r.get('in_process_s'))} | {r.get('inner_s', math.nan):.2f} | {r['status']} |")
-    lines += ["", "| scene | p₀ and a within | time | GetFEM: fastest run | signorini: fastest run "
-              "| signorini / GetFEM |", "|---|---:|---|---|---|---:|"]
-    # a run recorded before the in-process measure (or with --in-process 0) has no such rows
-    measures = {by: name for by, name in MEASURES.items() if any(r.get(by) is not None for r in rows)}
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        for target in TARGETS:
-            for by, measure in measures.items():
-                cells = " | ".join(_fastest_cells(rows, scene, target, by))
-                lines.append(f"| {scene} | {100 * target:g} % | {measure} | {cells} |")
-    return lines
-
-
-def peer_figure(rows: list[dict[str, Any]]):
-    """Time against accuracy, whole process (left) and in process (right), a row per scene."""
-    from matplotlib.figure import Figure
-
-    scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    figure = Figure(figsize=(10, 3.8 * len(scenes)), layout="constrained")
-    grid = figure.subplots(len(scenes), len(MEASURES), squeeze=False, sharex="row",
-                           sharey="row")
-    for scene, panels in zip(scenes, grid):
-        mine = [dict(r, error=_error(r)) for r in rows if r["scene"] == scene]
-        for ax, (by, measure) in zip(panels, MEASURES.items()):
-            plots.peer_times(mine, by=by, label=f"{measure} wall time [s]", targets=TARGETS,
-                             names=NAMES, ax=ax).set_title(f"{scene}: {measure}", fontsize=9)
-    return figure
-
-
-CSV_COLUMNS = ("scene", "code", "rung", "mesh", "dofs", "contact_nodes", "active_nodes", "p0",
-               "p0_ref", "p0_rel", "a", "a_ref", "a_rel", "total_force", "load", "force_rel",
-               "wall_s", "in_process_s", "inner_s", "status", "message", "walls_s", "in_process_runs_s")
-
-
-def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
-               meta: dict[str, Any]) -> dict[str, Path]:
-    """peer.csv, peer.json, peer.md and peer.png in ``out``, each written whole or not at all."""
-    import csv
-    import io
-
-    directory = writable_directory(out)
-    paths = {k: directory / f"peer.{k}" for k in ("csv", "json", "md", "png")}
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore",
-                            lineterminator="\n")
-    writer.writeheader()
-    # every run's times in one cell each, separated by spaces
-    writer.writerows({k: " ".join(f"{t:.6f}" for t in v) if isinstance(v, list) else v
-                      for k, v in r.items()} for r in rows)
-    atomic_write_text(paths["csv"], buffer.getvalue())
-    atomic_write_text(paths["json"], to_json({"command": command, **meta, "rows": rows}) + "\n")
-    save_figure(peer_figure(rows), paths["png"])
-    machine = meta.get("machine", {})
-    head = [f"# Peer benchmark: GetFEM and signorini on Hertz's contact", "",
-            f"`{command}` — {machine.get('date', '')}, {machine.get('cpu', '')} "
-            f"({machine.get('cores', '?')} cores), GetFEM {meta.get('getfem', '?')}, "
-            f"signorini {machine.get('versions', {}).get('signorini', '?')}.", "",
-            f"Whole-process wall time: the fastest of {meta.get('repeat', '?')} runs, each from "
-            "process start to exit, with Python's byte-code cache on as on a user's machine. "
-            + (f"In process: the fastest of {meta['in_process']} solves after one warm-up, in one "
-               "process per code and rung, each solve from the mesh to the answer's record (the "
-               "imports not counted). " if meta.get("in_process") else "In process: not measured. ")
-            + "'inside' is the time the code reports for its own phases (the fastest whole-process run's). "
-            "p₀ and a: one least-squares fit of each code's nodal pressures "
-            "(`signorini.studies.peer.fit_hertz`), against Hertz for the applied load. "
-            "GetFEM's dofs are all its displacement dofs; signorini's its free dofs.", ""]
-    if "load_average" in meta:
-        before, after = (", ".join(f"{v:.1f}" for v in meta["load_average"][k]) for k in ("before", "after"))
-        head += [f"Load average of the machine (1, 5, 15 min) before the runs: {before}; after: "
-                 f"{after} (other work on the machine slows both codes alike).", ""]
-    atomic_write_text(paths["md"], "\n".join(head + peer_table(rows) + [
-        "", "![time against accuracy, whole process and in process](peer.png)", ""]))
-    return paths
