@@ -22,15 +22,16 @@ from typing import Iterable
 
 import numpy as np
 
-__all__ = ["ACCURACY", "Judged", "judge", "run"]
+__all__ = ["ACCURACY", "DENSE_SCRIPT", "SCRIPT", "Judged", "judge", "run"]
 
 log = logging.getLogger(__name__)
 
 #: the relative distance to the certified answer (x and z, ∞-norm) that counts as close, per
 #: qpbenchmark settings
 ACCURACY = {"default": 1e-3, "low_accuracy": 1e-3, "mid_accuracy": 1e-6, "high_accuracy": 1e-6}
-#: the test set's script, as ``signorini export qpbenchmark`` writes it
-SCRIPT = "signorini_contact.py"
+#: the test set's scripts, as ``signorini export qpbenchmark`` writes them: the sparse set and
+#: its dense subset
+SCRIPT, DENSE_SCRIPT = "signorini_contact.py", "signorini_contact_dense.py"
 
 
 @dataclass
@@ -88,12 +89,14 @@ def judge(qp, solution, reference: tuple, tolerance, settings: str, runtime: flo
 
 def run(directory: str, *, solvers: Iterable[str] | None = None,
         settings: Iterable[str] = ("default", "high_accuracy"), author: str = "signorini",
-        problems: Iterable[str] | None = None) -> list[Judged]:
+        script: str = SCRIPT) -> list[Judged]:
     """Every (problem, solver, settings) of the test set in ``directory``, judged twice.
 
-    Writes qpbenchmark's results (``results/qpbenchmark_results.csv``) and report
-    (``results/signorini_contact.md``) as ``python signorini_contact.py run`` would, and
-    returns the judged runs in the test set's order (solvers and settings sorted).
+    ``script`` is the test set (:data:`SCRIPT` or :data:`DENSE_SCRIPT`); ``solvers`` default to
+    every one it takes; the settings not named are left out of the run and of the report.
+    Writes qpbenchmark's results (``results/qpbenchmark_results*.csv``) and report
+    (``results/<script>.md``) as ``python <script> run`` would, and returns the judged runs
+    in the test set's order (solvers sorted).
     """
     from qpbenchmark import Report, Results  # optional: pip install qpbenchmark
     from qpbenchmark.benchmark import load_test_set
@@ -101,15 +104,18 @@ def run(directory: str, *, solvers: Iterable[str] | None = None,
 
     import signorini  # per call (start-up)
 
-    path = os.path.abspath(os.path.join(directory, SCRIPT))
+    path = os.path.abspath(os.path.join(directory, script))
     test_set = load_test_set(path)
+    settings = list(settings)
+    for name in set(test_set.solver_settings) - set(settings):
+        del test_set.solver_settings[name], test_set.tolerances[name]
     chosen = sorted(test_set.solvers if solvers is None else set(solvers) & test_set.solvers)
+    stem = os.path.splitext(script)[0]
     results_dir = os.path.join(os.path.dirname(path), "results")
-    results = Results(os.path.join(results_dir, "qpbenchmark_results.csv"), test_set)
+    results = Results(os.path.join(results_dir, "qpbenchmark_results"
+                                   + ("_dense" if script == DENSE_SCRIPT else "") + ".csv"), test_set)
     judged = []
     for problem in test_set:
-        if problems is not None and problem.name not in set(problems):
-            continue
         qp = signorini.ContactProblem.from_qp(problem.P, -problem.q, problem.G, problem.h,
                                               name=problem.name)
         reference = test_set.reference(problem.name)
@@ -122,5 +128,5 @@ def run(directory: str, *, solvers: Iterable[str] | None = None,
                 judged.append(judge(qp, solution, reference, test_set.tolerances[name], name,
                                     runtime, solver, problem.name))
         results.write()
-    Report(author, results).write(os.path.join(results_dir, "signorini_contact.md"))
+    Report(author, results).write(os.path.join(results_dir, f"{stem}.md"))
     return judged
