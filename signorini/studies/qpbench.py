@@ -36,7 +36,10 @@ from typing import Any, Callable
 import numpy as np
 import scipy.sparse as sp
 
+from signorini.api import certificate, scene_families, solve
 from signorini.errors import InputError
+from signorini.problem import ContactProblem
+from signorini.studies import qpbench_files
 
 __all__ = ["DENSE_MAX_DOFS", "FAMILIES", "Entry", "Reference", "entries", "export", "reference"]
 
@@ -126,8 +129,6 @@ def entries(refine: int = 0, three_d: bool = False) -> list[Entry]:
     unknowns); the 3D family comes with ``three_d`` (its refinements 8× each). Families whose
     scene is not registered are left out.
     """
-    from signorini import scene_families  # per call (start-up)
-
     if isinstance(refine, bool) or not isinstance(refine, int) or refine < 0:
         raise InputError(f"refine must be a whole number ≥ 0, got {refine!r}")
     known = scene_families()
@@ -194,16 +195,14 @@ def reference(entry: Entry) -> Reference:
     from the exported arrays alone (:meth:`ContactProblem.from_qp`), so that the stored answer
     and its certificate are those of exactly the stored problem.
     """
-    import signorini  # per call (start-up)
-
-    loaded = signorini.solve(entry.scene, "pdas", tol=REFERENCE_TOL, params=entry.params)
+    loaded = solve(entry.scene, "pdas", tol=REFERENCE_TOL, params=entry.params)
     K, f, N, d = loaded.problem.qp()
     P, G = _csc(0.5 * (K + K.T)), _csc(N)
     q, h = -np.asarray(f, dtype=np.float64), np.asarray(d, dtype=np.float64)
-    qp = signorini.ContactProblem.from_qp(P, -q, G, h, name=entry.name)
-    answer = signorini.solve(qp, "pdas", tol=REFERENCE_TOL)
+    qp = ContactProblem.from_qp(P, -q, G, h, name=entry.name)
+    answer = solve(qp, "pdas", tol=REFERENCE_TOL)
     x, z = np.asarray(answer.u, dtype=np.float64), np.asarray(answer.force, dtype=np.float64)
-    cert = signorini.certificate(qp, u=x, force=z)
+    cert = certificate(qp, u=x, force=z)
     if not cert.passed(CERTIFIED_TOL):
         log.warning("%s: pdas's answer is certified only at %.1e (%s), above %g",
                     entry.name, cert.worst()[1], cert.worst()[0], CERTIFIED_TOL)
@@ -220,8 +219,6 @@ def export(directory: str, *, refine: int = 0, three_d: bool = False,
     ``only`` keeps the named problems (InputError for a name not in the set). Returns what
     was written, in the test set's order.
     """
-    from signorini.studies import qpbench_files  # per call (start-up)
-
     chosen = entries(refine, three_d)
     if only:
         unknown = sorted(set(only) - {e.name for e in chosen})

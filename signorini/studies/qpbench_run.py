@@ -22,6 +22,9 @@ from typing import Iterable
 
 import numpy as np
 
+from signorini.api import certificate
+from signorini.problem import ContactProblem
+
 __all__ = ["ACCURACY", "DENSE_SCRIPT", "SCRIPT", "Judged", "judge", "run"]
 
 log = logging.getLogger(__name__)
@@ -70,8 +73,6 @@ def _relative(a, b: np.ndarray) -> float:
 def judge(qp, solution, reference: tuple, tolerance, settings: str, runtime: float,
           solver: str, name: str) -> Judged:
     """Judge one qpsolvers ``solution`` of the ContactProblem ``qp`` against ``reference``."""
-    import signorini  # per call (start-up)
-
     x_ref, z_ref, _ = reference
     found = bool(solution.found)
     residuals = (solution.primal_residual(), solution.dual_residual(), solution.duality_gap())
@@ -82,7 +83,7 @@ def judge(qp, solution, reference: tuple, tolerance, settings: str, runtime: flo
     close = found and max(x_error, z_error) <= ACCURACY[settings]
     worst, value = "not found", float("inf")
     if found and np.isfinite(x_error) and np.isfinite(z_error):
-        worst, value = signorini.certificate(qp, u=solution.x, force=solution.z).worst()
+        worst, value = certificate(qp, u=solution.x, force=solution.z).worst()
     return Judged(name, solver, settings, float(runtime), found, *map(float, residuals), bool(valid),
                   x_error, z_error, bool(close), float(value), worst)
 
@@ -102,8 +103,6 @@ def run(directory: str, *, solvers: Iterable[str] | None = None,
     from qpbenchmark.benchmark import load_test_set
     from qpbenchmark.utils import time_solve_problem
 
-    import signorini  # per call (start-up)
-
     path = os.path.abspath(os.path.join(directory, script))
     test_set = load_test_set(path)
     settings = list(settings)
@@ -116,7 +115,7 @@ def run(directory: str, *, solvers: Iterable[str] | None = None,
                                    + ("_dense" if script == DENSE_SCRIPT else "") + ".csv"), test_set)
     judged = []
     for problem in test_set:
-        qp = signorini.ContactProblem.from_qp(problem.P, -problem.q, problem.G, problem.h,
+        qp = ContactProblem.from_qp(problem.P, -problem.q, problem.G, problem.h,
                                               name=problem.name)
         reference = test_set.reference(problem.name)
         for solver in chosen:
