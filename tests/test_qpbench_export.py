@@ -136,3 +136,9 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "--only NOPE" in err[0] and "--refine" in err[1]
     assert not folder.exists()
+
+
+def test_a_second_export_into_the_folder_leaves_only_its_own_problems(tmp_path):
+    qpbench.export(str(tmp_path), only=TINY)
+    qpbench.export(str(tmp_path), only=TINY[:1])
+    assert sorted(p.name for p in (tmp_path / "data").iterdir()) == [f"{TINY[0]}.npz"]

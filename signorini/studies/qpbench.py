@@ -152,7 +152,6 @@ class Reference:
     x: np.ndarray
     z: np.ndarray
     certificate: dict[str, float]
-    status: str
 
     def worst(self) -> tuple[str, float]:
         """The certificate's largest residual (NaN entries, not estimated, left out)."""
@@ -176,7 +175,7 @@ class Reference:
         out.update({"q": self.q, "h": self.h, "x_ref": self.x, "z_ref": self.z,
                     "certificate_names": np.array(names),
                     "certificate_values": np.array([self.certificate[k] for k in names]),
-                    "status": np.array(self.status), "scene": np.array(self.entry.scene),
+                    "scene": np.array(self.entry.scene),
                     "params": np.array(json.dumps(self.entry.params, sort_keys=True))})
         return out
 
@@ -208,13 +207,13 @@ def reference(entry: Entry) -> Reference:
                     entry.name, cert.worst()[1], cert.worst()[0], CERTIFIED_TOL)
     log.info("%s: n = %d, m = %d, certified at %.1e", entry.name, P.shape[0], G.shape[0],
              cert.worst()[1])
-    return Reference(entry, P, q, G, h, x, z, {k: float(v) for k, v in cert.residuals().items()},
-                     answer.status)
+    return Reference(entry, P, q, G, h, x, z, {k: float(v) for k, v in cert.residuals().items()})
 
 
 def export(directory: str, *, refine: int = 0, three_d: bool = False,
            only: list[str] | None = None) -> list[Reference]:
-    """Write the test set into ``directory`` (created; files already there are replaced).
+    """Write the test set into ``directory`` (created; its files replaced, and problems a
+    previous export left in ``data/`` removed: the folder holds this command's set alone).
 
     ``only`` keeps the named problems (InputError for a name not in the set). Returns what
     was written, in the test set's order.
@@ -230,6 +229,11 @@ def export(directory: str, *, refine: int = 0, three_d: bool = False,
     data = os.path.join(directory, "data")
     os.makedirs(data, exist_ok=True)
     os.makedirs(os.path.join(directory, "results"), exist_ok=True)
+    written = {f"{ref.entry.name}.npz" for ref in refs}
+    for stale in sorted(set(os.listdir(data)) - written):
+        if stale.endswith(".npz"):
+            log.info("removing %s: not in this export", stale)
+            os.remove(os.path.join(data, stale))
     for ref in refs:
         qpbench_files.write_npz(os.path.join(data, f"{ref.entry.name}.npz"), ref.arrays())
     qpbench_files.write_test_set(directory, refs, DENSE_MAX_DOFS)

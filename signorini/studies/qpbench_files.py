@@ -277,6 +277,7 @@ python signorini_contact.py run --solver osqp --author your-name
 
 The outcome, written to the `results/` directory, is qpbenchmark's standardized report
 (`results/signorini_contact.md`) and its results (`results/qpbenchmark_results.csv`).
+qpbenchmark asks for the report's author (a GitHub user name) unless `--author` is given.
 
 ## Settings
 
