@@ -20,7 +20,8 @@ def cmd_export_qpbenchmark(args: argparse.Namespace) -> int:
         name, worst = r.worst()
         print(f"{r.entry.name:<13} n = {r.P.shape[0]:>7}  m = {r.G.shape[0]:>5}  "
               f"certified at {worst:.1e} ({name})")
-    print(f"wrote {len(refs)} problems to {folder}: python {folder}/signorini_contact.py run")
+    print(f"wrote {len(refs)} problem{'s' * (len(refs) != 1)} to {folder}: "
+          f"python {folder}/signorini_contact.py run")
     if weak:
         print(f"not certified at {CERTIFIED_TOL:g}: {', '.join(weak)}")
         return EXIT_FAILED
