@@ -142,3 +142,29 @@ def test_a_second_export_into_the_folder_leaves_only_its_own_problems(tmp_path):
     qpbench.export(str(tmp_path), only=TINY)
     qpbench.export(str(tmp_path), only=TINY[:1])
     assert sorted(p.name for p in (tmp_path / "data").iterdir()) == [f"{TINY[0]}.npz"]
+
+
+def test_the_committed_run_covers_every_solver_and_the_page_reads_it():
+    """docs/qpbench.md's tables are what tools/qpbench.py renders from docs/qpbench/runs.json,
+    which has every solver installed when it ran, each at default and high accuracy, and
+    judges "close" by the accuracy the runner defines."""
+    import importlib.util
+    import json
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("qpbench_tool", root / "tools" / "qpbench.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    from readme import current  # tools/readme.py, put on the path by the tool
+
+    record = json.loads(tool.OUT.read_text())
+    text = tool.DOC.read_text(encoding="utf-8")
+    for name, body in tool.blocks(record).items():
+        assert current(text, name) == body, f"docs/qpbench.md block {name!r}: run tools/qpbench.py --doc"
+    runs = record["runs"] + record["dense_runs"]
+    assert set(record["available"]) == {r["solver"] for r in runs}
+    assert {r["settings"] for r in runs} == {"default", "high_accuracy"}
+    for r in runs:
+        assert r["close"] == (r["found"] and max(r["x_error"], r["z_error"]) <= ACCURACY[r["settings"]])
+    for name in ("signorini_contact.md", "signorini_contact_dense.md"):
+        assert (tool.OUT.parent / name).is_file()

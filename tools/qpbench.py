@@ -172,13 +172,18 @@ def provenance_line(record: dict) -> str:
             f"solvers: {', '.join(record['solvers'])}")
 
 
+def blocks(record: dict) -> dict[str, str]:
+    """docs/qpbench.md's generated blocks, by name."""
+    return {"qpbench-provenance": provenance_line(record),
+            **{f"qpbench-{name}-{s}": summary(record, key, s)
+               for name, key in (("sparse", "runs"), ("dense", "dense_runs"))
+               for s in record["settings"]},
+            "qpbench-disagreements": disagreements(record),
+            "qpbench-crosscheck": crosscheck_table(record)}
+
+
 def write_doc(record: dict) -> None:
-    fill_blocks(DOC, {"qpbench-provenance": provenance_line(record),
-                      **{f"qpbench-{name}-{s}": summary(record, key, s)
-                         for name, key in (("sparse", "runs"), ("dense", "dense_runs"))
-                         for s in record["settings"]},
-                      "qpbench-disagreements": disagreements(record),
-                      "qpbench-crosscheck": crosscheck_table(record)})
+    fill_blocks(DOC, blocks(record))
 
 
 if __name__ == "__main__":
