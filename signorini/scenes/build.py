@@ -9,6 +9,7 @@ coarser, which predicts the contact zone of large models.
 from __future__ import annotations
 
 import logging
+import time
 from typing import Any
 
 from signorini.errors import InputError
@@ -67,8 +68,11 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     read as stored, with no parameters to set. A target load stays pending (load
     control matches it when the problem is solved). ``solved_by`` names the
     method that will solve it, for the size guard (a method that never
-    factorises needs less memory).
+    factorises needs less memory). The problem's ``discretisation.mesh_s`` is
+    the time spent up to assembly (checking, meshing, the model) and
+    ``assemble_s`` assembly's.
     """
+    start = time.perf_counter()
     values = scene_params(params)
     nondimensionalise = flag_argument(nondimensionalise, "nondimensionalise")
     if not isinstance(name, str):
@@ -107,7 +111,9 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
                          f"hands on {model.reference!r}: give its SceneModel "
                          f"reference=ReferenceData({declared!r}, ...) with the fields that "
                          "reference reads (signorini.problem.ReferenceData)")
+    mesh_s = time.perf_counter() - start
     problem = (model.assemble(nondimensionalise) if isinstance(model, TwoBodyModel)
                else assemble(model, nondimensionalise=nondimensionalise))
     problem.name = name
+    problem.discretisation.mesh_s = mesh_s
     return problem
