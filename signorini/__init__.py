@@ -12,7 +12,8 @@ The public API (see the README's "Python" section)::
 own units; :func:`certificate` judges any answer; :func:`derivative`
 differentiates an output with respect to a scene parameter; :func:`crosscheck` solves one
 problem with several methods and compares every pair; :func:`methods` and
-:func:`scene_families` list what there is.
+:func:`scene_families` list what there is; :func:`with_load` moves a built scene's target
+load on its mesh and K (a load slider).
 
 The names are loaded when first used (module ``__getattr__``): ``import signorini``
 costs nothing beyond the package itself, and a command imports only what it uses.
@@ -24,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # what the names below are, for readers and type checkers
     from signorini.api import (DEFAULT_METHOD, Result, at_load, build_problem, certificate, methods,
-                               scene_families, solve, solve_adaptive)
+                               scene_families, solve, solve_adaptive, with_load)
     from signorini.crosschecking import CrossCheck, crosscheck
     from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
     from signorini.kkt import Certificate
@@ -36,7 +37,7 @@ if TYPE_CHECKING:  # what the names below are, for readers and type checkers
 #: the module each public name lives in, imported at the name's first use
 _HOMES = {
     **dict.fromkeys(("DEFAULT_METHOD", "Result", "at_load", "build_problem", "certificate", "methods",
-                     "scene_families", "solve", "solve_adaptive"), "signorini.api"),
+                     "scene_families", "solve", "solve_adaptive", "with_load"), "signorini.api"),
     **dict.fromkeys(("CrossCheck", "crosscheck"), "signorini.crosschecking"),
     **dict.fromkeys(("BackendNotInstalled", "InputError", "SignoriniError", "SolverError"),
                     "signorini.errors"),
@@ -67,4 +68,5 @@ def __dir__() -> list[str]:
 __all__ = ["DEFAULT_METHOD", "DEFAULT_TOL", "BackendNotInstalled", "Certificate", "ContactProblem",
            "ContactSolution", "CrossCheck", "Discretisation", "InputError", "Result", "Scales",
            "SignoriniError", "SolverError", "WarmStart", "__version__", "at_load", "build_problem",
-           "certificate", "crosscheck", "derivative", "methods", "scene_families", "solve", "solve_adaptive"]
+           "certificate", "crosscheck", "derivative", "methods", "scene_families", "solve", "solve_adaptive",
+           "with_load"]

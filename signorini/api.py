@@ -36,7 +36,7 @@ from signorini.scenes import SCENES, SceneFamily, build_problem
 from signorini.scenes.adapt import parse_target, solve_adaptive as adapt
 from signorini.scenes.base import scene_params
 from signorini.scales import record_units
-from signorini.scenes.build import coarse_problem
+from signorini.scenes.build import coarse_problem, with_load
 from signorini.numerics.arrays import vector_argument
 from signorini.numerics.work import stage_times, time_line, timed
 from signorini.solution import ContactSolution
@@ -428,4 +428,4 @@ def scene_families() -> dict[str, SceneFamily]:
 
 
 __all__ = ["DEFAULT_METHOD", "Result", "at_load", "build_problem", "certificate", "methods", "scene_families",
-           "solve", "solve_adaptive", "solve_summary"]
+           "solve", "solve_adaptive", "solve_summary", "with_load"]
