@@ -19,6 +19,7 @@ are yours.
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,39 +35,19 @@ from signorini.references import Reference, reference_of, summary_lines
 from signorini.scenes import SCENES, SceneFamily, build_problem
 from signorini.scenes.adapt import parse_target, solve_adaptive as adapt
 from signorini.scenes.base import scene_params
-from signorini.scenes.build import coarse_problem
+from signorini.scales import record_units
+from signorini.scenes.build import coarse_problem, with_load
 from signorini.numerics.arrays import vector_argument
+from signorini.numerics.work import stage_times, time_line, timed
 from signorini.solution import ContactSolution
 from signorini.solvers.registry import Method, check_request
 from signorini.solvers.registry import methods as _all_methods
 
 DEFAULT_METHOD = "auto"
 #: the version of the solve record's layout (docs/json.md): raised when a key changes meaning or goes
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 3
 
 log = logging.getLogger(__name__)
-
-
-def record_units(problem: ContactProblem) -> dict[str, str]:
-    """The unit of each physical quantity of the solve record, in the problem's input units.
-
-    A scene's units are those of its parameters: ``length`` the unit its lengths are given in
-    (R, W, H, mesh coordinates), ``stress`` the unit of E; so a scene given in SI has lengths
-    in m and pressures in Pa. A problem from its QP data (:meth:`ContactProblem.from_qp`) is in
-    the units of d (lengths) and of f (forces).
-    """
-    if problem.mesh is None:
-        return {"system": "the QP's own", "length": "the unit of d", "force": "the unit of f",
-                "total_force": "the unit of f", "pressure": "the unit of f per unit of the weights",
-                "time": "s"}
-    if problem.mesh.p.shape[0] == 2 and not problem.axisymmetric:
-        force = total = "stress·length (per unit thickness, plane strain)"
-    else:
-        total = "stress·length²"
-        force = total + (" (per radian: axisymmetric)" if problem.axisymmetric else "")
-    return {"system": "the scene's own (length: its lengths' unit, stress: E's unit)",
-            "length": "length", "force": force, "total_force": total, "pressure": "stress",
-            "time": "s"}
 
 
 def _scalar_rows(value: Any) -> bool:
@@ -229,13 +210,20 @@ class Result:
         """
         if not hasattr(self, "_estimate"):
             log.info("estimating the discretisation error (ZZ)")
-            self._estimate = estimate(self.problem, self.solution) if self.finite else None
+            with timed(self.solution.seconds, "estimate"):
+                self._estimate = estimate(self.problem, self.solution) if self.finite else None
         return self._estimate
 
     # -- records ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """The record ``signorini solve --json`` writes (arrays as NumPy until serialised)."""
-        problem, solution = self.problem, self.solution
+        """The record ``signorini solve --json`` writes (arrays as NumPy until serialised).
+
+        ``time`` has the seconds of every stage of a solve (``mesh_s``, ..., ``output_s``:
+        building this record, the estimate apart) and their sum ``total_s``
+        (:func:`signorini.numerics.work.stage_times`).
+        """
+        problem, solution, estimated = self.problem, self.solution, self.estimate  # timed apart
+        start = time.perf_counter()
         record: dict[str, Any] = {
             "schema_version": SCHEMA_VERSION, "units": record_units(problem),
             "scene": problem.scene, "params": problem.params, "method": solution.method,
@@ -243,11 +231,10 @@ class Result:
             "message": solution.message,
             "iterations": self.iterations, "dofs": problem.n,
             "contact_candidates": problem.m,
-            "time": {"assemble_s": problem.discretisation.assemble_s if problem.discretisation
-                     else 0.0, "build_s": solution.build_time, "solve_s": solution.solve_time},
+            "time": {},
             "work": solution.work,
             "kkt": self.certificate.as_dict(),
-            "estimate": None if self.estimate is None else self.estimate.as_dict(),
+            "estimate": None if estimated is None else estimated.as_dict(),
         }
         if self.finite:
             record["total_force"] = self.total_force
@@ -264,6 +251,11 @@ class Result:
             record["adequacy"] = solution.extras["adequacy"]
         record["extras"] = {k: v for k, v in solution.extras.items()
                             if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}
+        disc = problem.discretisation
+        built = {"mesh": disc.mesh_s, "assemble": disc.assemble_s} if disc is not None else {}
+        record["time"] = {**stage_times({**built, **solution.seconds,
+                                         "output": time.perf_counter() - start}),
+                          "build_s": solution.build_time, "solve_s": solution.solve_time}
         return record
 
     def summary(self) -> str:
@@ -276,8 +268,7 @@ def solve_summary(record: dict[str, Any]) -> str:
     lines = [f"{record['scene'] or 'problem'} with {record['method']}: {record['status']} "
              f"after {record['iterations']} iterations ({record['message']})",
              f"  {record['dofs']} dofs, {record['contact_candidates']} contact candidates; "
-             f"assemble {record['time']['assemble_s']:.2f} s, build {record['time']['build_s']:.2f} s, "
-             f"solve {record['time']['solve_s']:.2f} s"]
+             + time_line(record["time"])]
     kkt = record["kkt"]
     lines.append("  KKT (relative): " + ", ".join(f"{k} {v:.1e}" for k, v in kkt.items()))
     if record.get("contact"):
@@ -437,4 +428,4 @@ def scene_families() -> dict[str, SceneFamily]:
 
 
 __all__ = ["DEFAULT_METHOD", "Result", "at_load", "build_problem", "certificate", "methods", "scene_families",
-           "solve", "solve_adaptive", "solve_summary"]
+           "solve", "solve_adaptive", "solve_summary", "with_load"]

@@ -219,7 +219,7 @@ def _run_of(result: Result, tol: float) -> MethodRun:
     worst_name, worst = cert.worst()
     polish = solution.extras.get("polish")
     return MethodRun(result.method, tol, solution.status, solution.own_status, solution.message,
-                     result.iterations, float(solution.extras.get("method_s", float("nan"))),
+                     result.iterations, float(solution.seconds.get("method", float("nan"))),
                      str(solution.extras.get("form", "")),
                      None if polish is None else bool(polish.get("kept")), cert.as_dict(),
                      float(worst), worst_name, _reference_errors(result))

@@ -132,7 +132,9 @@ class Discretisation:
     says how f, d and the load depend on the prescribed push (load control,
     :mod:`signorini.load_control`), ``predicted_contact`` which candidates the
     scene expects in contact (where load control starts), ``watch`` the
-    boundary beyond the candidates (see :class:`Watch`).
+    boundary beyond the candidates (see :class:`Watch`). ``mesh_s`` and
+    ``assemble_s`` are the seconds spent building the scene's mesh and model,
+    and assembling the QP from it.
     """
 
     mesh: Any
@@ -149,4 +151,5 @@ class Discretisation:
     push: Push | None = None
     predicted_contact: np.ndarray | None = None
     watch: Watch | None = None
+    mesh_s: float = 0.0
     assemble_s: float = 0.0

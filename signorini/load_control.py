@@ -29,7 +29,7 @@ takes load control's answer as an explicit warm start (``warm_from_load``);
 a method that does not starts cold and the iterations it reports are its own.
 Every stage's work is in ``solution.work``: ``load control``, the
 ``prediction`` (a coarser model solved to predict the contact) and the
-``method``.
+``method``; their wall times, and the certificate's, in ``solution.seconds``.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ from signorini.errors import InputError
 from signorini.kkt import Certificate
 from signorini.numerics.factor import FactorTooLarge, selection_dofs
 from signorini.numerics.push import calibrate_push
-from signorini.numerics.work import counting
+from signorini.numerics.work import counting, timed
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
                                      zone_around_points)
 from signorini.problem import ContactProblem
@@ -229,23 +229,26 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
     start = None if warm_start is None else WarmStart.of(warm_start)
     runs = request.method.runs(problem, request.options, start)  # itself, or the one it picks
     stages: dict[str, dict[str, int]] = {}
+    seconds: dict[str, float] = {}
     zone, matched, options = None, None, request.options
     if problem.pending and not runs.matches(problem):
         log.info("matching the target load: predicting the contact zone on a coarser model")
-        zone = predicted_zone(problem, coarse)  # predicted once: load control's and the method's
-        matched = match(problem, zone)
+        with timed(seconds, "load control"):
+            zone = predicted_zone(problem, coarse)  # predicted once: load control's and the method's
+            matched = match(problem, zone)
         stages["load control"] = matched.work
         problem = matched.problem
     if matched is not None and start is None and request.method.warm_from_load:
         start = matched.warm_start  # load control's answer, taken as an explicit warm start
     elif runs.prediction:  # a method that starts cold, from the scene's predictions only
-        with counting() as work:
+        with counting() as work, timed(seconds, "prediction"):
             options = {**_predictions(problem, runs.prediction, options, coarse, zone), **options}
         if work.listed():  # a coarser model solved for its prediction
             stages["prediction"] = work.listed()
     solved = Solved(*registry.run(problem, request._replace(options=options), warm_start=start,
                                   keep_factor=keep_factor))
     solved.solution.work = {**stages, **solved.solution.work}
+    solved.solution.seconds = {**seconds, **solved.solution.seconds}
     if matched is not None:
         solved.solution.message += f"; load matched by {matched.how} ({_said(matched.work)})"
     return solved

@@ -314,6 +314,33 @@ class ContactProblem:
         new._factor, new._basis = self._factor, self._basis  # K is unchanged
         return new
 
+    def with_target(self, P: float, params: dict[str, Any] | None = None,
+                    predicted_contact: np.ndarray | None = None) -> "ContactProblem":
+        """The same body with the target load ``P`` (the scene's units, full body), pending.
+
+        Mesh, K and K's cached factorisation are shared (nothing is meshed or
+        assembled: ``mesh_s`` and ``assemble_s`` are 0); load control matches
+        the new target when the problem is solved. ``params`` are the
+        parameters the problem records (default: its own with ``P``),
+        ``predicted_contact`` the candidates load control starts from (default: as before).
+        """
+        pu = self.push
+        if pu is None or pu.target is None:
+            raise InputError("this problem has no target load to change: build the scene with a "
+                             "load P (or a_over_R), or build it again with the new load")
+        target = P / self.scales.force
+        load = target if pu.f_load is not None else pu.load  # a cut's traction is the load itself
+        discretisation = dataclasses.replace(
+            self.discretisation, load_offset=pu.offset(pu.scale, load), mesh_s=0.0, assemble_s=0.0,
+            params=dict(self.params, P=P) if params is None else params,
+            predicted_contact=(self.discretisation.predicted_contact if predicted_contact is None
+                               else predicted_contact),
+            push=dataclasses.replace(pu, load=load, target=target, pending=True, P=P))
+        new = self.with_data(f=pu.f(pu.scale, load), d=pu.d0 + pu.scale * pu.d1,
+                             discretisation=discretisation)
+        new._factor, new._basis = self._factor, self._basis  # K is unchanged
+        return new
+
     def with_data(self, **changes: Any) -> "ContactProblem":
         """A copy with some fields (or fields of its discretisation) replaced.
 

@@ -16,7 +16,6 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import MeshTet, MeshTri
 
 from signorini.discretisation import Discretisation, Push, ReferenceData
 from signorini.errors import InputError
@@ -88,6 +87,8 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
                         p.get("delta"), p.get("P"))
         mesh = None
         if "mesh_p" in z:
+            from skfem import MeshTet, MeshTri  # a saved mesh only (start-up)
+
             kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
             mesh = kind(z["mesh_p"], z["mesh_t"])
         discretisation = Discretisation(

@@ -24,7 +24,8 @@ import scipy.sparse as sp
 
 from signorini.solution import WarmStart
 
-__all__ = ["ORDER_ONE", "Scales", "UnitsFactor", "in_problem_units", "qp_scales", "scaled_view"]
+__all__ = ["ORDER_ONE", "Scales", "UnitsFactor", "in_problem_units", "qp_scales", "record_units",
+           "scaled_view"]
 
 
 @dataclass(frozen=True)
@@ -145,3 +146,25 @@ class UnitsFactor:
     def fixed_rows(self, u: np.ndarray) -> np.ndarray:
         """``(K u)[fixed]``."""
         return self.stiffness * self.factor.fixed_rows(u)
+
+
+def record_units(problem: Any) -> dict[str, str]:
+    """The unit of each physical quantity of the solve record, in the problem's input units.
+
+    A scene's units are those of its parameters: ``length`` the unit its lengths are given in
+    (R, W, H, mesh coordinates), ``stress`` the unit of E; so a scene given in SI has lengths
+    in m and pressures in Pa. A problem from its QP data (:meth:`ContactProblem.from_qp`) is in
+    the units of d (lengths) and of f (forces).
+    """
+    if problem.mesh is None:
+        return {"system": "the QP's own", "length": "the unit of d", "force": "the unit of f",
+                "total_force": "the unit of f", "pressure": "the unit of f per unit of the weights",
+                "time": "s"}
+    if problem.mesh.p.shape[0] == 2 and not problem.axisymmetric:
+        force = total = "stress·length (per unit thickness, plane strain)"
+    else:
+        total = "stress·length²"
+        force = total + (" (per radian: axisymmetric)" if problem.axisymmetric else "")
+    return {"system": "the scene's own (length: its lengths' unit, stress: E's unit)",
+            "length": "length", "force": force, "total_force": total, "pressure": "stress",
+            "time": "s"}

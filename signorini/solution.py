@@ -90,6 +90,9 @@ class ContactSolution:
     #: the work of every stage that ran, by stage ("method", "load control"): active-set or
     #: load-control steps, factorisations, back-solves, CG iterations
     work: dict[str, dict[str, int]] = field(default_factory=dict)
+    #: the wall time of every stage that ran, by stage ("load control", "method",
+    #: "certificate"), in seconds (:func:`signorini.numerics.work.timed`)
+    seconds: dict[str, float] = field(default_factory=dict)
     __repr__ = short_repr
 
     def __post_init__(self) -> None:

@@ -1,6 +1,7 @@
-"""Import only what a command uses: ``import signorini`` and ``signorini solve block`` load no
-plotting, no QP backend and no ``scipy.spatial`` (only meshing with Delaunay and the k-d tree
-lookups need it); the number of modules ``import signorini`` adds is held under a bound.
+"""Import only what a command uses: ``import signorini`` loads the package alone (its names load
+at first use); the public API and ``signorini solve block`` load no plotting, no QP backend and
+no ``scipy.spatial`` (only meshing with Delaunay and the k-d tree lookups need it); the number
+of modules the public API adds is held under a bound.
 
 Each check runs in a fresh interpreter (this one has imported everything by now).
 """
@@ -16,7 +17,10 @@ from test_startup import HEAVY
 #: what neither ``import signorini`` nor a solve of the block may load
 NOT_ON_IMPORT = HEAVY + ("scipy.spatial", "rich")
 
-#: modules ``import signorini`` may add to a fresh interpreter. Measured with
+#: what ``import signorini`` and ``signorini --help`` leave to the first use of a name
+LAZY = ("numpy", "scipy", "skfem", "triangle", "signorini.api", "signorini.solvers.registry")
+
+#: modules the public API (``import signorini; signorini.solve``) may add to a fresh interpreter. Measured with
 #: ``python -c "import sys; b = set(sys.modules); import signorini; print(len(set(sys.modules) - b))"``
 #: on Python 3.11, NumPy 2.4, SciPy 1.17, scikit-fem 12: 641 modules (740 while scipy.spatial and
 #: scipy.io were imported up front), and about 10 % more is allowed for other versions.
@@ -29,9 +33,9 @@ def run(args: list[str]) -> subprocess.CompletedProcess:
     return proc
 
 
-def added_by_import() -> set[str]:
-    """The modules ``import signorini`` adds to a fresh interpreter."""
-    proc = run(["-c", "import json, sys\nbefore = set(sys.modules)\nimport signorini\n"
+def added_by_import(statements: str = "import signorini\nsignorini.solve") -> set[str]:
+    """The modules ``statements`` (by default: the public API) add to a fresh interpreter."""
+    proc = run(["-c", f"import json, sys\nbefore = set(sys.modules)\n{statements}\n"
                       "print(json.dumps(sorted(set(sys.modules) - before)))"])
     return set(json.loads(proc.stdout.strip().splitlines()[-1]))
 
@@ -47,7 +51,22 @@ def loaded(modules: set[str], names=NOT_ON_IMPORT) -> list[str]:
     return [name for name in names if any(m == name or m.startswith(name + ".") for m in modules)]
 
 
-def test_import_signorini_loads_no_backend_plotting_or_spatial():
+def test_import_signorini_loads_the_package_alone():
+    added = added_by_import("import signorini")
+    assert "signorini" in added and loaded(added, LAZY) == []
+
+
+def test_the_cli_help_loads_no_numerics():
+    added = added_by_import("import contextlib, io\nfrom signorini.cli import main\n"
+                            "with contextlib.redirect_stdout(io.StringIO()) as out:\n"
+                            "    with contextlib.suppress(SystemExit):\n"
+                            "        main(['solve', '--help'])\n"
+                            "assert '--method' in out.getvalue()")
+    assert "signorini.cli.solve" in added
+    assert loaded(added, LAZY) in ([], ["numpy"])  # numpy: the options' checks read its types
+
+
+def test_the_public_api_loads_no_backend_plotting_or_spatial():
     added = added_by_import()
     assert "signorini.api" in added  # the public API is what was imported
     assert loaded(added) == []

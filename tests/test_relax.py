@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import signorini.scenes.relax as relax_module
-from signorini.scenes.meshing import graded_quarter_disc
+from signorini.scenes.meshing import graded_quarter_disc, graded_unit_disc
 
 
 def _triangle_set(t: np.ndarray) -> set[tuple[int, ...]]:
@@ -21,10 +21,12 @@ def test_the_mesh_is_the_one_qhull_alone_gives(monkeypatch, n_contact, grading):
         return delaunay(p, general_position)
 
     monkeypatch.setattr(relax_module, "_delaunay", counted)
+    graded_unit_disc.cache_clear()  # meshed here, not kept from an earlier test
     mixed = graded_quarter_disc(1.0, 0.05, n_contact, grading).mesh
     assert calls.count(False) == 1 and calls.count(True) >= 2  # qhull once, then Triangle
 
     monkeypatch.setattr(relax_module, "_delaunay", lambda p, general_position: delaunay(p, False))
+    graded_unit_disc.cache_clear()
     qhull = graded_quarter_disc(1.0, 0.05, n_contact, grading).mesh
     assert np.array_equal(mixed.p, qhull.p)
     assert _triangle_set(mixed.t) == _triangle_set(qhull.t)

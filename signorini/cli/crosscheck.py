@@ -8,7 +8,7 @@ from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, p
                                   stdout_to_stderr, user_methods_in_workers,
                                   write_output)
 from signorini.errors import InputError
-from signorini.solvers.base import DEFAULT_TOL
+from signorini.solvers.defaults import DEFAULT_TOL
 from signorini.solvers.options import guess_value
 
 

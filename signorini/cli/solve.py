@@ -9,7 +9,7 @@ import sys
 from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, parse_time_limit,
                                   parse_tol, stdout_to_stderr, write_output)
 from signorini.errors import InputError
-from signorini.solvers.base import DEFAULT_TOL
+from signorini.solvers.defaults import DEFAULT_TOL
 from signorini.solvers.options import guess_value
 
 

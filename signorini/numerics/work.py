@@ -13,10 +13,16 @@ running side by side never see each other's work, and outside any
 ...     count("back_solves", 2)
 >>> work.as_dict()
 {'back_solves': 2}
+
+Time is the other record a solve carries: :func:`timed` adds a block's wall
+time to a stage of a plain ``{stage: seconds}`` dict that travels with the
+problem or the answer (``solution.seconds``), so the stages of one solve sum
+to its wall time.
 """
 
 from __future__ import annotations
 
+import time
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import asdict, dataclass
@@ -70,4 +76,39 @@ def count(kind: str, amount: int = 1) -> None:
         setattr(work, kind, getattr(work, kind) + amount)
 
 
-__all__ = ["Work", "count", "counting"]
+#: the stages of a solve, in the order they run (the solve record's ``time``)
+STAGES = ("mesh", "assemble", "load control", "prediction", "method", "certificate", "estimate",
+          "output")
+
+
+def stage_key(stage: str) -> str:
+    """The record's key of a stage's seconds: ``load_control_s``."""
+    return f"{stage.replace(' ', '_')}_s"
+
+
+def stage_times(seconds: dict[str, float]) -> dict[str, float]:
+    """Every stage of :data:`STAGES` by its key (0 for one that did not run) and their sum,
+    ``total_s``."""
+    stages = {stage_key(stage): seconds.get(stage, 0.0) for stage in STAGES}
+    return {**stages, "total_s": sum(stages.values())}
+
+
+def time_line(times: dict[str, float], parts: int = 3) -> str:
+    """``time 0.31 s: mesh 0.23, method 0.03, assemble 0.02``: the total of :func:`stage_times`
+    and its ``parts`` largest stages."""
+    largest = sorted(((times.get(stage_key(stage), 0.0), stage) for stage in STAGES),
+                     reverse=True)[:parts]
+    return f"time {times['total_s']:.2f} s: " + ", ".join(f"{stage} {s:.2f}" for s, stage in largest)
+
+
+@contextmanager
+def timed(seconds: dict[str, float], stage: str) -> Iterator[None]:
+    """Add the wall time of the block to ``seconds[stage]`` (seconds, :func:`time.perf_counter`)."""
+    start = time.perf_counter()
+    try:
+        yield
+    finally:
+        seconds[stage] = seconds.get(stage, 0.0) + time.perf_counter() - start
+
+
+__all__ = ["STAGES", "Work", "count", "counting", "stage_key", "stage_times", "time_line", "timed"]

@@ -9,15 +9,18 @@ coarser, which predicts the contact zone of large models.
 from __future__ import annotations
 
 import logging
+import time
 from typing import Any
 
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.two_bodies import TwoBodyModel
 from signorini.numerics.arrays import flag_argument
+from signorini.numerics.zone import radial_distance
 from signorini.problem import ContactProblem, Scales
 from signorini.problem_files import is_problem_file, read_problem
-from signorini.scenes.base import scene_params
+from signorini.references import reference_of
+from signorini.scenes.base import LOAD_NAMES, scene_params
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import check_size
@@ -67,8 +70,11 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     read as stored, with no parameters to set. A target load stays pending (load
     control matches it when the problem is solved). ``solved_by`` names the
     method that will solve it, for the size guard (a method that never
-    factorises needs less memory).
+    factorises needs less memory). The problem's ``discretisation.mesh_s`` is
+    the time spent up to assembly (checking, meshing, the model) and
+    ``assemble_s`` assembly's.
     """
+    start = time.perf_counter()
     values = scene_params(params)
     nondimensionalise = flag_argument(nondimensionalise, "nondimensionalise")
     if not isinstance(name, str):
@@ -107,7 +113,46 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
                          f"hands on {model.reference!r}: give its SceneModel "
                          f"reference=ReferenceData({declared!r}, ...) with the fields that "
                          "reference reads (signorini.problem.ReferenceData)")
+    mesh_s = time.perf_counter() - start
     problem = (model.assemble(nondimensionalise) if isinstance(model, TwoBodyModel)
                else assemble(model, nondimensionalise=nondimensionalise))
     problem.name = name
+    problem.discretisation.mesh_s = mesh_s
     return problem
+
+
+def with_load(problem: ContactProblem, **load: float) -> ContactProblem:
+    """``problem``, built from a scene by name, at another target load on the same mesh and K.
+
+    ``load`` names the scene's load parameters in its units, as
+    :func:`build_problem` takes them: ``with_load(problem, P=2.5)`` or
+    ``with_load(problem, a_over_R=0.08)``. Nothing is meshed or assembled, and K's
+    factorisation, when cached, is kept (:meth:`ContactProblem.with_target`): what a
+    load slider needs. The mesh stays graded for the load it was built at, so
+    the answer is that mesh's; a contact zone that outgrows the candidates is
+    judged ``model_inadequate`` as in any solve.
+    """
+    family = SCENES.get(problem.scene or "")
+    if family is None or family.loads is None or problem.push is None or problem.push.target is None:
+        raise InputError("with_load moves the target load of a scene built by name with one "
+                         "(P or a_over_R): build this problem again with the new load instead")
+    moved = sorted(set(load) - set(LOAD_NAMES))
+    if not load or moved:
+        raise InputError(f"with_load takes the scene's load ({', '.join(LOAD_NAMES)}), got "
+                         f"{', '.join(moved) or 'none'}: e.g. with_load(problem, P=2.5)")
+    kept = {p.name: problem.params[p.name] for p in family.params
+            if p.name in problem.params and p.name not in LOAD_NAMES}
+    target = family.loads(family.parse({**kept, **load}), set(load))[0]
+    if target is None:
+        raise InputError("with_load moves a target load: give P (or a_over_R); a prescribed push "
+                         "delta is a new build")
+    recorded = {**problem.params, **{name: None for name in LOAD_NAMES if name in problem.params},
+                **load, "P": target}
+    moved = problem.with_target(target, recorded)
+    reference = reference_of(moved)  # load control starts from the reference's contact zone
+    a = reference.extent(moved) if reference is not None and reference.extent else None
+    if a is None:
+        return moved
+    return problem.with_target(target, recorded, radial_distance(moved.contact_points)
+                               < a / moved.scales.length)
+

@@ -95,9 +95,9 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
     R, E, nu = p["R"], p["E"], p["nu"]
     E_star = E / (1.0 - nu ** 2)
     target, delta = _load_choice(p, given)
-    if target is not None:
+    if target is not None and "P" in given and p["P"] is not None:  # the mesh's a from the force
         a_est = hertz_cylinder_half_width(target, R, E_star) / R  # in range: _load_choice
-    else:
+    else:  # as given (not through P and back, which rounds differently for every E)
         a_est = p["a_over_R"]
     if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
         disc = quarter_disc_on(mesh, R, a_est, p["candidates"])

@@ -15,6 +15,7 @@ from __future__ import annotations
 import logging
 from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import lru_cache
 from itertools import combinations
 from typing import Any, Callable
 
@@ -292,16 +293,28 @@ def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: floa
     moves its nodes into near-equilateral triangles
     (:func:`signorini.scenes.relax.relax`: more accurate per dof); ``triangle`` is
     Triangle's quality mesh (:func:`signorini.scenes.triangulated.triangulated_quarter_disc`:
-    much faster, near-equilateral), built from a/R to 12 digits so that the same
-    scene in other units gives the same mesh.
+    much faster, near-equilateral), built from a/R to 12 digits so that the same scene in other
+    units gives the same mesh. The last graded unit discs are kept (:func:`graded_unit_disc`).
     """
     if mesher not in MESHERS:
         raise ValueError(f"mesher={mesher!r} is not a mesher of the quarter disc: "
                          f"choose one of {', '.join(MESHERS)}")
     if mesher == "triangle":  # a ratio computed in other units differs in its last bits, which
         a_over_R = float(f"{a_over_R:.12g}")  # would tip Triangle's near-cocircular choices
-    h_contact = a_over_R / n_contact
-    zone_end = np.array([1.25 * a_over_R, 0.0])
+    p, t, chain = graded_unit_disc(a_over_R, n_contact, grading, mesher)
+    for _ in range(refine):
+        p, t, chain = refine_uniformly(p, t, chain)
+        offset = p[:, chain] - np.array([[0.0], [1.0]])
+        p[:, chain] = np.array([[0.0], [1.0]]) + offset / np.linalg.norm(offset, axis=0)
+    return quarter_disc_on(MeshTri(p * R, t.copy()), R, a_over_R, candidate_extent)
+
+
+@lru_cache(maxsize=8)
+def graded_unit_disc(a_over_R: float, n_contact: int, grading: float,
+                     mesher: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The graded quarter of the unit disc of :func:`graded_quarter_disc`: its points, triangles
+    and the arc's nodes from the bottom (read-only: kept for the next call with these values)."""
+    h_contact, zone_end = a_over_R / n_contact, np.array([1.25 * a_over_R, 0.0])
 
     def target_size(points: np.ndarray) -> np.ndarray:
         dist = distance_to_segment(points, np.zeros(2), zone_end)
@@ -319,12 +332,8 @@ def graded_quarter_disc(R: float, a_over_R: float, n_contact: int, grading: floa
                       | (np.hypot(mesh.p[0] - 1.0, mesh.p[1] - 1.0) < 1e-12))[0]
     chain = np.union1d(arc, ends)
     chain = chain[np.argsort(np.arctan2(mesh.p[1, chain] - 1.0, mesh.p[0, chain]))]  # from the bottom
-    p, t = mesh.p, mesh.t
-    for _ in range(refine):
-        p, t, chain = refine_uniformly(p, t, chain)
-        offset = p[:, chain] - np.array([[0.0], [1.0]])
-        p[:, chain] = np.array([[0.0], [1.0]]) + offset / np.linalg.norm(offset, axis=0)
-    return quarter_disc_on(MeshTri(p * R, t), R, a_over_R, candidate_extent)
+    mesh.p.flags.writeable = mesh.t.flags.writeable = chain.flags.writeable = False
+    return mesh.p, mesh.t, chain
 
 
 def _edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:

@@ -249,7 +249,7 @@ def run_on(problem: ContactProblem, task: Task,
                claimed_status=solution.own_status, wrapper=wrapper, iterations=solution.iterations,
                time_s=elapsed)
     if "times" in task.measure or "factorisation" in task.measure:
-        method_s = float(solution.extras.get("method_s", elapsed))
+        method_s = float(solution.seconds.get("method", elapsed))
         row.update(build_s=solution.build_time, solve_s=solution.solve_time, method_s=method_s)
         if "factor_s" in row:
             row["ratio_to_factor"] = method_s / row["factor_s"]
