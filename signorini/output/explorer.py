@@ -56,7 +56,9 @@ def _(bound, rho):
     screen("Uzawa on the bogie",
            "Projected gradient ascent on the dual, λ ← max(0, λ + ρ (N u(λ) − d)), drawn on "
            f"the dual function D(λ). It converges for 0 < ρ < 2/λ_max(W) = **{bound:.4f}**; "
-           "past it the iterates fly off or bounce, and the status turns `diverged`.",
+           "past it the iterates fly off or bounce, and the status turns `diverged`. Far below "
+           "it the status may read `inaccurate`: Uzawa's own stop test is met before the "
+           "certificate's duality gap is under the tolerance.",
            [rho],
            numbers_table("uzawa", {"rho": ("ρ", uzawa.rho), "bound": ("2/λ_max(W)", uzawa.bound),
                                    "force": ("λ (last iterate)", " ".join(

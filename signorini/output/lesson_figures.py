@@ -1,13 +1,15 @@
 """The explorer's figures: each draws one lesson of :mod:`signorini.output.lessons`.
 
 Figures are built with :class:`matplotlib.figure.Figure` (no pyplot state), so that a web app
-can draw one per interaction from any thread.
+can draw one per interaction from any thread, with fixed margins (:data:`MARGINS`) rather than
+a layout engine's search, which would be redone at every slider move.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogFormatter
 
 from signorini.output.lessons import HertzLesson, PricesLesson, RaceRow, UzawaLesson
 
@@ -15,19 +17,21 @@ __all__ = ["hertz_figure", "prices_figure", "race_figure", "uzawa_figure"]
 
 #: the window of the bogie's dual plane drawn (λ₁, λ₂)
 DUAL_WINDOW = ((-0.1, 1.2), (-0.1, 1.2))
+#: the figures' margins and spacing, as fractions of the figure
+MARGINS = {"left": 0.08, "right": 0.98, "bottom": 0.11, "top": 0.93, "wspace": 0.25, "hspace": 0.55}
 
 
 def uzawa_figure(lesson: UzawaLesson) -> Figure:
     """Contours of ``D(λ)`` with the iterates and λ*, their distance to λ*, and ρ against
     its bound ``2/λ_max(W)``."""
-    fig = Figure(figsize=(10, 4.6), layout="constrained")
-    grid = fig.add_gridspec(2, 2, height_ratios=(6, 1), width_ratios=(1.1, 1))
+    fig = Figure(figsize=(10, 4.6))
+    grid = fig.add_gridspec(2, 2, height_ratios=(6, 1), width_ratios=(1.1, 1), **MARGINS)
     dual, distance, step = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, :])
     (x0, x1), (y0, y1) = DUAL_WINDOW
-    plane = np.stack(np.meshgrid(np.linspace(x0, x1, 160), np.linspace(y0, y1, 160)), axis=-1)
+    plane = np.stack(np.meshgrid(np.linspace(x0, x1, 100), np.linspace(y0, y1, 100)), axis=-1)
     values = (-0.5 * np.einsum("...i,ij,...j->...", plane, lesson.W, plane) + plane @ lesson.b
               + lesson.constant)
-    dual.contourf(plane[..., 0], plane[..., 1], values, levels=30, cmap="Blues")
+    dual.imshow(values, origin="lower", extent=(x0, x1, y0, y1), cmap="Blues", aspect="auto")
     dual.fill_between([x0, x1], y0, 0, color="0.5", alpha=0.35, lw=0)
     dual.fill_betweenx([y0, y1], x0, 0, color="0.5", alpha=0.35, lw=0)
     path = lesson.iterates
@@ -38,6 +42,7 @@ def uzawa_figure(lesson: UzawaLesson) -> Figure:
     dual.legend(loc="upper right", fontsize=8), dual.set_title("The dual function D(λ) of the bogie")
     gaps = np.linalg.norm(path - lesson.maximiser, axis=1)
     distance.semilogy(np.maximum(gaps, 1e-17), color="C0")
+    distance.yaxis.set_major_formatter(LogFormatter())  # plain text: no mathtext per move
     distance.set_xlabel("iteration k"), distance.set_ylabel("‖λᵏ − λ*‖")
     distance.set_title(f"{lesson.result.iterations} iterations, status {lesson.result.status}")
     step.axvspan(0, lesson.bound, color="C2", alpha=0.2, label="converges")
@@ -53,8 +58,8 @@ def uzawa_figure(lesson: UzawaLesson) -> Figure:
 
 def hertz_figure(lesson: HertzLesson) -> Figure:
     """The nodal pressure against Hertz's curve, the two half-widths, and the active set."""
-    fig = Figure(figsize=(10, 4.6), layout="constrained")
-    grid = fig.add_gridspec(2, 1, height_ratios=(6, 1))
+    fig = Figure(figsize=(10, 4.6))
+    grid = fig.add_gridspec(2, 1, height_ratios=(6, 1), **MARGINS)
     ax, nodes = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
     reach = 1.6 * lesson.a_ref
     shown = lesson.x <= reach
@@ -78,8 +83,8 @@ def hertz_figure(lesson: HertzLesson) -> Figure:
 
 def prices_figure(lesson: PricesLesson) -> Figure:
     """``J*(g₂)`` with the tangent of slope ``−λ₂`` at the gap, and λ beside the prices."""
-    fig = Figure(figsize=(10, 4.2), layout="constrained")
-    curve, bars = fig.subplots(1, 2, width_ratios=(1.4, 1))
+    fig = Figure(figsize=(10, 4.2))
+    curve, bars = fig.subplots(1, 2, width_ratios=(1.4, 1), gridspec_kw=MARGINS)
     curve.plot(lesson.curve_gaps, lesson.curve_energy, "C0", lw=2, label="J*(g₂), re-solved")
     run = np.array([-0.4, 0.4])
     curve.plot(lesson.gap + run, lesson.result.energy - lesson.force[1] * run, "k-",
@@ -97,13 +102,15 @@ def prices_figure(lesson: PricesLesson) -> Figure:
 
 def race_figure(rows: list[RaceRow]) -> Figure:
     """Iterations and the worst KKT residual of each method, side by side."""
-    fig = Figure(figsize=(10, 3.4), layout="constrained")
-    iterations, residual = fig.subplots(1, 2)
+    fig = Figure(figsize=(10, 3.4))
+    iterations, residual = fig.subplots(1, 2, gridspec_kw={**MARGINS, "left": 0.14, "wspace": 0.05})
     names = [row.method for row in rows]
     iterations.barh(names, [max(row.iterations, 1) for row in rows], color="C0")
     iterations.set_xscale("log"), iterations.set_xlabel("iterations")
+    iterations.xaxis.set_major_formatter(LogFormatter())
     residual.barh(names, [max(row.worst[1], 1e-17) for row in rows],
                   color=["C2" if row.status == "converged" else "C3" for row in rows])
     residual.set_xscale("log"), residual.set_xlabel("worst KKT residual (green: converged)")
+    residual.xaxis.set_major_formatter(LogFormatter())
     residual.set_yticks([])
     return fig
