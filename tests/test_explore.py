@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import socket
 import subprocess
 import sys
@@ -109,6 +110,16 @@ def test_explore_refuses_a_port_in_use(capsys):
     assert f"--port {port} is in use" in capsys.readouterr().err
 
 
+def test_explore_serves_with_marimo_headless_only_without_a_browser():
+    from signorini.cli.explore import server_command
+
+    headless, browsing = server_command(8800, open_browser=False), server_command(8800, True)
+    assert headless[:3] == [sys.executable, "-m", "marimo"] and "--headless" in headless
+    assert "--headless" not in browsing
+    assert headless[headless.index("--port") + 1] == "8800"
+    assert Path(headless[headless.index("run") + 1]).is_file()
+
+
 # -- the app in a real browser ------------------------------------------------------------------
 def free_port() -> int:
     with socket.socket() as probe:
@@ -142,18 +153,22 @@ def explorer():
                     if probe.connect_ex(("127.0.0.1", port)) == 0:
                         break
                 page.wait_for_timeout(500)
+            requested: list[str] = []
+            page.on("request", lambda request: requested.append(request.url))
             page.goto(f"http://127.0.0.1:{port}")
             for element in ("uzawa-figure", "hertz-figure", "prices-figure", "race-figure"):
                 page.locator(f"#{element}").wait_for()
-            yield page, sync_api.expect
+            yield page, sync_api.expect, requested, f"http://127.0.0.1:{port}/"
             browser.close()
     finally:
         server.terminate()
         try:
-            server.wait(timeout=30)
+            code = server.wait(timeout=30)
         except subprocess.TimeoutExpired:
             server.kill()
             server.wait(timeout=30)
+            code = None
+    assert code == 128 + signal.SIGTERM, "signorini explore did not stop cleanly on SIGTERM"
 
 
 def move(page, name: str, value: float) -> None:
@@ -170,7 +185,7 @@ def wait_for_number(page, expect, element: str, value: float) -> None:
 
 
 def test_uzawa_slider_re_solves_and_diverges_past_the_bound(explorer):
-    page, expect = explorer
+    page, expect, _, _ = explorer
     before = page.locator("#uzawa-figure").get_attribute("src")
     lesson = lessons.uzawa_lesson(0.2)
     move(page, "rho", 0.2)
@@ -192,7 +207,7 @@ def test_uzawa_slider_re_solves_and_diverges_past_the_bound(explorer):
 
 
 def test_hertz_sliders_re_solve(explorer):
-    page, expect = explorer
+    page, expect, _, _ = explorer
     before = page.locator("#hertz-figure").get_attribute("src")
     move(page, "load", 0.01)
     lesson = lessons.hertz_lesson(0.01)
@@ -206,7 +221,7 @@ def test_hertz_sliders_re_solve(explorer):
 
 
 def test_prices_slider_re_solves(explorer):
-    page, expect = explorer
+    page, expect, _, _ = explorer
     before = page.locator("#prices-figure").get_attribute("src")
     move(page, "gap", 1.0)
     lesson = lessons.prices_lesson(1.0)
@@ -217,7 +232,7 @@ def test_prices_slider_re_solves(explorer):
 
 
 def test_race_slider_re_solves(explorer):
-    page, expect = explorer
+    page, expect, _, _ = explorer
     picked = [re.sub(r"^race-", "", row.get_attribute("id"))
               for row in page.locator("#race-table tr[id]").all()]
     assert "pdas" in picked
@@ -227,3 +242,10 @@ def test_race_slider_re_solves(explorer):
         expect(page.locator(f"#race-{row.method}-iterations")).to_have_text(str(row.iterations),
                                                                              timeout=WAIT_MS)
         assert shown(page, f"race-{row.method}-status") == row.status
+
+
+def test_the_page_asks_nothing_of_the_network(explorer):
+    page, _, requested, served = explorer
+    page.wait_for_load_state("networkidle")
+    outside = [url for url in requested if not url.startswith((served, "data:", "blob:"))]
+    assert requested and not outside, f"requests that leave the machine: {outside}"

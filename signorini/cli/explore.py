@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import os
 import socket
-import threading
-import webbrowser
+import subprocess
+import sys
+from pathlib import Path
 
 from signorini.errors import InputError
 
@@ -22,10 +24,13 @@ examples:
   signorini explore --no-browser --port 8800  serve only (open http://127.0.0.1:8800 yourself)
 
 exit codes:
-  0  the server was stopped (Ctrl-C)
-  2  bad input: a port out of range or in use, or marimo not installed"""
+  0    the server ended by itself
+  2    bad input: a port out of range or in use, or marimo not installed
+  130  stopped by Ctrl-C; 143 by SIGTERM (128 + the signal's number)"""
 
 HOST = "127.0.0.1"
+#: seconds the server has to close its sessions once asked to stop
+GRACE = 10
 
 
 def free(port: int) -> bool:
@@ -38,15 +43,11 @@ def free(port: int) -> bool:
     return True
 
 
-def _open_when_up(url: str, port: int, stop: threading.Event) -> None:
-    """Open ``url`` in a browser once the server answers (at most a minute of waiting)."""
-    for _ in range(600):
-        if stop.wait(0.1):
-            return
-        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-            if probe.connect_ex((HOST, port)) == 0:
-                webbrowser.open(url)
-                return
+def server_command(port: int, open_browser: bool) -> list[str]:
+    """``marimo run`` of the lessons' app on ``HOST:port`` (headless unless ``open_browser``)."""
+    app = Path(__file__).resolve().parents[1] / "output" / "explorer.py"
+    return ([sys.executable, "-m", "marimo", "--quiet", "--yes", "run", str(app), "--host", HOST,
+             "--port", str(port)] + ([] if open_browser else ["--headless"]))
 
 
 def cmd_explore(args: argparse.Namespace) -> int:
@@ -56,22 +57,23 @@ def cmd_explore(args: argparse.Namespace) -> int:
         raise InputError("the explorer needs marimo and anywidget: pip install 'signorini[explore]'")
     if not free(args.port):
         raise InputError(f"--port {args.port} is in use on {HOST}: give another with --port")
-    import marimo  # per command: the web app's libraries start only here
-    import uvicorn  # (marimo's own server)
-
-    from signorini.output import explorer  # per command (start-up)
-
-    server = marimo.create_asgi_app(quiet=True).with_app(path="", root=explorer.__file__).build()
-    url = f"http://{HOST}:{args.port}"
-    print(f"signorini explore: serving the lessons on {url} (Ctrl-C stops)", flush=True)
-    stop = threading.Event()
-    if not args.no_browser:
-        threading.Thread(target=_open_when_up, args=(url, args.port, stop), daemon=True).start()
-    try:
-        uvicorn.run(server, host=HOST, port=args.port, log_level="warning")
-    finally:
-        stop.set()
-    return 0
+    # marimo's own server, in a child that imports this same package and never checks for updates
+    package_root = str(Path(__file__).resolve().parents[2])
+    env = {**os.environ, "MARIMO_SKIP_UPDATE_CHECK": "1",
+           "PYTHONPATH": os.pathsep.join(filter(None, [package_root, os.environ.get("PYTHONPATH")]))}
+    print(f"signorini explore: serving the lessons on http://{HOST}:{args.port} (Ctrl-C stops)",
+          flush=True)
+    with subprocess.Popen(server_command(args.port, not args.no_browser), env=env) as server:
+        try:
+            return server.wait()
+        finally:  # stopped by a signal: the server closes its sessions, or is ended
+            if server.poll() is None:
+                server.terminate()
+                try:
+                    server.wait(timeout=GRACE)
+                except subprocess.TimeoutExpired:
+                    server.kill()
+                    server.wait()
 
 
 def add_parsers(sub) -> None:

@@ -6,8 +6,7 @@ this file only lays the sliders, numbers and figures out.
 
 import marimo
 
-__all__ = ["app"]
-
+__generated_with = "0.25.2"
 app = marimo.App(width="full", app_title="signorini: interactive lessons")
 
 with app.setup:
