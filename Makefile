@@ -13,12 +13,14 @@ $(STAMP): pyproject.toml tools/install_petsc.sh
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --quiet --upgrade pip
 	$(VENV)/bin/python -m pip install --quiet -e '.[all]'
-	@# CHOLMOD (the fastest factorisation here) needs SuiteSparse's headers: install them with
-	@# apt when we are root on Debian; without them SciPy's SuperLU is used and nothing fails.
-	@if [ ! -e /usr/include/suitesparse/cholmod.h ] && command -v apt-get >/dev/null 2>&1 \
-	    && [ "$$(id -u)" = 0 ]; then \
+	@# Debian packages, installed with apt when we are root on Debian: SuiteSparse's headers for
+	@# CHOLMOD, the fastest factorisation here (without them SciPy's SuperLU is used), and chromium
+	@# for tests/test_explore.py, which drives the explorer in a browser (it skips without one).
+	@missing=""; [ -e /usr/include/suitesparse/cholmod.h ] || missing="libsuitesparse-dev"; \
+	  [ -e /usr/bin/chromium ] || missing="$$missing chromium"; \
+	  if [ -n "$$missing" ] && command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
 	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
-	    libsuitesparse-dev >/dev/null) || echo "make: libsuitesparse-dev not installed"; fi
+	    $$missing >/dev/null) || echo "make: $$missing not installed"; fi
 	@$(VENV)/bin/python -m pip install --quiet -e '.[fast]' \
 	  || echo "make: CHOLMOD (scikit-sparse) not installed; SuperLU will be used"
 	@# the petsc methods (SNES-VI, TAO under MPI): Debian's PETSc + petsc4py built against it

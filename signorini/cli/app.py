@@ -20,12 +20,12 @@ import threading
 from typing import Sequence
 
 from signorini import __version__
-from signorini.cli import bench, crosscheck, export, listing, solve, studies
+from signorini.cli import bench, crosscheck, explore, export, listing, solve, studies
 from signorini.cli.common import EXIT_FAILED, EXIT_USAGE, Parser
 from signorini.cli.progress import progress
 from signorini.errors import InputError, OutputError, SignoriniError
 
-COMMANDS = (solve, crosscheck, studies, bench, export, listing)
+COMMANDS = (solve, crosscheck, studies, bench, export, listing, explore)
 
 
 def add_verbosity(parser: argparse.ArgumentParser, default) -> None:
