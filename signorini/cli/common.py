@@ -89,7 +89,7 @@ def input_files(scene: str | None = None, methods: Sequence[str] = ()) -> dict[s
     found.update({f"file of --method {m}": m.rpartition(":")[0] for m in methods
                   if m.rpartition(":")[0].endswith(".py")})
     for what, path in found.items():
-        check_input_file(path, what)
+        check_input_file(path, what.removesuffix(f" {path}"))
     return found
 
 

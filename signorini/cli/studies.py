@@ -66,7 +66,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
     from signorini.files import all_or_none, check_outputs  # as above
     from signorini.output.ci import github_annotations, junit_xml  # as above
-    from signorini.output.report import checks_summary, write_suite_report  # as above
+    from signorini.output.report import REPORT_FILES, checks_summary, write_suite_report  # as above
     from signorini.problem_files import problem_file_paths, read_problem  # as above
     from signorini.solvers.registry import check_request  # as above
     from signorini.studies.suite import (TIGHT_TOL, problem_case, read_limits, run_suite,
@@ -80,7 +80,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
         inputs.update({f"problem file {p}": p for p in problem_file_paths(path)})
     if args.limits:
         inputs["limits file"] = args.limits
-    outputs = check_outputs({"--junit": args.junit}, {"--out": args.out}, inputs=inputs)
+    outputs = check_outputs({"--junit": args.junit}, {"--out": args.out}, inputs=inputs,
+                            fills={"--out": REPORT_FILES})
     out = outputs["--out"]
     if args.junit == "-":  # the summary and the annotations are printed there
         raise InputError("--junit - would mix the XML with the summary on stdout: give a file "

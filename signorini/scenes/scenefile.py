@@ -56,6 +56,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.files import check_input_file
 from signorini.fem.checks import check_mesh
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery
@@ -132,6 +133,7 @@ def read_scene_file(path: str | Path) -> tuple[dict[str, Any], _Context]:
         import tomli as tomllib
 
     path = Path(path)
+    check_input_file(str(path), "scene file")  # a FIFO would wait forever
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -287,8 +289,10 @@ def read_mesh(path: str | Path) -> MeshWithBoundaries:
     from skfem import MeshTri
 
     path = Path(path)
+    check_input_file(str(path), "mesh file")  # a FIFO would wait forever
     if not path.is_file():
-        raise InputError(f"mesh file {path} does not exist")
+        raise InputError(f"mesh file {path} does not exist: give the path of a mesh file "
+                         "(relative to the scene file)")
     # .msh is Gmsh's (meshio would also try ANSYS and print its complaint on stdout)
     file_format = "gmsh" if path.suffix.lower() == ".msh" else None
     said = io.StringIO()

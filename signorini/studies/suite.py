@@ -30,6 +30,7 @@ import numpy as np
 
 from signorini.crosschecking import agreement
 from signorini.errors import InputError
+from signorini.files import check_input_file
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.problem_files import is_problem_file
 from signorini.references import reference_metrics, reference_of
@@ -405,6 +406,7 @@ def read_limits(path: str) -> dict[str, float]:
     InputError naming the file and the fix for a missing file, bad TOML, an
     unknown name or a value that is not a positive number.
     """
+    check_input_file(path, "limits file")  # a FIFO would wait forever
     try:
         with open(path, "rb") as handle:
             data = tomllib.load(handle)
