@@ -45,7 +45,7 @@ from signorini.solvers.registry import methods as _all_methods
 
 DEFAULT_METHOD = "auto"
 #: the version of the solve record's layout (docs/json.md): raised when a key changes meaning or goes
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 log = logging.getLogger(__name__)
 
@@ -293,8 +293,9 @@ def solve_summary(record: dict[str, Any]) -> str:
     lines.append("  KKT (relative): " + ", ".join(f"{k} {v:.1e}" for k, v in kkt.items()))
     if record.get("contact"):
         active = sum(record["contact"]["active"])
-        lines.append(f"  total force {record['total_force']:.6g} (applied {record['applied_load']:.6g}), "
-                     f"{active} nodes in contact")
+        applied = record.get("applied_load")  # none for a QP without a loaded boundary
+        said = "" if applied is None or not np.isfinite(applied) else f" (applied {applied:.6g})"
+        lines.append(f"  total force {record['total_force']:.6g}{said}, {active} nodes in contact")
     if record.get("estimate"):
         lines.append(f"  error estimate (energy norm, ZZ): {100 * record['estimate']['relative']:.2f} % "
                      f"of ‖u_h‖ over {record['estimate']['elements']} elements")

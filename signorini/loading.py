@@ -230,9 +230,9 @@ def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = 
         log.info("matching the target load: predicting the contact zone on a coarser model")
         zone = predicted_zone(problem, coarse)  # predicted once: load control's, and nested's
         matched = match(problem, zone)
-        stages["load control"] = matched.work
+        stages["load_control"] = matched.work
         problem = matched.problem
-    if method == "auto" and start is None and "load control" in stages:
+    if method == "auto" and start is None and "load_control" in stages:
         start = matched.warm_start  # the fastest route: confirm what load control found
     else:  # a method named by the caller starts cold, from the scene's predictions only
         before = counters()
@@ -243,7 +243,7 @@ def solve(problem: ContactProblem, method: str = "auto", *, tol: float | None = 
     settled, solution = registry.run(problem, method, tol=tol, max_iter=max_iter,
                                      warm_start=start, keep_factor=keep_factor, **options)
     solution.work = {**stages, **solution.work}
-    if "load control" in stages:
+    if "load_control" in stages:
         solution.message += f"; load matched by {matched.how} ({_said(matched.work)})"
     return settled, solution
 

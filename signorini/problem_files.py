@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.errors import InputError
+from signorini.errors import InputError, docs_page
 from signorini.files import check_input_file
 from signorini.problem import ContactProblem
 
@@ -50,7 +50,7 @@ OPTIONAL_KEYS = {"weights": "the lumped boundary weight of each candidate, m val
 SPARSE_PARTS = ("row", "col", "data", "indices", "indptr", "shape")
 #: the files of a Matrix Market problem, in its folder (``weights`` optional)
 MATRIX_MARKET_NAMES = ("K", "f", "N", "d", "weights")
-FORMATS = "see docs/problem-files.md"
+FORMATS = f"see {docs_page('problem-files')}"
 
 
 def is_problem_file(name: Any) -> bool:
@@ -122,7 +122,7 @@ def _matrix_market_folder(name: str | os.PathLike) -> Path | None:
 def _npz(path: Path) -> dict[str, np.ndarray]:
     if not zipfile.is_zipfile(path):  # np.load would try it as a pickle
         raise InputError(f"problem file {str(path)!r} is not a NumPy .npz archive: write it with "
-                         "numpy.savez (see docs/problem-files.md)")
+                         f"numpy.savez ({FORMATS})")
     try:
         with np.load(path, allow_pickle=False) as stored:
             _check_declared_sizes(path, stored.zip)
@@ -131,7 +131,7 @@ def _npz(path: Path) -> dict[str, np.ndarray]:
         raise
     except (zipfile.BadZipFile, EOFError, OSError) as exc:
         raise InputError(f"problem file {str(path)!r} is not a NumPy .npz archive ({exc}): write "
-                         "it with numpy.savez (see docs/problem-files.md)") from None
+                         f"it with numpy.savez ({FORMATS})") from None
     except ValueError as exc:  # an array of Python objects (pickled)
         raise InputError(f"problem file {str(path)!r} holds an array that is not numbers ({exc}): "
                          "store plain numeric arrays") from None

@@ -24,7 +24,7 @@ from signorini import __version__
 from signorini.cli import bench, crosscheck, listing, solve, studies
 from signorini.cli.common import EXIT_FAILED, EXIT_USAGE, Parser
 from signorini.cli.progress import progress
-from signorini.errors import InputError, OutputError, SignoriniError
+from signorini.errors import InputError, OutputError, SignoriniError, docs_page
 
 COMMANDS = (solve, crosscheck, studies, bench, listing)
 
@@ -93,7 +93,7 @@ def _main_ranks(argv: Sequence[str] | None) -> int:
             return cluster.serve()
     except ImportError:
         print("signorini: error: started by mpirun but mpi4py is not installed: "
-              "pip install 'signorini[petsc]' (see docs/performance.md, 'PETSc and MPI')", file=sys.stderr)
+              f"pip install 'signorini[petsc]' (see {docs_page('performance', 'petsc-and-mpi')})", file=sys.stderr)
         return EXIT_USAGE
     try:
         return _main(argv, ranks=cluster.size())

@@ -8,11 +8,11 @@ import os
 import sys
 from typing import Any, Iterator, Sequence
 
-from signorini.errors import InputError
+from signorini.errors import InputError, docs_page
 
 EXIT_FAILED, EXIT_USAGE = 1, 2
 #: what a problem file is, in every command's help
-PROBLEM_FILES = ".npz (save's or plain) or Matrix Market (docs/problem-files.md)"
+PROBLEM_FILES = f".npz (save's or plain) or Matrix Market ({docs_page('problem-files')})"
 #: the positional input of solve and crosscheck
 SCENE_HELP = f"scene name (see 'signorini scenes'), a .toml scene file, or a problem file: {PROBLEM_FILES}"
 

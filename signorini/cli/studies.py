@@ -6,7 +6,7 @@ import argparse
 import shlex
 import sys
 
-from signorini.errors import InputError
+from signorini.errors import InputError, docs_page
 from signorini.cli.common import (EXIT_FAILED, PROBLEM_FILES, input_files, out_folder, pairs,
                                   parse_time_limit, parse_tol, user_methods_in_workers,
                                   write_output)
@@ -222,7 +222,7 @@ def add_parsers(sub) -> None:
                           help="an option of one method, e.g. --opt uzawa:step_fraction=0.5 "
                                "(KEY=VALUE alone when one --method is named)")
     validate.add_argument("--limits", metavar="FILE", help="a TOML file whose [limits] table "
-                          "replaces some of the checks' limits (docs/ci.md)")
+                          f"replaces some of the checks' limits ({docs_page('ci', 'limits-file')})")
     validate.add_argument("--junit", metavar="FILE", help="also write the checks as JUnit XML "
                           "for CI, e.g. report.xml; under GitHub Actions failed checks are "
                           "also annotations")
