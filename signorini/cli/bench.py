@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from signorini.errors import InputError
-from signorini.cli.common import PROBLEM_FILES, input_files, out_folder, pairs, parse_sizes
+from signorini.cli.common import PROBLEM_FILES, family_of, input_files, out_folder, pairs, parse_sizes
 
 
 def _bench_peer(args: argparse.Namespace) -> int:
@@ -84,8 +84,19 @@ def cmd_bench(args: argparse.Namespace) -> int:
         problem = read_problem(args.problem)  # a bad file is refused before any work
         family, levels = None, [0]
     else:
-        family = get_scene(args.scene or "hertz-cylinder")
+        scene, base = family_of(args.scene or "hertz-cylinder", pairs(args.set, "--set"), "bench")
+        family = get_scene(scene)
         levels = _sizes(args.sizes, "0,1")
+        refine = next((p for p in family.params if p.name == "refine"), None)
+        wrong = [(level, refine.check(level)) for level in levels if refine and refine.check
+                 and refine.check(level)]
+        if refine is None:
+            raise InputError(f"--scene {family.name}: bench sizes a scene by its parameter "
+                             "refine, which this one has not: choose a scene with it (see "
+                             "'signorini scenes'), or give --problem a saved problem of it")
+        if wrong:
+            raise InputError(f"--sizes {args.sizes!r}: level {wrong[0][0]} must be {wrong[0][1]} "
+                             f"(the refinements of {family.name}), e.g. --sizes 0,1")
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
                          "e.g. --time-limit 120")
@@ -113,7 +124,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
         from signorini.solvers.cluster import mpirun_command  # only when ranks are asked for
 
         mpirun_command(ranks[-1], [])  # no mpirun, or more ranks than cores: fail before any run
-    base = pairs(args.set, "--set")
     runs = []
     for level in levels:
         if family is None:

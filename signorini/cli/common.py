@@ -138,3 +138,19 @@ def parse_sizes(text: str) -> list[int]:
     except ValueError:
         raise InputError(f"--sizes {text!r} is not a comma-separated list of sizes, "
                          "e.g. --sizes 0,1,2") from None
+
+
+def family_of(scene: str, params: dict[str, Any], command: str) -> tuple[str, dict[str, Any]]:
+    """``(scene family, parameters)`` of a scene name, or of a scene file that names its family
+    (``scene = "hertz-cylinder"``, its values under ``params``): what a command that refines a
+    family by its ``refine`` parameter takes. InputError for a mesh scene file."""
+    if not scene.lower().endswith(".toml"):
+        return scene, params
+    from signorini.scenes.scenefile import family_scene_values  # per command (start-up)
+
+    found = family_scene_values(scene, params)
+    if found is None:
+        raise InputError(f"scene file {scene!r} meshes its own body, which {command} cannot "
+                         "refine: give a scene name (see 'signorini scenes') or a scene file "
+                         "that names one (scene = \"hertz-cylinder\")")
+    return found

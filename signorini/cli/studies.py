@@ -7,8 +7,8 @@ import shlex
 import sys
 
 from signorini.errors import InputError, docs_page
-from signorini.cli.common import (EXIT_FAILED, PROBLEM_FILES, input_files, out_folder, pairs,
-                                  parse_time_limit, parse_tol, user_methods_in_workers,
+from signorini.cli.common import (EXIT_FAILED, PROBLEM_FILES, family_of, input_files, out_folder,
+                                  pairs, parse_time_limit, parse_tol, user_methods_in_workers,
                                   write_output)
 
 
@@ -21,16 +21,16 @@ def cmd_converge(args: argparse.Namespace) -> int:
         raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
     if args.uniform_levels is not None and not 0 <= args.uniform_levels <= 4:
         raise InputError(f"--uniform-levels {args.uniform_levels} must be in 0..4")
-    params = pairs(args.set, "--set")
     out = out_folder(args.out, input_files(args.scene, args.method))
-    check_study(args.scene, args.levels, params, args.method or None, args.fit_from)
+    scene, params = family_of(args.scene, pairs(args.set, "--set"), "converge")
+    check_study(scene, args.levels, params, args.method or None, args.fit_from)
     say = (lambda line: print(line, file=sys.stderr))
     with user_methods_in_workers(args.method):  # a user's method runs in a worker process
-        study = run_study(args.scene, args.levels, params, methods=args.method or None,
+        study = run_study(scene, args.levels, params, methods=args.method or None,
                           fit_from=args.fit_from, progress=say)
     comparison = None
     if args.uniform_levels is not None:
-        comparison = grading_comparison(args.scene, study, args.uniform_levels, params, progress=say)
+        comparison = grading_comparison(scene, study, args.uniform_levels, params, progress=say)
     command = "signorini converge " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
         if len(sys.argv) > 2 and sys.argv[1] == "converge" else f"signorini converge {args.scene} --levels {args.levels}"
     with all_or_none():  # the whole report, or none of it
@@ -190,7 +190,8 @@ def cmd_stability(args: argparse.Namespace) -> int:
 def add_parsers(sub) -> None:
     """Register the study commands."""
     converge = sub.add_parser("converge", help="refine a scene k times: errors, rates, figures")
-    converge.add_argument("scene", help="a scene with a 'refine' parameter (see 'signorini scenes')")
+    converge.add_argument("scene", help="a scene with a 'refine' parameter (see 'signorini "
+                          "scenes'), or a .toml scene file that names one (scene = \"hertz-cylinder\")")
     converge.add_argument("--levels", type=int, default=3, help="refinements: levels 0..k (default 3)")
     converge.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                           help="scene parameter of level 0, e.g. --set n_contact=15")

@@ -86,12 +86,13 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
         if small and len(installed) > 1:
             installed = [b for b in installed if b != "pardiso"]
         return installed[0]
+    given = "factorisation backend" if backend else "SIGNORINI_FACTOR (the factorisation backend)"
     if name not in BACKENDS:
-        raise InputError(f"unknown factorisation backend {name!r}: choose auto, {', '.join(BACKENDS)}")
+        raise InputError(f"{given} {name!r} is unknown: choose auto, {', '.join(BACKENDS)}"
+                         + ("" if backend else ", or unset SIGNORINI_FACTOR"))
     if name not in available_backends():
         hint = install_hint(EXTRAS.get(name, ""), [_MODULES[name]])
-        raise BackendNotInstalled(f"factorisation backend {name!r} needs the module "
-                                  f"{_MODULES[name]!r}: {hint}")
+        raise BackendNotInstalled(f"{given} {name!r} needs the module {_MODULES[name]!r}: {hint}")
     return name
 
 
