@@ -166,6 +166,19 @@ def between(lo: float, hi: float) -> Callable[[float], str | None]:
     return lambda x: None if lo < x <= hi else f"in ({lo:g}, {hi:g}]"
 
 
+#: the graded meshes' growth of the element size: below the least, the mesh is nearly uniform at
+#: the contact's element size over the whole body (millions of elements) and the mesher's series
+#: of layers degenerates
+GRADING_RANGE = (0.01, 2.0)
+
+
+def grading_check(x: float) -> str | None:
+    """The range of every graded scene's ``grading`` (:data:`GRADING_RANGE`)."""
+    lo, hi = GRADING_RANGE
+    return None if lo <= x <= hi else (f"in [{lo:g}, {hi:g}] (smaller grows the elements more "
+                                       "slowly away from the contact: a larger mesh)")
+
+
 #: contact half-width (radius) over the radius a Hertz scene meshes: below it the gaps over the
 #: contact, about (a/R)² R, keep fewer than 8 digits next to R; above it Hertz's half-space
 #: theory does not hold
