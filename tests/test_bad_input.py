@@ -49,7 +49,7 @@ CASES = [
     (["stability", "--quick", "--fast"], ["unrecognized arguments", "--fast"]),
     # signorini bench
     (["bench", "--sizes", "a,b"], ["--sizes", "e.g."]),
-    (["bench", "--sizes", "7", "--method", "pdas"], ["refine=7", "0..6"]),
+    (["bench", "--sizes", "7", "--method", "pdas"], ["--sizes '7'", "0..6"]),
     (["bench", "--tolerance", "tight"], ["--tolerance", "'tight'", "high"]),
     (["bench", "--method", "simplex"], ["unknown method", "pdas"]),
     (["bench", "--scene", "nowhere"], ["unknown scene"]),

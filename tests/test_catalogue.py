@@ -161,7 +161,8 @@ CLI = [
     # bench
     (["bench", "--method", "nope"], 2, ["unknown method", "'nope'"]),
     (["bench", "--sizes", "a,b"], 2, ["--sizes"]),
-    (["bench", "--sizes", "7", "--method", "pdas"], 2, ["refine=7"]),
+    (["bench", "--sizes", "7", "--method", "pdas"], 2, ["--sizes", "level 7"]),
+    (["bench", "--sizes", "-1", "--method", "pdas"], 2, ["--sizes", "level -1", "0..6"]),
     (["bench", "--tolerance", "tight"], 2, ["--tolerance", "'tight'"]),
     (["bench", "--time-limit", "-1"], 2, ["--time-limit"]),
     (["bench", "--ranks", "0"], 2, ["--ranks"]),

@@ -166,10 +166,10 @@ def between(lo: float, hi: float) -> Callable[[float], str | None]:
     return lambda x: None if lo < x <= hi else f"in ({lo:g}, {hi:g}]"
 
 
-#: the graded meshes' growth of the element size: below the least, the mesh is nearly uniform at
-#: the contact's element size over the whole body (millions of elements) and the mesher's series
-#: of layers degenerates
-GRADING_RANGE = (0.01, 2.0)
+#: the graded meshes' growth of the element size: the least is a uniform mesh at the contact's
+#: element size (the convergence study's uniform comparison); below it the mesher's series of
+#: layers degenerates
+GRADING_RANGE = (1e-6, 2.0)
 
 
 def grading_check(x: float) -> str | None:
