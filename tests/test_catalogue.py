@@ -163,7 +163,7 @@ CLI = [
     (["bench", "--sizes", "a,b"], 2, ["--sizes"]),
     (["bench", "--sizes", "7", "--method", "pdas"], 2, ["--sizes", "level 7"]),
     (["bench", "--sizes", "-1", "--method", "pdas"], 2, ["--sizes", "level -1", "0..6"]),
-    (["bench", "--tolerance", "tight"], 2, ["--tolerance", "'tight'"]),
+    (["bench", "--tol", "tight"], 2, ["--tol", "'tight'"]),
     (["bench", "--time-limit", "-1"], 2, ["--time-limit"]),
     (["bench", "--ranks", "0"], 2, ["--ranks"]),
     (["bench", "--sizes", "6", "--method", "pdas", "--scene", "hertz-cylinder"], 2, ["dofs", "GB"]),

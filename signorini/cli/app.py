@@ -24,7 +24,7 @@ from signorini import __version__
 from signorini.cli import bench, crosscheck, listing, solve, studies
 from signorini.cli.common import EXIT_FAILED, EXIT_USAGE, Parser
 from signorini.cli.progress import progress
-from signorini.errors import InputError, OutputError, SignoriniError, docs_page
+from signorini.errors import DOCS_SITE, InputError, OutputError, SignoriniError, docs_page
 
 COMMANDS = (solve, crosscheck, studies, bench, listing)
 
@@ -41,7 +41,8 @@ def add_verbosity(parser: argparse.ArgumentParser, default) -> None:
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="signorini", description="Frictionless contact as one QP, solved many ways. "
                     "On a terminal, a step that takes longer than a second shows a progress line "
-                    "on stderr.")
+                    "on stderr.", epilog=f"'signorini COMMAND --help' gives a command's examples "
+                    f"and exit codes. Documentation: {DOCS_SITE}")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     add_verbosity(parser, False)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)

@@ -6,15 +6,33 @@ import argparse
 import contextlib
 import os
 import sys
+import textwrap
 from typing import Any, Iterator, Sequence
 
-from signorini.errors import InputError, docs_page
+from signorini.errors import DOCS_SITE, InputError
 
 EXIT_FAILED, EXIT_USAGE = 1, 2
 #: what a problem file is, in every command's help
-PROBLEM_FILES = f".npz (save's or plain) or Matrix Market ({docs_page('problem-files')})"
+PROBLEM_FILES = ".npz (save's or plain) or Matrix Market (the documentation's page problem-files)"
 #: the positional input of solve and crosscheck
 SCENE_HELP = f"scene name (see 'signorini scenes'), a .toml scene file, or a problem file: {PROBLEM_FILES}"
+
+
+#: what every command's exit codes share
+EXITS = {EXIT_USAGE: "bad input: one line on stderr says which and how to fix it",
+         130: "stopped by SIGINT (143 SIGTERM, 129 SIGHUP): no output left half-written"}
+
+
+def add_command(sub, name: str, summary: str, description: str, examples: Sequence[str],
+                exits: dict[int, str]):
+    """The parser of one command: its one-line ``summary`` in ``signorini --help``; in its own
+    help the ``description``, ``examples`` and exit codes (``exits`` before the shared ones)."""
+    codes = {**exits, **EXITS}
+    epilog = "\n".join(["examples:", *(f"  {line}" for line in examples), "", "exit codes:",
+                        *(f"  {code:<3} {meaning}" for code, meaning in codes.items()), "",
+                        f"documentation: {DOCS_SITE}"])
+    return sub.add_parser(name, help=summary, description=textwrap.fill(description, 79),
+                          epilog=epilog, formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
 class Parser(argparse.ArgumentParser):
@@ -31,6 +49,31 @@ def pairs(items: Sequence[str], flag: str) -> dict[str, Any]:
         if not sep or not key.strip():
             raise InputError(f"{flag} {item!r} is not key=value: write {flag} name=value")
         out[key.strip()] = value.strip()
+    return out
+
+
+#: the one spelling of a method's option on every command
+OPT_METAVAR = "[METHOD:]KEY=VALUE"
+
+
+def method_options(items: Sequence[str], methods: Sequence[str]) -> dict[str, dict[str, str]]:
+    """``--opt [METHOD:]KEY=VALUE`` strings to each method's options (values as text):
+    ``METHOD:KEY=VALUE`` names its method, ``KEY=VALUE`` alone is for the one method named."""
+    out: dict[str, dict[str, str]] = {}
+    for item in items:
+        head, sep, value = item.partition("=")
+        method, colon, key = head.rpartition(":")
+        if not sep or not key.strip() or colon and not method:
+            raise InputError(f"--opt {item!r} is not [METHOD:]key=value: write e.g. --opt "
+                             "qp-osqp:eps_abs=1e-10 (or --opt eps_abs=1e-10 with one --method)")
+        if not colon and len(methods) != 1:
+            raise InputError(f"--opt {item!r} names no method: write --opt METHOD:key=value, "
+                             f"here --opt METHOD:{item} (or name one --method)")
+        out.setdefault(method if colon else methods[0], {})[key.strip()] = value.strip()
+    stray = sorted(set(out) - set(methods)) if methods else []
+    if stray:
+        raise InputError(f"--opt for {stray[0]!r}, which is not among the --method: add "
+                         f"--method {stray[0]} (or drop the option)")
     return out
 
 

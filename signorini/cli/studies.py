@@ -6,9 +6,11 @@ import argparse
 import shlex
 import sys
 
-from signorini.errors import InputError, docs_page
-from signorini.cli.common import (EXIT_FAILED, PROBLEM_FILES, family_of, input_files, out_folder,
-                                  pairs, parse_time_limit, parse_tol, user_methods_in_workers,
+from signorini.errors import InputError
+from signorini.solvers.options import guess_value
+from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, PROBLEM_FILES, add_command, family_of,
+                                  input_files,
+                                  method_options, out_folder, pairs, parse_time_limit, parse_tol, user_methods_in_workers,
                                   write_output)
 
 
@@ -49,17 +51,6 @@ def cmd_converge(args: argparse.Namespace) -> int:
     return 0
 
 
-def validate_options(items: list[str], methods: list[str]) -> dict[str, dict]:
-    """``--opt METHOD:key=value`` (or ``key=value`` when one --method is named) per method."""
-    from signorini.cli.crosscheck import method_options  # per command (start-up)
-
-    bare = [item for item in items if ":" not in item.partition("=")[0]]
-    if bare and len(methods) != 1:
-        raise InputError(f"--opt {bare[0]!r} names no method: write --opt METHOD:{bare[0]} (or "
-                         "name one --method)")
-    return method_options([f"{methods[0]}:{item}" if item in bare else item for item in items])
-
-
 def cmd_validate(args: argparse.Namespace) -> int:
     # each command loads what it needs (the report starts matplotlib)
     import os
@@ -86,11 +77,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if args.junit == "-":  # the summary and the annotations are printed there
         raise InputError("--junit - would mix the XML with the summary on stdout: give a file "
                          "name, e.g. --junit report.xml")
-    options = validate_options(args.opt, args.method)
-    stray = sorted(set(options) - set(args.method)) if args.method else []
-    if stray:
-        raise InputError(f"--opt for {stray[0]!r}, which is not among the --method: add "
-                         f"--method {stray[0]}")
+    options = {name: {key: guess_value(value) for key, value in given.items()}
+               for name, given in method_options(args.opt, args.method).items()}
     for name in args.method or list(options):
         check_request(name, options=options.get(name))  # refused before any work
     limits = read_limits(args.limits) if args.limits else None
@@ -189,7 +177,15 @@ def cmd_stability(args: argparse.Namespace) -> int:
 
 def add_parsers(sub) -> None:
     """Register the study commands."""
-    converge = sub.add_parser("converge", help="refine a scene k times: errors, rates, figures")
+    converge = add_command(
+        sub, "converge", "refine a scene k times: errors, rates, figures",
+        "Solve a scene at refinement levels 0..k with every installed exact method (or those "
+        "named), fit the convergence rates of its errors against the analytic reference, and "
+        "write the report (Markdown, JSON, figures) into --out.",
+        ["signorini converge hertz-cylinder --levels 3",
+         "signorini converge examples/hertz-cylinder.toml --levels 2 --method pdas",
+         "signorini converge hertz-sphere --levels 2 --uniform-levels 1 --out conv"],
+        {0: "the report was written", 1: "a method named with --method converged at no level"})
     converge.add_argument("scene", help="a scene with a 'refine' parameter (see 'signorini "
                           "scenes'), or a .toml scene file that names one (scene = \"hertz-cylinder\")")
     converge.add_argument("--levels", type=int, default=3, help="refinements: levels 0..k (default 3)")
@@ -204,8 +200,17 @@ def add_parsers(sub) -> None:
     converge.add_argument("--out", default="convergence-report", help="output directory")
     converge.set_defaults(run=cmd_converge)
 
-    validate = sub.add_parser("validate", help="run the validation suite on the default scenes "
-                              "or your problem files")
+    validate = add_command(
+        sub, "validate", "run the validation suite on the default scenes or your problem files",
+        "Run the validation suite: every case (the default scenes, or your problem files) solved "
+        "by every installed method (or those named), each answer checked against its KKT "
+        "certificate, the exact answer (pdas at 1e-9) and the analytic reference, within limits "
+        "a --limits file may change. Writes the report into --out and, with --junit, the checks "
+        "as JUnit XML for CI.",
+        ["signorini validate",
+         "signorini validate --problem my.npz --method mine.py:solve --junit report.xml",
+         "signorini validate --case hertz-cylinder --method uzawa --opt step_fraction=0.5"],
+        {0: "every check passed", 1: "a check failed (the report says which)"})
     validate.add_argument("--out", default="validation-report", help="report directory")
     validate.add_argument("--method", action="append", default=[],
                           help="only this method (repeatable; default: every installed one); "
@@ -219,17 +224,24 @@ def add_parsers(sub) -> None:
                                "these unless --case")
     validate.add_argument("--tol", help="the relative KKT tolerance asked of every method "
                           "(default 1e-9; the exact answer stays pdas at 1e-9)")
-    validate.add_argument("--opt", action="append", default=[], metavar="METHOD:KEY=VALUE",
+    validate.add_argument("--opt", action="append", default=[], metavar=OPT_METAVAR,
                           help="an option of one method, e.g. --opt uzawa:step_fraction=0.5 "
                                "(KEY=VALUE alone when one --method is named)")
     validate.add_argument("--limits", metavar="FILE", help="a TOML file whose [limits] table "
-                          f"replaces some of the checks' limits ({docs_page('ci', 'limits-file')})")
+                          "replaces some of the checks' limits (the documentation's page ci)")
     validate.add_argument("--junit", metavar="FILE", help="also write the checks as JUnit XML "
                           "for CI, e.g. report.xml; under GitHub Actions failed checks are "
                           "also annotations")
     validate.set_defaults(run=cmd_validate)
 
-    sweep = sub.add_parser("sweep", help="solve many load levels with one factorisation")
+    sweep = add_command(
+        sub, "sweep", "solve many load levels with one factorisation",
+        "Solve one scene at n load levels with one factorisation of K, and write sweep.csv, "
+        "sweep.json and sweep.png into --out: the contact half-width and peak pressure at each "
+        "level beside Hertz's.",
+        ["signorini sweep hertz-cylinder --load 0.001:0.004:4",
+         "signorini sweep hertz-sphere --load 1e-4:1e-3:5 --out sweep"],
+        {0: "every load level converged", 1: "a level did not (printed after the table)"})
     sweep.add_argument("scene", help="scene name (see 'signorini scenes')")
     sweep.add_argument("--load", required=True, metavar="P1:P2:n",
                        help="n loads from P1 to P2 (per unit thickness of the full body)")
@@ -238,7 +250,13 @@ def add_parsers(sub) -> None:
     sweep.add_argument("--out", default="sweep-report", help="output directory")
     sweep.set_defaults(run=cmd_sweep)
 
-    stability = sub.add_parser("stability", help="the stability atlas: where each method fails")
+    stability = add_command(
+        sub, "stability", "the stability atlas: where each method fails",
+        "The stability atlas: every method run along eight axes (tolerance, mesh size, load, "
+        "Poisson's ratio and more) to where it fails, each run judged by the certificate; the "
+        "report says where each method fails and whether the package's status said so.",
+        ["signorini stability --quick", "signorini stability --axis 1 --axis 2 --out atlas"],
+        {0: "the atlas was written (its report says where methods fail)"})
     stability.add_argument("--out", default="stability-report",
                            help="writes OUT/stability.md and OUT/stability/ (runs, figures)")
     stability.add_argument("--axis", action="append", default=[],
