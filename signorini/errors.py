@@ -37,7 +37,7 @@ def docs_page(page: str, section: str = "") -> str:
 
 
 #: the pip distribution of a module whose import name differs from it
-DISTRIBUTIONS = {"sksparse": "scikit-sparse"}
+DISTRIBUTIONS = {"sksparse": "scikit-sparse", "cvxpy": "cvxpy-base"}
 
 
 def install_hint(extra: str, modules: tuple[str, ...] | list[str] = ()) -> str:
