@@ -292,9 +292,8 @@ def solve_summary(record: dict[str, Any]) -> str:
     kkt = record["kkt"]
     lines.append("  KKT (relative): " + ", ".join(f"{k} {v:.1e}" for k, v in kkt.items()))
     if record.get("contact"):
-        active = sum(record["contact"]["active"])
-        applied = record.get("applied_load")  # none for a QP without a loaded boundary
-        said = "" if applied is None or not np.isfinite(applied) else f" (applied {applied:.6g})"
+        active, applied = sum(record["contact"]["active"]), record.get("applied_load")
+        said = f" (applied {applied:.6g})" if applied is not None and np.isfinite(applied) else ""
         lines.append(f"  total force {record['total_force']:.6g}{said}, {active} nodes in contact")
     if record.get("estimate"):
         lines.append(f"  error estimate (energy norm, ZZ): {100 * record['estimate']['relative']:.2f} % "

@@ -41,10 +41,9 @@ _EXAMPLES = {"--json": "result.json", "--md": "result.md", "--vtk": "result.vtu"
 _staged: list[tuple[str | None, Path | int, bytes | None]] | None = None
 #: folders :func:`writable_directory` created (removed again while still empty)
 _created: list[Path] = []
-#: the mark of a file being written under a temporary name (:func:`atomic_write`)
-PARTIAL = ".signorini-partial."
-#: folders written into (by this process, or by its workers below them)
-_written: set[Path] = set()
+#: the mark of a file being written under a temporary name (:func:`atomic_write`), and the
+#: folders written into, by this process or by its workers below them (:func:`remove_partial_files`)
+PARTIAL, _written = ".signorini-partial.", set[Path]()
 
 
 def _where(path: str | os.PathLike) -> tuple[str, Path | int]:
@@ -138,8 +137,11 @@ def check_output_folder(path: str | os.PathLike, flag: str = "--out") -> str:
     return str(folder)
 
 
-def check_input_file(path: str, what: str) -> None:
-    """InputError when ``path`` exists but is not a regular file (a FIFO would wait forever)."""
+def check_input_file(path: str, what: str, missing: str = "") -> None:
+    """InputError when ``path`` exists but is not a regular file (a FIFO would wait forever), or
+    with ``missing`` (the fix) when it does not exist."""
+    if missing and not os.path.exists(path):
+        raise InputError(f"{what} {path} does not exist: {missing}")
     if os.path.exists(path) and not os.path.isfile(path):
         raise InputError(f"{what} {path!r} is not a regular file (a folder, FIFO or device): "
                          "give a file")
@@ -164,9 +166,9 @@ def check_outputs(files: Mapping[str, str | None] = {}, folders: Mapping[str, st
 
     ``files`` and ``folders`` map flags to output paths, ``inputs`` names to
     the command's input files, ``fills`` a folder's flag to the names (glob
-    patterns) of the files written into it. InputError, naming both, when two
-    outputs are the same file, a file output is one the folder will hold, or
-    an output is an input; a device (``/dev/null``) may take several.
+    patterns) of the files it will hold. InputError, naming both, when two
+    outputs are one file (or a folder's), or an output is an input; a device
+    (``/dev/null``) may take several.
     """
     given = {**files, **folders}
     out = {flag: None if path is None else check_output_file(path, flag)
@@ -198,11 +200,8 @@ def check_outputs(files: Mapping[str, str | None] = {}, folders: Mapping[str, st
 
 def _fills(folder: str | None, patterns: tuple[str, ...], path: str | None) -> bool:
     """Whether ``path`` is one of the files named by ``patterns`` in ``folder``."""
-    if not folder or not path or path == STDOUT:
-        return False
-    path = os.path.abspath(path)
-    return os.path.dirname(path) == folder and any(fnmatch.fnmatch(os.path.basename(path), p)
-                                                   for p in patterns)
+    inside = bool(folder and path and path != STDOUT) and os.path.dirname(os.path.abspath(path)) == folder
+    return inside and any(fnmatch.fnmatch(os.path.basename(path), p) for p in patterns)
 
 
 def writable_directory(path: str | os.PathLike) -> Path:
@@ -230,9 +229,8 @@ def writable_directory(path: str | os.PathLike) -> Path:
 def remove_partial_files() -> None:
     """Remove the temporary files of writes that never finished (a worker killed while writing,
     a signal between two steps) from the folders written into and their subfolders."""
-    for folder in _written:
-        for leftover in [*folder.glob(f"*{PARTIAL}*"), *folder.glob(f"*/*{PARTIAL}*")]:
-            leftover.unlink(missing_ok=True)
+    for leftover in [p for f in _written for p in (*f.glob(f"*{PARTIAL}*"), *f.glob(f"*/*{PARTIAL}*"))]:
+        leftover.unlink(missing_ok=True)
 
 
 def remove_empty_folders() -> None:
@@ -268,15 +266,12 @@ def _discard(staged: list) -> None:
 
 
 def _place(staged: list) -> None:
-    """Write through first (the writes that can fail), then rename every file into place.
-
-    OutputError, nothing written, when two of them would land on one file.
-    """
+    """Write through first (the writes that can fail), then rename every file into place;
+    OutputError, nothing written, when two of them would land on one file."""
     try:
-        targets = [target for tmp, target, _ in staged if tmp is not None]
-        twice = next((t for i, t in enumerate(targets) if t in targets[:i]), None)
-        if twice is not None:
-            raise OutputError(f"two outputs of the command are the same file {str(twice)!r}: "
+        targets = [str(target) for tmp, target, _ in staged if tmp is not None]
+        for twice in {t for t in targets if targets.count(t) > 1}:
+            raise OutputError(f"two outputs of the command are the same file {twice!r}: "
                               "nothing was written; give them different paths")
         for tmp, target, data in staged:
             if tmp is None:

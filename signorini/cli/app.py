@@ -94,7 +94,8 @@ def _main_ranks(argv: Sequence[str] | None) -> int:
             return cluster.serve()
     except ImportError:
         print("signorini: error: started by mpirun but mpi4py is not installed: "
-              f"pip install 'signorini[petsc]' (see {docs_page('performance', 'petsc-and-mpi')})", file=sys.stderr)
+              f"pip install 'signorini[petsc]' (see {docs_page('performance', 'petsc-and-mpi')})",
+              file=sys.stderr)
         return EXIT_USAGE
     try:
         return _main(argv, ranks=cluster.size())

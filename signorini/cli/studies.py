@@ -9,9 +9,8 @@ import sys
 from signorini.errors import InputError
 from signorini.solvers.options import guess_value
 from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, PROBLEM_FILES, add_command, family_of,
-                                  input_files,
-                                  method_options, out_folder, pairs, parse_time_limit, parse_tol, user_methods_in_workers,
-                                  write_output)
+                                  input_files, method_options, out_folder, pairs, parse_time_limit,
+                                  parse_tol, user_methods_in_workers, write_output)
 
 
 def cmd_converge(args: argparse.Namespace) -> int:

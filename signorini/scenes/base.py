@@ -137,7 +137,8 @@ MESHER = Param("mesher", MESHERS[0],
 VOLUMETRIC = Param("volumetric", "auto",
                    "element: plain P1, the volumetric strain element by element (locks as nu -> "
                    "0.5); nodal: the volumetric strain averaged at the nodes (no locking, K with "
-                   f"2.7x the nonzeros in 2D, 5.2x in 3D: {docs_page('accuracy')}); auto: nodal from nu = 0.4 "
+                   f"2.7x the nonzeros in 2D, 5.2x in 3D: {docs_page('accuracy')}); auto: nodal from "
+                   "nu = 0.4 "
                    "on in 2D and axisymmetric models, element in 3D",
                    kind=str, check=one_of(*CHOICES))
 

@@ -99,11 +99,11 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
             given = ", ".join(f"{k}={v}" for k, v in values.items()) or "its defaults"
             relaxed = parsed.get("mesher") == "relaxed" and "grading" in parsed
             lo, hi = GRADING_RANGE
+            default = next((q.default for q in family.params if q.name == "grading"), None)
             raise InputError(
                 f"scene {name!r} with {given} could not be meshed" + (
                     f" by the relaxed mesher, which folds nearly uniform meshes: give a larger "
-                    f"grading (in [{lo:g}, {hi:g}], default "
-                    f"{next(q.default for q in family.params if q.name == 'grading'):g}), a smaller n_contact, or "
+                    f"grading (in [{lo:g}, {hi:g}], default {default}), a smaller n_contact, or "
                     "mesher=bisection" if relaxed else
                     f" ({type(exc).__name__}: {exc}): make the mesh coarser (a larger grading or "
                     "a smaller n_contact)")) from None
