@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from signorini.errors import docs_page
 from signorini.kkt import ACTIVE, classify, gap_scale
 from signorini.problem import ContactProblem, ContactSolution
 
@@ -92,7 +93,7 @@ def warnings(problem: ContactProblem, solution: ContactSolution | None = None) -
     nu = None if disc is None else disc.nu
     if nu is not None and nu > LOCKING_NU and disc.volumetric == "element":
         said.append(f"ν = {nu:g} > {LOCKING_NU:g}: P1 triangles lock, the pressure can be several "
-                    "percent off (docs/accuracy.md); set the scene parameter volumetric=nodal "
+                    f"percent off ({docs_page('accuracy')}); set the scene parameter volumetric=nodal "
                     "(the volumetric strain averaged at the nodes: no locking)")
     watch = None if disc is None else disc.watch
     if watch is not None and watch.candidate_gaps.size:

@@ -272,9 +272,9 @@ def solve_summary(record: dict[str, Any]) -> str:
     kkt = record["kkt"]
     lines.append("  KKT (relative): " + ", ".join(f"{k} {v:.1e}" for k, v in kkt.items()))
     if record.get("contact"):
-        active = sum(record["contact"]["active"])
-        lines.append(f"  total force {record['total_force']:.6g} (applied {record['applied_load']:.6g}), "
-                     f"{active} nodes in contact")
+        active, applied = sum(record["contact"]["active"]), record.get("applied_load")
+        said = f" (applied {applied:.6g})" if applied is not None and np.isfinite(applied) else ""
+        lines.append(f"  total force {record['total_force']:.6g}{said}, {active} nodes in contact")
     if record.get("estimate"):
         lines.append(f"  error estimate (energy norm, ZZ): {100 * record['estimate']['relative']:.2f} % "
                      f"of ‖u_h‖ over {record['estimate']['elements']} elements")

@@ -26,8 +26,18 @@ class OutputError(SignoriniError):
     """An output that could not be written (a full disk, say): nothing was left half-written."""
 
 
+#: the documentation site (mkdocs.yml's site_url): what a message or a help text points to, since
+#: an installed wheel holds no docs/ folder
+DOCS_SITE = "https://signorini.readthedocs.io/en/latest/"
+
+
+def docs_page(page: str, section: str = "") -> str:
+    """The address of the documentation page ``page`` (docs/``page``.md), at ``section``'s anchor."""
+    return f"{DOCS_SITE}{page}/" + (f"#{section}" if section else "")
+
+
 #: the pip distribution of a module whose import name differs from it
-DISTRIBUTIONS = {"sksparse": "scikit-sparse"}
+DISTRIBUTIONS = {"sksparse": "scikit-sparse", "cvxpy": "cvxpy-base"}
 
 
 def install_hint(extra: str, modules: tuple[str, ...] | list[str] = ()) -> str:

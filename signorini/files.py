@@ -21,6 +21,7 @@ a method that changes the working folder cannot move them.
 from __future__ import annotations
 
 import contextlib
+import fnmatch
 import json
 import math
 import os
@@ -40,6 +41,9 @@ _EXAMPLES = {"--json": "result.json", "--md": "result.md", "--vtk": "result.vtu"
 _staged: list[tuple[str | None, Path | int, bytes | None]] | None = None
 #: folders :func:`writable_directory` created (removed again while still empty)
 _created: list[Path] = []
+#: the mark of a file being written under a temporary name (:func:`atomic_write`), and the
+#: folders written into, by this process or by its workers below them (:func:`remove_partial_files`)
+PARTIAL, _written = ".signorini-partial.", set[Path]()
 
 
 def _where(path: str | os.PathLike) -> tuple[str, Path | int]:
@@ -133,8 +137,11 @@ def check_output_folder(path: str | os.PathLike, flag: str = "--out") -> str:
     return str(folder)
 
 
-def check_input_file(path: str, what: str) -> None:
-    """InputError when ``path`` exists but is not a regular file (a FIFO would wait forever)."""
+def check_input_file(path: str, what: str, missing: str = "") -> None:
+    """InputError when ``path`` exists but is not a regular file (a FIFO would wait forever), or
+    with ``missing`` (the fix) when it does not exist."""
+    if missing and not os.path.exists(path):
+        raise InputError(f"{what} {path} does not exist: {missing}")
     if os.path.exists(path) and not os.path.isfile(path):
         raise InputError(f"{what} {path!r} is not a regular file (a folder, FIFO or device): "
                          "give a file")
@@ -153,13 +160,15 @@ def _same(path: str, other: str) -> bool:
 
 
 def check_outputs(files: Mapping[str, str | None] = {}, folders: Mapping[str, str | None] = {},
-                  inputs: Mapping[str, str | None] = {}) -> dict[str, str | None]:
+                  inputs: Mapping[str, str | None] = {},
+                  fills: Mapping[str, tuple[str, ...]] = {}) -> dict[str, str | None]:
     """Every output of a command checked before any work: flag → absolute path (None when not given).
 
     ``files`` and ``folders`` map flags to output paths, ``inputs`` names to
-    the command's input files. InputError, naming both, when two outputs are
-    the same file or an output is an input; a device (``/dev/null``) may take
-    several.
+    the command's input files, ``fills`` a folder's flag to the names (glob
+    patterns) of the files it will hold. InputError, naming both, when two
+    outputs are one file (or a folder's), or an output is an input; a device
+    (``/dev/null``) may take several.
     """
     given = {**files, **folders}
     out = {flag: None if path is None else check_output_file(path, flag)
@@ -172,11 +181,27 @@ def check_outputs(files: Mapping[str, str | None] = {}, folders: Mapping[str, st
             if path == there == STDOUT or STDOUT not in (path, there) and _same(path, there):
                 raise InputError(f"{other} {given[other]!r} and {flag} {given[flag]!r} are the "
                                  "same file: give them different paths")
+        for folder, patterns in fills.items():
+            if flag != folder and _fills(out.get(folder), patterns, path):
+                raise InputError(f"{flag} {given[flag]!r} is a file that {folder} "
+                                 f"{given[folder]!r} writes ({', '.join(patterns)}): give "
+                                 f"{flag} another name or folder")
         for name, source in inputs.items():
             if source and path != STDOUT and os.path.exists(source) and _same(path, source):
                 raise InputError(f"{flag} {given[flag]!r} is the {name}: writing it would destroy "
                                  f"an input; choose another path for {flag}")
+    for folder, patterns in fills.items():
+        taken = [name for name, source in inputs.items() if _fills(out.get(folder), patterns, source)]
+        if taken:
+            raise InputError(f"{folder} {given[folder]!r} would write over the {taken[0]}: "
+                             f"choose another folder for {folder}")
     return out
+
+
+def _fills(folder: str | None, patterns: tuple[str, ...], path: str | None) -> bool:
+    """Whether ``path`` is one of the files named by ``patterns`` in ``folder``."""
+    inside = bool(folder and path and path != STDOUT) and os.path.dirname(os.path.abspath(path)) == folder
+    return inside and any(fnmatch.fnmatch(os.path.basename(path), p) for p in patterns)
 
 
 def writable_directory(path: str | os.PathLike) -> Path:
@@ -195,9 +220,17 @@ def writable_directory(path: str | os.PathLike) -> Path:
         raise InputError(f"--out {str(directory)!r} cannot be created ({exc.strerror}): "
                          "choose a writable directory") from None
     _created.extend(reversed(missing))
+    _written.add(directory.absolute())
     if not os.access(directory, os.W_OK):
         raise InputError(f"--out {str(directory)!r} is not writable: choose a writable directory")
     return directory
+
+
+def remove_partial_files() -> None:
+    """Remove the temporary files of writes that never finished (a worker killed while writing,
+    a signal between two steps) from the folders written into and their subfolders."""
+    for leftover in [p for f in _written for p in (*f.glob(f"*{PARTIAL}*"), *f.glob(f"*/*{PARTIAL}*"))]:
+        leftover.unlink(missing_ok=True)
 
 
 def remove_empty_folders() -> None:
@@ -233,8 +266,13 @@ def _discard(staged: list) -> None:
 
 
 def _place(staged: list) -> None:
-    """Write through first (the writes that can fail), then rename every file into place."""
+    """Write through first (the writes that can fail), then rename every file into place;
+    OutputError, nothing written, when two of them would land on one file."""
     try:
+        targets = [str(target) for tmp, target, _ in staged if tmp is not None]
+        for twice in {t for t in targets if targets.count(t) > 1}:
+            raise OutputError(f"two outputs of the command are the same file {twice!r}: "
+                              "nothing was written; give them different paths")
         for tmp, target, data in staged:
             if tmp is None:
                 _write_through(target, data)
@@ -263,7 +301,8 @@ def _write_through(target: Path | int, data: bytes) -> None:
     except BrokenPipeError:  # the command says so (signorini.cli.app)
         raise
     except OSError as exc:
-        raise OutputError(f"cannot write {str(target)!r} ({exc.strerror}): free some space or "
+        where = {1: "standard output", 2: "standard error"}.get(target, repr(str(target)))
+        raise OutputError(f"cannot write {where} ({exc.strerror}): free some space or "
                           "choose another path") from None
 
 
@@ -278,7 +317,8 @@ def atomic_write(path: str | os.PathLike, produce: Callable[[str], None], suffix
         raise InputError(f"cannot write {str(path)!r}: it is a directory; give a file name")
     folder = target.parent if kind == "replace" else None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}.", suffix=suffix, dir=folder)
+        fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}{PARTIAL}", suffix=suffix, dir=folder)
+        _written.add(Path(tmp).parent)
     except OSError as exc:  # no such folder, or one that takes no files: the path is at fault
         raise InputError(f"cannot write {str(path)!r} ({exc.strerror}): choose a writable path") \
             from None

@@ -236,7 +236,7 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
         with timed(seconds, "load control"):
             zone = predicted_zone(problem, coarse)  # predicted once: load control's and the method's
             matched = match(problem, zone)
-        stages["load control"] = matched.work
+        stages["load_control"] = matched.work
         problem = matched.problem
     if matched is not None and start is None and request.method.warm_from_load:
         start = matched.warm_start  # load control's answer, taken as an explicit warm start

@@ -22,6 +22,7 @@ file, the array and the fix.
 
 from __future__ import annotations
 
+import math
 import os
 import zipfile
 from pathlib import Path
@@ -30,7 +31,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.errors import InputError
+from signorini.errors import InputError, docs_page
+from signorini.files import check_input_file
 from signorini.problem import ContactProblem
 
 __all__ = ["MATRIX_MARKET_NAMES", "PLAIN_KEYS", "is_problem_file", "problem_file_paths",
@@ -48,7 +50,7 @@ OPTIONAL_KEYS = {"weights": "the lumped boundary weight of each candidate, m val
 SPARSE_PARTS = ("row", "col", "data", "indices", "indptr", "shape")
 #: the files of a Matrix Market problem, in its folder (``weights`` optional)
 MATRIX_MARKET_NAMES = ("K", "f", "N", "d", "weights")
-FORMATS = "see docs/problem-files.md"
+FORMATS = f"see {docs_page('problem-files')}"
 
 
 def is_problem_file(name: Any) -> bool:
@@ -120,16 +122,37 @@ def _matrix_market_folder(name: str | os.PathLike) -> Path | None:
 def _npz(path: Path) -> dict[str, np.ndarray]:
     if not zipfile.is_zipfile(path):  # np.load would try it as a pickle
         raise InputError(f"problem file {str(path)!r} is not a NumPy .npz archive: write it with "
-                         "numpy.savez (see docs/problem-files.md)")
+                         f"numpy.savez ({FORMATS})")
     try:
         with np.load(path, allow_pickle=False) as stored:
+            _check_declared_sizes(path, stored.zip)
             return {key: stored[key] for key in stored.files}
+    except InputError:
+        raise
     except (zipfile.BadZipFile, EOFError, OSError) as exc:
         raise InputError(f"problem file {str(path)!r} is not a NumPy .npz archive ({exc}): write "
-                         "it with numpy.savez (see docs/problem-files.md)") from None
+                         f"it with numpy.savez ({FORMATS})") from None
     except ValueError as exc:  # an array of Python objects (pickled)
         raise InputError(f"problem file {str(path)!r} holds an array that is not numbers ({exc}): "
                          "store plain numeric arrays") from None
+
+
+def _check_declared_sizes(path: Path, archive: zipfile.ZipFile) -> None:
+    """InputError for an array whose header declares more bytes than its member of the archive
+    holds (read before the array is allocated)."""
+    for info in archive.infolist():
+        with archive.open(info) as member:
+            try:
+                fmt = np.lib.format
+                header = fmt.read_array_header_1_0 if fmt.read_magic(member) == (1, 0) else \
+                    fmt.read_array_header_2_0
+                shape, _, dtype = header(member)
+            except ValueError:
+                continue  # not an array: np.load says so
+        if dtype.itemsize * math.prod(shape) > info.file_size:
+            raise InputError(f"problem file {str(path)!r}: {info.filename.removesuffix('.npy')!r} "
+                             f"declares shape {shape} ({dtype}), more than the {info.file_size} "
+                             "bytes stored: write it again with numpy.savez")
 
 
 def _saved(path: Path) -> ContactProblem:
@@ -144,14 +167,18 @@ def _saved(path: Path) -> ContactProblem:
 def _matrix_market(folder: Path) -> dict[str, Any]:
     import scipy.io  # on use: scipy.io is slow to import, and only Matrix Market needs it
 
-    arrays: dict[str, Any] = {}
+    files = {}
     for key in MATRIX_MARKET_NAMES:
         file = folder / f"{key}.mtx"
         if not file.exists() and key in PLAIN_KEYS:
             raise InputError(f"problem folder {str(folder)!r} holds no {key}.mtx "
                              f"({PLAIN_KEYS[key]}): write it with scipy.io.mmwrite ({FORMATS})")
-        if not file.exists():
-            continue
+        if file.exists():
+            check_input_file(str(file), "problem file")
+            files[key] = file
+    _check_headers(files)  # the sizes they declare, before anything of that size is allocated
+    arrays: dict[str, Any] = {}
+    for key, file in files.items():
         try:
             arrays[key] = scipy.io.mmread(file)
         except (ValueError, OSError, IndexError, TypeError) as exc:
@@ -160,11 +187,53 @@ def _matrix_market(folder: Path) -> dict[str, Any]:
     return arrays
 
 
-def _sparse(arrays: dict[str, Any], key: str) -> Any:
-    """Matrix ``key``: dense, or from its COO or CSR parts (``K_row``, ``K_col``, ``K_data``...)."""
+#: the fewest bytes one stored entry takes: a value and a newline; two indices and a value
+_ENTRY_BYTES = {"array": 2, "coordinate": 6}
+
+
+def _check_headers(files: dict[str, Path]) -> None:
+    """InputError when the Matrix Market headers declare sizes that disagree with each other
+    (K n × n, f n, N m × n, d and weights m) or entries their file is too short to hold."""
+    import scipy.io
+
+    shapes = {}
+    for key, file in files.items():
+        try:
+            rows, cols, entries, layout, field, _ = scipy.io.mminfo(file)
+        except (ValueError, OSError, IndexError, TypeError) as exc:
+            raise InputError(f"problem file {str(file)!r} has no Matrix Market header ({exc}): "
+                             "write it with scipy.io.mmwrite") from None
+        least = _ENTRY_BYTES.get(layout, 2) - (2 if field == "pattern" else 0)
+        if entries * least > file.stat().st_size:
+            raise InputError(f"problem file {str(file)!r} declares {entries} entries, more than "
+                             f"its {file.stat().st_size} bytes can hold: write it again with "
+                             "scipy.io.mmwrite")
+        shapes[key] = (rows, cols)
+    said = {key: " × ".join(map(str, shape)) for key, shape in shapes.items()}
+    for key in set(shapes) - {"K", "N"}:
+        if min(shapes[key]) != 1:
+            raise InputError(f"{key}.mtx declares {said[key]}: store {key} as one column")
+        shapes[key] = max(shapes[key])
+    n, m = shapes["f"], shapes["d"]
+    expected = {"K": (n, n), "N": (m, n), "f": n, "d": m, "weights": m}
+    wrong = [key for key, shape in shapes.items() if shape != expected[key]]
+    if wrong:
+        raise InputError(f"{wrong[0]}.mtx declares {said[wrong[0]]}, but f.mtx declares {n} values "
+                         f"and d.mtx {m}: K must be {n} × {n}, N {m} × {n}, weights {m} values")
+
+
+def _sparse(arrays: dict[str, Any], key: str, expected: tuple[int, int]) -> Any:
+    """Matrix ``key``: dense, or from its COO or CSR parts (``K_row``, ``K_col``, ``K_data``...).
+
+    A declared ``{key}_shape`` must be ``expected`` (the sizes of f and d) before anything of
+    that size is allocated.
+    """
+    parts = {part: arrays[f"{key}_{part}"] for part in SPARSE_PARTS if f"{key}_{part}" in arrays}
+    if key in arrays and parts:
+        raise InputError(f"{key} is stored twice, dense as {key!r} and sparse as "
+                         f"{', '.join(f'{key}_{part}' for part in parts)}: keep one of them")
     if key in arrays:
         return arrays[key]
-    parts = {part: arrays[f"{key}_{part}"] for part in SPARSE_PARTS if f"{key}_{part}" in arrays}
     if not parts:
         raise InputError(f"no {key!r} ({PLAIN_KEYS[key]}): store it dense as {key}, or sparse as "
                          f"{key}_row, {key}_col, {key}_data and {key}_shape ({FORMATS})")
@@ -173,6 +242,11 @@ def _sparse(arrays: dict[str, Any], key: str) -> Any:
         raise InputError(f"{key} is stored sparse without {key}_{missing}: store {key}_data "
                          f"and {key}_shape with its indices")
     shape = tuple(int(v) for v in np.ravel(parts["shape"]))
+    if shape != expected:
+        sizes = "f has length" if key == "K" else f"d has length {expected[0]} and f"
+        raise InputError(f"{key}_shape declares {' × '.join(map(str, shape))}, but {sizes} "
+                         f"{expected[1]}: {key} must be {expected[0]} × {expected[1]}; fix "
+                         f"{key}_shape (or the vectors)")
     try:
         if "row" in parts and "col" in parts:
             return sp.coo_matrix((parts["data"], (parts["row"], parts["col"])), shape=shape).tocsr()
@@ -212,13 +286,14 @@ def _from_arrays(path: Path, arrays: dict[str, Any], name: str) -> ContactProble
     if stray:
         raise InputError(f"{stray[0]!r} is not an array of the format (K, f, N, d, weights, "
                          f"contact_points, force_multiplicity): rename or drop it ({FORMATS})")
-    K, N = _sparse(arrays, "K"), _sparse(arrays, "N")
     vectors = {}
     for key, what in (("f", PLAIN_KEYS["f"]), ("d", PLAIN_KEYS["d"]),
                       ("weights", OPTIONAL_KEYS["weights"])):
         vectors[key] = _vector(arrays, key, what)
         if vectors[key] is None and key != "weights":
             raise InputError(f"no {key!r} ({what}): store it beside K and N ({FORMATS})")
+    n, m = vectors["f"].size, vectors["d"].size  # the sizes the stored values give
+    K, N = _sparse(arrays, "K", (n, n)), _sparse(arrays, "N", (m, n))
     for key, matrix in (("K", K), ("N", N)):
         data = matrix.data if sp.issparse(matrix) else np.asarray(matrix)
         if data.dtype.kind not in "fiu":

@@ -87,7 +87,7 @@ class ContactSolution:
     #: first derivative of the answer then reuses it when it pins the final active set)
     factor: Any = field(default=None, repr=False, compare=False)
     keep_factor: bool = field(default=False, repr=False, compare=False)
-    #: the work of every stage that ran, by stage ("method", "load control"): active-set or
+    #: the work of every stage that ran, by stage ("method", "load_control"): active-set or
     #: load-control steps, factorisations, back-solves, CG iterations
     work: dict[str, dict[str, int]] = field(default_factory=dict)
     #: the wall time of every stage that ran, by stage ("load control", "method",

@@ -49,8 +49,8 @@ CASES = [
     (["stability", "--quick", "--fast"], ["unrecognized arguments", "--fast"]),
     # signorini bench
     (["bench", "--sizes", "a,b"], ["--sizes", "e.g."]),
-    (["bench", "--sizes", "7", "--method", "pdas"], ["refine=7", "0..6"]),
-    (["bench", "--tolerance", "tight"], ["--tolerance", "'tight'", "high"]),
+    (["bench", "--sizes", "7", "--method", "pdas"], ["--sizes '7'", "0..6"]),
+    (["bench", "--tol", "tight"], ["--tol", "'tight'", "high"]),
     (["bench", "--method", "simplex"], ["unknown method", "pdas"]),
     (["bench", "--scene", "nowhere"], ["unknown scene"]),
     (["bench", "--set", "nu=0.7", "--method", "pdas"], ["nu=", "(-1, 0.5)"]),
@@ -155,7 +155,7 @@ def test_a_stability_run_writes_whole_files_only(capsys, tmp_path):
 
 @pytest.mark.parametrize("value", ["0", "nan"])
 def test_bench_time_limit_must_be_positive(capsys, tmp_path, value):
-    code, out, err = run(capsys, ["bench", "--sizes", "0", "--method", "pdas", "--tolerance", "high",
+    code, out, err = run(capsys, ["bench", "--sizes", "0", "--method", "pdas", "--tol", "high",
                                   "--time-limit", value, "--out", str(tmp_path / "out")])
     assert_one_line_exit_2(code, err, ["--time-limit"])
 

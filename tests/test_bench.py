@@ -87,7 +87,7 @@ def test_summary_metrics(tmp_path, saved_figures):
 
 def test_bench_command_checks_its_arguments(tmp_path, capsys):
     assert main(["bench", "--sizes", "a,b", "--out", str(tmp_path)]) == 2
-    assert main(["bench", "--tolerance", "tight", "--out", str(tmp_path)]) == 2
+    assert main(["bench", "--tol", "tight", "--out", str(tmp_path)]) == 2
     assert "tight" in capsys.readouterr().err
 
 

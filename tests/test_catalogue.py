@@ -161,8 +161,9 @@ CLI = [
     # bench
     (["bench", "--method", "nope"], 2, ["unknown method", "'nope'"]),
     (["bench", "--sizes", "a,b"], 2, ["--sizes"]),
-    (["bench", "--sizes", "7", "--method", "pdas"], 2, ["refine=7"]),
-    (["bench", "--tolerance", "tight"], 2, ["--tolerance", "'tight'"]),
+    (["bench", "--sizes", "7", "--method", "pdas"], 2, ["--sizes", "level 7"]),
+    (["bench", "--sizes", "-1", "--method", "pdas"], 2, ["--sizes", "level -1", "0..6"]),
+    (["bench", "--tol", "tight"], 2, ["--tol", "'tight'"]),
     (["bench", "--time-limit", "-1"], 2, ["--time-limit"]),
     (["bench", "--ranks", "0"], 2, ["--ranks"]),
     (["bench", "--sizes", "6", "--method", "pdas", "--scene", "hertz-cylinder"], 2, ["dofs", "GB"]),

@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-DOTTED = re.compile(r"\bsignorini(?:\.[A-Za-z_][A-Za-z0-9_]*)+")
+DOTTED = re.compile(r"(?<!//)\bsignorini(?:\.[A-Za-z_][A-Za-z0-9_]*)+")  # not a host in a URL
 FILE_ENDINGS = (".py", ".toml", ".json", ".md", ".msh", ".png", ".csv", ".vtu", ".npz")
 
 

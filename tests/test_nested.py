@@ -96,7 +96,7 @@ def test_auto_reuses_the_load_targeting_factorisation_of_a_large_3d_model():
     problem = build_problem("hertz-sphere-3d", params={"refine": 1})
     answer = signorini.solve(problem)
     assert answer.method == "nested" and answer.status == "converged"
-    assert answer.solution.work["load control"]["factorisations"] == 1
+    assert answer.solution.work["load_control"]["factorisations"] == 1
     assert "factorisations" not in answer.solution.work["method"]
     assert answer.solution.extras["auto"].startswith("K (")
     assert signorini.solve(problem, c=2.0).method == "pdas"  # an option nested does not take

@@ -102,6 +102,27 @@ def test_every_extra_a_message_names_exists():
     assert named and named <= set(EXTRAS), named - set(EXTRAS)
 
 
+def test_the_default_install_holds_what_the_default_methods_use_and_no_more():
+    default = {requirement_name(r) for r in PYPROJECT["project"]["dependencies"]}
+    for method in methods():
+        if not method.install_hint.startswith("pip install 'signorini["):
+            assert {distribution(m) for m in method.requires} <= default | {"qpsolvers"}, method.name
+    # cvxpy without its bundled solvers: SCS and HiGHS are extras, and `all` brings every backend
+    assert "cvxpy-base" in default and not {"cvxpy", "scs", "highspy"} & default
+    assert {"scs", "highspy", "ecos"} <= installed_by("all")
+
+
+def test_the_metadata_points_to_the_docs_site_messages_name():
+    from signorini.errors import DOCS_SITE
+
+    assert PYPROJECT["project"]["urls"]["Documentation"] == DOCS_SITE
+    site = re.search(r"^site_url: (\S+)$", (ROOT / "mkdocs.yml").read_text(), re.M)
+    assert site and site.group(1) == DOCS_SITE
+    for url in PYPROJECT["project"]["urls"].values():  # each names a page of the site
+        page = url.removeprefix(DOCS_SITE).strip("/")
+        assert url.startswith(DOCS_SITE) and (not page or (ROOT / "docs" / f"{page}.md").is_file())
+
+
 def test_a_hint_without_an_extra_names_the_pip_distributions():
     assert install_hint("", ["sksparse", "osqp"]) == "pip install scikit-sparse osqp"
     assert install_hint("gurobi", ["gurobipy"]) == "pip install 'signorini[gurobi]'"
@@ -176,3 +197,6 @@ def test_the_wheel_installs_into_a_clean_environment_and_solves(installed, dists
     typed = run(installed / "python", "-c", "import importlib.resources as r; "
                 "print(r.files('signorini').joinpath('py.typed').is_file())").stdout
     assert typed.strip() == "True"
+    urls = run(installed / "python", "-c", "import importlib.metadata as m; "
+               "print(m.metadata('signorini').get_all('Project-URL'))").stdout
+    assert "Documentation, " + signorini.errors.DOCS_SITE in urls

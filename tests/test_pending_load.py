@@ -65,7 +65,7 @@ def test_pdas_amg_matches_the_load_without_a_factorisation(pair):
     with counting() as work:
         settled, solution = solved(pending, "pdas-amg")
     assert solution.status == "converged", solution.message
-    assert "one more unknown" in solution.message and "load control" not in solution.work
+    assert "one more unknown" in solution.message and "load_control" not in solution.work
     assert not settled.pending
     # no factorisation of the fine model (its coarse model, if any, is small and counted apart)
     assert work.factorisations <= 1
@@ -83,7 +83,7 @@ def test_any_other_method_gets_the_problem_matched_first(pair):
         solve(pending, "pdas")  # the method alone solves the QP as it is: it refuses
     settled, solution = solved(pending, "pdas")
     assert solution.status == "converged" and not settled.pending
-    assert solution.work["load control"]["factorisations"] >= 1
+    assert solution.work["load_control"]["factorisations"] >= 1
     assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
                                                                       rel=1e-9)
 
@@ -102,7 +102,7 @@ def test_small_models_keep_the_factorised_targeting():
     pdas confirms what it found in one step."""
     result = signorini.solve(SCENE)
     assert result.method == "pdas" and result.iterations == 1
-    assert result.solution.work["load control"]["factorisations"] >= 1
+    assert result.solution.work["load_control"]["factorisations"] >= 1
 
 
 def test_a_pending_problem_is_saved_pending(tmp_path, pair):

@@ -245,7 +245,7 @@ def test_bench_takes_a_problem_file_as_one_size(block, tmp_path, capsys):
     path = write_matrix_market(block, tmp_path)
     out = tmp_path / "bench"
     assert main(["bench", "--problem", str(path), "--method", "pdas", "--method", "uzawa",
-                 "--tolerance", "mid", "--out", str(out)]) == 0
+                 "--tol", "mid", "--out", str(out)]) == 0
     with open(out / "bench.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert {(r["scene"], r["size"], r["method"]) for r in rows} == {

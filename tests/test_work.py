@@ -19,8 +19,8 @@ def test_the_default_solve_costs_at_most_three_factorisations(scene):
     # load control starts from the analytic zone and auto's pdas from its answer: one step each
     assert result.iterations == 1
     work = result.solution.work
-    assert work["load control"]["steps"] == 1 and work["method"]["steps"] == 1
-    assert work["load control"]["factorisations"] + work["method"]["factorisations"] <= factorisations
+    assert work["load_control"]["steps"] == 1 and work["method"]["steps"] == 1
+    assert work["load_control"]["factorisations"] + work["method"]["factorisations"] <= factorisations
 
 
 def test_a_named_method_starts_cold_and_reports_its_own_steps():
@@ -28,7 +28,7 @@ def test_a_named_method_starts_cold_and_reports_its_own_steps():
     result = signorini.solve(signorini.build_problem("hertz-cylinder"), "pdas")
     assert result.converged and result.iterations >= 2
     assert result.solution.work["method"]["steps"] == result.iterations
-    assert result.solution.work["load control"]["steps"] >= 1
+    assert result.solution.work["load_control"]["steps"] >= 1
     again = signorini.solve(result.problem, "pdas", warm_start=result)  # explicitly warm
     assert again.converged and again.iterations == 1
     assert abs(again.total_force - result.total_force) <= 1e-12 * abs(result.total_force)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import logging
 import os
 import select
@@ -23,7 +24,7 @@ from signorini import __version__
 from signorini.cli import bench, crosscheck, explore, export, listing, solve, studies
 from signorini.cli.common import EXIT_FAILED, EXIT_USAGE, Parser
 from signorini.cli.progress import progress
-from signorini.errors import InputError, OutputError, SignoriniError
+from signorini.errors import DOCS_SITE, InputError, OutputError, SignoriniError, docs_page
 
 COMMANDS = (solve, crosscheck, studies, bench, export, listing, explore)
 
@@ -40,7 +41,8 @@ def add_verbosity(parser: argparse.ArgumentParser, default) -> None:
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="signorini", description="Frictionless contact as one QP, solved many ways. "
                     "On a terminal, a step that takes longer than a second shows a progress line "
-                    "on stderr.")
+                    "on stderr.", epilog=f"'signorini COMMAND --help' gives a command's examples "
+                    f"and exit codes. Documentation: {DOCS_SITE}")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     add_verbosity(parser, False)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
@@ -92,7 +94,8 @@ def _main_ranks(argv: Sequence[str] | None) -> int:
             return cluster.serve()
     except ImportError:
         print("signorini: error: started by mpirun but mpi4py is not installed: "
-              "pip install 'signorini[petsc]' (see docs/performance.md, 'PETSc and MPI')", file=sys.stderr)
+              f"pip install 'signorini[petsc]' (see {docs_page('performance', 'petsc-and-mpi')})",
+              file=sys.stderr)
         return EXIT_USAGE
     try:
         return _main(argv, ranks=cluster.size())
@@ -125,12 +128,14 @@ def _main(argv: Sequence[str] | None, ranks: int = 1) -> int:
 
 
 def _clean_up() -> None:
-    """No worker process outlives the command; no folder it made stays empty."""
+    """No worker process outlives the command; no file is left half-written; no folder it made
+    stays empty."""
     worker = sys.modules.get("signorini.studies.worker")
     if worker is not None:
         worker.stop_all()
     files = sys.modules.get("signorini.files")
     if files is not None:
+        files.remove_partial_files()
         files.remove_empty_folders()
 
 
@@ -145,6 +150,18 @@ def _stdout_closed() -> bool:
     except OSError:
         return True
     return sys.stdout is None or sys.stdout.closed
+
+
+def _output_full(exc: OSError) -> bool:
+    """Whether ``exc`` is a write to stdout or stderr that found no space: a file's write names
+    the file (the library says those as OutputError), a print's does not."""
+    return exc.filename is None and exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO)
+
+
+def _drop_stdout() -> None:
+    """What is still buffered for a stdout that fails goes nowhere: no second error at exit."""
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
 def _reader_gone() -> bool:
@@ -193,11 +210,15 @@ def _run(argv: Sequence[str] | None, ranks: int) -> int:
              "no output left half-written")
         return 128 + signum
     except BrokenPipeError:  # e.g. piped into `head`: say so once, on stderr, and fail
-        try:  # what is still buffered for the closed stdout must not raise again at exit
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except (OSError, ValueError):
-            pass
+        _drop_stdout()
         _say("error: standard output was closed before the output was written")
+        return EXIT_FAILED
+    except OSError as exc:  # stdout on a full disk (> /dev/full): one line, not a traceback
+        if not _output_full(exc):
+            raise
+        _drop_stdout()
+        _say(f"error: standard output cannot be written ({exc.strerror}): free some space or "
+             "send it elsewhere")
         return EXIT_FAILED
     except ValueError:
         if not _stdout_closed():

@@ -9,7 +9,8 @@ import sys
 from pathlib import Path
 
 from signorini.errors import InputError
-from signorini.cli.common import PROBLEM_FILES, input_files, out_folder, pairs, parse_sizes
+from signorini.cli.common import (PROBLEM_FILES, add_command, family_of, input_files, out_folder,
+                                  pairs, parse_sizes)
 
 
 def _bench_peer(args: argparse.Namespace) -> int:
@@ -84,15 +85,27 @@ def cmd_bench(args: argparse.Namespace) -> int:
         problem = read_problem(args.problem)  # a bad file is refused before any work
         family, levels = None, [0]
     else:
-        family = get_scene(args.scene or "hertz-cylinder")
+        scene, base = family_of(args.scene or "hertz-cylinder", pairs(args.set, "--set"), "bench")
+        family = get_scene(scene)
         levels = _sizes(args.sizes, "0,1")
+        refine = next((p for p in family.params if p.name == "refine"), None)
+        wrong = [(level, refine.check(level)) for level in levels if refine and refine.check
+                 and refine.check(level)]
+        if refine is None:
+            raise InputError(f"--scene {family.name}: bench sizes a scene by its parameter "
+                             "refine, which this one has not: choose a scene with it (see "
+                             "'signorini scenes'), or give --problem a saved problem of it")
+        if wrong:
+            raise InputError(f"--sizes {args.sizes!r}: level {wrong[0][0]} must be {wrong[0][1]} "
+                             f"(the refinements of {family.name}), e.g. --sizes 0,1")
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
                          "e.g. --time-limit 120")
-    tolerances = args.tolerance.split(",")
+    tolerances = args.tol.split(",")
     unknown = [t for t in tolerances if t not in TOLERANCES]
     if unknown:
-        raise InputError(f"--tolerance {unknown[0]!r} is not one of {', '.join(TOLERANCES)}")
+        raise InputError(f"--tol {unknown[0]!r} is not one of {', '.join(TOLERANCES)}: give "
+                         "levels, e.g. --tol mid,high")
     inputs = input_files(args.problem, args.method)
     out = out_folder(args.out or "bench-report", inputs)
     csv_path = Path(out) / "bench.csv"
@@ -113,7 +126,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
         from signorini.solvers.cluster import mpirun_command  # only when ranks are asked for
 
         mpirun_command(ranks[-1], [])  # no mpirun, or more ranks than cores: fail before any run
-    base = pairs(args.set, "--set")
     runs = []
     for level in levels:
         if family is None:
@@ -144,7 +156,16 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def add_parsers(sub) -> None:
     """Register ``bench``."""
-    bench = sub.add_parser("bench", help="benchmark methods × sizes × tolerances (resumable CSV)")
+    bench = add_command(
+        sub, "bench", "benchmark methods × sizes × tolerances (resumable CSV)",
+        "Benchmark methods × sizes × tolerances on a scene at several refinements (or on a "
+        "problem file), each run in a process of its own within a time limit: one row per run "
+        "in a resumable CSV, then a report (bench.md) and figures in --out. --peer getfem runs "
+        "GetFEM on the Hertz scenes beside this package.",
+        ["signorini bench --sizes 0,1 --method pdas --method qp-osqp",
+         "signorini bench --problem my.npz --tol mid,high --out bench",
+         "signorini bench --peer getfem --sizes 0,1"],
+        {0: "the report was written (a run that failed is a row of it)"})
     bench.add_argument("--scene", help="default hertz-cylinder (with --peer: hertz-cylinder and "
                        "hertz-sphere; or hertz-two-cylinders)")
     bench.add_argument("--problem", metavar="FILE", help="benchmark on a problem file of yours "
@@ -160,8 +181,9 @@ def add_parsers(sub) -> None:
                             "fastest kept (default 5; 0: whole process only)")
     bench.add_argument("--method", action="append", default=[],
                        help="only this method (repeatable; default: every installed sparse one)")
-    bench.add_argument("--tolerance", default="low,mid,high,default",
-                       help="tolerance levels: low (1e-3), mid (1e-6), high (1e-9), default")
+    bench.add_argument("--tol", default="low,mid,high,default", metavar="LEVELS",
+                       help="the tolerances asked of the iterative methods, as levels: low (1e-3), "
+                            "mid (1e-6), high (1e-9), default (the method's own); default all four")
     bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     bench.add_argument("--default-only-from", type=int, default=None, metavar="LEVEL",
                        help="from this refinement level on, iterative methods run at their "

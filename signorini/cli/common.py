@@ -6,15 +6,33 @@ import argparse
 import contextlib
 import os
 import sys
+import textwrap
 from typing import Any, Iterator, Sequence
 
-from signorini.errors import InputError
+from signorini.errors import DOCS_SITE, InputError
 
 EXIT_FAILED, EXIT_USAGE = 1, 2
 #: what a problem file is, in every command's help
-PROBLEM_FILES = ".npz (save's or plain) or Matrix Market (docs/problem-files.md)"
+PROBLEM_FILES = ".npz (save's or plain) or Matrix Market (the documentation's page problem-files)"
 #: the positional input of solve and crosscheck
 SCENE_HELP = f"scene name (see 'signorini scenes'), a .toml scene file, or a problem file: {PROBLEM_FILES}"
+
+
+#: what every command's exit codes share
+EXITS = {EXIT_USAGE: "bad input: one line on stderr says which and how to fix it",
+         130: "stopped by SIGINT (143 SIGTERM, 129 SIGHUP): no output left half-written"}
+
+
+def add_command(sub, name: str, summary: str, description: str, examples: Sequence[str],
+                exits: dict[int, str]):
+    """The parser of one command: its one-line ``summary`` in ``signorini --help``; in its own
+    help the ``description``, ``examples`` and exit codes (``exits`` before the shared ones)."""
+    codes = {**exits, **EXITS}
+    epilog = "\n".join(["examples:", *(f"  {line}" for line in examples), "", "exit codes:",
+                        *(f"  {code:<3} {meaning}" for code, meaning in codes.items()), "",
+                        f"documentation: {DOCS_SITE}"])
+    return sub.add_parser(name, help=summary, description=textwrap.fill(description, 79),
+                          epilog=epilog, formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
 class Parser(argparse.ArgumentParser):
@@ -31,6 +49,31 @@ def pairs(items: Sequence[str], flag: str) -> dict[str, Any]:
         if not sep or not key.strip():
             raise InputError(f"{flag} {item!r} is not key=value: write {flag} name=value")
         out[key.strip()] = value.strip()
+    return out
+
+
+#: the one spelling of a method's option on every command
+OPT_METAVAR = "[METHOD:]KEY=VALUE"
+
+
+def method_options(items: Sequence[str], methods: Sequence[str]) -> dict[str, dict[str, str]]:
+    """``--opt [METHOD:]KEY=VALUE`` strings to each method's options (values as text):
+    ``METHOD:KEY=VALUE`` names its method, ``KEY=VALUE`` alone is for the one method named."""
+    out: dict[str, dict[str, str]] = {}
+    for item in items:
+        head, sep, value = item.partition("=")
+        method, colon, key = head.rpartition(":")
+        if not sep or not key.strip() or colon and not method:
+            raise InputError(f"--opt {item!r} is not [METHOD:]key=value: write e.g. --opt "
+                             "qp-osqp:eps_abs=1e-10 (or --opt eps_abs=1e-10 with one --method)")
+        if not colon and len(methods) != 1:
+            raise InputError(f"--opt {item!r} names no method: write --opt METHOD:key=value, "
+                             f"here --opt METHOD:{item} (or name one --method)")
+        out.setdefault(method if colon else methods[0], {})[key.strip()] = value.strip()
+    stray = sorted(set(out) - set(methods)) if methods else []
+    if stray:
+        raise InputError(f"--opt for {stray[0]!r}, which is not among the --method: add "
+                         f"--method {stray[0]} (or drop the option)")
     return out
 
 
@@ -89,7 +132,7 @@ def input_files(scene: str | None = None, methods: Sequence[str] = ()) -> dict[s
     found.update({f"file of --method {m}": m.rpartition(":")[0] for m in methods
                   if m.rpartition(":")[0].endswith(".py")})
     for what, path in found.items():
-        check_input_file(path, what)
+        check_input_file(path, what.removesuffix(f" {path}"))
     return found
 
 
@@ -138,3 +181,19 @@ def parse_sizes(text: str) -> list[int]:
     except ValueError:
         raise InputError(f"--sizes {text!r} is not a comma-separated list of sizes, "
                          "e.g. --sizes 0,1,2") from None
+
+
+def family_of(scene: str, params: dict[str, Any], command: str) -> tuple[str, dict[str, Any]]:
+    """``(scene family, parameters)`` of a scene name, or of a scene file that names its family
+    (``scene = "hertz-cylinder"``, its values under ``params``): what a command that refines a
+    family by its ``refine`` parameter takes. InputError for a mesh scene file."""
+    if not scene.lower().endswith(".toml"):
+        return scene, params
+    from signorini.scenes.scenefile import family_scene_values  # per command (start-up)
+
+    found = family_scene_values(scene, params)
+    if found is None:
+        raise InputError(f"scene file {scene!r} meshes its own body, which {command} cannot "
+                         "refine: give a scene name (see 'signorini scenes') or a scene file "
+                         "that names one (scene = \"hertz-cylinder\")")
+    return found

@@ -4,25 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, parse_tol,
-                                  stdout_to_stderr, user_methods_in_workers,
-                                  write_output)
+from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, SCENE_HELP, add_command, input_files,
+                                  method_options, pairs, parse_tol, stdout_to_stderr,
+                                  user_methods_in_workers, write_output)
 from signorini.errors import InputError
 from signorini.solvers.defaults import DEFAULT_TOL
 from signorini.solvers.options import guess_value
-
-
-def method_options(items: list[str]) -> dict[str, dict]:
-    """``METHOD:key=value`` strings (``--opt qp-osqp:eps_abs=1e-10``) to per-method options."""
-    out: dict[str, dict] = {}
-    for item in items:
-        method, sep, setting = item.rpartition(":")
-        if not sep or not method or "=" not in setting:
-            raise InputError(f"--opt {item!r} is not METHOD:key=value: write e.g. "
-                             "--opt qp-osqp:eps_abs=1e-10")
-        for key, value in pairs([setting], "--opt").items():
-            out.setdefault(method, {})[key] = guess_value(value)
-    return out
 
 
 def cmd_crosscheck(args: argparse.Namespace) -> int:
@@ -35,11 +22,13 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     outputs = check_outputs({"--json": args.json, "--md": args.md},
                             inputs=input_files(args.scene, methods))
     params = pairs(args.set, "--set")
+    options = {name: {key: guess_value(value) for key, value in given.items()}
+               for name, given in method_options(args.opt, args.method).items()}
     tol = parse_tol(args.tol) if args.tol is not None else None
     # what a method prints stays off the record; a user's method runs in a worker process
     with stdout_to_stderr(STDOUT in outputs.values()), user_methods_in_workers(methods):
         check = crosscheck(args.scene, methods, tol=DEFAULT_TOL if tol is None else tol,
-                           params=params, options=method_options(args.opt), allow=args.allow,
+                           params=params, options=options, allow=args.allow,
                            polish=args.polish)
     texts = {"--json": to_json(check.to_dict()) + "\n", "--md": check.markdown().rstrip("\n") + "\n"}
     with all_or_none():  # both files, or neither
@@ -53,13 +42,18 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
 
 def add_parsers(sub) -> None:
     """Register ``crosscheck``."""
-    cross = sub.add_parser(
-        "crosscheck", help="solve one scene with several methods and compare every pair",
-        description="Solve one scene with several methods at one tolerance and compare every pair "
-                    "of answers: λ and u (relative), nodes classified differently, each method's "
-                    "status and KKT certificate, its own (unpolished) answer's distance to pdas's "
-                    "and its active set, Hertz's errors. Exit 1 when a method does not converge "
-                    "or two methods that say converged disagree (--allow lets a method through).")
+    cross = add_command(
+        sub, "crosscheck", "solve one scene with several methods and compare every pair",
+        "Solve one scene or problem file with several methods at one tolerance and compare every "
+        "pair of answers: λ and u (relative), nodes classified differently, each method's status "
+        "and KKT certificate, its own (unpolished) answer's distance to pdas's and its active "
+        "set, Hertz's errors.",
+        ["signorini crosscheck hertz-cylinder",
+         "signorini crosscheck my.npz --method pdas --method mine.py:solve --json check.json",
+         "signorini crosscheck block --method pdas --method qp-osqp --opt qp-osqp:eps_abs=1e-10"],
+        {0: "every method converged and every pair agrees",
+         1: "a method did not converge, or two that say converged disagree (--allow lets a "
+            "method through)"})
     cross.add_argument("scene", help=SCENE_HELP)
     cross.add_argument("--method", action="append", default=[], metavar="M",
                        help="a method to compare (repeat; default uzawa, qp-osqp, qp-clarabel, "
@@ -68,8 +62,9 @@ def add_parsers(sub) -> None:
                                      f"(default {DEFAULT_TOL:g})")
     cross.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="scene parameter, e.g. --set a_over_R=0.05")
-    cross.add_argument("--opt", action="append", default=[], metavar="METHOD:KEY=VALUE",
-                       help="an option of one method, e.g. --opt qp-osqp:eps_abs=1e-10")
+    cross.add_argument("--opt", action="append", default=[], metavar=OPT_METAVAR,
+                       help="an option of one method, e.g. --opt qp-osqp:eps_abs=1e-10 "
+                            "(KEY=VALUE alone when one --method is named)")
     cross.add_argument("--allow", action="append", default=[], metavar="M",
                        help="a known-weak method whose failure or disagreement does not fail the "
                             "check (repeat)")

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from signorini.cli.common import add_command
+
 
 def cmd_scenes(args: argparse.Namespace) -> int:
     from signorini.scenes import SCENES  # per command (start-up)
@@ -31,6 +33,14 @@ def cmd_methods(args: argparse.Namespace) -> int:
 
 def add_parsers(sub) -> None:
     """Register the listings."""
-    sub.add_parser("scenes", help="list the scenes and their parameters").set_defaults(run=cmd_scenes)
-    sub.add_parser("methods", help="list the methods and whether they are installed").set_defaults(
-        run=cmd_methods)
+    add_command(sub, "scenes", "list the scenes and their parameters",
+                "List the built-in scenes, each with its parameters, their defaults and meaning; "
+                "a command takes them as --set KEY=VALUE, a scene file as keys.",
+                ["signorini scenes",
+                 "signorini solve hertz-cylinder --set n_contact=60 --set grading=0.1"],
+                {0: "listed"}).set_defaults(run=cmd_scenes)
+    add_command(sub, "methods", "list the methods and whether they are installed",
+                "List the methods, whether each is installed (with the pip command that installs "
+                "it when not) and what it is, and the factorisation backend in use.",
+                ["signorini methods", "SIGNORINI_FACTOR=superlu signorini methods"],
+                {0: "listed"}).set_defaults(run=cmd_methods)

@@ -6,8 +6,9 @@ import argparse
 import os
 import sys
 
-from signorini.cli.common import (EXIT_FAILED, SCENE_HELP, input_files, pairs, parse_time_limit,
-                                  parse_tol, stdout_to_stderr, write_output)
+from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, SCENE_HELP, add_command, input_files,
+                                  method_options, pairs, parse_time_limit, parse_tol, stdout_to_stderr,
+                                  write_output)
 from signorini.errors import InputError
 from signorini.solvers.defaults import DEFAULT_TOL
 from signorini.solvers.options import guess_value
@@ -21,7 +22,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
 
     params = pairs(args.set, "--set")
-    texts = pairs(args.opt, "--opt")
+    texts = method_options(args.opt, [args.method]).get(args.method, {})
     max_iter = guess_value(texts.pop("max_iter")) if "max_iter" in texts else None
     tol = parse_tol(args.tol) if args.tol is not None else None
     inputs = input_files(args.scene, [args.method])  # before the method's file is imported
@@ -105,7 +106,17 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 def add_parsers(sub) -> None:
     """Register ``solve``."""
-    solve = sub.add_parser("solve", help="solve one scene with one method")
+    solve = add_command(
+        sub, "solve", "solve one scene with one method",
+        "Solve one scene (by name or from a .toml scene file) or one problem file with one "
+        "method, and print the summary: the method's status, the independent KKT certificate "
+        "that backs it, the contact and, for a scene with an analytic reference, its errors "
+        "against it. --json writes the whole record, --vtk the mesh and fields for ParaView.",
+        ["signorini solve hertz-cylinder",
+         "signorini solve examples/hertz-cylinder.toml --method qp-clarabel --tol 1e-9 --json r.json",
+         "signorini solve my.npz --method mine.py:solve --time-limit 60"],
+        {0: "the method converged and the certificate agrees",
+         1: "it did not (failed, max_iter, inaccurate), or --vtk had no finite answer to write"})
     solve.add_argument("scene", help=SCENE_HELP)
     solve.add_argument("--method", default="auto",
                        help="method name (see 'signorini methods'; auto: pdas in 2D, pdas-amg for large 3D)")
@@ -113,8 +124,9 @@ def add_parsers(sub) -> None:
                        f"backend runs at its own settings, its answer held to {DEFAULT_TOL:g})")
     solve.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="scene parameter, e.g. --set a_over_R=0.05")
-    solve.add_argument("--opt", action="append", default=[], metavar="KEY=VALUE",
-                       help="method option, e.g. --opt step_fraction=0.5")
+    solve.add_argument("--opt", action="append", default=[], metavar=OPT_METAVAR,
+                       help="method option, e.g. --opt step_fraction=0.5 (METHOD: may name the "
+                            "--method, as in crosscheck and validate)")
     solve.add_argument("--json", metavar="FILE", help="write the result as JSON ('-' for stdout)")
     solve.add_argument("--raw-units", action="store_true",
                        help="solve in the user's units instead of non-dimensionalising")

@@ -7,9 +7,10 @@ import shlex
 import sys
 
 from signorini.errors import InputError
-from signorini.cli.common import (EXIT_FAILED, PROBLEM_FILES, input_files, out_folder, pairs,
-                                  parse_time_limit, parse_tol, user_methods_in_workers,
-                                  write_output)
+from signorini.solvers.options import guess_value
+from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, PROBLEM_FILES, add_command, family_of,
+                                  input_files, method_options, out_folder, pairs, parse_time_limit,
+                                  parse_tol, user_methods_in_workers, write_output)
 
 
 def cmd_converge(args: argparse.Namespace) -> int:
@@ -21,16 +22,16 @@ def cmd_converge(args: argparse.Namespace) -> int:
         raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
     if args.uniform_levels is not None and not 0 <= args.uniform_levels <= 4:
         raise InputError(f"--uniform-levels {args.uniform_levels} must be in 0..4")
-    params = pairs(args.set, "--set")
     out = out_folder(args.out, input_files(args.scene, args.method))
-    check_study(args.scene, args.levels, params, args.method or None, args.fit_from)
+    scene, params = family_of(args.scene, pairs(args.set, "--set"), "converge")
+    check_study(scene, args.levels, params, args.method or None, args.fit_from)
     say = (lambda line: print(line, file=sys.stderr))
     with user_methods_in_workers(args.method):  # a user's method runs in a worker process
-        study = run_study(args.scene, args.levels, params, methods=args.method or None,
+        study = run_study(scene, args.levels, params, methods=args.method or None,
                           fit_from=args.fit_from, progress=say)
     comparison = None
     if args.uniform_levels is not None:
-        comparison = grading_comparison(args.scene, study, args.uniform_levels, params, progress=say)
+        comparison = grading_comparison(scene, study, args.uniform_levels, params, progress=say)
     command = "signorini converge " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
         if len(sys.argv) > 2 and sys.argv[1] == "converge" else f"signorini converge {args.scene} --levels {args.levels}"
     with all_or_none():  # the whole report, or none of it
@@ -49,24 +50,13 @@ def cmd_converge(args: argparse.Namespace) -> int:
     return 0
 
 
-def validate_options(items: list[str], methods: list[str]) -> dict[str, dict]:
-    """``--opt METHOD:key=value`` (or ``key=value`` when one --method is named) per method."""
-    from signorini.cli.crosscheck import method_options  # per command (start-up)
-
-    bare = [item for item in items if ":" not in item.partition("=")[0]]
-    if bare and len(methods) != 1:
-        raise InputError(f"--opt {bare[0]!r} names no method: write --opt METHOD:{bare[0]} (or "
-                         "name one --method)")
-    return method_options([f"{methods[0]}:{item}" if item in bare else item for item in items])
-
-
 def cmd_validate(args: argparse.Namespace) -> int:
     # each command loads what it needs (the report starts matplotlib)
     import os
 
     from signorini.files import all_or_none, check_outputs  # as above
     from signorini.output.ci import github_annotations, junit_xml  # as above
-    from signorini.output.report import checks_summary, write_suite_report  # as above
+    from signorini.output.report import REPORT_FILES, checks_summary, write_suite_report  # as above
     from signorini.problem_files import problem_file_paths, read_problem  # as above
     from signorini.solvers.registry import check_request  # as above
     from signorini.studies.suite import (TIGHT_TOL, problem_case, read_limits, run_suite,
@@ -80,16 +70,14 @@ def cmd_validate(args: argparse.Namespace) -> int:
         inputs.update({f"problem file {p}": p for p in problem_file_paths(path)})
     if args.limits:
         inputs["limits file"] = args.limits
-    outputs = check_outputs({"--junit": args.junit}, {"--out": args.out}, inputs=inputs)
+    outputs = check_outputs({"--junit": args.junit}, {"--out": args.out}, inputs=inputs,
+                            fills={"--out": REPORT_FILES})
     out = outputs["--out"]
     if args.junit == "-":  # the summary and the annotations are printed there
         raise InputError("--junit - would mix the XML with the summary on stdout: give a file "
                          "name, e.g. --junit report.xml")
-    options = validate_options(args.opt, args.method)
-    stray = sorted(set(options) - set(args.method)) if args.method else []
-    if stray:
-        raise InputError(f"--opt for {stray[0]!r}, which is not among the --method: add "
-                         f"--method {stray[0]}")
+    options = {name: {key: guess_value(value) for key, value in given.items()}
+               for name, given in method_options(args.opt, args.method).items()}
     for name in args.method or list(options):
         check_request(name, options=options.get(name))  # refused before any work
     limits = read_limits(args.limits) if args.limits else None
@@ -188,8 +176,17 @@ def cmd_stability(args: argparse.Namespace) -> int:
 
 def add_parsers(sub) -> None:
     """Register the study commands."""
-    converge = sub.add_parser("converge", help="refine a scene k times: errors, rates, figures")
-    converge.add_argument("scene", help="a scene with a 'refine' parameter (see 'signorini scenes')")
+    converge = add_command(
+        sub, "converge", "refine a scene k times: errors, rates, figures",
+        "Solve a scene at refinement levels 0..k with every installed exact method (or those "
+        "named), fit the convergence rates of its errors against the analytic reference, and "
+        "write the report (Markdown, JSON, figures) into --out.",
+        ["signorini converge hertz-cylinder --levels 3",
+         "signorini converge examples/hertz-cylinder.toml --levels 2 --method pdas",
+         "signorini converge hertz-sphere --levels 2 --uniform-levels 1 --out conv"],
+        {0: "the report was written", 1: "a method named with --method converged at no level"})
+    converge.add_argument("scene", help="a scene with a 'refine' parameter (see 'signorini "
+                          "scenes'), or a .toml scene file that names one (scene = \"hertz-cylinder\")")
     converge.add_argument("--levels", type=int, default=3, help="refinements: levels 0..k (default 3)")
     converge.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                           help="scene parameter of level 0, e.g. --set n_contact=15")
@@ -202,8 +199,17 @@ def add_parsers(sub) -> None:
     converge.add_argument("--out", default="convergence-report", help="output directory")
     converge.set_defaults(run=cmd_converge)
 
-    validate = sub.add_parser("validate", help="run the validation suite on the default scenes "
-                              "or your problem files")
+    validate = add_command(
+        sub, "validate", "run the validation suite on the default scenes or your problem files",
+        "Run the validation suite: every case (the default scenes, or your problem files) solved "
+        "by every installed method (or those named), each answer checked against its KKT "
+        "certificate, the exact answer (pdas at 1e-9) and the analytic reference, within limits "
+        "a --limits file may change. Writes the report into --out and, with --junit, the checks "
+        "as JUnit XML for CI.",
+        ["signorini validate",
+         "signorini validate --problem my.npz --method mine.py:solve --junit report.xml",
+         "signorini validate --case hertz-cylinder --method uzawa --opt step_fraction=0.5"],
+        {0: "every check passed", 1: "a check failed (the report says which)"})
     validate.add_argument("--out", default="validation-report", help="report directory")
     validate.add_argument("--method", action="append", default=[],
                           help="only this method (repeatable; default: every installed one); "
@@ -217,17 +223,24 @@ def add_parsers(sub) -> None:
                                "these unless --case")
     validate.add_argument("--tol", help="the relative KKT tolerance asked of every method "
                           "(default 1e-9; the exact answer stays pdas at 1e-9)")
-    validate.add_argument("--opt", action="append", default=[], metavar="METHOD:KEY=VALUE",
+    validate.add_argument("--opt", action="append", default=[], metavar=OPT_METAVAR,
                           help="an option of one method, e.g. --opt uzawa:step_fraction=0.5 "
                                "(KEY=VALUE alone when one --method is named)")
     validate.add_argument("--limits", metavar="FILE", help="a TOML file whose [limits] table "
-                          "replaces some of the checks' limits (docs/ci.md)")
+                          "replaces some of the checks' limits (the documentation's page ci)")
     validate.add_argument("--junit", metavar="FILE", help="also write the checks as JUnit XML "
                           "for CI, e.g. report.xml; under GitHub Actions failed checks are "
                           "also annotations")
     validate.set_defaults(run=cmd_validate)
 
-    sweep = sub.add_parser("sweep", help="solve many load levels with one factorisation")
+    sweep = add_command(
+        sub, "sweep", "solve many load levels with one factorisation",
+        "Solve one scene at n load levels with one factorisation of K, and write sweep.csv, "
+        "sweep.json and sweep.png into --out: the contact half-width and peak pressure at each "
+        "level beside Hertz's.",
+        ["signorini sweep hertz-cylinder --load 0.001:0.004:4",
+         "signorini sweep hertz-sphere --load 1e-4:1e-3:5 --out sweep"],
+        {0: "every load level converged", 1: "a level did not (printed after the table)"})
     sweep.add_argument("scene", help="scene name (see 'signorini scenes')")
     sweep.add_argument("--load", required=True, metavar="P1:P2:n",
                        help="n loads from P1 to P2 (per unit thickness of the full body)")
@@ -236,7 +249,13 @@ def add_parsers(sub) -> None:
     sweep.add_argument("--out", default="sweep-report", help="output directory")
     sweep.set_defaults(run=cmd_sweep)
 
-    stability = sub.add_parser("stability", help="the stability atlas: where each method fails")
+    stability = add_command(
+        sub, "stability", "the stability atlas: where each method fails",
+        "The stability atlas: every method run along eight axes (tolerance, mesh size, load, "
+        "Poisson's ratio and more) to where it fails, each run judged by the certificate; the "
+        "report says where each method fails and whether the package's status said so.",
+        ["signorini stability --quick", "signorini stability --axis 1 --axis 2 --out atlas"],
+        {0: "the atlas was written (its report says where methods fail)"})
     stability.add_argument("--out", default="stability-report",
                            help="writes OUT/stability.md and OUT/stability/ (runs, figures)")
     stability.add_argument("--axis", action="append", default=[],

@@ -8,9 +8,8 @@ Backends for the SPD stiffness (one interface, ``factorize(K).solve(b)``):
 
 ``auto`` (the default) takes the first installed of pardiso, cholmod, superlu
 (leaving PARDISO, 0.2 s to import, the small matrices where it does not pay:
-:data:`PARDISO_OVER_CHOLMOD_FROM`); the environment variable ``SIGNORINI_FACTOR``
-overrides it. docs/speed.md (§1) compares the three backends' times and
-holds the measurements this module's thresholds were chosen from.
+:data:`PARDISO_OVER_CHOLMOD_FROM`); the environment variable ``SIGNORINI_FACTOR`` overrides it.
+docs/speed.md (§1) compares the backends' times and holds the measurements behind the thresholds.
 
 Every factorisation knows the matrix it factorised (``matrix``) and the dofs it
 pinned (``fixed``; none for a plain one), so that the certificate can reuse a
@@ -83,8 +82,9 @@ def resolve_backend(backend: str | None = None, n: int | None = None,
         if small and len(installed) > 1:
             installed = [b for b in installed if b != "pardiso"]
         return installed[0]
-    if name not in BACKENDS:
-        raise InputError(f"unknown factorisation backend {name!r}: choose auto, {', '.join(BACKENDS)}")
+    if name not in BACKENDS:  # named as it was given: the argument or the environment variable
+        raise InputError(f"{'backend' if backend else 'SIGNORINI_FACTOR'}={name!r} names no "
+                         f"factorisation backend: choose auto, {', '.join(BACKENDS)}")
     if name not in available_backends():
         hint = install_hint(EXTRAS.get(name, ""), [_MODULES[name]])
         raise BackendNotInstalled(f"factorisation backend {name!r} needs the module "

@@ -72,6 +72,10 @@ def runs_table(runs: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+#: the files :func:`write_suite_report` writes into its folder
+REPORT_FILES = ("report.md", "report.json", "*.png")
+
+
 def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, Path]:
     """Write report.md, report.json and the figures of a suite run to ``out``."""
     directory = writable_directory(out)

@@ -53,7 +53,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from signorini.errors import InputError
+from signorini.errors import InputError, docs_page
 from signorini.fem.assembly import assemble
 from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.fem.transfer import refined_model, with_candidates
@@ -273,7 +273,7 @@ def _steeper_than_measured(scene: _Scene) -> str:
         return ""
     return (f"; warning: the mesh started graded at {scene.params['grading']:g}, more steeply than "
             f"the default {default:g}: from there the pressure estimate was measured below the true "
-            "error (docs/estimate.md); start from the default grading or finer")
+            f"error ({docs_page('estimate')}); start from the default grading or finer")
 
 
 def _checked(scene: _Scene) -> _Scene:

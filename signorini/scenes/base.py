@@ -19,7 +19,7 @@ from typing import Any, Callable, Mapping, Protocol
 
 from signorini.analytic import contact_modulus
 from signorini.discretisation import ReferenceData
-from signorini.errors import InputError
+from signorini.errors import InputError, docs_page
 from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel
 from signorini.fem.volumetric import CHOICES
@@ -128,16 +128,17 @@ LOADING = Param("loading", "traction",
 #: how the Hertz scenes mesh their disc (signorini.scenes.meshing.graded_quarter_disc)
 MESHER = Param("mesher", MESHERS[0],
                "relaxed: the graded mesh's nodes moved into near-equilateral triangles (more "
-               "accurate per dof: docs/accuracy.md); bisection: the graded mesh as refined; "
+               f"accurate per dof: {docs_page('accuracy')}); bisection: the graded mesh as refined; "
                "triangle: Shewchuk's Triangle, much faster meshing, but at equal dofs less "
-               "accurate than relaxed on the default cylinder (docs/mesher.md)",
+               f"accurate than relaxed on the default cylinder ({docs_page('mesher')})",
                kind=str, check=one_of(*MESHERS))
 
 #: how every scene's K integrates λ (tr ε)² (signorini.fem.volumetric)
 VOLUMETRIC = Param("volumetric", "auto",
                    "element: plain P1, the volumetric strain element by element (locks as nu -> "
                    "0.5); nodal: the volumetric strain averaged at the nodes (no locking, K with "
-                   "2.7x the nonzeros in 2D, 5.2x in 3D: docs/accuracy.md); auto: nodal from nu = 0.4 "
+                   f"2.7x the nonzeros in 2D, 5.2x in 3D: {docs_page('accuracy')}); auto: nodal from "
+                   "nu = 0.4 "
                    "on in 2D and axisymmetric models, element in 3D",
                    kind=str, check=one_of(*CHOICES))
 
@@ -164,6 +165,19 @@ def block_size(smallest: float) -> Callable[[float], str | None]:
 
 def between(lo: float, hi: float) -> Callable[[float], str | None]:
     return lambda x: None if lo < x <= hi else f"in ({lo:g}, {hi:g}]"
+
+
+#: the graded meshes' growth of the element size: the least is a uniform mesh at the contact's
+#: element size (the convergence study's uniform comparison); below it the mesher's series of
+#: layers degenerates
+GRADING_RANGE = (1e-6, 2.0)
+
+
+def grading_check(x: float) -> str | None:
+    """The range of every graded scene's ``grading`` (:data:`GRADING_RANGE`)."""
+    lo, hi = GRADING_RANGE
+    return None if lo <= x <= hi else (f"in [{lo:g}, {hi:g}] (smaller grows the elements more "
+                                       "slowly away from the contact: a larger mesh)")
 
 
 #: contact half-width (radius) over the radius a Hertz scene meshes: below it the gaps over the

@@ -20,7 +20,7 @@ from signorini.numerics.zone import radial_distance
 from signorini.problem import ContactProblem, Scales
 from signorini.problem_files import is_problem_file, read_problem
 from signorini.references import reference_of
-from signorini.scenes.base import LOAD_NAMES, scene_params
+from signorini.scenes.base import GRADING_RANGE, LOAD_NAMES, scene_params
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import check_size
@@ -104,9 +104,16 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
             # the mesher gave up (too many elements, a relaxation that folded the mesh) or ran
             # out of memory: the parameters asked for a mesh it cannot make
             given = ", ".join(f"{k}={v}" for k, v in values.items()) or "its defaults"
-            raise InputError(f"scene {name!r} with {given} could not be meshed "
-                             f"({type(exc).__name__}: {exc}): make the mesh coarser (a larger "
-                             "grading or a smaller n_contact)") from None
+            relaxed = parsed.get("mesher") == "relaxed" and "grading" in parsed
+            lo, hi = GRADING_RANGE
+            default = next((q.default for q in family.params if q.name == "grading"), None)
+            raise InputError(
+                f"scene {name!r} with {given} could not be meshed" + (
+                    f" by the relaxed mesher, which folds nearly uniform meshes: give a larger "
+                    f"grading (in [{lo:g}, {hi:g}], default {default}), a smaller n_contact, or "
+                    "mesher=bisection" if relaxed else
+                    f" ({type(exc).__name__}: {exc}): make the mesh coarser (a larger grading or "
+                    "a smaller n_contact)")) from None
     declared = SCENES[name].reference if name in SCENES else ""
     if model.reference is None and declared or model.reference and model.reference.name != declared:
         raise InputError(f"scene family {name!r} declares the reference {declared!r}, but its build "

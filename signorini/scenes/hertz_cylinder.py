@@ -21,6 +21,7 @@ many elements lie across it.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
@@ -35,13 +36,13 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    between,
     checked_ratio,
     contact_ratio,
+    grading_check,
+    hertz_record,
     length,
     poisson_ratio,
     positive,
-    hertz_record,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
@@ -64,7 +65,7 @@ PARAMS = (
     Param("n_contact", 40, "elements across the contact half-width (mesh fineness)", kind=int,
           check=at_least(4)),
     Param("grading", 0.15, "growth of the element size with distance from the contact zone",
-          check=between(0.0, 2.0)),
+          check=grading_check),
     Param("candidates", 2.0, "contact candidates extend to this multiple of the half-width",
           check=at_least(1.2)),
     Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
@@ -81,7 +82,8 @@ def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, floa
         raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
                          "give only one of P, a_over_R, delta")
     E_star = p["E"] / (1.0 - p["nu"] ** 2)
-    if "delta" in chosen:
+    if "delta" in chosen:  # a ~ √(δ R) up to Hertz's logarithm: refused where a/R would be
+        checked_ratio(math.sqrt(p["delta"] / p["R"]), "delta", p["delta"])
         return None, p["delta"]
     if "P" in chosen:
         checked_ratio(hertz_cylinder_half_width(p["P"], p["R"], E_star) / p["R"], "P", p["P"])

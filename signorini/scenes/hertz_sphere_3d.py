@@ -33,7 +33,7 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    between,
+    grading_check,
     hertz_record,
     two_refinements_coarser,
 )
@@ -51,7 +51,7 @@ PARAMS = COMMON_PARAMS + (
     Param("n_contact", 10, "elements across the contact radius (mesh fineness)", kind=int,
           check=at_least(3)),
     Param("grading", 0.5, "growth of the element size with distance from the contact zone",
-          check=between(0.0, 2.0)),
+          check=grading_check),
     Param("candidates", 1.3, "contact candidates extend to this multiple of the contact radius",
           check=at_least(1.2)),
     Param("refine", 0, "uniform refinements of the graded mesh (each multiplies the dofs by "

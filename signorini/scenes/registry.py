@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
-from signorini.errors import InputError
+from signorini.errors import InputError, docs_page
 from signorini.problem_files import is_problem_file
 from signorini.scenes.base import Case, SceneFamily
 
@@ -54,7 +54,7 @@ def get_scene(name: str) -> SceneFamily:
     if name not in SCENES:
         raise InputError(f"unknown scene {name!r}: choose one of {', '.join(sorted(SCENES))} "
                          "(or give the path of a .toml scene file, or of a problem file: .npz or "
-                         "Matrix Market, see docs/problem-files.md)")
+                         f"Matrix Market, see {docs_page('problem-files')})")
     return SCENES[name]
 
 

@@ -18,6 +18,7 @@ the contact zone and the candidates reach ``candidates · a``.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
@@ -31,10 +32,10 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    between,
     block_size,
     checked_ratio,
     contact_ratio,
+    grading_check,
     length,
     poisson_ratio,
     positive,
@@ -62,7 +63,7 @@ PARAMS = (
     Param("n_contact", 128, "elements across the contact half-width (rounded up to a power of two)",
           kind=int, check=at_least(4)),
     Param("grading", 0.3, "growth of the element size with distance from the contact zone",
-          check=between(0.0, 2.0)),
+          check=grading_check),
     Param("candidates", 2.0, "contact candidates extend to this multiple of the half-width",
           check=at_least(1.2)),
     Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
@@ -79,7 +80,8 @@ def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float
         raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
                          "give only one of P, a_over_R, delta")
     R, E_star = p["R"], contact_modulus(p["E"], p["nu"])
-    if "delta" in chosen:
+    if "delta" in chosen:  # a ~ √(δ R) up to Hertz's logarithm: refused where a/R would be
+        checked_ratio(math.sqrt(p["delta"] / R), "delta", p["delta"])
         return None, p["delta"], p["a_over_R"]
     if "P" in chosen:
         a_over_R = checked_ratio(hertz_cylinder_half_width(p["P"], R, E_star) / R, "P", p["P"])

@@ -56,6 +56,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.files import check_input_file
 from signorini.fem.checks import check_mesh
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery
@@ -132,11 +133,10 @@ def read_scene_file(path: str | Path) -> tuple[dict[str, Any], _Context]:
         import tomli as tomllib
 
     path = Path(path)
+    check_input_file(str(path), "scene file", "give the path to a .toml file (examples: the sdist's "
+                     "examples/; a built-in scene runs by name: signorini scenes)")
     try:
         text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(f"scene file {path} does not exist: give the path to a .toml file (examples: "
-                         "the sdist's examples/; a built-in scene runs by name: signorini scenes)") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"scene file {path} cannot be read ({exc})") from None
     try:
@@ -287,8 +287,8 @@ def read_mesh(path: str | Path) -> MeshWithBoundaries:
     from skfem import MeshTri
 
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"mesh file {path} does not exist")
+    check_input_file(str(path), "mesh file", "give the path of a mesh file (relative to the "
+                     "scene file)")  # and refuses a FIFO, which would wait forever
     # .msh is Gmsh's (meshio would also try ANSYS and print its complaint on stdout)
     file_format = "gmsh" if path.suffix.lower() == ".msh" else None
     said = io.StringIO()

@@ -31,7 +31,7 @@ from typing import Any, Callable, Iterable
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.files import atomic_write_text, save_figure
+from signorini.files import all_or_none, atomic_write_text, save_figure, writable_directory
 from signorini.output import plots
 from signorini.output.report import provenance
 from signorini.scenes import build_problem
@@ -143,7 +143,7 @@ def problem_file(directory: Path, scene: str, size: str, params: dict[str, Any],
     ``source`` (read once and stored in the package's own format)."""
     path = directory / "problems" / f"{scene}-{size}.npz"
     if not path.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
+        writable_directory(path.parent)  # removed again at exit while empty
         build_problem(source or scene, params=None if source else params).save(path)
     return path
 
@@ -162,7 +162,12 @@ def run_benchmark(runs: Iterable[Run], out: Path, time_limit: float = 600.0,
     csv_path = out / "bench.csv"
     done = done_keys(csv_path)
     todo = [r for r in runs if r.key not in done]
-    paths = {r.key: problem_file(out, r.scene, r.size, r.params, r.source) for r in todo}
+    stored: dict[tuple[str, str], Path] = {}
+    with all_or_none():  # every problem stored, or none: a later size may fail to build
+        for r in todo:
+            if (r.scene, r.size) not in stored:
+                stored[r.scene, r.size] = problem_file(out, r.scene, r.size, r.params, r.source)
+    paths = {r.key: stored[r.scene, r.size] for r in todo}
     sizes = {path: stored_size(path) for path in set(paths.values())}
 
     def record(index: int, count: int, task: Task, row: Row) -> None:

@@ -30,6 +30,7 @@ import numpy as np
 
 from signorini.crosschecking import agreement
 from signorini.errors import InputError
+from signorini.files import check_input_file
 from signorini.problem import ContactProblem, ContactSolution
 from signorini.problem_files import is_problem_file
 from signorini.references import reference_metrics, reference_of
@@ -405,12 +406,10 @@ def read_limits(path: str) -> dict[str, float]:
     InputError naming the file and the fix for a missing file, bad TOML, an
     unknown name or a value that is not a positive number.
     """
+    check_input_file(path, "limits file", "give a TOML file with a [limits] table")  # FIFO too
     try:
         with open(path, "rb") as handle:
             data = tomllib.load(handle)
-    except FileNotFoundError:
-        raise InputError(f"limits file {path!r} does not exist: give a TOML file with a "
-                         "[limits] table") from None
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise InputError(f"limits file {path!r} cannot be read as TOML ({exc}): fix it") from None
     stray = sorted(set(data) - {"limits"})
