@@ -275,3 +275,22 @@ def test_the_docs_show_the_table():
     for key, row in TABLE.items():
         tol = "its backend" if row.tol is None else f"{row.tol:g}"
         assert f"| `{key}` | {tol} |" in text, key
+
+
+@pytest.mark.parametrize("method, option", [("uzawa", "rho"), ("pdas", "c")])
+def test_options_in_the_users_units_run_on_the_users_arrays(method, option):
+    """A step, a start or a callback is in the problem's units: the method then works on the
+    arrays as given (no scaled view), so the callback reads the user's λ and the step is the
+    user's: Uzawa's first step from λ = 0 is ρ (N K⁻¹ f − d)⁺ in the user's numbers."""
+    problem = signorini.ContactProblem.from_qp(K, F, N, D)
+    seen = []
+    record = (lambda it, lam, displacement: seen.append(np.array(lam))) if method == "uzawa" \
+        else (lambda it, u, lam: seen.append(np.array(lam)))
+    rho = 0.5 / np.linalg.eigvalsh(N @ np.linalg.solve(K, N.T))[-1]
+    value = rho if option == "rho" else 1e5
+    result = signorini.solve(problem, method, tol=1e-10, callback=record, **{option: value})
+    assert result.converged, result.message
+    assert np.allclose(seen[-1], result.force, rtol=1e-6)  # the callback's λ is the user's λ
+    if method == "uzawa":
+        first = rho * np.maximum(N @ np.linalg.solve(K, F) - D, 0.0)
+        assert not np.any(seen[0]) and np.allclose(seen[1], first, rtol=1e-9)  # from λ = 0

@@ -41,13 +41,19 @@ _EXAMPLE = {"positive": "1e-6", "nonnegative": "0", "fraction": "0.5", "number":
 
 @dataclass(frozen=True)
 class Option:
-    """One option of a method: its name, kind (:data:`KINDS`), default and allowed values."""
+    """One option of a method: its name, kind (:data:`KINDS`), default and allowed values.
+
+    ``in_units`` marks an option whose value is in the problem's units (a step, a starting λ, a
+    callback that reads the iterates): a method given one runs on the problem as given, not on
+    a scaled view of it.
+    """
 
     name: str
     kind: str
     default: Any = None
     choices: tuple[Any, ...] = ()
     types: tuple[type, ...] = ()
+    in_units: bool = False
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:

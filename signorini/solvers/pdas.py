@@ -51,7 +51,8 @@ from signorini.solvers.options import Option, declare, take_options
 log = logging.getLogger(__name__)
 
 DEFAULTS = declare(
-    Option("c", "positive", 1.0), Option("lam0", "vector"), Option("callback", "callable"),
+    Option("c", "positive", 1.0, in_units=True), Option("lam0", "vector", in_units=True),
+    Option("callback", "callable", in_units=True),
     Option("warm_start", "object", types=(WarmStart,)),
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)))
 

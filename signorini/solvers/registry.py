@@ -6,8 +6,9 @@ A ``tol`` or ``max_iter`` not asked for is the method's row of
 :mod:`signorini.solvers.defaults` (None for a QP backend: its own settings,
 untouched), which :func:`run` hands every method as numbers. A ``scaled`` method
 gets a view of the problem in units of order one
-(:func:`signorini.scales.scaled_view`); a user's method gets the problem as
-given. Unknown options raise :class:`InputError`.
+(:func:`signorini.scales.scaled_view`); a user's method, and a method given an
+option in the problem's units (``Option.in_units``: a step, a starting λ, a
+callback), gets the problem as given. Unknown options raise :class:`InputError`.
 """
 
 from __future__ import annotations
@@ -130,7 +131,10 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
     log.info("solving %d dofs, %d contact candidates with %s", problem.n, problem.m, method)
     start = time.perf_counter()
     tol, max_iter = spec.defaults_for(tol, max_iter)
-    given, units = scaled_view(problem, options) if spec.scaled else (problem, Scales())
+    as_given = not spec.scaled or any(  # a step, a start or a callback in the problem's units
+        value is not None and name in spec.typed_options and spec.typed_options[name].in_units
+        for name, value in options.items())
+    given, units = (problem, Scales()) if as_given else scaled_view(problem, options)
     held = fingerprint(given)
     with counting() as work:
         try:

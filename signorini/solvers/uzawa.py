@@ -54,10 +54,11 @@ from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 DEFAULTS = declare(
-    Option("rho", "positive"), Option("step_fraction", "positive", 0.9), Option("lam0", "vector"),
+    Option("rho", "positive", in_units=True), Option("step_fraction", "positive", 0.9),
+    Option("lam0", "vector", in_units=True),
     Option("divergence_factor", "positive", 1e8),
     Option("operator", "choice", "auto", choices=("auto", "delassus", "backsolve")),
-    Option("callback", "callable"),
+    Option("callback", "callable", in_units=True),
     Option("acceleration", "choice", "none", choices=("none", "nesterov")))
 #: the accelerated variant: FISTA's momentum needs ρ ≤ 1/λ_max(W), half the plain bound
 NESTEROV_DEFAULTS = {**DEFAULTS, "step_fraction": Option("step_fraction", "positive", 0.5),
