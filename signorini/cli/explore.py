@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from signorini.cli.common import add_command
 from signorini.errors import InputError
 
 DESCRIPTION = """\
@@ -17,16 +18,6 @@ Serve four interactive lessons in a local web app (marimo): Uzawa on the bogie (
 bound 2/lambda_max(W)), Hertz live (load, E, nu), Prices (the envelope theorem) and the
 methods race. Every slider re-solves in the package; each lesson shows the answer's KKT
 certificate. Nothing is fetched from the network. Ctrl-C stops the server."""
-
-EPILOG = """\
-examples:
-  signorini explore                           serve on port 2718 and open a browser
-  signorini explore --no-browser --port 8800  serve only (open http://127.0.0.1:8800 yourself)
-
-exit codes:
-  0    the server ended by itself
-  2    bad input: a port out of range or in use, or marimo not installed
-  130  stopped by Ctrl-C; 143 by SIGTERM (128 + the signal's number)"""
 
 HOST = "127.0.0.1"
 #: seconds the server has to close its sessions once asked to stop
@@ -78,9 +69,12 @@ def cmd_explore(args: argparse.Namespace) -> int:
 
 def add_parsers(sub) -> None:
     """Register ``explore``."""
-    parser = sub.add_parser("explore", help="serve the interactive lessons in a local web app",
-                            description=DESCRIPTION, epilog=EPILOG,
-                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = add_command(
+        sub, "explore", "serve the interactive lessons in a local web app", DESCRIPTION,
+        ["signorini explore                           # serve on port 2718, open a browser",
+         "signorini explore --no-browser --port 8800  # serve only: open http://127.0.0.1:8800"],
+        {0: "the server ended by itself", 2: "bad input: a port out of range or in use, or "
+         "marimo not installed"})
     parser.add_argument("--port", type=int, default=2718, help="the port to serve on (default 2718)")
     parser.add_argument("--no-browser", action="store_true",
                         help="serve without opening a browser")

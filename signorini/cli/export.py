@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from signorini.cli.common import EXIT_FAILED, out_folder
+from signorini.cli.common import EXIT_FAILED, add_command, out_folder
 from signorini.errors import InputError
 
 
@@ -28,32 +28,29 @@ def cmd_export_qpbenchmark(args: argparse.Namespace) -> int:
     return 0
 
 
-EPILOG = """examples:
-  signorini export qpbenchmark contact-qps && python contact-qps/signorini_contact.py run
-  signorini export qpbenchmark big --refine 2 --3d --only HERTZCYL2 --only SPH3D
-
-exit codes:
-  0  written, and every reference answer certified at 1e-10 (relative)
-  1  written, but some reference answer is certified only above 1e-10 (named)
-  2  bad input (one line on stderr; nothing written)"""
-
-
 def add_parsers(sub) -> None:
     """Register ``export`` and its one format, ``qpbenchmark``."""
-    export = sub.add_parser("export", help="write problems for other tools (a qpbenchmark test set)",
-                            description="Write the package's contact problems for other tools.")
+    export = add_command(
+        sub, "export", "write problems for other tools (a qpbenchmark test set)",
+        "Write the package's contact problems for other tools: 'signorini export qpbenchmark "
+        "DIR' writes a qpbenchmark test set of contact QPs with certified answers.",
+        ["signorini export qpbenchmark contact-qps",
+         "signorini export qpbenchmark --help"],
+        {0: "written (see the format's own help)"})
     formats = export.add_subparsers(dest="format", required=True, parser_class=type(export))
-    qpb = formats.add_parser(
-        "qpbenchmark", help="contact QPs with certified answers as a qpbenchmark test set",
-        formatter_class=argparse.RawDescriptionHelpFormatter, epilog=EPILOG,
-        description="Write a test set that qpbenchmark (pip install qpbenchmark) runs as it is: "
-                    "each problem's QP in qpsolvers' form (P = K, q = -f, G = N, h = d, in the "
-                    "scene's units) with pdas's answer, its KKT certificate and forward error "
-                    "(DIR/data/*.npz); DIR/signorini_contact.py (the TestSet), "
-                    "DIR/signorini_contact_dense.py (the dense subset) and DIR/README.md. "
-                    "Families: Hertz cylinder and sphere at 3 sizes, ν → ½, SI and mm–MPa "
-                    "units, weakly active edges, 3D (--3d). The same command writes the same "
-                    "bytes.")
+    qpb = add_command(
+        formats, "qpbenchmark", "contact QPs with certified answers as a qpbenchmark test set",
+        "Write a test set that qpbenchmark (pip install qpbenchmark) runs as it is: each "
+        "problem's QP in qpsolvers' form (P = K, q = -f, G = N, h = d, in the scene's units) "
+        "with pdas's answer, its KKT certificate and forward error (DIR/data/*.npz); "
+        "DIR/signorini_contact.py (the TestSet), DIR/signorini_contact_dense.py (the dense "
+        "subset) and DIR/README.md. Families: Hertz cylinder and sphere at 3 sizes, ν → ½, SI "
+        "and mm–MPa units, weakly active edges, two bodies, 3D (--3d). The same command writes "
+        "the same bytes.",
+        ["signorini export qpbenchmark contact-qps && python contact-qps/signorini_contact.py run",
+         "signorini export qpbenchmark big --refine 2 --3d --only HERTZCYL2 --only SPH3D"],
+        {0: "written, and every reference answer certified at 1e-10 (relative)",
+         1: "written, but some reference answer is certified only above 1e-10 (named)"})
     qpb.add_argument("dir", metavar="DIR", help="the folder to write (created; files in it replaced)")
     qpb.add_argument("--refine", type=int, default=0, metavar="R",
                      help="uniform refinements of every scene (each about 4x the unknowns in 2D; "
