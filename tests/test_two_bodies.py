@@ -9,7 +9,7 @@ from signorini.cli import main
 from signorini.errors import InputError
 from signorini.fem.two_bodies import Body, assemble_two_bodies
 from signorini.scenes.two_block_patch import FAMILY, build, patch_pressure
-from signorini.solvers.registry import get_method
+from signorini.solvers.registry import get_method, methods
 
 #: two materials, so that the blocks shorten by different amounts and slide against each other
 MATERIALS = {"E1": 1.0, "nu1": 0.3, "E2": 3.0, "nu2": 0.2, "H2": 0.7}
@@ -105,3 +105,17 @@ def test_the_cli_solves_the_patch_scene(capsys):
 def test_adaptive_refinement_refuses_two_bodies_in_one_line():
     with pytest.raises(InputError, match="of two bodies: .*mesh parameters"):
         signorini.solve_adaptive("two-block-patch", 0.01)
+
+
+def test_methods_that_take_rows_as_bounds_refuse_two_bodies_in_one_line(capsys):
+    problem, _ = patch()
+    bounds = [m for m in methods() if m.bound_rows]
+    assert bounds and not get_method("pdas").bound_rows  # pdas takes rows that share dofs
+    for method in (m for m in bounds if m.installed):
+        with pytest.raises(InputError, match=f"method '{method.name}' .*share dofs.*use pdas"):
+            signorini.solve(problem, method.name)
+    assert main(["solve", "two-block-patch", "--method", bounds[0].name]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+    main(["methods"])
+    listed = {line.split()[0]: line for line in capsys.readouterr().out.splitlines()[1:]}
+    assert all(("one body" in listed[m.name]) == m.bound_rows for m in methods())

@@ -34,7 +34,7 @@ from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus
-from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Param, SceneFamily, checked_ratio,
+from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Case, Param, SceneFamily, checked_ratio,
                                    contact_ratio, length, one_of, positive)
 from signorini.scenes.hertz_cylinder import PARAMS as CYLINDER_PARAMS
 from signorini.scenes.hertz_cylinder import SIZE as ONE_DISC
@@ -161,4 +161,7 @@ FAMILY = SceneFamily(
     name="hertz-two-cylinders",
     summary="two elastic cylinders in contact, plane strain, each quarter meshed on its own",
     params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE,
-    size_model=CountedSize(mesh_dofs), convergence_start={"n_contact": 15, "grading": 0.6})
+    size_model=CountedSize(mesh_dofs), convergence_start={"n_contact": 15, "grading": 0.6},
+    # unlike cylinders on a coarse mesh: every method of the suite, the dense ones too
+    validation=(Case("hertz-two-cylinders", "hertz-two-cylinders",
+                     {"E2": 3.0, "nu2": 0.2, "R2": 2.0, "n_contact": 16, "grading": 0.4}),))

@@ -27,7 +27,7 @@ from signorini.analytic import hertz_sphere_load, hertz_sphere_radius
 from signorini.discretisation import ReferenceData
 from signorini.fem.two_bodies import TwoBodyModel
 from signorini.scenes import hertz_two_cylinders as cylinders
-from signorini.scenes.base import SceneFamily
+from signorini.scenes.base import Case, SceneFamily
 from signorini.scenes.hertz_sphere import SIZE as ONE_SPHERE
 from signorini.scenes.size import CountedSize
 
@@ -91,4 +91,6 @@ FAMILY = SceneFamily(
     name="hertz-two-spheres",
     summary="two elastic spheres in contact, axisymmetric (r, z), each quarter meshed on its own",
     params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE,
-    size_model=CountedSize(mesh_dofs), convergence_start={"n_contact": 12, "grading": 0.6})
+    size_model=CountedSize(mesh_dofs), convergence_start={"n_contact": 12, "grading": 0.6},
+    validation=(Case("hertz-two-spheres", "hertz-two-spheres",
+                     {"E2": 3.0, "nu2": 0.2, "R2": 2.0, "n_contact": 16, "grading": 0.4}),))
