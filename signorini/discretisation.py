@@ -132,7 +132,9 @@ class Discretisation:
     says how f, d and the load depend on the prescribed push (load control,
     :mod:`signorini.load_control`), ``predicted_contact`` which candidates the
     scene expects in contact (where load control starts), ``watch`` the
-    boundary beyond the candidates (see :class:`Watch`).
+    boundary beyond the candidates (see :class:`Watch`). ``materials`` lists, for a mesh of
+    several bodies (:mod:`signorini.fem.two_bodies`), each body's ``(elements, E, nu)`` in the
+    mesh's order (``E`` and ``nu`` are then the first body's); empty for one body.
     """
 
     mesh: Any
@@ -150,3 +152,11 @@ class Discretisation:
     predicted_contact: np.ndarray | None = None
     watch: Watch | None = None
     assemble_s: float = 0.0
+    materials: tuple[tuple[int, float, float], ...] = ()
+
+    def element_materials(self) -> tuple[Any, Any]:
+        """``(E, nu)`` of the model: two numbers, or one per element for several bodies."""
+        if not self.materials:
+            return self.E, self.nu
+        counts, E, nu = (np.array(column) for column in zip(*self.materials))
+        return np.repeat(E.astype(float), counts), np.repeat(nu.astype(float), counts)
