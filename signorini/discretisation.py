@@ -133,8 +133,9 @@ class Discretisation:
     :mod:`signorini.load_control`), ``predicted_contact`` which candidates the
     scene expects in contact (where load control starts), ``watch`` the
     boundary beyond the candidates (see :class:`Watch`). ``materials`` lists, for a mesh of
-    several bodies (:mod:`signorini.fem.two_bodies`), each body's ``(elements, E, nu)`` in the
-    mesh's order (``E`` and ``nu`` are then the first body's); empty for one body.
+    several bodies (:mod:`signorini.fem.two_bodies`), each body's ``(elements, E, nu,
+    volumetric)`` in the mesh's order (``E``, ``nu`` and ``volumetric`` are then the first
+    body's); empty for one body.
     """
 
     mesh: Any
@@ -152,11 +153,11 @@ class Discretisation:
     predicted_contact: np.ndarray | None = None
     watch: Watch | None = None
     assemble_s: float = 0.0
-    materials: tuple[tuple[int, float, float], ...] = ()
+    materials: tuple[tuple[int, float, float, str], ...] = ()
 
     def element_materials(self) -> tuple[Any, Any]:
         """``(E, nu)`` of the model: two numbers, or one per element for several bodies."""
         if not self.materials:
             return self.E, self.nu
-        counts, E, nu = (np.array(column) for column in zip(*self.materials))
+        counts, E, nu, _ = (np.array(column) for column in zip(*self.materials))
         return np.repeat(E.astype(float), counts), np.repeat(nu.astype(float), counts)

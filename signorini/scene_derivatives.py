@@ -17,7 +17,6 @@ import numpy as np
 from signorini.derivatives import Sensitivity, exact_answer
 from signorini.errors import InputError
 from signorini.fem.assembly import lame_stiffness, nodal_dofs
-from signorini.fem.volumetric import resolve
 from signorini import load_control
 from signorini.pressure import contact_profile, hertz_fit, hertz_fit_tangent
 from signorini.problem import ContactProblem
@@ -79,9 +78,9 @@ def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Chan
     u = solution.u
     lift = push.scale * push.f1  # the load the prescribed push puts on the free dofs
     if wrt.startswith(("E", "nu")):  # one body's material: its rows of K, f alone
-        name, on, E, nu = _material(problem, wrt)
+        name, on, E, nu, volumetric = _material(problem, wrt)
         if name == "nu":
-            return _poisson_change(problem, u, E, nu, on)
+            return _poisson_change(problem, u, E, nu, volumetric, on)
         return Change(np.where(on, problem.K @ u, 0.0) / E, np.where(on, lift, 0.0) / E, zero_m)
     if wrt == "P":
         if not _load_controlled(problem):
@@ -104,9 +103,10 @@ def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Chan
     raise InputError(f"wrt must be one of {', '.join(PARAMETERS)}, got {wrt!r}")
 
 
-def _material(problem: ContactProblem, wrt: str) -> tuple[str, np.ndarray, float, float]:
-    """``("E" or "nu", the free dofs it acts on, the body's E, its ν)`` of ``wrt``: ``E``/``nu``
-    for one body, ``E1``/``nu1`` (the first body's, the slave) and ``E2``/``nu2`` for two."""
+def _material(problem: ContactProblem, wrt: str) -> tuple[str, np.ndarray, float, float, str]:
+    """``("E" or "nu", the free dofs it acts on, the body's E, ν and volumetric integration)``
+    of ``wrt``: ``E``/``nu`` for one body, ``E1``/``nu1`` (the first body's, the slave) and
+    ``E2``/``nu2`` for two."""
     disc = problem.discretisation
     name, body = wrt.rstrip("12"), wrt[len(wrt.rstrip("12")):]
     if not body and disc.materials:
@@ -116,24 +116,23 @@ def _material(problem: ContactProblem, wrt: str) -> tuple[str, np.ndarray, float
         raise InputError(f"{problem.scene or 'this scene'} has one body: differentiate with "
                          f"respect to {name}")
     if not body:
-        return name, np.ones(problem.n, dtype=bool), disc.E, disc.nu
-    counts = [count for count, _, _ in disc.materials]
+        return name, np.ones(problem.n, dtype=bool), disc.E, disc.nu, disc.volumetric
+    counts = [material[0] for material in disc.materials]
     first = sum(counts[:int(body) - 1])
     on = np.zeros(disc.prescribed.size, dtype=bool)
     on[nodal_dofs(disc.mesh)[:, np.unique(disc.mesh.t[:, first:first + counts[int(body) - 1]])]] = True
-    _, E, nu = disc.materials[int(body) - 1]
-    return name, on[disc.free_dofs], E, nu
+    _, E, nu, volumetric = disc.materials[int(body) - 1]
+    return name, on[disc.free_dofs], E, nu, volumetric
 
 
 def _poisson_change(problem: ContactProblem, u: np.ndarray, E: float, nu: float,
-                    on: np.ndarray) -> Change:
+                    volumetric: str, on: np.ndarray) -> Change:
     """∂K/∂ν from K's two Lamé parts, ``∂K/∂ν = E (∂Λ/∂ν K_Λ + ∂μ/∂ν K_μ)`` (exact), on the
     free dofs ``on`` of the body of modulus E and ratio ν (K is block diagonal by body)."""
     disc, s = problem.discretisation, problem.scales
     k = 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
     E = E * s.displacement * s.length ** k / s.force  # E in the problem's units
     lame = (1 + 2 * nu ** 2) / ((1 + nu) * (1 - 2 * nu)) ** 2, -0.5 / (1 + nu) ** 2
-    volumetric = resolve(disc.params["volumetric"], nu) if disc.materials else disc.volumetric
     dK = lame_stiffness(disc.mesh, E * lame[0], E * lame[1], axisymmetric=disc.axisymmetric,
                         volumetric=volumetric)
     free = disc.free_dofs

@@ -93,3 +93,20 @@ def test_the_load_derivative_of_the_pair_follows_hertz():
 def test_a_material_of_the_wrong_body_count_is_refused_in_one_line(scene, wrt, words):
     with pytest.raises(InputError, match=words):
         signorini.derivative(scene, "total_force", wrt, params=COARSE, method="pdas")
+
+
+@pytest.mark.parametrize("method", ["pdas", "auto"])
+def test_two_bodies_cost_at_most_a_third_more_than_one_body_of_as_many_dofs(method):
+    """Counted in factorisations and back-solves, the certificate's included: the method's
+    saddle-point system serves the certificate (no factorisation of K, no Delassus operator)."""
+    from signorini.numerics.work import counting
+
+    cost = {}
+    for scene, params in (("hertz-cylinder", {"refine": 1}), ("hertz-two-cylinders", {})):
+        with counting() as work:
+            result = signorini.solve(scene, method, params=params)
+        assert result.converged
+        cost[scene] = (result.problem.n, work.factorisations + work.back_solves)
+    (n1, one), (n2, two) = cost.values()
+    assert abs(n2 / n1 - 1) < 0.1  # about the same dofs
+    assert two <= 1.3 * one, cost

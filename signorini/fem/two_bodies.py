@@ -177,7 +177,8 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
         mesh=mesh, free_dofs=free, prescribed=prescribed, load_row=load_full[free],
         load_offset=offset, E=float(slave.E), nu=float(slave.nu),
         volumetric=resolve(slave.volumetric, slave.nu), axisymmetric=axisymmetric,
-        reference=reference, materials=tuple((body.mesh.t.shape[1], float(body.E), float(body.nu))
+        reference=reference, materials=tuple((body.mesh.t.shape[1], float(body.E), float(body.nu),
+                                              resolve(body.volumetric, body.nu))
                                              for body in (slave, master)),
         params=dict(params or {}, discretisation=discretisation), push=push,
         predicted_contact=None if predicted is None else np.asarray(predicted(points * L)))

@@ -179,7 +179,7 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
     materials = problem.discretisation.materials
     if materials:
         cell_data["body"] = [np.repeat(np.arange(1, len(materials) + 1, dtype=np.int32),
-                                       [count for count, _, _ in materials])]
+                                       [material[0] for material in materials])]
     return meshio.Mesh(xyz, [(cell_type, mesh.t.T.astype(np.int64))],
                        point_data=point_data, cell_data=cell_data)
 
