@@ -156,3 +156,21 @@ def test_the_vtu_holds_both_bodies_each_stressed_by_its_own_material(tmp_path):
     nu = np.where(body == 1, MATERIALS["nu2"], MATERIALS["nu1"])  # the upper block is the slave
     np.testing.assert_allclose(mesh.cell_data["sigma_zz"][0], -nu * p, rtol=1e-8)
     assert np.count_nonzero(mesh.point_data["contact_candidate"]) == problem.m
+
+
+def test_a_picture_shows_both_deformed_bodies_and_the_pressure():
+    pytest.importorskip("matplotlib", reason="the picture is drawn with matplotlib")
+    from signorini.output.export import candidate_nodes, nodal_displacement
+    from signorini.output.plots import deformed_bodies
+    from signorini.pressure import contact_profile
+
+    problem, p = patch()
+    result = signorini.solve(problem, "pdas")
+    body = np.repeat([1, 2], [material[0] for material in problem.discretisation.materials])
+    ax = deformed_bodies(problem.mesh.p * problem.scales.length, problem.mesh.t,
+                         nodal_displacement(problem, result.solution), body,
+                         candidate_nodes(problem), contact_profile(problem, result.solution).pressure)
+    assert {t.get_text() for t in ax.get_legend().get_texts()} == {"body 1", "body 2"}
+    (dots,) = ax.collections[-1:]
+    np.testing.assert_allclose(dots.get_array(), p, rtol=1e-8)  # the uniform pressure, on the face
+    assert len(ax.figure.axes) == 2  # and its colour bar
