@@ -280,6 +280,8 @@ def solve_summary(record: dict[str, Any]) -> str:
                      f"of ‖u_h‖ over {record['estimate']['elements']} elements")
         if record["estimate"].get("pressure") is not None:
             lines[-1] += f"; contact pressure {100 * record['estimate']['pressure']:.2f} % (L2)"
+        elif record["estimate"].get("bodies", 1) > 1:
+            lines[-1] += ", each body with its own material; contact pressure not estimated"
     lines += summary_lines(record)  # the comparison with the analytic reference
     units = record.get("units") or {}
     if units.get("length") == "length":  # a scene's: in the units its parameters were given in

@@ -134,7 +134,10 @@ class Discretisation:
     scene expects in contact (where load control starts), ``watch`` the
     boundary beyond the candidates (see :class:`Watch`). ``mesh_s`` and
     ``assemble_s`` are the seconds spent building the scene's mesh and model,
-    and assembling the QP from it.
+    and assembling the QP from it. ``materials`` lists, for a mesh of
+    several bodies (:mod:`signorini.fem.two_bodies`), each body's ``(elements, E, nu,
+    volumetric)`` in the mesh's order (``E``, ``nu`` and ``volumetric`` are then the first
+    body's); empty for one body.
     """
 
     mesh: Any
@@ -153,3 +156,11 @@ class Discretisation:
     watch: Watch | None = None
     mesh_s: float = 0.0
     assemble_s: float = 0.0
+    materials: tuple[tuple[int, float, float, str], ...] = ()
+
+    def element_materials(self) -> tuple[Any, Any]:
+        """``(E, nu)`` of the model: two numbers, or one per element for several bodies."""
+        if not self.materials:
+            return self.E, self.nu
+        counts, E, nu, _ = (np.array(column) for column in zip(*self.materials))
+        return np.repeat(E.astype(float), counts), np.repeat(nu.astype(float), counts)

@@ -216,6 +216,8 @@ def _system(K: sp.spmatrix, N: sp.csr_matrix, rows: np.ndarray, solve: _Counted)
     """``(r, g) ↦ M⁻¹(−r, −g)`` on the rows ``rows`` by the factorisation behind ``solve``
     (pinned or plain); None when it cannot (more than :data:`MAX_BORDER` rows to border, rows
     that are dependent, or a pinned factorisation while the rows of N do not each bound one dof)."""
+    if getattr(solve.factor, "newton", None) is not None:  # the active set's own system
+        return solve.factor.newton(solve)
     fixed = np.asarray(solve.factor.fixed, dtype=int)
     if not fixed.size:
         return _schur_system(K, solve, N, rows)[0] if rows.size <= MAX_BORDER else None

@@ -261,14 +261,15 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
     (:attr:`ContactProblem.factorises_for_certificates`: big and not on a 2D mesh), where the
     duality gap uses CG and the forward error is not estimated.
     """
-    offers = offers or _Offers(problem, solution)
-    offered = [f for f in offers() if f.pinned is not None]
+    offers, active = offers or _Offers(problem, solution), active_set(problem, solution)
+    offered = [f for f in offers() if f.pinned is not None  # or the saddle point of this system
+               or (getattr(f, "on", None) and f.on(problem.K, problem.N, active))]
     if not offered and problem.factorises_for_certificates:
         offered = [offers.wrap(problem.factor())]
     if not offered:
         return ForwardError.unknown()
     return forward_error(problem.K, problem.f, problem.N, problem.d, solution.u, solution.lam,
-                         active_set(problem, solution), offered[0], scale)
+                         active, offered[0], scale)
 
 
 #: what the certificate says when it cannot vouch for the contact force, by the error's name
@@ -351,17 +352,18 @@ def primal_dual_gap(problem: ContactProblem, u: np.ndarray, lam: np.ndarray, fac
     Ku = problem.K @ u if Ku is None else Ku
     for factor in factors:
         pinned = factor.pinned if isinstance(factor, _Remembering) else _pinned_rows(problem, factor)
-        if pinned is not None:
-            gap = _gap_on(problem, u, lam_plus, Ku, factor, *pinned)
-            if gap is not None:
-                return gap
+        gap = None if pinned is None else _gap_on(problem, u, lam_plus, Ku, factor, *pinned)
+        if getattr(factor, "on", None) and factor.on(problem.K, problem.N):  # a saddle point's
+            gap = factor.gap(problem.K, problem.f, problem.N, problem.d, u, lam_plus, Ku)
+        if gap is not None:
+            return gap
     r = Ku - problem.f + problem.N.T @ lam_plus
     return float(lam_plus @ (problem.d - problem.N @ u)) + 0.5 * problem.inverse_energy(r)
 
 
 def _pinned_rows(problem: ContactProblem, factor) -> tuple[np.ndarray, np.ndarray] | None:
     """``(rows C, their coefficients n_C)`` of ``factor``'s pinned dofs, or None when unusable."""
-    if factor is None or not _same_matrix(problem.K, getattr(factor, "matrix", None)):
+    if getattr(factor, "fixed", None) is None or not _same_matrix(problem.K, factor.matrix):
         return None
     fixed = np.asarray(factor.fixed, dtype=int)
     if fixed.size == 0:
@@ -462,8 +464,7 @@ class Comparison:
     def same_active_set(self) -> bool:
         return self.misclassified == 0
 
-    def as_dict(self) -> dict[str, float | int]:
-        return asdict(self)
+    as_dict = asdict
 
 
 def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
@@ -475,8 +476,7 @@ def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
 def compare(problem: ContactProblem, first: ContactSolution, second: ContactSolution,
             weak_tol: float = WEAK_TOL) -> Comparison:
     """Compare two solutions: displacements, multipliers and active sets."""
-    u_rel = _rel_diff(first.u, second.u)
-    lam_rel = _rel_diff(first.lam, second.lam)
+    u_rel, lam_rel = _rel_diff(first.u, second.u), _rel_diff(first.lam, second.lam)
     if not np.isfinite(lam_rel) or not np.isfinite(u_rel):
         return Comparison(u_rel, lam_rel, problem.m, 0)
     a, b = classify(problem, first, weak_tol), classify(problem, second, weak_tol)

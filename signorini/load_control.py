@@ -228,6 +228,7 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
     """
     start = None if warm_start is None else WarmStart.of(warm_start)
     runs = request.method.runs(problem, request.options, start)  # itself, or the one it picks
+    runs.check_rows(problem)  # before load control's work
     stages: dict[str, dict[str, int]] = {}
     seconds: dict[str, float] = {}
     zone, matched, options = None, None, request.options

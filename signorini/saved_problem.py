@@ -54,6 +54,7 @@ def save(problem: Any, path: str | os.PathLike) -> None:
             "volumetric": disc.volumetric, "axisymmetric": disc.axisymmetric,
             "reference": None if disc.reference is None else dataclasses.asdict(disc.reference),
             "params": disc.params, "assemble_s": disc.assemble_s,
+            "materials": [list(m) for m in disc.materials],
             "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
                                              "offset_load": pu.offset_load, "load": pu.load,
                                              "target": pu.target, "pending": pu.pending,
@@ -97,7 +98,8 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
             load_offset=about["load_offset"], E=about["E"], nu=about["nu"],
             volumetric=about["volumetric"], axisymmetric=about["axisymmetric"],
             reference=_reference_data(about["reference"]), params=about["params"], push=push,
-            assemble_s=about["assemble_s"])
+            assemble_s=about["assemble_s"],
+            materials=tuple(tuple(m) for m in about.get("materials", ())))
     K = symmetric_argument(sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]),
                                          shape=(n, n)))
     problem = problem_type(

@@ -111,9 +111,11 @@ def in_problem_units(problem: Any, solution: Any, scales: Scales) -> Any:
         return solution
     solution.u = solution.u * scales.displacement
     solution.lam = solution.lam * scales.force
+    stiffness = scales.force / scales.displacement
+    in_units = getattr(solution.factor, "in_units", None)  # a saddle-point system's own
     if solution.factor is not None:
-        solution.factor = UnitsFactor(solution.factor, problem.K,
-                                      scales.force / scales.displacement)
+        solution.factor = (in_units(problem.K, stiffness) if in_units is not None
+                           else UnitsFactor(solution.factor, problem.K, stiffness))
     return solution
 
 

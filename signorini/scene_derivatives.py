@@ -16,7 +16,7 @@ import numpy as np
 
 from signorini.derivatives import Sensitivity, exact_answer
 from signorini.errors import InputError
-from signorini.fem.assembly import lame_stiffness
+from signorini.fem.assembly import lame_stiffness, nodal_dofs
 from signorini import load_control
 from signorini.pressure import contact_profile, hertz_fit, hertz_fit_tangent
 from signorini.problem import ContactProblem
@@ -28,7 +28,7 @@ from signorini.solution import ContactSolution
 from signorini.solvers.registry import check_request
 
 OUTPUTS = ("total_force", "energy", "displacement", "pressure", "p0", "a")
-PARAMETERS = ("E", "nu", "P", "delta", "obstacle")
+PARAMETERS = ("E", "nu", "E1", "E2", "nu1", "nu2", "P", "delta", "obstacle")
 
 
 @dataclass(frozen=True)
@@ -77,10 +77,11 @@ def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Chan
     zero_n, zero_m = np.zeros(problem.n), np.zeros(problem.m)
     u = solution.u
     lift = push.scale * push.f1  # the load the prescribed push puts on the free dofs
-    if wrt == "E":  # K ∝ E, and so is the lift of the prescribed push
-        return Change(problem.K @ u / disc.E, lift / disc.E, zero_m)
-    if wrt == "nu":
-        return _poisson_change(problem, u)
+    if wrt.startswith(("E", "nu")):  # one body's material: its rows of K, f alone
+        name, on, E, nu, volumetric = _material(problem, wrt)
+        if name == "nu":
+            return _poisson_change(problem, u, E, nu, volumetric, on)
+        return Change(np.where(on, problem.K @ u, 0.0) / E, np.where(on, lift, 0.0) / E, zero_m)
     if wrt == "P":
         if not _load_controlled(problem):
             raise InputError(f"{problem.scene or 'this scene'} is loaded by a prescribed push, not "
@@ -102,19 +103,44 @@ def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Chan
     raise InputError(f"wrt must be one of {', '.join(PARAMETERS)}, got {wrt!r}")
 
 
-def _poisson_change(problem: ContactProblem, u: np.ndarray) -> Change:
-    """∂K/∂ν from K's two Lamé parts, ``∂K/∂ν = E (∂Λ/∂ν K_Λ + ∂μ/∂ν K_μ)`` (exact)."""
+def _material(problem: ContactProblem, wrt: str) -> tuple[str, np.ndarray, float, float, str]:
+    """``("E" or "nu", the free dofs it acts on, the body's E, ν and volumetric integration)``
+    of ``wrt``: ``E``/``nu`` for one body, ``E1``/``nu1`` (the first body's, the slave) and
+    ``E2``/``nu2`` for two."""
+    disc = problem.discretisation
+    name, body = wrt.rstrip("12"), wrt[len(wrt.rstrip("12")):]
+    if not body and disc.materials:
+        raise InputError(f"{problem.scene or 'this scene'} has two bodies: differentiate with "
+                         f"respect to {wrt}1 or {wrt}2")
+    if body and not disc.materials:
+        raise InputError(f"{problem.scene or 'this scene'} has one body: differentiate with "
+                         f"respect to {name}")
+    if not body:
+        return name, np.ones(problem.n, dtype=bool), disc.E, disc.nu, disc.volumetric
+    counts = [material[0] for material in disc.materials]
+    first = sum(counts[:int(body) - 1])
+    on = np.zeros(disc.prescribed.size, dtype=bool)
+    on[nodal_dofs(disc.mesh)[:, np.unique(disc.mesh.t[:, first:first + counts[int(body) - 1]])]] = True
+    _, E, nu, volumetric = disc.materials[int(body) - 1]
+    return name, on[disc.free_dofs], E, nu, volumetric
+
+
+def _poisson_change(problem: ContactProblem, u: np.ndarray, E: float, nu: float,
+                    volumetric: str, on: np.ndarray) -> Change:
+    """∂K/∂ν from K's two Lamé parts, ``∂K/∂ν = E (∂Λ/∂ν K_Λ + ∂μ/∂ν K_μ)`` (exact), on the
+    free dofs ``on`` of the body of modulus E and ratio ν (K is block diagonal by body)."""
     disc, s = problem.discretisation, problem.scales
-    nu, k = disc.nu, 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
-    E = disc.E * s.displacement * s.length ** k / s.force  # E in the problem's units
+    k = 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
+    E = E * s.displacement * s.length ** k / s.force  # E in the problem's units
     lame = (1 + 2 * nu ** 2) / ((1 + nu) * (1 - 2 * nu)) ** 2, -0.5 / (1 + nu) ** 2
     dK = lame_stiffness(disc.mesh, E * lame[0], E * lame[1], axisymmetric=disc.axisymmetric,
-                        volumetric=disc.volumetric)
+                        volumetric=volumetric)
     free = disc.free_dofs
     on_free, prescribed = np.zeros(disc.prescribed.size), disc.prescribed.copy()
     on_free[free] = u
     prescribed[free] = 0.0
-    return Change((dK @ on_free)[free], -(dK @ prescribed)[free], np.zeros(problem.m))
+    return Change(np.where(on, (dK @ on_free)[free], 0.0),
+                  np.where(on, -(dK @ prescribed)[free], 0.0), np.zeros(problem.m))
 
 
 def scene_tangent(sensitivity: Sensitivity, delta: Change) -> tuple[np.ndarray, np.ndarray, float]:
@@ -200,7 +226,8 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
     ``total_force``, ``energy`` (the optimal ½uᵀKu − fᵀu), ``displacement``
     (at the mesh node nearest ``at``), ``pressure`` (nodal), ``p0`` and ``a``
     (Hertz's profile fitted to the pressures, :func:`signorini.pressure.hertz_fit`);
-    ``wrt`` one of ``E``, ``nu``, ``P`` (a load-controlled scene's target
+    ``wrt`` one of ``E``, ``nu`` (``E1``, ``E2``, ``nu1``, ``nu2``: each body's of a two-body
+    scene), ``P`` (a load-controlled scene's target
     load), ``delta`` (a push-controlled scene's push) and ``obstacle`` (the
     obstacle's position along the load axis, towards the body). A parameter
     that moves the mesh is refused: shape derivatives are not provided.

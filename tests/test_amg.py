@@ -178,10 +178,11 @@ def test_a_problem_without_a_mesh():
     assert_agrees(problem, solution, solve(problem, "pdas"))
 
 
-def test_rows_sharing_a_dof_fail_with_the_alternative():
+def test_rows_sharing_a_dof_are_refused_in_one_line_with_the_alternative():
     problem = random_problem(60, 20, seed=3, condition=50.0)
-    solution = solve(problem, "pdas-amg")
-    assert solution.status == "failed" and "use pdas" in solution.message
+    with counting() as work, pytest.raises(InputError, match="method 'pdas-amg' .*use pdas"):
+        solve(problem, "pdas-amg")
+    assert work.as_dict() == {}  # before any work
 
 
 # --- auto: the default method -------------------------------------------------------------------

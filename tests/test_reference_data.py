@@ -29,12 +29,15 @@ from signorini.solvers.registry import solve
 RECORD_PARAMS = {"hertz-2d": {"R": "R"}, "hertz-3d": {"R": "R"}, "reverse-hertz": {"R": "R"},
                  "punch": {"a": "a", "corner_radius": "corner_radius"}, "uniform": {"H": "H"}}
 #: the records of two-body families, from their parameters
+def _hertz_pair(p):
+    return {"R": 1.0 / (1.0 / p["R1"] + 1.0 / p["R2"]),
+            "E_star": 1.0 / (1.0 / contact_modulus(p["E1"], p["nu1"])
+                             + 1.0 / contact_modulus(p["E2"], p["nu2"]))}
+
+
 TWO_BODIES = {"two-block-patch": lambda p: {"H": p["H1"] + p["H2"],
                                             "E_star": (p["H1"] + p["H2"]) / compliance(p)},
-              "hertz-two-cylinders": lambda p: {
-                  "R": 1.0 / (1.0 / p["R1"] + 1.0 / p["R2"]),
-                  "E_star": 1.0 / (1.0 / contact_modulus(p["E1"], p["nu1"])
-                                   + 1.0 / contact_modulus(p["E2"], p["nu2"]))}}
+              "hertz-two-cylinders": _hertz_pair, "hertz-two-spheres": _hertz_pair}
 #: coarse meshes, so that building every family stays quick
 COARSE = {"punch": {"n_contact": 16, "grading": 0.6}, "reverse-hertz": {"n_contact": 16, "grading": 0.6},
           "hertz-sphere-3d": {"n_contact": 4, "grading": 1.0}}

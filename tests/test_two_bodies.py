@@ -9,7 +9,7 @@ from signorini.cli import main
 from signorini.errors import InputError
 from signorini.fem.two_bodies import Body, assemble_two_bodies
 from signorini.scenes.two_block_patch import FAMILY, build, patch_pressure
-from signorini.solvers.registry import get_method
+from signorini.solvers.registry import get_method, methods
 
 #: two materials, so that the blocks shorten by different amounts and slide against each other
 MATERIALS = {"E1": 1.0, "nu1": 0.3, "E2": 3.0, "nu2": 0.2, "H2": 0.7}
@@ -105,3 +105,72 @@ def test_the_cli_solves_the_patch_scene(capsys):
 def test_adaptive_refinement_refuses_two_bodies_in_one_line():
     with pytest.raises(InputError, match="of two bodies: .*mesh parameters"):
         signorini.solve_adaptive("two-block-patch", 0.01)
+
+
+def test_methods_that_take_rows_as_bounds_refuse_two_bodies_in_one_line(capsys):
+    problem, _ = patch()
+    bounds = [m for m in methods() if m.bound_rows]
+    assert bounds and not get_method("pdas").bound_rows  # pdas takes rows that share dofs
+    for method in (m for m in bounds if m.installed):
+        with pytest.raises(InputError, match=f"method '{method.name}' .*share dofs.*use pdas"):
+            signorini.solve(problem, method.name)
+    assert main(["solve", "two-block-patch", "--method", bounds[0].name]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+    main(["methods"])
+    listed = {line.split()[0]: line for line in capsys.readouterr().out.splitlines()[1:]}
+    assert all(("one body" in listed[m.name]) == m.bound_rows for m in methods())
+
+
+def test_the_error_estimate_takes_each_body_s_own_material_and_no_pressure():
+    from skfem import MeshTri
+
+    from signorini.fem.two_bodies import series_modulus
+    from signorini.scenes import hertz_two_cylinders as cylinders
+
+    params = cylinders.FAMILY.parse({"n_contact": 12, "grading": 0.5, "E2": 5.0, "nu2": 0.2})
+    result = signorini.solve(signorini.build_problem("hertz-two-cylinders", params=params), "pdas")
+    estimate = result.estimate
+    assert estimate.bodies == 2 and estimate.pressure is None and estimate.contact == 0.0
+    # ‖u_h‖²_E = Σ u_bᵀ K_b u_b, each body's K assembled with its own material
+    model, problem = cylinders.FAMILY.build(params), result.problem
+    L, stress = problem.scales.length, series_modulus(1.0, 0.3, 5.0, 0.2)
+    u = problem.expand(result.solution.u)
+    first = 2 * model.slave.mesh.p.shape[1]
+    energy = sum(part @ body.stiffness(MeshTri(body.mesh.p / L, body.mesh.t), stress) @ part
+                 for body, part in ((model.slave, u[:first]), (model.master, u[first:])))
+    assert estimate.energy_norm ** 2 == pytest.approx(energy, rel=1e-10)
+    assert "contact pressure not estimated" in result.summary()
+
+
+def test_the_vtu_holds_both_bodies_each_stressed_by_its_own_material(tmp_path):
+    meshio = pytest.importorskip("meshio", reason="the VTU export writes through meshio")
+    from signorini.output.export import export_vtk
+
+    problem, p = patch()
+    result = signorini.solve(problem, "pdas")
+    mesh = meshio.read(export_vtk(problem, result.solution, tmp_path / "patch.vtu"))
+    body = mesh.cell_data["body"][0]
+    assert body.size == problem.mesh.t.shape[1] and set(body) == {1, 2}
+    # uniaxial in each block: σ_yy = −p in both, σ_zz = ν σ_yy with the block's own ν
+    np.testing.assert_allclose(mesh.cell_data["sigma_yy"][0], -p, rtol=1e-8)
+    nu = np.where(body == 1, MATERIALS["nu2"], MATERIALS["nu1"])  # the upper block is the slave
+    np.testing.assert_allclose(mesh.cell_data["sigma_zz"][0], -nu * p, rtol=1e-8)
+    assert np.count_nonzero(mesh.point_data["contact_candidate"]) == problem.m
+
+
+def test_a_picture_shows_both_deformed_bodies_and_the_pressure():
+    pytest.importorskip("matplotlib", reason="the picture is drawn with matplotlib")
+    from signorini.output.export import candidate_nodes, nodal_displacement
+    from signorini.output.plots import deformed_bodies
+    from signorini.pressure import contact_profile
+
+    problem, p = patch()
+    result = signorini.solve(problem, "pdas")
+    body = np.repeat([1, 2], [material[0] for material in problem.discretisation.materials])
+    ax = deformed_bodies(problem.mesh.p * problem.scales.length, problem.mesh.t,
+                         nodal_displacement(problem, result.solution), body,
+                         candidate_nodes(problem), contact_profile(problem, result.solution).pressure)
+    assert {t.get_text() for t in ax.get_legend().get_texts()} == {"body 1", "body 2"}
+    (dots,) = ax.collections[-1:]
+    np.testing.assert_allclose(dots.get_array(), p, rtol=1e-8)  # the uniform pressure, on the face
+    assert len(ax.figure.axes) == 2  # and its colour bar

@@ -3,6 +3,7 @@
 import pytest
 
 import signorini
+from signorini.errors import InputError
 from signorini.analytic import hertz_cylinder_load
 from signorini.scenes.hertz_two_cylinders import FAMILY, pair_radius
 
@@ -60,3 +61,52 @@ def test_the_rows_follow_the_normal_asked_for():
     for problem, tilted in ((vertical, False), (master, True)):
         x_dofs = problem.discretisation.free_dofs % 2 == 0  # dofs interleaved by node: x even
         assert (abs(problem.N[:, x_dofs]).max() > 1e-3) == tilted
+
+
+#: a prescribed push: the mesh (graded to a/R*) does not move with the materials
+PUSHED = {"n_contact": 12, "grading": 0.5, "E2": 3.0, "nu2": 0.2, "R2": 2.0, "delta": 0.004}
+
+
+@pytest.mark.parametrize("wrt, h", [("E1", 1e-4), ("E2", 1e-4), ("nu1", 1e-5), ("nu2", 1e-5)])
+def test_each_body_s_material_derivative_is_the_finite_difference(wrt, h):
+    value = FAMILY.parse(PUSHED)[wrt]
+    exact = signorini.derivative("hertz-two-cylinders", "total_force", wrt, params=PUSHED,
+                                 method="pdas")
+    up, down = (signorini.derivative("hertz-two-cylinders", "total_force", wrt, method="pdas",
+                                     params={**PUSHED, wrt: value + step}).value
+                for step in (h, -h))
+    assert exact.derivative == pytest.approx((up - down) / (2 * h), rel=1e-6)
+    assert abs(exact.derivative) > 1e-5  # each body's material moves the force
+
+
+def test_the_load_derivative_of_the_pair_follows_hertz():
+    result = signorini.solve("hertz-two-cylinders", "pdas", params=COARSE)
+    force = signorini.derivative(result, "total_force", "P")
+    assert force.derivative == pytest.approx(1.0, rel=1e-8)  # the contact carries the load
+    peak = signorini.derivative(result, "p0", "P")
+    # Hertz: p0 = 2P/(πa) with a ∝ √P, so dp0/dP = p0 / (2P) (the mesh's own error aside)
+    assert peak.derivative == pytest.approx(peak.value / (2 * result.problem.push.P), rel=0.05)
+
+
+@pytest.mark.parametrize("scene, wrt, words", [("hertz-two-cylinders", "E", "E1 or E2"),
+                                               ("hertz-cylinder", "nu2", "respect to nu")])
+def test_a_material_of_the_wrong_body_count_is_refused_in_one_line(scene, wrt, words):
+    with pytest.raises(InputError, match=words):
+        signorini.derivative(scene, "total_force", wrt, params=COARSE, method="pdas")
+
+
+@pytest.mark.parametrize("method", ["pdas", "auto"])
+def test_two_bodies_cost_at_most_a_third_more_than_one_body_of_as_many_dofs(method):
+    """Counted in factorisations and back-solves, the certificate's included: the method's
+    saddle-point system serves the certificate (no factorisation of K, no Delassus operator)."""
+    from signorini.numerics.work import counting
+
+    cost = {}
+    for scene, params in (("hertz-cylinder", {"refine": 1}), ("hertz-two-cylinders", {})):
+        with counting() as work:
+            result = signorini.solve(scene, method, params=params)
+        assert result.converged
+        cost[scene] = (result.problem.n, work.factorisations + work.back_solves)
+    (n1, one), (n2, two) = cost.values()
+    assert abs(n2 / n1 - 1) < 0.1  # about the same dofs
+    assert two <= 1.3 * one, cost

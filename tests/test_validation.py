@@ -59,3 +59,13 @@ def test_block_patch_test_is_exact():
     assert np.all(block.profile.active)
     expected_total = 2 * block.PARAMS["W"] * block.pressure_expected
     assert block.profile.total_force == pytest.approx(expected_total, rel=1e-10)
+
+
+def test_two_unlike_cylinders_meet_two_body_hertz_and_uzawa_reaches_the_exact_answer():
+    pair = load("two_cylinders")
+    assert pair.problem.n <= 20_000 and pair.exact.status == "converged"
+    assert pair.hertz.p0_rel < 1e-3 and pair.hertz.a_rel < 1e-3  # two-body Hertz
+    assert pair.hertz.force_balance < 1e-8
+    assert pair.paper.status == "converged"
+    assert pair.agreement.lam_rel < 1e-6 and pair.agreement.misclassified == 0
+    assert "'pdas-amg'" in pair.refusal and "share dofs" in pair.refusal

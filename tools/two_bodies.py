@@ -1,6 +1,7 @@
 """Two elastic bodies: the contact patch test and Hertz between two cylinders, per discretisation.
 
     .venv/bin/python tools/two_bodies.py      # about five minutes; writes docs/two-bodies/runs.json
+    .venv/bin/python tools/two_bodies.py --figure   # docs/two-bodies/cylinders-deformed.png
 
 Every run is a task of the studies' runner (signorini.studies.runner): pdas (at tol 1e-10 on
 the blocks, 1e-8 on the cylinders: ``CYLINDERS_TOL``) on the scene as signorini.solve builds
@@ -23,6 +24,8 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+
+import numpy as np
 
 from signorini.analytic import contact_modulus, hertz_cylinder_load
 from signorini.files import atomic_write_text, to_json
@@ -126,11 +129,37 @@ def _pct(x: float) -> str:
     return f"{100 * x:+.3f} %"
 
 
+def figure(path: Path = OUT.parent / "cylinders-deformed.png") -> Path:
+    """Both deformed cylinders (E2 = 3 E1, R2 = 2 R1, on the default mesh) near the contact, at
+    true scale, and their contact pressure."""
+    import signorini
+    from signorini.files import save_figure
+    from signorini.output.export import candidate_nodes, nodal_displacement
+    from signorini.output.plots import deformed_bodies
+    from signorini.pressure import contact_profile
+
+    result = signorini.solve("hertz-two-cylinders", "pdas", params=PAIRS["different"])
+    problem, solution = result.problem, result.solution
+    body = np.repeat([1, 2], [material[0] for material in problem.discretisation.materials])
+    ax = deformed_bodies(problem.mesh.p * problem.scales.length, problem.mesh.t,
+                         nodal_displacement(problem, solution), body, candidate_nodes(problem),
+                         contact_profile(problem, solution).pressure, magnify=1.0)
+    a = result.comparison.a
+    ax.set_xlim(0.0, 2.5 * a)
+    ax.set_ylim(-1.2 * a, 1.2 * a)
+    ax.set_title(f"hertz-two-cylinders, E2 = 3 E1, R2 = 2 R1 ({problem.n:,} dofs):\n"
+                 f"deformed at true scale near the contact, a = {a:.4f}", fontsize=8)
+    save_figure(ax.figure, path)
+    return path
+
+
 def load() -> list[dict]:
     return json.loads(OUT.read_text())["rows"]
 
 
 if __name__ == "__main__":
+    if "--figure" in sys.argv:
+        sys.exit(print(f"written: {figure()}", file=sys.stderr))
     if "--tables" not in sys.argv:
         rows = run()
         atomic_write_text(OUT, to_json({"command": "python tools/two_bodies.py", "rows": rows}))

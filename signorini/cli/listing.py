@@ -26,7 +26,8 @@ def cmd_methods(args: argparse.Namespace) -> int:
           "set SIGNORINI_FACTOR to choose)")
     for m in methods():
         state = "installed" if m.installed else f"not installed ({m.install_hint})"
-        kind = ", ".join(x for x in ("exact" if m.exact else "", "dense" if m.dense else "") if x)
+        kind = ", ".join(x for x in ("exact" if m.exact else "", "dense" if m.dense else "",
+                                     "one row per dof: one body" if m.bound_rows else "") if x)
         print(f"{m.name:<14} {state:<12} {m.summary}" + (f" [{kind}]" if kind else ""))
     return 0
 

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from skfem.models.elasticity import lame_parameters as lame  # Lamé's λ and μ of E and ν
 from skfem.quadrature import get_quadrature
 
 from signorini.fem.topology import facets_on
@@ -66,7 +67,8 @@ class ErrorEstimate:
     ``elements`` are the per-element indicators ``η_K`` (recovery part, and the
     contact term of the element's contact edges), ``recovery`` and ``contact``
     the two parts of ``total = (Σ η_K²)^½``, ``energy_norm`` is ``‖u_h‖_E``;
-    ``scale`` turns them into physical units (√(force · length)).
+    ``scale`` turns them into physical units (√(force · length)). ``bodies``: each estimated
+    with its own material; for two, no contact term and no pressure estimate.
     """
 
     elements: np.ndarray
@@ -75,6 +77,7 @@ class ErrorEstimate:
     energy_norm: float
     scale: float = 1.0
     pressure: "PressureEstimate | None" = None
+    bodies: int = 1
 
     @property
     def total(self) -> float:
@@ -94,7 +97,8 @@ class ErrorEstimate:
                 "max_element": float(np.max(self.elements)) * self.scale,
                 "recovery": self.recovery * self.scale, "contact": self.contact * self.scale,
                 "energy_norm": self.energy_norm * self.scale,
-                "pressure": None if self.pressure is None else self.pressure.relative}
+                "pressure": None if self.pressure is None else self.pressure.relative,
+                "bodies": self.bodies}
 
 
 @dataclass(frozen=True)
@@ -137,11 +141,9 @@ def strains(mesh: Any, u: np.ndarray, rule: Quadrature, axisymmetric: bool = Fal
     """
     values = np.take(u, mesh.t, axis=0)  # (d + 1, elements, dim)
     grad = np.einsum("kei,ekj->eij", values, rule.gradients)  # ∂u_i/∂x_j per element
-    dim = grad.shape[1]
-    pairs = STRAIN_PAIRS[dim]
     q = rule.bary.shape[1]
     parts = [np.repeat((0.5 * (grad[:, i, j] + grad[:, j, i]))[:, None], q, axis=1)
-             for i, j in pairs]
+             for i, j in STRAIN_PAIRS[grad.shape[1]]]
     if axisymmetric:
         u_r = np.einsum("ke,kq->eq", values[:, :, 0], rule.bary)
         parts.append(u_r / rule.points[0])
@@ -155,8 +157,11 @@ def energy_density(eps: np.ndarray, Lambda: float, Mu: float, dim: int,
     The first ``dim`` components are the diagonal, the next ``dim (dim − 1) / 2``
     the shears (counted twice in ``ε : ε``) and one more, if any, the hoop strain.
     ``trace`` replaces ``tr ε`` in the λ term: the volumetric strain averaged at
-    the nodes when K was assembled so (:mod:`signorini.fem.volumetric`).
+    the nodes when K was assembled so (:mod:`signorini.fem.volumetric`). λ and μ are numbers
+    or one per element (bodies of several materials).
     """
+    Lambda, Mu = (np.reshape(x, np.shape(x) + (1,) * (eps.ndim - 1 - np.ndim(x)))
+                  for x in (Lambda, Mu))
     shears = dim * (dim - 1) // 2
     diagonal = np.concatenate([eps[:dim], eps[dim + shears:]])
     if trace is None:
@@ -196,11 +201,6 @@ def recover(mesh: Any, eps: np.ndarray, rule: Quadrature) -> np.ndarray:
                      rule.bary)
 
 
-def lame(E: float, nu: float) -> tuple[float, float]:
-    """Lamé's λ and μ of Young's modulus and Poisson's ratio."""
-    return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
-
-
 def element_energies(mesh: Any, u: np.ndarray, E: float, nu: float,
                      axisymmetric: bool = False) -> np.ndarray:
     """``a_K(u, u)`` on every element of ``mesh`` for the nodal field ``u`` (nodes, dim)."""
@@ -230,11 +230,9 @@ def _same_coordinates(p: np.ndarray, points: np.ndarray) -> np.ndarray | None:
     """The column of ``p`` (dim, n) equal to each row of ``points`` (m, dim); None unless all are."""
     dim = p.shape[0]
     points = np.atleast_2d(np.asarray(points, dtype=float))
-    if points.shape[1] != dim or p.shape[1] == 0:
+    if points.shape[1] != dim or p.shape[1] == 0 or points.shape[0] == 0:
         return None
     # only the nodes whose first coordinate is one of the points' can match: sort those alone
-    if points.shape[0] == 0:
-        return None
     firsts = np.sort(points[:, 0])  # searched, not merged: np.isin would sort every node's too
     near = np.flatnonzero(firsts[np.minimum(np.searchsorted(firsts, p[0]), firsts.size - 1)] == p[0])
     if near.size == 0:
@@ -383,8 +381,9 @@ def pressure_estimate(problem: ContactProblem, solution: ContactSolution, nodal:
                             indicators=shares / scale, active=active)
 
 
-def material_units(problem: ContactProblem) -> tuple[float, float] | None:
-    """Young's modulus in the problem's units and Poisson's ratio (None without a material).
+def material_units(problem: ContactProblem) -> tuple[Any, Any] | None:
+    """Young's modulus in the problem's units and Poisson's ratio (None without a material):
+    two numbers, or one of each per element for a mesh of several bodies.
 
     Assembly divides E by a stress scale ``force / (displacement · length^k)``
     (k = 1 in axisymmetric and 3D models), which is E itself for a scene made
@@ -396,7 +395,8 @@ def material_units(problem: ContactProblem) -> tuple[float, float] | None:
     s = problem.scales
     k = 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
     stress = s.force / (s.displacement * s.length ** k)
-    return disc.E / stress, disc.nu
+    E, nu = disc.element_materials()
+    return E / stress, nu
 
 
 def _by_quadrature(problem: ContactProblem, mesh: Any, u: np.ndarray, Lambda: float,
@@ -461,10 +461,10 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
     if material is None or not np.all(np.isfinite(solution.u)):
         return None
     mesh, axisymmetric = problem.mesh, bool(problem.axisymmetric)
-    E, nu = material
-    Lambda, Mu = lame(E, nu)
-    dim = mesh.p.shape[0]
-    u = problem.expand(solution.u).reshape(-1, dim)
+    Lambda, Mu = lame(*material)
+    bodies = max(1, len(problem.discretisation.materials))
+    contact = contact and bodies == 1
+    u = problem.expand(solution.u).reshape(-1, mesh.p.shape[0])
     if axisymmetric or problem.discretisation.volumetric == "nodal":
         energy, squares, nodal, theta = _by_quadrature(problem, mesh, u, Lambda, Mu)
     else:
@@ -487,4 +487,4 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
                          energy_norm=float(np.sqrt(energy.sum())),
                          scale=float(np.sqrt(s.force * s.displacement)),
                          pressure=pressure_estimate(problem, solution, nodal, Lambda, Mu, theta)
-                         if contact else None)
+                         if contact else None, bodies=bodies)

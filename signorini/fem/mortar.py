@@ -21,7 +21,8 @@ keeps the package's one sign convention and ``λ ≥ 0`` is compressive.
   a rigid flat's). ``Dₛₖ = ∫ ψₛ φ¹ₖ``,
   ``Mₛⱼ = ∫ ψₛ φ²ⱼ`` and the weighted gap ``g̃ₛ = ∫ ψₛ g``. The standard basis
   ψₛ = φₛ has D lumped to ``diag(∫ φₛ)``; the dual (biorthogonal) basis
-  ψₛ = 2φₛ − φₒ on each slave segment (o the segment's other node) has
+  ψₛ = 2φₛ − φₒ on each slave segment (o the segment's other node; in an
+  axisymmetric face, weighted by r, its own combination :func:`_dual`) has
   ``∫ ψₛ φₖ = δₛₖ ∫ φₛ``, so D is diagonal without lumping.
 
 The weight of a row is ``wₛ = ∫ φₛ ds`` over the part of the slave face the
@@ -98,10 +99,15 @@ class Face:
         ends = self.points[:, self.segments]
         return np.linalg.norm(ends[:, 1] - ends[:, 0], axis=0)
 
-    def weights(self) -> np.ndarray:
-        """Lumped weights ``∫ φₛ ds`` of the face's nodes (k,): half of each segment to each end."""
-        return np.bincount(self.segments.ravel(), np.tile(0.5 * self.lengths, 2),
-                           minlength=self.nodes.size)
+    def weights(self, radial: bool = False) -> np.ndarray:
+        """Lumped weights ``∫ φₛ ds`` of the face's nodes (k,): half of each segment to each end;
+        ``radial``: ``∫ φₛ r ds`` (an axisymmetric face, r = x), ``ℓ (2 rₛ + rₒ)/6``."""
+        if not radial:
+            return np.bincount(self.segments.ravel(), np.tile(0.5 * self.lengths, 2),
+                               minlength=self.nodes.size)
+        r = self.points[0, self.segments]  # (2, e)
+        share = self.lengths * (2.0 * r + r[::-1]) / 6.0
+        return np.bincount(self.segments.ravel(), share.ravel(), minlength=self.nodes.size)
 
 
 def _along(ends: np.ndarray) -> np.ndarray:
@@ -212,7 +218,8 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[0] * b[1] - a[1] * b[0]
 
 
-def node_to_segment(slave: Face, master: Face, direction: np.ndarray | None = None) -> Coupling:
+def node_to_segment(slave: Face, master: Face, direction: np.ndarray | None = None,
+                    radial: bool = False) -> Coupling:
     """One-pass node-to-segment rows: each slave node projected on the master face.
 
     Slave node s is projected along each master segment's normal n² (or along
@@ -221,7 +228,7 @@ def node_to_segment(slave: Face, master: Face, direction: np.ndarray | None = No
     row is ``n`` on u¹ₛ and ``−φⱼ(ξₛ) n`` on the master segment's two nodes,
     with ``n = −n²`` (or ``direction``), and its gap ``gₛ = (x²(ξₛ) − xₛ)·n``.
     Slave nodes that project on no master segment get no row. Weights are the
-    slave face's lumped ``∫ φₛ ds``.
+    slave face's lumped ``∫ φₛ ds`` (``∫ φₛ r ds`` when ``radial``).
     """
     ends = master.points[:, master.segments]  # (2, 2, e)
     tangent = ends[:, 1] - ends[:, 0]
@@ -244,18 +251,30 @@ def node_to_segment(slave: Face, master: Face, direction: np.ndarray | None = No
     D = sp.identity(slave.nodes.size, format="csr")
     M = build_m()
     coupling = Coupling(kind="nts", slave=k, D=D, M=M, slave_rows=_vector(D, normal),
-                        master_rows=-_vector(M, normal), gap=gap, weights=slave.weights())
+                        master_rows=-_vector(M, normal), gap=gap, weights=slave.weights(radial))
     return _kept(coupling, keep)
 
 
-def _multiplier(eta: np.ndarray, basis: str) -> np.ndarray:
-    """ψ of a slave segment's two nodes at its coordinates ``eta`` (2, ...): standard or dual."""
+def _dual(r0: float, r1: float, radial: bool) -> np.ndarray:
+    """The coefficients A (2, 2) of the dual basis ``ψ = A φ`` on a slave segment whose ends
+    have radii ``r0, r1``: ``A = D Mₑ⁻¹``, Mₑ the segment's mass matrix ∫ φ φᵀ (weight r when
+    ``radial``) and D its row sums, so that ``∫ ψᵢ φⱼ = δᵢⱼ ∫ φᵢ``; ``[[2, −1], [−1, 2]]`` when
+    the weight is 1."""
+    phi = np.stack([1.0 - GAUSS_POINTS, GAUSS_POINTS])
+    weight = GAUSS_WEIGHTS * ((1.0 - GAUSS_POINTS) * r0 + GAUSS_POINTS * r1 if radial else 1.0)
+    mass = np.einsum("iq,jq,q->ij", phi, phi, weight)
+    return np.diag(mass.sum(axis=1)) @ np.linalg.inv(mass)
+
+
+def _multiplier(eta: np.ndarray, dual: np.ndarray | None) -> np.ndarray:
+    """ψ of a slave segment's two nodes at its coordinates ``eta`` (2, ...): φ (standard,
+    ``dual`` None) or ``A φ`` with the segment's dual coefficients A."""
     phi = np.stack([1.0 - eta, eta])
-    return phi if basis == "standard" else 2.0 * phi - phi[::-1]
+    return phi if dual is None else np.einsum("ik,k...->i...", dual, phi)
 
 
 def mortar(slave: Face, master: Face, basis: str = "dual",
-           direction: np.ndarray | None = None) -> Coupling:
+           direction: np.ndarray | None = None, radial: bool = False) -> Coupling:
     """Mortar rows: ``D n`` on the slave nodes, ``−M n`` on the master nodes, gap ``g̃``.
 
     Segment to segment on the slave face: each master segment that faces a
@@ -264,7 +283,9 @@ def mortar(slave: Face, master: Face, basis: str = "dual",
     segment's normal reversed, and ``Dₛₖ``,
     ``Mₛⱼ``, ``g̃ₛ`` and ``wₛ = ∫ φₛ ds`` accumulate over the overlaps with
     ψₛ the ``basis`` ("dual": biorthogonal, "standard": ψₛ = φₛ with D lumped).
-    Slave nodes the master face does not reach get no row.
+    Slave nodes the master face does not reach get no row. ``radial``: every
+    integral carries the weight r = x (an axisymmetric face), the dual basis is
+    biorthogonal in that weight (:func:`_dual`) and D stays diagonal.
     """
     if basis not in ("dual", "standard"):
         raise InputError(f"mortar basis={basis!r} must be 'dual' or 'standard'")
@@ -289,10 +310,12 @@ def mortar(slave: Face, master: Face, basis: str = "dual",
             continue
         eta = lo[pieces, None] + (hi - lo)[pieces, None] * GAUSS_POINTS  # (p, q)
         dw = (hi - lo)[pieces, None] * GAUSS_WEIGHTS * np.sqrt(h2)  # ds of each point
+        if radial:  # r ds: the integrands stay cubic in eta, the two points exact
+            dw = dw * (x0[0] + eta * t[0])
         xi = (eta - eta_ends[0, pieces, None]) / (eta_ends[1, pieces, None] - eta_ends[0, pieces, None])
         phi_s = np.stack([1.0 - eta, eta])  # (2, p, q)
         phi_m = np.stack([1.0 - xi, xi])
-        psi = _multiplier(eta, basis)
+        psi = _multiplier(eta, None if basis == "standard" else _dual(x0[0], x1[0], radial))
         y0, y1 = master_ends[:, 0, pieces][..., None], master_ends[:, 1, pieces][..., None]
         across = (y0 + xi * (y1 - y0) - (x0[:, None, None] + eta * t[:, None, None]))
         normal = (-master.normals[:, pieces] if direction is None  # (2, p): as node-to-segment
@@ -318,12 +341,13 @@ def mortar(slave: Face, master: Face, basis: str = "dual",
 
 
 def couple(slave: Face, master: Face, discretisation: str = "mortar",
-           direction: np.ndarray | None = None) -> Coupling:
+           direction: np.ndarray | None = None, radial: bool = False) -> Coupling:
     """The rows of ``discretisation`` (one of :data:`DISCRETISATIONS`), unscaled; with a fixed
-    ``direction`` (the slave's outward unit normal) every row and projection takes it."""
+    ``direction`` (the slave's outward unit normal) every row and projection takes it;
+    ``radial``: axisymmetric faces in (r, z), every integral weighted by r."""
     if discretisation == "nts":
-        return node_to_segment(slave, master, direction)
+        return node_to_segment(slave, master, direction, radial)
     if discretisation in ("mortar", "mortar-standard"):
         return mortar(slave, master, "dual" if discretisation == "mortar" else "standard",
-                      direction)
+                      direction, radial)
     raise InputError(f"discretisation={discretisation!r} must be one of {', '.join(DISCRETISATIONS)}")

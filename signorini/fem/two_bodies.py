@@ -1,4 +1,4 @@
-"""Two elastic bodies in contact, plane strain: one QP ``min ½uᵀKu − fᵀu, Nu ≤ d``.
+"""Two elastic bodies in contact, plane strain or axisymmetric: one QP ``min ½uᵀKu − fᵀu, Nu ≤ d``.
 
 The unknown is u = (u¹, u²), each body's free dofs; ``K = diag(K¹, K²)`` and
 ``f = (f¹, f²)``, each body assembled on its own mesh with its own material
@@ -63,10 +63,11 @@ class Body:
     volumetric: str = "auto"
     traction: tuple[np.ndarray, float] | None = None
 
-    def stiffness(self, mesh: Any, stress: float) -> sp.csr_matrix:
+    def stiffness(self, mesh: Any, stress: float, axisymmetric: bool = False) -> sp.csr_matrix:
         """K of the whole body on ``mesh`` (its nodes scaled), E in units of ``stress``."""
         Lambda, Mu = lame_parameters(self.E / stress, self.nu)
-        return lame_stiffness(mesh, Lambda, Mu, volumetric=resolve(self.volumetric, self.nu))
+        return lame_stiffness(mesh, Lambda, Mu, axisymmetric=axisymmetric,
+                              volumetric=resolve(self.volumetric, self.nu))
 
 
 def series_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
@@ -92,7 +93,7 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
                         length_scale: float, force_multiplicity: float = 1.0,
                         reference: ReferenceData | None = None, params: dict[str, Any] | None = None,
                         target_load: float | None = None, predicted: Any = None,
-                        direction: np.ndarray | None = None,
+                        direction: np.ndarray | None = None, axisymmetric: bool = False,
                         nondimensionalise: bool = True) -> ContactProblem:
     """The contact QP of two bodies: ``K = diag(K¹, K²)``, f, N, d, weights, points, scales.
 
@@ -110,6 +111,8 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     ``direction`` fixes the rows' normal (the slave's outward unit normal, e.g.
     the common normal at the first point of contact, along which Hertz's
     theory measures the gap); None: each master segment's normal.
+    ``axisymmetric``: both meshes in the meridian half-plane (r, z), K and
+    the rows' integrals per radian (weight r), forces in units of E*·U·L.
     """
     start = time.perf_counter()
     _check_held(slave, "slave")
@@ -119,12 +122,12 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     values = [abs(v) for body in (slave, master) for _, nodes, v in body.dirichlet if len(nodes)]
     U = (max(values, default=0.0) or length_scale) if nondimensionalise else 1.0
     first = slave.mesh.p.shape[1]
+    k = 1 if axisymmetric else 0  # force = E*·U·L^k, weight = L^(k+1)
     mesh = MeshTri(np.hstack([slave.mesh.p, master.mesh.p]) / L,
                    np.hstack([slave.mesh.t, master.mesh.t + first]))
     dof_table = nodal_dofs(mesh)
-    K_full = sp.block_diag([slave.stiffness(MeshTri(slave.mesh.p / L, slave.mesh.t), stress),
-                            master.stiffness(MeshTri(master.mesh.p / L, master.mesh.t), stress)],
-                           format="csr")
+    K_full = sp.block_diag([body.stiffness(MeshTri(body.mesh.p / L, body.mesh.t), stress,
+                                           axisymmetric) for body in (slave, master)], format="csr")
     n_full = K_full.shape[0]
 
     prescribed = np.zeros(n_full)
@@ -138,7 +141,7 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
 
     slave_face = Face.of(slave.mesh, slave.contact_facets)
     master_face = Face.of(master.mesh, master.contact_facets)
-    coupling = couple(slave_face, master_face, discretisation, direction).scaled()
+    coupling = couple(slave_face, master_face, discretisation, direction, axisymmetric).scaled()
     N_full = coupling.rows(dof_table[:, slave_face.nodes], dof_table[:, master_face.nodes + first],
                            n_full)
     load_dofs = np.concatenate([dof_table[1, slave.load_nodes],
@@ -152,9 +155,9 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     d0 = coupling.gap / U
     d1 = -(N_full[:, fixed] @ u_D)
     offset1 = float(load_full[fixed] @ u_D)
-    target = None if target_load is None else target_load / (stress * U)
+    target = None if target_load is None else target_load / (stress * U * L ** k)
     f_load, offset_load = _cut_traction((slave, master), (0, first), L, dof_table, load_dofs,
-                                        force_multiplicity)
+                                        force_multiplicity, axisymmetric)
     if f_load is not None and target is None:
         raise InputError("a load applied on a cut needs a target load: give P (or a_over_R)")
     load = 0.0 if f_load is None else target
@@ -173,14 +176,18 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     discretisation_record = Discretisation(
         mesh=mesh, free_dofs=free, prescribed=prescribed, load_row=load_full[free],
         load_offset=offset, E=float(slave.E), nu=float(slave.nu),
-        volumetric=resolve(slave.volumetric, slave.nu), reference=reference,
+        volumetric=resolve(slave.volumetric, slave.nu), axisymmetric=axisymmetric,
+        reference=reference, materials=tuple((body.mesh.t.shape[1], float(body.E), float(body.nu),
+                                              resolve(body.volumetric, body.nu))
+                                             for body in (slave, master)),
         params=dict(params or {}, discretisation=discretisation), push=push,
         predicted_contact=None if predicted is None else np.asarray(predicted(points * L)))
     problem = ContactProblem(
-        K=K_II, f=f, N=N_full[:, free].tocsr(), d=d0 + d1, weights=coupling.weights / L,
+        K=K_II, f=f, N=N_full[:, free].tocsr(), d=d0 + d1,
+        weights=coupling.weights / L ** (k + 1),
         contact_points=points,
         force_multiplicity=force_multiplicity,
-        scales=Scales(length=L, displacement=U, force=stress * U, weight=L),
+        scales=Scales(length=L, displacement=U, force=stress * U * L ** k, weight=L ** (k + 1)),
         discretisation=discretisation_record)
     discretisation_record.assemble_s = time.perf_counter() - start
     log.info("assembled two bodies: %d free dofs, %d %s rows in %.2f s", problem.n, problem.m,
@@ -189,12 +196,13 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
 
 
 def _cut_traction(bodies: tuple[Body, Body], offsets: tuple[int, int], L: float,
-                  dof_table: np.ndarray, load_dofs: np.ndarray,
-                  multiplicity: float) -> tuple[np.ndarray | None, float]:
+                  dof_table: np.ndarray, load_dofs: np.ndarray, multiplicity: float,
+                  axisymmetric: bool = False) -> tuple[np.ndarray | None, float]:
     """Nodal forces of the bodies' cut tractions per unit load of the full pair (None: no cut
     is loaded), and the part of the applied load the load dofs' reactions do not see.
 
-    Each cut's uniform traction is ``1 / (μ A)`` along its direction, A the cut's length; its
+    Each cut's uniform traction is ``1 / (μ A)`` along its direction, A the cut's length (its
+    area per radian when ``axisymmetric``); its
     consistent nodal forces are the lumped weights times it (exact for P1).
     """
     f_load = np.zeros(dof_table.size)
@@ -204,7 +212,7 @@ def _cut_traction(bodies: tuple[Body, Body], offsets: tuple[int, int], L: float,
             continue
         facets, direction = body.traction
         cut = Face.of(MeshTri(body.mesh.p / L, body.mesh.t), facets)
-        weights = cut.weights()
+        weights = cut.weights(axisymmetric)
         dofs = dof_table[1, cut.nodes + first]
         f_load[dofs] = direction * weights / (multiplicity * weights.sum())
         loaded = True
@@ -228,6 +236,7 @@ class TwoBodyModel:
     target_load: float | None = None
     predicted: Any = None
     direction: np.ndarray | None = None
+    axisymmetric: bool = False
 
     def assemble(self, nondimensionalise: bool = True) -> ContactProblem:
         """The model's contact QP (:func:`assemble_two_bodies`)."""
@@ -236,5 +245,5 @@ class TwoBodyModel:
                                    force_multiplicity=self.force_multiplicity,
                                    reference=self.reference, params=self.params,
                                    target_load=self.target_load, predicted=self.predicted,
-                                   direction=self.direction,
+                                   direction=self.direction, axisymmetric=self.axisymmetric,
                                    nondimensionalise=nondimensionalise)

@@ -29,6 +29,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.errors import BackendNotInstalled, InputError, install_hint
+from signorini.numerics.saddle_point import SaddlePoint
 from signorini.numerics.work import count
 
 log = logging.getLogger(__name__)
@@ -319,9 +320,10 @@ class ActiveSetSolver:
     size in any units; ``λ = s μ``), is factorised by LU.
 
     ``factor`` is the factorisation of K (with the last active set's dofs
-    pinned, or none) that the last solve used, for the certificate to reuse;
-    None after a saddle-point solve. It is let go before the next one is made,
-    so that two never live at once.
+    pinned, or none) or the saddle-point system
+    (:class:`~signorini.numerics.saddle_point.SaddlePoint`) that the last solve used, for the
+    certificate to reuse. It is let go before the next one is made, so that two never live at
+    once.
     """
 
     def __init__(self, K: sp.csr_matrix, N: sp.csr_matrix, backend: str | None = None):
@@ -373,29 +375,11 @@ class ActiveSetSolver:
             self.factor = factorize(self.K, self.backend)
             return self.factor.solve(f), lam
         if self.saddle_point is None or not np.array_equal(self.saddle_point.active, active):
-            self.saddle_point = SaddlePoint(self.K, N_A, active)
+            self.saddle_point = None  # let go before the next one is made
+            self.saddle_point = SaddlePoint(self.K, self.N, active)
+        self.factor = self.saddle_point  # the certificate's, on the final active set
         u, lam[active] = self.saddle_point.solve(f, d[active])
         return u, lam
-
-
-class SaddlePoint:
-    """The factorised saddle-point matrix ``[K N_Aᵀ; N_A 0]`` of one active set (LU).
-
-    Its constraint rows are scaled by ``s = mean |diag K|``, so that both blocks
-    are of one size in any units (``λ = s μ``).
-    """
-
-    def __init__(self, K: sp.spmatrix, N_A: sp.spmatrix, active: np.ndarray):
-        self.active, self.n = active.copy(), K.shape[0]
-        self.scale = float(np.mean(np.abs(K.diagonal()))) or 1.0
-        system = sp.bmat([[K, self.scale * N_A.T], [self.scale * N_A, None]], format="csc")
-        count("factorisations")
-        self._lu = spla.splu(system)
-
-    def solve(self, f: np.ndarray, d_A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(u, λ_A)`` with ``K u + N_Aᵀ λ_A = f`` and ``N_A u = d_A`` (n × k, |A| × k alike)."""
-        solution = self._lu.solve(_count_solve(np.concatenate([f, self.scale * d_A])))
-        return solution[:self.n], self.scale * solution[self.n:]
 
 
 class Pinning:

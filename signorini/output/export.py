@@ -17,7 +17,8 @@ Data written:
   ``d − Nu`` at contact candidates, NaN elsewhere), ``pressure`` and
   ``contact_force`` (zero off the candidates), ``contact_candidate`` (1 or 0);
 - cell data ``von_mises``, ``sigma_xx``, ``sigma_yy``, ``sigma_xy``,
-  ``sigma_zz`` (in 3D also ``sigma_yz``, ``sigma_xz``).
+  ``sigma_zz`` (in 3D also ``sigma_yz``, ``sigma_xz``), and for a mesh of two bodies
+  ``body`` (1 the slave, 2 the master; each body's stress from its own material).
 
 No point array shares a cell array's name, so ParaView lists each once. The
 points are the undeformed (reference) positions: ParaView's *Warp By Vector*
@@ -83,9 +84,9 @@ def element_stress(problem: ContactProblem, solution: ContactSolution,
     """
     if problem.discretisation is None or problem.mesh is None:
         raise InputError("stresses need the mesh and the material: this problem has neither")
-    E, nu = problem.discretisation.E, problem.discretisation.nu
-    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-    mu = E / (2 * (1 + nu))
+    E, nu = problem.discretisation.element_materials()  # one per element for several bodies
+    lam = np.reshape(E * nu / ((1 + nu) * (1 - 2 * nu)), (-1, 1, 1))
+    mu = np.reshape(E / (2 * (1 + nu)), (-1, 1, 1))
     mesh = problem.mesh
     points = mesh.p * problem.scales.length
     dim = points.shape[0]
@@ -175,6 +176,10 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
         components.update(sigma_yz=(1, 2), sigma_xz=(0, 2))
     cell_data = {"von_mises": [mises]}
     cell_data.update({name: [stress[:, i, j]] for name, (i, j) in components.items()})
+    materials = problem.discretisation.materials
+    if materials:
+        cell_data["body"] = [np.repeat(np.arange(1, len(materials) + 1, dtype=np.int32),
+                                       [material[0] for material in materials])]
     return meshio.Mesh(xyz, [(cell_type, mesh.t.T.astype(np.int64))],
                        point_data=point_data, cell_data=cell_data)
 

@@ -227,3 +227,32 @@ def peer_times(rows: list[dict], *, by: str = "wall_s", label: str = "wall time 
     if drawn:
         ax.legend(fontsize=7)
     return ax
+
+
+def deformed_bodies(points: np.ndarray, elements: np.ndarray, displacement: np.ndarray,
+                    body: np.ndarray, contact: np.ndarray, pressure: np.ndarray, *,
+                    magnify: float | None = None, ax=None):
+    """The deformed meshes of one or more bodies, each in its colour, and the contact pressure.
+
+    ``points`` (2, k) and ``displacement`` (k, 2) are the nodes and their
+    displacements, ``elements`` (3, e) the triangles and ``body`` (e,) the body of
+    each (1, 2, ...); ``contact`` indexes the contact nodes and ``pressure`` is
+    theirs, drawn as coloured dots on the deformed face. Displacements are
+    magnified by ``magnify`` (None: so that the largest is a tenth of the extent).
+    """
+    ax = axes(ax)
+    extent = float(np.ptp(points, axis=1).max())
+    largest = float(np.abs(displacement).max())
+    if magnify is None:
+        magnify = 0.1 * extent / largest if largest > 0 else 1.0
+    x, y = points + magnify * np.asarray(displacement).T
+    for i, which in enumerate(np.unique(body)):
+        ax.triplot(x, y, elements[:, body == which].T, color=series_style(i)[0], lw=0.3,
+                   label=f"body {which}")
+    dots = ax.scatter(x[contact], y[contact], c=pressure, s=8, cmap="viridis", zorder=3,
+                      vmin=0.0, vmax=max(float(np.max(pressure, initial=0.0)), 1e-300))
+    ax.figure.colorbar(dots, ax=ax, label="contact pressure")
+    ax.set_aspect("equal")
+    ax.set_title(f"deformed (displacements × {magnify:.3g})", fontsize=9)
+    ax.legend(fontsize=7)
+    return ax

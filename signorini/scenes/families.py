@@ -8,12 +8,12 @@ from __future__ import annotations
 
 from signorini.problem_files import is_problem_file
 from signorini.scenes import (block, hertz_cylinder, hertz_sphere, hertz_sphere_3d, hertz_two_cylinders,
-                              punch, reverse_hertz, two_block_patch)
+                              hertz_two_spheres, punch, reverse_hertz, two_block_patch)
 from signorini.scenes.registry import SCENES, get_scene, register, scene_reference, unregister
 
 # in this order the validation suite runs their cases (the simplest scene first)
 for _module in (block, hertz_cylinder, hertz_sphere, hertz_sphere_3d, punch, reverse_hertz,
-                two_block_patch, hertz_two_cylinders):
+                two_block_patch, hertz_two_cylinders, hertz_two_spheres):
     register(_module.FAMILY)
 
 #: the families every process knows (registered on import of the package)

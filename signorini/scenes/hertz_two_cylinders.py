@@ -34,7 +34,7 @@ from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus
-from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Param, SceneFamily, checked_ratio,
+from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Case, Param, SceneFamily, checked_ratio,
                                    contact_ratio, length, one_of, positive)
 from signorini.scenes.hertz_cylinder import PARAMS as CYLINDER_PARAMS
 from signorini.scenes.hertz_cylinder import SIZE as ONE_DISC
@@ -42,7 +42,7 @@ from signorini.scenes.meshing import GradedDisc, graded_quarter_disc
 from signorini.scenes.size import CountedSize
 from signorini.scenes.two_block_patch import DISCRETISATION, materials
 
-__all__ = ["FAMILY", "pair_radius"]
+__all__ = ["FAMILY", "body", "disc", "pair_load_choice", "pair_modulus", "pair_radius"]
 
 #: the analytic reference (signorini.references) this family's problems compare with
 REFERENCE = "hertz-2d"
@@ -82,12 +82,15 @@ def pair_radius(p: dict[str, Any]) -> float:
     return 1.0 / (1.0 / p["R1"] + 1.0 / p["R2"])
 
 
-def _modulus(p: dict[str, Any]) -> float:
+def pair_modulus(p: dict[str, Any]) -> float:
+    """``E*`` of the pair (:func:`~signorini.fem.two_bodies.series_modulus`)."""
     return series_modulus(p["E1"], p["nu1"], p["E2"], p["nu2"])
 
 
-def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
-    """The target load P (None: a prescribed push) and the push δ (None: matched to P)."""
+def pair_load_choice(p: dict[str, Any], given: set[str], half_width: Any,
+                     load: Any) -> tuple[float | None, float | None]:
+    """The target load P (None: a prescribed push) and the push δ (None: matched to P), with
+    Hertz's ``half_width(P, R*, E*)`` and its inverse ``load(a, R*, E*)``."""
     chosen = {name for name in given & {"P", "a_over_R", "delta"} if p[name] is not None}
     if len(chosen) > 1:
         raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
@@ -96,17 +99,23 @@ def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, floa
     if "delta" in chosen:
         return None, p["delta"]
     if "P" in chosen:
-        checked_ratio(hertz_cylinder_half_width(p["P"], R, _modulus(p)) / R, "P", p["P"])
+        checked_ratio(half_width(p["P"], R, pair_modulus(p)) / R, "P", p["P"])
         return p["P"], None
-    return hertz_cylinder_load(p["a_over_R"] * R, R, _modulus(p)), None
+    return load(p["a_over_R"] * R, R, pair_modulus(p)), None
 
 
-def _disc(p: dict[str, Any], radius: float, a: float, extent: float) -> GradedDisc:
+def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
+    return pair_load_choice(p, given, hertz_cylinder_half_width, hertz_cylinder_load)
+
+
+def disc(p: dict[str, Any], radius: float, a: float, extent: float) -> GradedDisc:
+    """One cylinder's quarter disc of ``radius``, graded to the half-width ``a``, its contact
+    candidates reaching ``extent`` times a."""
     return graded_quarter_disc(radius, a / radius, p["n_contact"], p["grading"], 0, extent,
                                mesher=p["mesher"])
 
 
-def _body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str, upper: bool,
+def body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str, upper: bool,
           traction: bool) -> Body:
     """One cylinder: its quarter disc (mirrored below y = 0 for the lower one) held on its axis,
     its cut pushed by ``push`` (the lower one's: held), whole or at its centre node under a
@@ -124,16 +133,16 @@ def _body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str, u
 def build(p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
     """The two quarter discs in physical units: upper (slave) on lower (master)."""
     target, delta = _load_choice(p, set() if given is None else given)
-    R, E_star = pair_radius(p), _modulus(p)
+    R, E_star = pair_radius(p), pair_modulus(p)
     a = hertz_cylinder_half_width(target, R, E_star) if target is not None else p["a_over_R"] * R
     delta_nominal = delta if delta is not None else a * a / R
-    upper = _disc(p, p["R1"], a, p["candidates"])
-    lower = _disc(p, p["R2"], a, MASTER_REACH * p["candidates"])
+    upper = disc(p, p["R1"], a, p["candidates"])
+    lower = disc(p, p["R2"], a, MASTER_REACH * p["candidates"])
     traction = target is not None and p["loading"] == "traction"
     params = dict(p, P=target, delta=delta_nominal, a_over_R=a / R if target is not None else None)
     return TwoBodyModel(
-        slave=_body(upper, p["E1"], p["nu1"], delta_nominal, p["volumetric"], True, traction),
-        master=_body(lower, p["E2"], p["nu2"], 0.0, p["volumetric"], False, traction),
+        slave=body(upper, p["E1"], p["nu1"], delta_nominal, p["volumetric"], True, traction),
+        master=body(lower, p["E2"], p["nu2"], 0.0, p["volumetric"], False, traction),
         discretisation=p["discretisation"], length_scale=R, force_multiplicity=2.0,
         reference=ReferenceData(REFERENCE, E_star=E_star, R=R), params=params,
         target_load=target, predicted=lambda points: points[:, 0] < a,
@@ -144,7 +153,7 @@ def mesh_dofs(p: dict[str, Any]) -> float:
     """The dofs of the two graded discs: ``hertz-cylinder``'s size model for each."""
     target, _ = _load_choice(p, set())
     R = pair_radius(p)
-    a = hertz_cylinder_half_width(target, R, _modulus(p)) if target is not None else p["a_over_R"] * R
+    a = hertz_cylinder_half_width(target, R, pair_modulus(p)) if target is not None else p["a_over_R"] * R
     return sum(ONE_DISC.graded({**p, "P": None, "a_over_R": a / radius}) for radius in (p["R1"], p["R2"]))
 
 
@@ -152,4 +161,7 @@ FAMILY = SceneFamily(
     name="hertz-two-cylinders",
     summary="two elastic cylinders in contact, plane strain, each quarter meshed on its own",
     params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE,
-    size_model=CountedSize(mesh_dofs), convergence_start={"n_contact": 15, "grading": 0.6})
+    size_model=CountedSize(mesh_dofs), convergence_start={"n_contact": 15, "grading": 0.6},
+    # unlike cylinders on a coarse mesh: every method of the suite, the dense ones too
+    validation=(Case("hertz-two-cylinders", "hertz-two-cylinders",
+                     {"E2": 3.0, "nu2": 0.2, "R2": 2.0, "n_contact": 16, "grading": 0.4}),))

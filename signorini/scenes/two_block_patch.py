@@ -37,7 +37,7 @@ from signorini.errors import InputError
 from signorini.fem.mortar import DISCRETISATIONS
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel
-from signorini.scenes.base import (VOLUMETRIC, Param, SceneFamily, at_least, length, one_of,
+from signorini.scenes.base import (VOLUMETRIC, Case, Param, SceneFamily, at_least, length, one_of,
                                    poisson_ratio, positive)
 from signorini.scenes.size import CountedSize
 
@@ -142,4 +142,6 @@ FAMILY = SceneFamily(
     name="two-block-patch",
     summary="contact patch test: an elastic block on an elastic block, non-matching faces",
     params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE,
-    size_model=CountedSize(mesh_dofs))
+    size_model=CountedSize(mesh_dofs),
+    validation=(Case("two-block-patch", "two-block-patch",
+                     {"E1": 1.0, "nu1": 0.3, "E2": 3.0, "nu2": 0.2, "H2": 0.7}),))

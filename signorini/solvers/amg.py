@@ -402,5 +402,5 @@ METHODS = (
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
            requires=("pyamg",), extra="", options=tuple(DEFAULTS),
            matches_load=lambda problem: border_factor(problem) is not None,
-           prediction="active set"),
+           prediction="active set", bound_rows=True),
 )

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
 import numpy as np
+import scipy.sparse as sp
 
 from signorini.adequacy import adequacy, warnings
 from signorini.diagnose import explain
@@ -64,7 +65,10 @@ class Method:
     whose capabilities are then the ones asked (:meth:`runs`). A ``scaled`` method is
     handed a view of the problem in units that make its numbers of order one (its answer
     mapped back to the problem's units before it is judged); a method that is not scaled (a
-    user's) is handed the problem as it was given.
+    user's) is handed the problem as it was given. A ``bound_rows`` method takes each contact
+    row as a bound on dofs of its own (:mod:`signorini.solvers.bounds`): it refuses, by
+    :meth:`check_rows`, a problem whose rows share a dof (two bodies' rows on the master's
+    dofs, obstacles that meet at a node).
     """
 
     name: str
@@ -82,6 +86,7 @@ class Method:
     warm_from_load: bool = False
     chooses: Callable[..., "Method"] | None = None
     scaled: bool = True
+    bound_rows: bool = False
 
     @property
     def defaults(self) -> Defaults:
@@ -111,6 +116,13 @@ class Method:
         """The method that runs on ``problem``: this one, or the one it chooses."""
         return self if self.chooses is None else self.chooses(problem, options or {}, warm_start)
 
+    def check_rows(self, problem: ContactProblem) -> None:
+        """InputError when this method takes the rows as bounds and ``problem``'s share a dof."""
+        if self.bound_rows and rows_share_dofs(problem.N):
+            raise InputError(f"method {self.name!r} takes each contact row as a bound on dofs of "
+                             "its own, and this problem's rows share dofs (two bodies, or "
+                             "obstacles that meet): use pdas, nested, condensed or a qp-* method")
+
     def matches(self, problem: ContactProblem) -> bool:
         """It matches ``problem``'s pending target load itself (see ``matches_load``)."""
         return self.matches_load is not None and bool(self.matches_load(problem))
@@ -136,6 +148,11 @@ class Method:
                 for name, text in texts.items()}
 
 
+def rows_share_dofs(N: Any) -> bool:
+    """Two rows of the constraint matrix N have a nonzero on one dof."""
+    columns = sp.csc_matrix(N, copy=True)
+    columns.eliminate_zeros()
+    return bool(np.any(np.diff(columns.indptr) > 1))
 
 
 def check_tol(tol: Any, name: str = "tol") -> float | None:

@@ -402,5 +402,5 @@ METHODS = tuple(
     Method(name=name, function=_make(name), summary=SUMMARIES[name],
            requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
            exact=name == "petsc-vi", options=tuple(DEFAULTS),
-           typed_options=DEFAULTS)
+           typed_options=DEFAULTS, bound_rows=True)
     for name in KINDS)

@@ -117,6 +117,7 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
     """
     spec, tol, max_iter, options = request
     method = spec.name  # a callable given as the method is known by its name
+    spec.runs(problem, options, warm_start).check_rows(problem)
     if problem.pending and not spec.runs(problem, options, warm_start).matches(problem):
         raise InputError(f"method {method!r} solves the QP as it is, and this problem's target "
                          "load is not matched yet: solve it with signorini.solve (load control "
