@@ -25,6 +25,7 @@ import mesher_compare  # noqa: E402  (tools/mesher_compare.py: the Hertz discs' 
 import mesher_front  # noqa: E402  (tools/mesher_front.py: accuracy against time per mesher)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 import startup  # noqa: E402  (tools/startup.py: whole-process time before the contact)
+import two_bodies  # noqa: E402  (tools/two_bodies.py: the patch test and Hertz between two bodies)
 
 from signorini.files import atomic_write_text  # noqa: E402
 from signorini.output.report import readme_validation  # noqa: E402
@@ -39,7 +40,9 @@ PEER = ROOT / "docs" / "peer.md"
 CONVERGENCE = ROOT / "docs" / "convergence.md"
 DERIVATIVES = ROOT / "docs" / "derivatives.md"
 MESHER = ROOT / "docs" / "mesher.md"
-DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE, DERIVATIVES, MESHER)
+TWO_BODIES = ROOT / "docs" / "two-bodies.md"
+DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE, DERIVATIVES, MESHER,
+             TWO_BODIES)
 #: the contact half-width of each convergence study's scene at its defaults (h / a in the tables)
 STUDY_A = {"hertz-cylinder": 0.05, "hertz-sphere": 0.05, "reverse-hertz": 0.02, "punch": 1.0}
 STUDY_COLUMNS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
@@ -168,6 +171,9 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
                 "mesher-load": mesher_compare.machine_load(),
                 "mesher-front": mesher_front.table(mesher_front.load()),
                 "mesher-front-load": mesher_front.machine_load()}
+    if document == TWO_BODIES:
+        return {**{f"two-bodies-{name}": table for name, table in two_bodies.tables(two_bodies.load()).items()},
+                "two-bodies-cost": two_bodies.cost_table(json.loads(two_bodies.COST.read_text()))}
     raise ValueError(f"no generated blocks for {document}")
 
 

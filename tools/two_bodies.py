@@ -2,6 +2,7 @@
 
     .venv/bin/python tools/two_bodies.py      # about five minutes; writes docs/two-bodies/runs.json
     .venv/bin/python tools/two_bodies.py --figure   # docs/two-bodies/cylinders-deformed.png
+    .venv/bin/python tools/two_bodies.py --cost     # docs/two-bodies/cost.json (a minute)
 
 Every run is a task of the studies' runner (signorini.studies.runner): pdas (at tol 1e-10 on
 the blocks, 1e-8 on the cylinders: ``CYLINDERS_TOL``) on the scene as signorini.solve builds
@@ -16,13 +17,21 @@ it, measured against the scene's reference.
 - ``dissimilar``: equal radii and ν, E1/E2 = 1, 3 and 1/3, with the rows' normal vertical
   (the default) or each master segment's, on the default mesh and a finer one.
 
-docs/two-bodies.md quotes the tables that ``tables`` renders from the JSON.
+``--cost`` times two bodies against one of about as many dofs: hertz-two-cylinders at its
+defaults and hertz-cylinder at refine=1, each solved in process by ``signorini.solve`` with
+pdas and with auto, the two scenes in turn, :data:`COST_REPEAT` times; the fastest of each is
+kept with the work counted (factorisations, back-solves) and the machine's load average.
+
+docs/two-bodies.md quotes the tables that ``tables`` and ``cost_table`` render from the JSON
+(tools/readme.py writes them).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +43,10 @@ from signorini.studies.task import Task
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "two-bodies" / "runs.json"
+COST = OUT.parent / "cost.json"
+#: two bodies and one body of about as many dofs, and how often each is solved for its time
+COST_SCENES = (("hertz-two-cylinders", {}), ("hertz-cylinder", {"refine": 1}))
+COST_REPEAT = 5
 DISCRETISATIONS = ("mortar", "mortar-standard", "nts")
 MESH_RATIOS = (1.0, 1.7, 1 / 1.7, 3.3, 1 / 3.3)
 PATCH = {"E2": 3.0, "nu2": 0.2, "H2": 0.7}
@@ -157,9 +170,55 @@ def load() -> list[dict]:
     return json.loads(OUT.read_text())["rows"]
 
 
+def cost() -> dict:
+    """In-process time and work of two bodies against one body of about as many dofs."""
+    import signorini
+    from signorini.numerics.work import counting
+
+    rows, before = [], os.getloadavg()[0]
+    for method in ("pdas", "auto"):
+        best: dict[str, dict] = {}
+        for _ in range(COST_REPEAT):
+            for scene, params in COST_SCENES:
+                with counting() as work:
+                    start = time.perf_counter()
+                    result = signorini.solve(scene, method, params=params)
+                    seconds = time.perf_counter() - start
+                if scene not in best or seconds < best[scene]["seconds"]:
+                    best[scene] = {"scene": scene, "method": method, "dofs": result.problem.n,
+                                   "status": result.status, "seconds": seconds,
+                                   "factorisations": work.factorisations,
+                                   "back_solves": work.back_solves}
+        rows += best.values()
+    return {"command": "python tools/two_bodies.py --cost", "cores": os.cpu_count(),
+            "load_average": [before, os.getloadavg()[0]], "rows": rows}
+
+
+def cost_table(record: dict) -> str:
+    """Two bodies against one, per method: dofs, time in process, work, and the ratios."""
+    lines = [f"Fastest of {COST_REPEAT} in-process solves each, the scenes in turn, on the "
+             f"machine's {record['cores']} cores at a load average of "
+             f"{record['load_average'][0]:.1f} before and {record['load_average'][1]:.1f} after "
+             f"(`{record['command']}`).", "",
+             "| method | scene | dofs | status | time | factorisations | back-solves | "
+             "time, two bodies / one |", "|---|---|---:|---|---:|---:|---:|---:|"]
+    for method in dict.fromkeys(r["method"] for r in record["rows"]):
+        two, one = (next(r for r in record["rows"] if r["method"] == method and r["scene"] == s)
+                    for s, _ in COST_SCENES)
+        for r in (one, two):
+            ratio = f"{two['seconds'] / one['seconds']:.2f}" if r is two else ""
+            lines.append(f"| {method} | {r['scene']} | {r['dofs']:,} | {r['status']} | "
+                         f"{r['seconds']:.3f} s | {r['factorisations']} | {r['back_solves']} | "
+                         f"{ratio} |")
+    return "\n".join(lines)
+
+
 if __name__ == "__main__":
     if "--figure" in sys.argv:
         sys.exit(print(f"written: {figure()}", file=sys.stderr))
+    if "--cost" in sys.argv:
+        atomic_write_text(COST, to_json(cost()))
+        sys.exit(print(cost_table(json.loads(COST.read_text()))))
     if "--tables" not in sys.argv:
         rows = run()
         atomic_write_text(OUT, to_json({"command": "python tools/two_bodies.py", "rows": rows}))
