@@ -44,6 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
+from signorini.fem.topology import with_topology
 
 log = logging.getLogger(__name__)
 
@@ -82,7 +83,7 @@ class Face:
         facets = np.asarray(facets, dtype=int)
         if mesh.p.shape[0] != 2 or facets.size == 0:
             raise InputError("a contact face needs boundary facets (edges) of a 2D mesh")
-        ends = mesh.facets[:, facets]
+        ends = with_topology(mesh).facets[:, facets]
         nodes = _along(ends)
         local = np.searchsorted(np.sort(nodes), ends)
         local = np.argsort(nodes)[local]
@@ -170,25 +171,10 @@ class Coupling:
         return sp.csr_matrix((local.data, (local.row, places[local.col])), shape=(self.m, n))
 
 
-def _triplets(shape: tuple[int, int]):
-    """A sparse matrix built from (row, column, value) lists, summed where they repeat."""
-    rows: list[np.ndarray] = []
-    cols: list[np.ndarray] = []
-    vals: list[np.ndarray] = []
-
-    def add(r, c, v) -> None:
-        r, c, v = np.broadcast_arrays(r, c, v)
-        rows.append(r.ravel())
-        cols.append(c.ravel())
-        vals.append(v.ravel())
-
-    def build() -> sp.csr_matrix:
-        if not rows:
-            return sp.csr_matrix(shape)
-        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                             shape=shape)
-
-    return add, build
+def _summed(rows, cols, vals, shape: tuple[int, int]) -> sp.csr_matrix:
+    """A sparse matrix from (row, column, value) arrays (broadcast), summed where they repeat."""
+    rows, cols, vals = np.broadcast_arrays(rows, cols, vals)
+    return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=shape)
 
 
 def _kept(coupling: Coupling, keep: np.ndarray) -> Coupling:
@@ -246,31 +232,54 @@ def node_to_segment(slave: Face, master: Face, direction: np.ndarray | None = No
     xi_s = xi[k, nearest]
     normal = along[:, nearest] if direction is None else along[:, [0] * k.size]  # towards the master
     gap = np.einsum("ik,ik->k", foot[:, k, nearest] - slave.points, normal)
-    add_m, build_m = _triplets((slave.nodes.size, master.nodes.size))
-    add_m(k[:, None], master.segments[:, nearest].T, np.stack([1.0 - xi_s, xi_s], axis=1))
+    M = _summed(k[:, None], master.segments[:, nearest].T, np.stack([1.0 - xi_s, xi_s], axis=1),
+                (slave.nodes.size, master.nodes.size))
     D = sp.identity(slave.nodes.size, format="csr")
-    M = build_m()
     coupling = Coupling(kind="nts", slave=k, D=D, M=M, slave_rows=_vector(D, normal),
                         master_rows=-_vector(M, normal), gap=gap, weights=slave.weights(radial))
     return _kept(coupling, keep)
 
 
-def _dual(r0: float, r1: float, radial: bool) -> np.ndarray:
-    """The coefficients A (2, 2) of the dual basis ``ψ = A φ`` on a slave segment whose ends
-    have radii ``r0, r1``: ``A = D Mₑ⁻¹``, Mₑ the segment's mass matrix ∫ φ φᵀ (weight r when
-    ``radial``) and D its row sums, so that ``∫ ψᵢ φⱼ = δᵢⱼ ∫ φᵢ``; ``[[2, −1], [−1, 2]]`` when
-    the weight is 1."""
+def _dual(r0, r1, radial: bool) -> np.ndarray:
+    """The coefficients A (..., 2, 2) of the dual basis ``ψ = A φ`` on slave segments whose ends
+    have radii ``r0, r1`` (broadcast): ``A = D Mₑ⁻¹``, Mₑ the segment's mass matrix ∫ φ φᵀ
+    (weight r when ``radial``) and D its row sums, so that ``∫ ψᵢ φⱼ = δᵢⱼ ∫ φᵢ``;
+    ``[[2, −1], [−1, 2]]`` when the weight is 1."""
+    r0, r1 = np.broadcast_arrays(np.asarray(r0, dtype=float), np.asarray(r1, dtype=float))
     phi = np.stack([1.0 - GAUSS_POINTS, GAUSS_POINTS])
-    weight = GAUSS_WEIGHTS * ((1.0 - GAUSS_POINTS) * r0 + GAUSS_POINTS * r1 if radial else 1.0)
-    mass = np.einsum("iq,jq,q->ij", phi, phi, weight)
-    return np.diag(mass.sum(axis=1)) @ np.linalg.inv(mass)
+    weight = GAUSS_WEIGHTS * ((1.0 - GAUSS_POINTS) * r0[..., None] + GAUSS_POINTS * r1[..., None]
+                              if radial else np.ones(r0.shape + (1,)))
+    mass = np.einsum("iq,jq,...q->...ij", phi, phi, weight)
+    return mass.sum(axis=-1)[..., None] * np.linalg.inv(mass)
 
 
-def _multiplier(eta: np.ndarray, dual: np.ndarray | None) -> np.ndarray:
-    """ψ of a slave segment's two nodes at its coordinates ``eta`` (2, ...): φ (standard,
-    ``dual`` None) or ``A φ`` with the segment's dual coefficients A."""
-    phi = np.stack([1.0 - eta, eta])
-    return phi if dual is None else np.einsum("ik,k...->i...", dual, phi)
+#: at most this many (slave, master) segment pairs are projected at once
+PAIRS_AT_ONCE = 1 << 20
+
+
+def _overlaps(slave: Face, master: Face, direction: np.ndarray | None) -> tuple[np.ndarray, ...]:
+    """The (slave, master) segment pairs that overlap, slave-major: each master segment facing
+    a slave segment (opposite normals) projected onto it along the slave normal (or
+    ``direction``). Returns the pairs' slave and master segments and the slave coordinates η
+    of the master segment's two ends (2, p) and of the overlap (lo, hi)."""
+    x0 = slave.points[:, slave.segments[0]]  # (2, e¹)
+    t = slave.points[:, slave.segments[1]] - x0
+    along = slave.normals if direction is None else np.asarray(direction, dtype=float)[:, None]
+    along = np.broadcast_to(along, x0.shape)
+    master_ends = master.points[:, master.segments][:, :, None, :]  # (2, 2, 1, e²)
+    block = max(1, PAIRS_AT_ONCE // max(1, master.segments.shape[1]))
+    found = []
+    for first in range(0, x0.shape[1], block):
+        part = slice(first, first + block)
+        with np.errstate(divide="ignore", invalid="ignore"):  # along the direction: no piece
+            ends = (_cross(master_ends - x0[:, None, part, None], along[:, None, part, None])
+                    / _cross(t[:, part], along[:, part])[None, :, None])  # (2, b, e²)
+        lo = np.clip(ends.min(axis=0), 0.0, 1.0)
+        hi = np.clip(ends.max(axis=0), 0.0, 1.0)
+        facing = slave.normals[:, part].T @ master.normals < 0.0  # (b, e²)
+        s, m = np.nonzero((hi - lo > END_TOLERANCE) & facing)
+        found.append((s + first, m, ends[:, s, m], lo[s, m], hi[s, m]))
+    return tuple(np.concatenate(column, axis=-1) for column in zip(*found))
 
 
 def mortar(slave: Face, master: Face, basis: str = "dual",
@@ -279,8 +288,8 @@ def mortar(slave: Face, master: Face, basis: str = "dual",
 
     Segment to segment on the slave face: each master segment that faces a
     slave segment (opposite normals) is projected onto it along the slave
-    normal, the overlap is integrated by two Gauss points with n the master
-    segment's normal reversed, and ``Dₛₖ``,
+    normal (:func:`_overlaps`), each overlap is integrated by two Gauss points
+    with n the master segment's normal reversed, and ``Dₛₖ``,
     ``Mₛⱼ``, ``g̃ₛ`` and ``wₛ = ∫ φₛ ds`` accumulate over the overlaps with
     ψₛ the ``basis`` ("dual": biorthogonal, "standard": ψₛ = φₛ with D lumped).
     Slave nodes the master face does not reach get no row. ``radial``: every
@@ -290,53 +299,46 @@ def mortar(slave: Face, master: Face, basis: str = "dual",
     if basis not in ("dual", "standard"):
         raise InputError(f"mortar basis={basis!r} must be 'dual' or 'standard'")
     ks, km = slave.nodes.size, master.nodes.size
-    add_d, build_d = _triplets((ks, ks))
-    add_m, build_m = _triplets((ks, km))
-    add_sr, build_sr = _triplets((ks, 2 * ks))
-    add_mr, build_mr = _triplets((ks, 2 * km))
-    gap, weights = np.zeros(ks), np.zeros(ks)
-    master_ends = master.points[:, master.segments]  # (2, 2, e²)
-    for (a, b), x0, x1, n in zip(slave.segments.T, slave.points[:, slave.segments[0]].T,
-                                 slave.points[:, slave.segments[1]].T, slave.normals.T):
-        t = x1 - x0
-        h2 = t @ t
-        along = n if direction is None else np.asarray(direction, dtype=float)
-        with np.errstate(divide="ignore", invalid="ignore"):  # along the direction: no piece
-            eta_ends = _cross(master_ends - x0[:, None, None], along) / _cross(t, along)  # (2, e²)
-        lo = np.clip(eta_ends.min(axis=0), 0.0, 1.0)
-        hi = np.clip(eta_ends.max(axis=0), 0.0, 1.0)
-        pieces = np.flatnonzero((hi - lo > END_TOLERANCE) & (n @ master.normals < 0.0))
-        if pieces.size == 0:
-            continue
-        eta = lo[pieces, None] + (hi - lo)[pieces, None] * GAUSS_POINTS  # (p, q)
-        dw = (hi - lo)[pieces, None] * GAUSS_WEIGHTS * np.sqrt(h2)  # ds of each point
-        if radial:  # r ds: the integrands stay cubic in eta, the two points exact
-            dw = dw * (x0[0] + eta * t[0])
-        xi = (eta - eta_ends[0, pieces, None]) / (eta_ends[1, pieces, None] - eta_ends[0, pieces, None])
-        phi_s = np.stack([1.0 - eta, eta])  # (2, p, q)
-        phi_m = np.stack([1.0 - xi, xi])
-        psi = _multiplier(eta, None if basis == "standard" else _dual(x0[0], x1[0], radial))
-        y0, y1 = master_ends[:, 0, pieces][..., None], master_ends[:, 1, pieces][..., None]
-        across = (y0 + xi * (y1 - y0) - (x0[:, None, None] + eta * t[:, None, None]))
-        normal = (-master.normals[:, pieces] if direction is None  # (2, p): as node-to-segment
-                  else np.repeat(np.asarray(direction, dtype=float)[:, None], pieces.size, axis=1))
-        g = np.einsum("ip,ipq->pq", normal, across)  # normal distance from slave to master
-        slave_pair, master_pair = np.array([a, b]), master.segments[:, pieces]  # (2,), (2, p)
-        mm = np.einsum("ipq,jpq,pq->ijp", psi, phi_m, dw)  # ∫ψᵢ φ²ⱼ on each piece
-        if basis == "standard":  # lumped: ∫ φᵢ on the diagonal
-            dd = np.einsum("ik,ipq,pq->ikp", np.eye(2), phi_s, dw)
-        else:
-            dd = np.einsum("ipq,kpq,pq->ikp", psi, phi_s, dw)
-        add_d(slave_pair[:, None], slave_pair[None, :], dd.sum(axis=2))
-        add_m(slave_pair[:, None, None], master_pair[None], mm)
-        for c in range(2):
-            add_sr(slave_pair[:, None, None], 2 * slave_pair[None, :, None] + c, dd * normal[c])
-            add_mr(slave_pair[:, None, None], 2 * master_pair[None] + c, -mm * normal[c])
-        np.add.at(gap, slave_pair, np.einsum("ipq,pq,pq->i", psi, g, dw))
-        np.add.at(weights, slave_pair, np.einsum("ipq,pq->i", phi_s, dw))
+    s, m, eta_ends, lo, hi = _overlaps(slave, master, direction)
+    x0 = slave.points[:, slave.segments[0, s]][..., None]  # (2, p, 1)
+    t = slave.points[:, slave.segments[1, s]][..., None] - x0
+    eta = lo[:, None] + (hi - lo)[:, None] * GAUSS_POINTS  # (p, q)
+    dw = (hi - lo)[:, None] * GAUSS_WEIGHTS * np.sqrt(t[0] ** 2 + t[1] ** 2)  # ds of each point
+    if radial:  # r ds: the integrands stay cubic in eta, the two points exact
+        dw = dw * (x0[0] + eta * t[0])
+    xi = (eta - eta_ends[0, :, None]) / (eta_ends[1, :, None] - eta_ends[0, :, None])
+    phi_s = np.stack([1.0 - eta, eta])  # (2, p, q)
+    phi_m = np.stack([1.0 - xi, xi])
+    if basis == "standard":
+        psi = phi_s
+    else:
+        ends_r = slave.points[0, slave.segments]  # (2, e¹)
+        psi = np.einsum("pik,kpq->ipq", _dual(ends_r[0], ends_r[1], radial)[s], phi_s)
+    y0, y1 = master.points[:, master.segments[0, m]], master.points[:, master.segments[1, m]]
+    across = y0[..., None] + xi * (y1 - y0)[..., None] - (x0 + eta * t)  # (2, p, q)
+    normal = (-master.normals[:, m] if direction is None  # (2, p): as node-to-segment
+              else np.repeat(np.asarray(direction, dtype=float)[:, None], s.size, axis=1))
+    g = np.einsum("ip,ipq->pq", normal, across)  # normal distance from slave to master
+    slave_pair, master_pair = slave.segments[:, s], master.segments[:, m]  # (2, p)
+    mm = np.einsum("ipq,jpq,pq->ijp", psi, phi_m, dw)  # ∫ψᵢ φ²ⱼ on each piece
+    if basis == "standard":  # lumped: ∫ φᵢ on the diagonal
+        dd = np.einsum("ik,ipq,pq->ikp", np.eye(2), phi_s, dw)
+    else:
+        dd = np.einsum("ipq,kpq,pq->ikp", psi, phi_s, dw)
+    row, xy = slave_pair[:, None], np.arange(2)  # rows (2, 1, p); the (x, y) dofs of a node
+    slave_rows = _summed(row[..., None], 2 * slave_pair[None, ..., None] + xy,
+                         dd[..., None] * normal.T, (ks, 2 * ks))
+    master_rows = _summed(row[..., None], 2 * master_pair[None, ..., None] + xy,
+                          -mm[..., None] * normal.T, (ks, 2 * km))
+    gap = np.bincount(slave_pair.ravel(), np.einsum("ipq,pq,pq->ip", psi, g, dw).ravel(),
+                      minlength=ks)
+    weights = np.bincount(slave_pair.ravel(), np.einsum("ipq,pq->ip", phi_s, dw).ravel(),
+                          minlength=ks)
     coupling = Coupling(kind="mortar" if basis == "dual" else "mortar-standard",
-                        slave=np.arange(ks), D=build_d(), M=build_m(), slave_rows=build_sr(),
-                        master_rows=build_mr(), gap=gap, weights=weights)
+                        slave=np.arange(ks), D=_summed(row, slave_pair[None], dd, (ks, ks)),
+                        M=_summed(row, master_pair[None], mm, (ks, km)),
+                        slave_rows=slave_rows, master_rows=master_rows, gap=gap,
+                        weights=weights)
     return _kept(coupling, weights > 0)
 
 

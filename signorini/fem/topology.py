@@ -143,6 +143,6 @@ def moved(mesh: Any, p: np.ndarray) -> Any:
 
 def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
     """The boundary facets whose ends are all among ``nodes`` (triangles or tetrahedra)."""
-    boundary = mesh.boundary_facets()
+    boundary = with_topology(mesh).boundary_facets()
     inside = np.isin(mesh.facets[:, boundary], nodes).all(axis=0)
     return boundary[inside]

@@ -31,6 +31,7 @@ from signorini.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.assembly import lame_stiffness, nodal_dofs
 from signorini.fem.mortar import Face, couple
+from signorini.fem.topology import moved
 from signorini.fem.volumetric import resolve
 from signorini.problem import ContactProblem, Discretisation, Push, Scales
 
@@ -126,7 +127,7 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     mesh = MeshTri(np.hstack([slave.mesh.p, master.mesh.p]) / L,
                    np.hstack([slave.mesh.t, master.mesh.t + first]))
     dof_table = nodal_dofs(mesh)
-    K_full = sp.block_diag([body.stiffness(MeshTri(body.mesh.p / L, body.mesh.t), stress,
+    K_full = sp.block_diag([body.stiffness(moved(body.mesh, body.mesh.p / L), stress,
                                            axisymmetric) for body in (slave, master)], format="csr")
     n_full = K_full.shape[0]
 
@@ -211,7 +212,7 @@ def _cut_traction(bodies: tuple[Body, Body], offsets: tuple[int, int], L: float,
         if body.traction is None:
             continue
         facets, direction = body.traction
-        cut = Face.of(MeshTri(body.mesh.p / L, body.mesh.t), facets)
+        cut = Face.of(moved(body.mesh, body.mesh.p / L), facets)
         weights = cut.weights(axisymmetric)
         dofs = dof_table[1, cut.nodes + first]
         f_load[dofs] = direction * weights / (multiplicity * weights.sum())
