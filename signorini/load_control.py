@@ -239,8 +239,11 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
             matched = match(problem, zone)
         stages["load_control"] = matched.work
         problem = matched.problem
-    if matched is not None and start is None and request.method.warm_from_load:
-        start = matched.warm_start  # load control's answer, taken as an explicit warm start
+    if matched is not None and start is None and request.method.warm_from_load and (
+            runs.prediction != "zone" or matched.warm_start.zone_solver is not None):
+        # load control's answer, taken as an explicit warm start (by a method that predicts a
+        # zone, only with K factorised around one: else it takes the scene's prediction)
+        start = matched.warm_start
     elif runs.prediction:  # a method that starts cold, from the scene's predictions only
         with counting() as work, timed(seconds, "prediction"):
             options = {**_predictions(problem, runs.prediction, options, coarse, zone), **options}
