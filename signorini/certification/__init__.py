@@ -2,6 +2,6 @@
 
 ``kkt`` the KKT certificate and active sets; ``forward_error`` the bound on the force's error;
 ``adequacy`` whether the model was adequate (the boundary beyond the candidates);
-``diagnosis`` what makes a problem or an answer wrong; ``fingerprint`` that the problem judged
-is the problem given.
+``diagnosis`` what makes a problem or an answer wrong (that the problem judged is the problem
+given is held with the method's contract, :mod:`signorini.solvers.base`).
 """
