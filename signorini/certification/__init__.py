@@ -6,3 +6,11 @@ method holds; ``forward_error`` the bound on the force's error;
 ``diagnosis`` what makes a problem or an answer wrong (that the problem judged is the problem
 given is held with the method's contract, :mod:`signorini.solvers.base`).
 """
+
+from signorini.certification.adequacy import Adequacy, adequacy
+from signorini.certification.diagnosis import explain
+from signorini.certification.kkt import (Certificate, Comparison, active_set, certificate, classify,
+                                         compare, shortfall)
+
+__all__ = ["Adequacy", "Certificate", "Comparison", "active_set", "adequacy", "certificate",
+           "classify", "compare", "explain", "shortfall"]
