@@ -98,7 +98,8 @@ class Result:
     # -- the answer in physical units -------------------------------------------------------
     @property
     def profile(self) -> ContactProfile:
-        """Gaps, forces and pressures at the candidates (see :func:`signorini.references.pressure.contact_profile`)."""
+        """Gaps, forces and pressures at the candidates (see
+        :func:`signorini.references.pressure.contact_profile`)."""
         if not hasattr(self, "_profile"):
             self._profile = contact_profile(self.problem, self.solution)
         return self._profile
@@ -233,7 +234,7 @@ class Result:
         else:
             record["total_force"] = None
             record["contact"] = None
-        if "adequacy" in solution.extras:  # the boundary beyond the candidates (signorini.certification.adequacy)
+        if "adequacy" in solution.extras:  # the boundary beyond the candidates (certification.adequacy)
             record["adequacy"] = solution.extras["adequacy"]
         record["extras"] = {k: v for k, v in solution.extras.items()
                             if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}

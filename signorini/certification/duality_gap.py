@@ -144,7 +144,8 @@ def same_matrix(K, other) -> bool:
         return False
     x = np.random.default_rng(0).uniform(0.5, 1.5, K.shape[0])
     y = K @ x
-    return bool(np.max(np.abs(y - other @ x), initial=0.0) <= SAME_MATRIX_RTOL * (np.max(np.abs(y), initial=0.0) or 1.0))
+    scale = float(np.max(np.abs(y), initial=0.0)) or 1.0
+    return bool(np.max(np.abs(y - other @ x), initial=0.0) <= SAME_MATRIX_RTOL * scale)
 
 
 def _gap_on(problem: ContactProblem, u: np.ndarray, lam_plus: np.ndarray, Ku: np.ndarray,
