@@ -107,5 +107,3 @@ def _family_values(data: dict[str, Any], ctx: SceneFileContext,
             raise ctx.error(str(exc), origin[key], key) from None
     values.update(overrides)
     return name, values
-
-
