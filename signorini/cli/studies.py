@@ -16,7 +16,8 @@ from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, PROBLEM_FILES, add_c
 def cmd_converge(args: argparse.Namespace) -> int:
     # each command loads what it needs (the studies start matplotlib)
     from signorini.files import all_or_none
-    from signorini.studies.convergence import check_study, grading_comparison, run_study, study_table, write_study  # as above
+    from signorini.studies.convergence import check_study, grading_comparison, run_study  # as above
+    from signorini.studies.convergence_report import study_table, write_study  # as above
 
     if args.levels < 0 or args.levels > 6:
         raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
