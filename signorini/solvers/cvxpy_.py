@@ -26,7 +26,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, take_options
-from signorini.solvers.qp import BACKEND_BY_NAME, COMMON_TYPES
+from signorini.solvers.qp_backends import BACKEND_BY_NAME, COMMON_TYPES
 
 log = logging.getLogger(__name__)
 
