@@ -60,8 +60,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from signorini.output.report import REPORT_FILES, checks_summary, write_suite_report  # as above
     from signorini.problem.files import problem_file_paths, read_problem  # as above
     from signorini.solvers.registry import check_request  # as above
-    from signorini.studies.suite import (TIGHT_TOL, problem_case, read_limits, run_suite,
-                                         select_cases)  # as above
+    from signorini.studies.suite import problem_case, run_suite, select_cases  # as above
+    from signorini.studies.suite_checks import TIGHT_TOL, read_limits  # as above
 
     time_limit = parse_time_limit(args.time_limit)
     tol = TIGHT_TOL if args.tol is None else parse_tol(args.tol)
