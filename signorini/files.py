@@ -96,10 +96,7 @@ def all_or_none() -> Iterator[None]:
         raise
     finally:
         _staged = outer
-    if outer is not None:
-        outer.extend(staged)
-    else:
-        _place(staged)
+    _place_or_stage(staged)  # into the enclosing block's outputs, or in their places
 
 
 def _discard(staged: list) -> None:

@@ -22,19 +22,10 @@ from signorini.references.analytic import (
     punch_pressure,
 )
 from signorini.problem.contact import ContactProblem, ContactSolution
-from signorini.references.profile import (
-    ContactProfile,
-    contact_half_width,
-    contact_profile,
-    half_line,
-    hertz_fit,
-    hertz_fit_tangent,
-    load_resultant,
-    radial_distance,
-    sub_profile,
-    symmetry_plane_profiles,
-    unit_of,
-)
+from signorini.references.profile import (ContactProfile, contact_half_width, contact_profile,
+                                          half_line, hertz_fit, hertz_fit_tangent, load_resultant,
+                                          radial_distance, sub_profile, symmetry_plane_profiles,
+                                          unit_of)
 
 __all__ = ["ContactProfile", "HertzComparison", "PunchComparison", "UniformComparison",
            "compare_hertz", "compare_hertz_sphere", "compare_punch", "compare_reverse_hertz",

@@ -43,16 +43,8 @@ from signorini.studies.runner import (
     run_tasks,
     task_row,
 )
-from signorini.studies.suite_checks import (
-    LIMITS,
-    REFERENCE_LABEL,
-    REFERENCE_METHOD,
-    TIGHT_TOL,
-    CaseResult,
-    Check,
-    case_checks,
-    label,
-)
+from signorini.studies.suite_checks import (LIMITS, REFERENCE_LABEL, REFERENCE_METHOD, TIGHT_TOL,
+                                           CaseResult, Check, case_checks, label)
 
 __all__ = ["DEFAULT_CASES", "REFERENCE", "SuiteResult", "TIME_LIMIT", "case_result", "case_tasks",
            "portable", "problem_case", "run_one", "run_suite", "run_task_of", "select_cases",
