@@ -188,7 +188,7 @@ def check_vtk_path(path: str | os.PathLike) -> tuple[str, str]:
     """``(absolute path, meshio format)`` of an export target, checked before any work.
 
     InputError for an empty path, a bad suffix, a directory or a path that
-    cannot be written (see :func:`signorini.files.check_output_file`).
+    cannot be written (see :func:`signorini.paths.check_output_file`).
     """
     file_format = FORMATS.get(Path(path).suffix.lower())
     if str(path) and file_format is None:

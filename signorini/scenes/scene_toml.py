@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from signorini.errors import InputError
-from signorini.files import check_input_file
+from signorini.paths import check_input_file
 
 __all__ = ["SceneFileContext", "read_scene_file"]
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from signorini.crosschecking import agreement
 from signorini.errors import InputError
-from signorini.files import check_input_file
+from signorini.paths import check_input_file
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.files import is_problem_file
 from signorini.references.catalogue import reference_metrics, reference_of
