@@ -28,8 +28,7 @@ from signorini.solvers import forms
 from signorini.solvers.base import Method
 from signorini.solvers.backend_output import c_output_discarded, silence_highs_banner
 from signorini.solvers.qp_backends import (BACKEND_BY_NAME, BACKENDS, COMMON_OPTIONS, COMMON_TYPES,
-                                           CONVERGED, DEFAULT_MAX_DENSE_DOFS, FAILED, MAX_ITER,
-                                           Backend)
+                                           DEFAULT_MAX_DENSE_DOFS, FAILED, MAX_ITER, Backend)
 from signorini.solvers.qp_options import typed
 
 __all__ = ["METHODS", "solve_qp"]
@@ -140,19 +139,12 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
     if result.build_time is not None and result.solve_time is not None:
         build_time += result.build_time
         elapsed = result.solve_time
-    extras = {"raw_status": report.raw_status, "backend": spec.name,
-              "backend_warnings": caught, **report.details, "form": data.name,
-              "form_work": data.work, "form_s": data.seconds, "form_note": note or data.note}
-    common = dict(message=f"{spec.label}: {report.raw_status}" + forms.said(data.name, extras),
-                  iterations=report.iterations or 0, build_time=build_time,
-                  solve_time=elapsed, extras=extras)
-    if result.x is None or (result.z is None and not data.bounds):
-        return ContactSolution.failure(spec.method_name, problem,
-                                       FAILED if status == CONVERGED else status, **common)
-    u, lam = data.answer(problem, result.x, result.z)
-    solution = ContactSolution(method=spec.method_name, u=u, lam=lam, status=status,
-                               factor=data.factor, **common)
-    return forms.polish(problem, data, solution, tol) if polishing else solution
+    extras = {"raw_status": report.raw_status, "backend": spec.name, "backend_warnings": caught,
+              **report.details}
+    return forms.solution_from(problem, data, spec.method_name, status, result.x, result.z,
+                               said_by=f"{spec.label}: {report.raw_status}", extras=extras,
+                               note=note, iterations=report.iterations, build_time=build_time,
+                               solve_time=elapsed, tol=tol, polishing=polishing)
 
 
 def _method_function(backend: Backend) -> Callable[..., ContactSolution]:
