@@ -32,7 +32,7 @@ the edge of the contact zone; :func:`contact_term` gives it per edge (2D models)
 measures what each part contributes and the estimate's effectivity.
 
 Everything here is in the problem's (dimensionless) units: energies in
-``force · displacement`` of :class:`signorini.problem.Scales`, per unit
+``force · displacement`` of :class:`signorini.problem.contact.Scales`, per unit
 thickness in plane strain and per radian in axisymmetric models.
 """
 
@@ -48,8 +48,8 @@ from skfem.quadrature import get_quadrature
 from signorini.fem.topology import facets_on
 from signorini.fem.stiffness import barycentric_gradients
 from signorini.fem.volumetric import nodal_volumetric_strain, simplex_gradients
-from signorini.kkt import active_set
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.certification.kkt import active_set
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: quadrature order of the element integrals: 2 integrates the plane-strain and 3D ones
 #: exactly (a linear field squared); the axisymmetric ones are rational (the hoop strain
