@@ -103,3 +103,13 @@ def test_the_pages_the_readme_moved_out_are_in_the_nav():
     nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
     for page in ("guide.md", "maths.md", "methods.md", "results.md", "performance.md", "tutorials.md"):
         assert f": {page}\n" in nav, page
+
+
+def test_mathjax_reads_the_notebooks_dollar_maths():
+    """Notebook pages keep Jupyter's $ $ maths (arithmatex converts only the Markdown pages'):
+    MathJax 3 must be configured for it before it loads, or the tutorials show raw TeX."""
+    config = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    scripts = config.split("extra_javascript:\n", 1)[1].split("\n")
+    assert scripts[0].startswith("  - javascripts/mathjax.js") and "mathjax@3" in scripts[1]
+    mathjax = (ROOT / "docs" / "javascripts" / "mathjax.js").read_text(encoding="utf-8")
+    assert '["$", "$"]' in mathjax and '["$$", "$$"]' in mathjax
