@@ -7,10 +7,10 @@ method holds; ``forward_error`` the bound on the force's error;
 given is held with the method's contract, :mod:`signorini.solvers.base`).
 """
 
-from signorini.certification.adequacy import Adequacy, adequacy
-from signorini.certification.diagnosis import explain
-from signorini.certification.kkt import (Certificate, Comparison, active_set, certificate, classify,
-                                         compare, shortfall)
+from signorini.certification.adequacy import Adequacy
+from signorini.certification.diagnosis import diagnose
+from signorini.certification.forward_error import ForwardError
+from signorini.certification.kkt import Certificate, active_set, certificate, compare
 
-__all__ = ["Adequacy", "Certificate", "Comparison", "active_set", "adequacy", "certificate",
-           "classify", "compare", "explain", "shortfall"]
+__all__ = ["Adequacy", "Certificate", "ForwardError", "active_set", "certificate", "compare",
+           "diagnose"]
