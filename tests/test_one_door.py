@@ -141,7 +141,7 @@ MUTATORS = {"append", "extend", "insert", "pop", "popitem", "remove", "clear", "
 #: module-level state kept on purpose, each with its reason (a public registration API, the
 #: outputs one command has written so far): not of the solve pipeline
 STATE_ALLOWED = {("scenes/registry.py", "SCENES"), ("files.py", "_created"),
-                 ("files.py", "_staged")}
+                 ("files.py", "_staged"), ("files.py", "_written")}
 
 
 def module_state_changed(path: Path) -> list[tuple[str, str]]:
@@ -149,15 +149,20 @@ def module_state_changed(path: Path) -> list[tuple[str, str]]:
     ``global`` statement."""
     tree = ast.parse(path.read_text())
     containers = (ast.Dict, ast.List, ast.Set, ast.DictComp, ast.ListComp, ast.SetComp)
+    def built(value) -> bool:
+        called = value.func if isinstance(value, ast.Call) else None
+        return isinstance(value, containers) or called is not None and ast.unparse(called).split(
+            "[")[0] in ("dict", "list", "set", "collections.OrderedDict", "defaultdict", "deque")
+
     state = set()
     for node in tree.body:
         value = node.value if isinstance(node, (ast.Assign, ast.AnnAssign)) else None
         targets = node.targets if isinstance(node, ast.Assign) else \
             [node.target] if isinstance(node, ast.AnnAssign) else []
-        called = value.func if isinstance(value, ast.Call) else None
-        built = isinstance(value, containers) or called is not None and ast.unparse(called).split(
-            "[")[0] in ("dict", "list", "set", "collections.OrderedDict", "defaultdict", "deque")
-        state |= {t.id for t in targets if isinstance(t, ast.Name) and built}
+        for target in targets:
+            pairs = zip(target.elts, value.elts) if isinstance(target, ast.Tuple) and \
+                isinstance(value, ast.Tuple) else [(target, value)]
+            state |= {name.id for name, each in pairs if isinstance(name, ast.Name) and built(each)}
     found = []
     for function in ast.walk(tree):
         if not isinstance(function, (ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -181,7 +186,7 @@ def test_no_module_keeps_state_that_its_functions_change(tmp_path):
              for name, how in module_state_changed(p)}
     assert {key: how for key, how in found.items() if key not in STATE_ALLOWED} == {}
     planted = tmp_path / "planted.py"
-    planted.write_text("CALLABLES: dict = {}\nSEEN = set()\n_last = None\n\n"
+    planted.write_text("CALLABLES: dict = {}\nLIMIT, SEEN = 3, set()\n_last = None\n\n"
                        "def remember(name, method):\n    CALLABLES[name] = method\n"
                        "    SEEN.add(name)\n    global _last\n    _last = name\n")
     assert sorted(module_state_changed(planted)) == [("CALLABLES", "item"), ("SEEN", "add"),
