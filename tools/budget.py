@@ -139,9 +139,11 @@ def built_and_solved(scene: str, params: dict, solved_by: str | None = None, **o
     and the result."""
     import signorini
     from signorini.scenes.build import build_problem
+    from signorini.solvers.registry import get_method
 
     start = time.perf_counter()
-    problem = build_problem(scene, params, solved_by=solved_by)
+    method = None if solved_by is None else get_method(solved_by)
+    problem = build_problem(scene, params, solved_by=method)
     parts = {"dofs": problem.n, "build_s": time.perf_counter() - start}
     del problem
     start = time.perf_counter()

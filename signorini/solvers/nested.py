@@ -34,7 +34,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
-from signorini.solvers.defaults import resolved
+from signorini.solvers.options import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 log = logging.getLogger(__name__)
