@@ -43,7 +43,8 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.certification.kkt import Certificate
-from signorini.numerics.factor import FactorTooLarge, selection_dofs
+from signorini.numerics.active_set import selection_dofs
+from signorini.numerics.factor import FactorTooLarge
 from signorini.numerics.push import calibrate_push
 from signorini.numerics.work import counting, timed
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
