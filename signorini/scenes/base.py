@@ -125,12 +125,13 @@ LOADING = Param("loading", "traction",
                 check=one_of("traction", "displacement"))
 
 
-#: how the Hertz scenes mesh their disc (signorini.scenes.meshing.graded_quarter_disc)
-MESHER = Param("mesher", MESHERS[0],
-               "relaxed: the graded mesh's nodes moved into near-equilateral triangles (more "
-               f"accurate per dof: {docs_page('accuracy')}); bisection: the graded mesh as refined; "
-               "triangle: Shewchuk's Triangle, much faster meshing, but at equal dofs less "
-               f"accurate than relaxed on the default cylinder ({docs_page('mesher')})",
+#: how the Hertz scenes mesh their disc (signorini.scenes.meshing.graded_quarter_disc); each
+#: scene sets its own default, chosen on the accuracy-time front (docs/mesher.md)
+MESHER = Param("mesher", "triangle",
+               "triangle: Shewchuk's Triangle, near-equilateral and fast; bisection: the graded "
+               "mesh as refined (right-angled triangles); relaxed: the bisection mesh's nodes "
+               "moved into near-equilateral triangles (slow to mesh) "
+               f"({docs_page('mesher')} compares them)",
                kind=str, check=one_of(*MESHERS))
 
 #: how every scene's K integrates λ (tr ε)² (signorini.fem.volumetric)

@@ -33,7 +33,8 @@ log = logging.getLogger(__name__)
 MAX_PASSES = 40
 #: the most triangles a graded 2D mesh may reach (before any uniform refinement)
 MAX_TRIANGLES = 400_000
-#: the meshers of the Hertz scenes' quarter disc (:func:`graded_quarter_disc`), the default first
+#: the meshers of the Hertz scenes' quarter disc (:func:`graded_quarter_disc`); each scene picks its
+#: default (its ``mesher`` parameter)
 MESHERS = ("relaxed", "bisection", "triangle")
 
 
