@@ -1,7 +1,7 @@
 """Effectivity of the a posteriori estimate (signorini.fem.estimate) on the Hertz scenes, and
 what adaptive refinement (signorini.scenes.adapt) reaches against uniform and hand-graded meshes.
 
-    .venv/bin/python tools/estimate.py [effectivity] [adaptive] [punch] [start]  # adaptive 2.4 min;
+    .venv/bin/python tools/estimate.py [effectivity] [adaptive] [punch] [start] [meshers]  # adaptive 2.4 min;
                                                                           # writes docs/estimate/runs.json
     .venv/bin/python tools/estimate.py figure                     # adaptive.png from the JSON
 
@@ -57,15 +57,22 @@ HAND_GRADED = ((40, 0.1), (60, 0.05), (120, 0.05))
 FIGURE = ROOT / "docs" / "estimate" / "adaptive.png"
 
 
+def mesh_params(scene: str, n_contact: int | None = None, grading: float | None = None,
+                mesher: str | None = None) -> dict:
+    """The mesh measured here: the scene's adaptive start (the relaxed mesh; the budgets and the
+    effectivity were measured from it), with the parameters given (not None) in its place."""
+    given = {"n_contact": n_contact, "grading": grading, "mesher": mesher}
+    return {**SCENE_FAMILIES[scene].adaptive_start, **{k: v for k, v in given.items() if v is not None}}
+
+
 def solve(scene: str, n_contact: int | None, grading: float | None, refine: int,
-          nu: float | None = None):
-    """The scene at ``refine`` (mesh parameters None: the scene's defaults), exactly; and the time."""
+          nu: float | None = None, mesher: str | None = None):
+    """The scene at ``refine`` on :func:`mesh_params`'s mesh, exactly; and the time."""
     method = "nested" if refine >= 2 else "pdas"
-    mesh = {"n_contact": n_contact, "grading": grading, "nu": nu}
     start = time.perf_counter()
     result = signorini.solve(scene, method=method, tol=1e-10,
-                             params={**{k: v for k, v in mesh.items() if v is not None},
-                                     "refine": refine})
+                             params={**mesh_params(scene, n_contact, grading, mesher), "refine": refine,
+                                     **({} if nu is None else {"nu": nu})})
     seconds = time.perf_counter() - start
     if result.status != "converged":
         raise RuntimeError(f"{scene} refine={refine}: {result.status} ({result.message})")
@@ -78,7 +85,7 @@ def tasks() -> list[Task]:
     out = []
     for scene in SCENES:
         for n_contact, grading, levels in BASES:
-            mesh = {k: v for k, v in (("n_contact", n_contact), ("grading", grading)) if v is not None}
+            mesh = mesh_params(scene, n_contact, grading)
             finest = levels + REFERENCE_STEPS - 1
             out += [Task(axis="effectivity", case=scene, value=refine,
                          problem={"kind": "scene", "scene": scene, "matched": False,
@@ -406,6 +413,38 @@ def adaptive_figure(rows: list[dict], path: Path) -> None:
     save_figure(fig, path)
 
 
+#: the pressure estimate against the true error on each mesher's meshes (ν = 0.3): the coarse
+#: base and each scene's default mesh, the error against the same mesh two refinements finer
+MESHER_BASES = ((16, 0.2), (None, None))
+
+
+def run_meshers() -> list[dict]:
+    rows = []
+    for scene in SCENES:
+        default = SCENE_FAMILIES[scene].parse({})
+        for mesher in ("triangle", "bisection", "relaxed"):
+            for n_contact, grading in MESHER_BASES:
+                n_contact, grading = n_contact or default["n_contact"], grading or default["grading"]
+                coarse, _ = solve(scene, n_contact, grading, 0, mesher=mesher)
+                fine, _ = solve(scene, n_contact, grading, 2, mesher=mesher)
+                error = pressure_error(coarse, fine)
+                rows.append({"scene": scene, "mesher": mesher, "n_contact": n_contact, "grading": grading,
+                             "dofs": coarse.problem.n, "pressure_estimate": coarse.estimate.pressure.relative,
+                             "pressure_error": error,
+                             "effectivity": coarse.estimate.pressure.relative / error})
+                print(rows[-1], file=sys.stderr)
+    return rows
+
+
+def meshers_table(rows: list[dict]) -> str:
+    lines = ["| scene | mesher | mesh (n_contact, grading) | dofs | pressure estimate | pressure error "
+             "| effectivity |", "|---|---|---|---:|---:|---:|---:|"]
+    lines += [f"| {r['scene']} | {r['mesher']} | {r['n_contact']}, {r['grading']:g} | {r['dofs']:,} "
+              f"| {100 * r['pressure_estimate']:.3f} % | {100 * r['pressure_error']:.3f} % "
+              f"| {r['effectivity']:.2f} |" for r in rows]
+    return "\n".join(lines)
+
+
 def load(part: str = "rows") -> list[dict]:
     return json.loads(OUT.read_text()).get(part, [])
 
@@ -424,6 +463,9 @@ if __name__ == "__main__":
         record["punch"] = run_punch()
     if "start" in parts:
         record["start"] = run_start()
+    if "meshers" in parts:
+        record["meshers"] = run_meshers()
+        print(meshers_table(record["meshers"]))
     if parts != ["figure"]:
         atomic_write_text(OUT, to_json(record))
         print(f"written: {OUT}", file=sys.stderr)

@@ -339,9 +339,11 @@ class ActiveSetSolver:
         self.saddle_point: SaddlePoint | None = None
 
     def pins(self, active: np.ndarray, factor: object) -> bool:
-        """``factor`` is a :class:`PinnedFactor` of this K with exactly the dofs of ``active`` pinned."""
+        """``factor`` is a :class:`PinnedFactor` of this K (or of a copy: a method's view) with
+        exactly the dofs of ``active`` pinned."""
         return (self._dofs is not None and isinstance(factor, PinnedFactor)
-                and factor.matrix is self.K
+                and (factor.matrix is self.K or factor.matrix.shape == self.K.shape
+                     and (factor.matrix != self.K).nnz == 0)
                 and np.array_equal(np.sort(factor.fixed), np.sort(self._dofs[active])))
 
     def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray,

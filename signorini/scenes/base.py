@@ -297,7 +297,9 @@ class SceneFamily:
     itself on each adaptive mesh (its ``build`` takes ``mesh=``);
     ``reference`` names its analytic reference (:data:`signorini.references.REFERENCES`);
     ``validation`` its cases in the validation suite; ``convergence_start``
-    the coarse mesh a convergence study starts from.
+    the coarse mesh a convergence study starts from; ``adaptive_start`` the mesh
+    parameters adaptive refinement starts from when none is given (those its dof budgets
+    and the error estimate's effectivity were measured from).
     """
 
     name: str
@@ -313,6 +315,8 @@ class SceneFamily:
     snap: Callable[[dict[str, Any]], Callable] | None = None
     validation: tuple[Case, ...] = ()
     convergence_start: Mapping[str, Any] = field(default_factory=dict)
+    adaptive_start: Mapping[str, Any] = field(default_factory=dict)
+
     def parse(self, values: dict[str, Any]) -> dict[str, Any]:
         """Defaults overridden by ``values``; unknown names, bad values and loads the family
         cannot model raise InputError (before any mesh is made)."""
