@@ -5,8 +5,8 @@ uniform and fine where the pressure varies, growing linearly away from it.
 Elements longer than the target are split (conforming red-green-blue
 refinement of triangles, longest-edge bisection of tetrahedra) until none is;
 nodes created on a curved boundary are moved onto it after every pass. The
-Hertz scenes' quarter disc is then relaxed into near-equilateral triangles
-(:mod:`signorini.scenes.relax`), or meshed by Triangle instead
+Hertz scenes' quarter disc is kept so, or relaxed into near-equilateral
+triangles (:mod:`signorini.scenes.relax`), or meshed by Triangle instead
 (:mod:`signorini.scenes.triangulated`): :func:`graded_quarter_disc`'s ``mesher``.
 """
 
