@@ -28,10 +28,10 @@ if TYPE_CHECKING:  # what the names below are, for readers and type checkers
                                scene_families, solve, solve_adaptive, with_load)
     from signorini.crosschecking import CrossCheck, crosscheck
     from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
-    from signorini.kkt import Certificate
-    from signorini.problem import ContactProblem, ContactSolution, Discretisation, Scales
-    from signorini.scene_derivatives import derivative
-    from signorini.solution import WarmStart
+    from signorini.certification.kkt import Certificate
+    from signorini.problem.contact import ContactProblem, ContactSolution, Discretisation, Scales
+    from signorini.derivatives.scene import derivative
+    from signorini.problem.solution import WarmStart
     from signorini.solvers.base import DEFAULT_TOL
 
 #: the module each public name lives in, imported at the name's first use
@@ -42,9 +42,9 @@ _HOMES = {
     **dict.fromkeys(("BackendNotInstalled", "InputError", "SignoriniError", "SolverError"),
                     "signorini.errors"),
     **dict.fromkeys(("ContactProblem", "ContactSolution", "Discretisation", "Scales"),
-                    "signorini.problem"),
-    "Certificate": "signorini.kkt", "derivative": "signorini.scene_derivatives",
-    "WarmStart": "signorini.solution", "DEFAULT_TOL": "signorini.solvers.base",
+                    "signorini.problem.contact"),
+    "Certificate": "signorini.certification.kkt", "derivative": "signorini.derivatives.scene",
+    "WarmStart": "signorini.problem.solution", "DEFAULT_TOL": "signorini.solvers.base",
 }
 
 __version__ = "0.1.0"

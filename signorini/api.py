@@ -11,7 +11,7 @@ in 2D, N per radian in axisymmetric models), ``pressure`` in Pa, ``gap`` and
 ``displacement`` in m; a QP of your own (:meth:`ContactProblem.from_qp`) answers in
 your units (``result.u`` is your unknown, ``result.force`` your λ). The answer's own
 vectors ``result.solution.u`` and ``result.solution.lam`` are in the problem's arrays' units:
-a scene's are dimensionless (see :class:`signorini.problem.Scales`), a ``from_qp`` problem's
+a scene's are dimensionless (see :class:`signorini.problem.contact.Scales`), a ``from_qp`` problem's
 are yours.
 ``Result.to_dict()`` is the JSON that ``signorini solve --json`` writes.
 """
@@ -25,21 +25,23 @@ from typing import Any
 
 import numpy as np
 
-from signorini import derivatives, kkt, load_control
+from signorini import load_control
+from signorini.certification import kkt
+from signorini.derivatives import implicit as derivatives
 from signorini.errors import InputError
 from signorini.fem.estimate import ErrorEstimate, estimate
-from signorini.kkt import Certificate
-from signorini.pressure import ContactProfile, contact_profile, load_resultant
-from signorini.problem import ContactProblem
-from signorini.references import Reference, reference_of, summary_lines
+from signorini.certification.kkt import Certificate
+from signorini.references.pressure import ContactProfile, contact_profile, load_resultant
+from signorini.problem.contact import ContactProblem
+from signorini.references.catalogue import Reference, reference_of, summary_lines
 from signorini.scenes import SCENES, SceneFamily, build_problem
 from signorini.scenes.adapt import parse_target, solve_adaptive as adapt
 from signorini.scenes.base import scene_params
-from signorini.scales import record_units
+from signorini.problem.scales import record_units
 from signorini.scenes.build import coarse_problem, with_load
 from signorini.numerics.arrays import vector_argument
 from signorini.numerics.work import stage_times, time_line, timed
-from signorini.solution import ContactSolution
+from signorini.problem.solution import ContactSolution
 from signorini.solvers.registry import Method, check_request
 from signorini.solvers.registry import methods as _all_methods
 
@@ -112,7 +114,7 @@ class Result:
     # -- the answer in physical units -------------------------------------------------------
     @property
     def profile(self) -> ContactProfile:
-        """Gaps, forces and pressures at the candidates (see :func:`signorini.pressure.contact_profile`)."""
+        """Gaps, forces and pressures at the candidates (see :func:`signorini.references.pressure.contact_profile`)."""
         if not hasattr(self, "_profile"):
             self._profile = contact_profile(self.problem, self.solution)
         return self._profile
@@ -151,7 +153,7 @@ class Result:
         scales = self.problem.scales
         return self.problem.energy(self.solution.u) * scales.force * scales.displacement
 
-    # -- derivatives (signorini.derivatives) ------------------------------------------------
+    # -- derivatives (signorini.derivatives.implicit) ------------------------------------------------
     @property
     def sensitivity(self) -> derivatives.Sensitivity:
         """The KKT system on the active set, factorised at the first derivative asked for."""
@@ -167,7 +169,7 @@ class Result:
 
         Implicit differentiation on the active set (back-solves once factorised);
         where candidates are weakly active the answer is one-sided and lists
-        them (``side``: ``auto``, ``in``, ``out``; see :mod:`signorini.derivatives`).
+        them (``side``: ``auto``, ``in``, ``out``; see :mod:`signorini.derivatives.implicit`).
         """
         return derivatives.jvp(self.sensitivity, df, dd, side)
 
@@ -184,7 +186,7 @@ class Result:
 
     @property
     def comparison(self) -> Any:
-        """The answer against the reference (e.g. :class:`signorini.pressure.HertzComparison`).
+        """The answer against the reference (e.g. :class:`signorini.references.pressure.HertzComparison`).
 
         None when the problem declares no reference or the answer is not finite.
         """
@@ -247,7 +249,7 @@ class Result:
         else:
             record["total_force"] = None
             record["contact"] = None
-        if "adequacy" in solution.extras:  # the boundary beyond the candidates (signorini.adequacy)
+        if "adequacy" in solution.extras:  # the boundary beyond the candidates (signorini.certification.adequacy)
             record["adequacy"] = solution.extras["adequacy"]
         record["extras"] = {k: v for k, v in solution.extras.items()
                             if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}

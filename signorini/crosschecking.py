@@ -1,11 +1,11 @@
 """Cross-checking methods against each other: the paper's Uzawa, QP backends, the exact answer.
 
 ``crosscheck(problem, methods)`` solves one problem with every method at one
-relative KKT tolerance and compares every pair of answers (:func:`signorini.kkt.compare`):
+relative KKT tolerance and compares every pair of answers (:func:`signorini.certification.kkt.compare`):
 
 - ``lam_rel`` = ‖λ_a − λ_b‖∞ / max(‖λ_a‖∞, ‖λ_b‖∞), ``u_rel`` likewise for u;
 - ``apart``: candidates active (λ̃ > g̃) in one answer and inactive in the other,
-  with λ̃ = λᵢ/‖λ‖∞ and g̃ the gap over the length scale of :class:`signorini.kkt.Certificate`;
+  with λ̃ = λᵢ/‖λ‖∞ and g̃ the gap over the length scale of :class:`signorini.certification.kkt.Certificate`;
   **weakly active** nodes are left out and counted apart (``weak``): a node is
   weakly active in an answer when both λ̃ and g̃ are at most
   ``max(kkt.WEAK_TOL, tol_a, tol_b)`` — it touches with (next to) no force, and a natural
@@ -48,9 +48,9 @@ import numpy as np
 from signorini.api import SCHEMA_VERSION, Result, build_problem, record_units, solve
 from signorini.crosscheck_tables import render, render_candidates, render_markdown
 from signorini.errors import BackendNotInstalled, InputError
-from signorini.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify, compare
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import reference_metrics, reference_of
+from signorini.certification.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify, compare
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.references.catalogue import reference_metrics, reference_of
 from signorini.solvers.base import DEFAULT_TOL, check_tol
 from signorini.solvers.registry import get_method
 
@@ -338,7 +338,7 @@ def _raw(name: str, options: dict[str, Any]) -> dict[str, Any]:
 def candidate_rows(problem: ContactProblem, results: dict[str, Result],
                    tol: float) -> list[dict[str, Any]]:
     """Per candidate: its index, point, and each method's gap (``d − Nu``: > 0 apart, < 0
-    penetrating), λ and classification (:func:`signorini.kkt.classify`, weak below
+    penetrating), λ and classification (:func:`signorini.certification.kkt.classify`, weak below
     ``max(WEAK_TOL, tol)``; ``penetrating`` an inactive one inside the obstacle), in the user's units."""
     labels = {name: classify(problem, result.solution, max(WEAK_TOL, tol))
               for name, result in results.items()}

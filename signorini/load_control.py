@@ -41,15 +41,15 @@ from typing import Any, Callable, NamedTuple
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.kkt import Certificate
+from signorini.certification.kkt import Certificate
 from signorini.numerics.factor import ActiveSetSolver, FactorTooLarge, selection_dofs
 from signorini.numerics.push import calibrate_push
 from signorini.numerics.work import counting, timed
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
                                      zone_around_points)
-from signorini.problem import ContactProblem
-from signorini.references import reference_of
-from signorini.solution import ContactSolution, WarmStart
+from signorini.problem.contact import ContactProblem
+from signorini.references.catalogue import reference_of
+from signorini.problem.solution import ContactSolution, WarmStart
 from signorini.solvers import registry
 from signorini.solvers.registry import Request
 

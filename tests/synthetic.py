@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.problem import ContactProblem, Discretisation
+from signorini.problem.contact import ContactProblem, Discretisation
 
 
 def random_problem(n: int = 8, m: int = 3, seed: int = 0, condition: float = 10.0,

@@ -1,4 +1,4 @@
-"""An exact answer to an inadequate model is not `converged` (signorini.adequacy)."""
+"""An exact answer to an inadequate model is not `converged` (signorini.certification.adequacy)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import signorini
-from signorini.adequacy import adequacy, warnings
+from signorini.certification.adequacy import adequacy, warnings
 from signorini.cli import main
-from signorini.problem import Watch
+from signorini.problem.contact import Watch
 
 SMALL = {"n_contact": 16, "grading": 0.3}
 

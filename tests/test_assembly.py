@@ -14,9 +14,9 @@ from skfem import asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 import signorini
-from signorini.analytic import contact_modulus, hertz_cylinder_load
+from signorini.references.analytic import contact_modulus, hertz_cylinder_load
 from signorini.errors import InputError
-from signorini.kkt import certificate
+from signorini.certification.kkt import certificate
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 

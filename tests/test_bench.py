@@ -8,7 +8,7 @@ import pytest
 import signorini
 
 from signorini.cli import main
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 from signorini.scenes import build_problem
 from signorini.studies.bench import (
     Run,

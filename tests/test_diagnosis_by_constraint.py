@@ -13,8 +13,8 @@ import pytest
 
 import signorini
 from signorini.cli import main
-from signorini.diagnose import explain, violations
-from signorini.kkt import INACTIVE, WEAK, classify, compare
+from signorini.certification.diagnosis import explain, violations
+from signorini.certification.kkt import INACTIVE, WEAK, classify, compare
 
 IGNORES = textwrap.dedent("""
     import numpy as np

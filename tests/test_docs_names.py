@@ -53,7 +53,7 @@ def test_every_cited_name_exists():
 
 
 def test_the_check_catches_a_missing_name():
-    assert resolves("signorini.kkt.certificate")
+    assert resolves("signorini.certification.kkt.certificate")
     assert not resolves("signorini.solvers.solve")
     assert not resolves("signorini.no_such_module.thing")
 

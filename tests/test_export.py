@@ -8,8 +8,8 @@ from skfem import MeshTet, MeshTri
 from signorini.cli import main
 from signorini.errors import InputError
 from signorini.output.export import element_gradients, export_vtk, project_to_nodes, von_mises
-from signorini.pressure import contact_profile
-from signorini.problem import ContactSolution
+from signorini.references.pressure import contact_profile
+from signorini.problem.contact import ContactSolution
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 

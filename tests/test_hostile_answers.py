@@ -21,12 +21,12 @@ import pytest
 
 import signorini
 from signorini.cli import main
-from signorini.forward_error import refined_on_active_set
-from signorini.kkt import ACTIVE, FORCE_FLOOR, active_set, certificate, classify, force_scale
+from signorini.certification.forward_error import refined_on_active_set
+from signorini.certification.kkt import ACTIVE, FORCE_FLOOR, active_set, certificate, classify, force_scale
 from signorini.numerics.factor import factorize
 from signorini.numerics.work import counting
-from signorini.pressure import compare_hertz
-from signorini.problem import ContactSolution
+from signorini.references.pressure import compare_hertz
+from signorini.problem.contact import ContactSolution
 from signorini import at_load
 from signorini.scenes import build_problem
 from signorini.solvers import registry

@@ -86,7 +86,7 @@ def test_a_write_that_never_finished_is_swept_at_exit(tmp_path):
 
 
 def test_an_interrupt_while_bench_copies_a_problem_leaves_no_copy(tmp_path, capsys, monkeypatch):
-    from signorini.problem import ContactProblem
+    from signorini.problem.contact import ContactProblem
 
     problem = tmp_path / "mine.npz"
     np.savez(problem, K=np.diag([2.0, 1.0]), f=np.ones(2), N=np.array([[1.0, 0.0]]),

@@ -19,7 +19,7 @@ from signorini import ContactProblem
 from signorini.cli import main
 from signorini.errors import InputError
 from signorini.fem.checks import check_mesh
-from signorini.references import reference_metrics
+from signorini.references.catalogue import reference_metrics
 from test_catalogue import SCENE_TOML  # the mesh scene of the catalogue, on a flat
 
 DIGITS_400 = "1" + "0" * 399

@@ -7,8 +7,9 @@ import pytest
 import scipy.sparse as sp
 
 import signorini
-from signorini import kkt, load_control
-from signorini.kkt import (
+from signorini import load_control
+from signorini.certification import kkt
+from signorini.certification.kkt import (
     ACTIVE,
     INACTIVE,
     MAX_RELEASED,
@@ -23,7 +24,7 @@ from signorini.kkt import (
 )
 from signorini.numerics.factor import factorize, selection_dofs
 from signorini.numerics.work import counting
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.scenes import build as scene_build
 from signorini.scenes import build_problem
 from signorini.solvers import registry
@@ -300,7 +301,7 @@ def test_judge_refuses_non_finite_claims(hertz):
 
 def test_duality_gap_by_conjugate_gradients_equals_the_factorised_one(hertz, exact, monkeypatch):
     """Big problems evaluate rᵀK⁻¹r by CG (no serial factorisation): the same gap."""
-    from signorini import problem as problem_module
+    from signorini.problem import contact as problem_module
 
     rng = np.random.default_rng(0)
     rough = with_(exact, u=exact.u * (1 + 1e-4 * rng.standard_normal(exact.u.size)),
@@ -318,7 +319,7 @@ def test_duality_gap_by_conjugate_gradients_equals_the_factorised_one(hertz, exa
 
 def test_a_big_2d_problem_factorises_for_its_certificate_instead_of_cg(hertz, exact, monkeypatch):
     """Past ITERATIVE_ENERGY_FROM a 2D mesh is still factorised (little fill), not solved by CG."""
-    from signorini import problem as problem_module
+    from signorini.problem import contact as problem_module
 
     monkeypatch.setattr(problem_module, "ITERATIVE_ENERGY_FROM", 0)
     monkeypatch.setattr("scipy.sparse.linalg.cg", lambda *a, **k: pytest.fail("CG was used"))

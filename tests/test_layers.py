@@ -4,11 +4,12 @@ Layers, low to high (a module may import its own layer and the layers below):
 
 0. ``errors``, ``files``, ``reprs``     exceptions, atomic writes, short reprs
 1. ``numerics``                          factorisations, dense LCP, zone kernel, the push kernel
-2. ``problem``, ``problem_files``, ``discretisation``, ``kkt``, ``analytic``, ``pressure``, ``references``, ``diagnose``, ``adequacy``, ``fem``
+2. ``problem``, ``certification``, ``references``, ``fem``  the QP and its answer, judging it,
+   analytic references and pressure, the finite elements
 3. ``solvers``                           the registry collects each backend's METHODS
 4. ``load_control``                      load control: the one driver around any method
 5. ``scenes``                            families, meshing, scene files, building problems
-6. ``api``, ``crosschecking``, the package: the public Python API
+6. ``api``, ``crosschecking``, ``derivatives``, the package: the public Python API
 7. ``studies``, ``output`` one runner and its studies; reports, plots, export
 8. ``cli``                               parsing only
 
@@ -35,21 +36,18 @@ PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
 LAYERS = {
     "errors": 0, "files": 0, "reprs": 0,
     "numerics": 1,
-    "problem": 2, "problem_files": 2, "discretisation": 2, "solution": 2, "kkt": 2, "analytic": 2, "pressure": 2, "references": 2, "diagnose": 2,
-    "adequacy": 2, "forward_error": 2, "fingerprint": 2, "scales": 2, "saved_problem": 2,
-    "fem": 2,
+    "problem": 2, "certification": 2, "references": 2, "fem": 2,
     "solvers": 3,
     "load_control": 4,
     "scenes": 5,
-    "api": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "scene_derivatives": 6, "": 6,
+    "api": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "": 6,
     "studies": 7, "output": 7,
     "cli": 8,
 }
 #: (package part, what it must not import): the data flow, beyond the order of the layers
 FORBIDDEN = [
     ("signorini.scenes", ("signorini.solvers", "signorini.load_control")),
-    ("signorini.solvers", ("signorini.references", "signorini.pressure", "signorini.analytic",
-                           "signorini.fem", "signorini.scenes")),
+    ("signorini.solvers", ("signorini.references", "signorini.fem", "signorini.scenes")),
     ("signorini.fem", ("signorini.solvers", "signorini.scenes", "signorini.load_control",
                        "signorini.numerics.zone", "signorini.numerics.push")),
     ("signorini.output", ("signorini.studies",)),
@@ -176,8 +174,8 @@ def test_modules_are_small(module):
 
 
 def test_the_resolver_sees_imports():
-    """The resolver is not blind: problem.py's own imports include lower layers' modules."""
-    targets = {t for t, _, _ in imports("signorini.problem")}
+    """The resolver is not blind: problem/contact.py's own imports include lower layers' modules."""
+    targets = {t for t, _, _ in imports("signorini.problem.contact")}
     assert "signorini.numerics.factor" in targets and "signorini.errors" in targets
 
 

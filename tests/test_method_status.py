@@ -14,7 +14,7 @@ import scipy.sparse as sp
 
 import signorini
 from signorini.errors import InputError
-from signorini.problem import STATUSES
+from signorini.problem.contact import STATUSES
 from signorini.solvers.base import MAX_ITER
 
 K = sp.diags([2.0, 2.0, 2.0]).tocsr()

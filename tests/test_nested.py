@@ -10,8 +10,8 @@ import signorini
 from signorini import load_control
 
 from signorini.fem.assembly import assemble
-from signorini.kkt import certificate, compare
-from signorini.references import reference_of
+from signorini.certification.kkt import certificate, compare
+from signorini.references.catalogue import reference_of
 from signorini.numerics.factor import PinnedFactor, factorize
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.scenes import build as scenes

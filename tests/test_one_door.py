@@ -29,7 +29,7 @@ def traced(step):
     files: set[str] = set()
     calls = {"check_request": 0, "certificate": 0}
     checking = os.path.join(ROOT, "solvers", "registry.py")
-    certifying = os.path.join(ROOT, "kkt.py")
+    certifying = os.path.join(ROOT, "certification", "kkt.py")
 
     def profile(frame, event, arg):
         if event != "call" or not frame.f_code.co_filename.startswith(ROOT):

@@ -18,10 +18,10 @@ import scipy.sparse as sp
 
 import signorini
 from signorini import load_control
-from signorini.kkt import certificate, compare
+from signorini.certification.kkt import certificate, compare
 from signorini.numerics.work import counting
 from signorini.numerics.multigrid import Bordered
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 from signorini.scenes import build_problem
 from signorini.solvers import auto
 from signorini.solvers.registry import solve

@@ -16,7 +16,7 @@ import scipy.sparse as sp
 import signorini
 from signorini.cli import main
 from signorini.errors import InputError
-from signorini.problem_files import is_problem_file, read_problem
+from signorini.problem.files import is_problem_file, read_problem
 
 
 @pytest.fixture(scope="module")

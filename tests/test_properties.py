@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from signorini.errors import InputError
-from signorini.kkt import certificate
+from signorini.certification.kkt import certificate
 from signorini.solvers import registry
 from signorini.solvers.base import rows_share_dofs
 from synthetic import random_problem

@@ -20,8 +20,8 @@ import scipy.sparse as sp
 import signorini.solvers.cvxpy_ as cvxpy_method  # registers "cvxpy"
 import signorini.solvers.qp as qp  # registers "qp-*"
 from signorini.errors import InputError, SolverError
-from signorini.kkt import certificate
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.certification.kkt import certificate
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import registry
 from signorini.solvers.registry import get_method, solve
 from synthetic import random_problem

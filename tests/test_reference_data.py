@@ -15,11 +15,11 @@ import logging
 import numpy as np
 import pytest
 
-from signorini.analytic import contact_modulus
+from signorini.references.analytic import contact_modulus
 from signorini.errors import InputError
-from signorini.pressure import compare_uniform
-from signorini.problem import ContactProblem
-from signorini.references import REFERENCES
+from signorini.references.pressure import compare_uniform
+from signorini.problem.contact import ContactProblem
+from signorini.references.catalogue import REFERENCES
 from signorini.scenes import SCENES, build_problem, register, unregister
 from signorini.scenes.block import FAMILY as BLOCK
 from signorini.scenes.two_block_patch import compliance
@@ -90,7 +90,7 @@ def test_a_file_that_stored_the_reference_by_name_loads_without_one(tmp_path, ca
     del meta["discretisation"]["push"]["delta"]
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     np.savez(tmp_path / "old.npz", **arrays)
-    with caplog.at_level(logging.WARNING, logger="signorini.problem"):
+    with caplog.at_level(logging.WARNING, logger="signorini.problem.contact"):
         old = ContactProblem.load(tmp_path / "old.npz")
     assert old.reference_data is None and old.reference == "" and old.push.delta is None
     assert "'uniform'" in caplog.text and "rebuild" in caplog.text

@@ -12,10 +12,10 @@ from skfem import MeshTri
 
 import signorini
 from signorini.cli import main
-from signorini.analytic import contact_modulus
+from signorini.references.analytic import contact_modulus
 from signorini.errors import InputError
-from signorini.pressure import compare_uniform, contact_profile
-from signorini.problem import ReferenceData
+from signorini.references.pressure import compare_uniform, contact_profile
+from signorini.problem.contact import ReferenceData
 from signorini.scenes import build_problem
 from signorini.scenes.scenefile import read_mesh
 from signorini.solvers.registry import solve
@@ -183,7 +183,7 @@ def test_mesh_scene_with_line_selectors_a_target_load_and_a_circle(tmp_path):
             .replace("multiplicity = 2.0", "multiplicity = 2.0\ntarget = 0.05"))
     problem = signorini.at_load(build_problem(str(write(tmp_path, text))))
     solution = solve(problem, "pdas", tol=1e-10)
-    from signorini.pressure import load_resultant
+    from signorini.references.pressure import load_resultant
     assert problem.m == 5
     # the target is the load applied: the contact resultant along the push, not Σλ (tilted normals)
     assert load_resultant(problem, solution.lam) == pytest.approx(0.05, rel=1e-8)

@@ -13,10 +13,10 @@ from skfem import Basis, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
 from skfem.models.elasticity import lame_parameters
 
 import signorini
-from signorini.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_peak, hertz_sphere_radius
+from signorini.references.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_peak, hertz_sphere_radius
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble, axisymmetric_elasticity
-from signorini.pressure import contact_profile, radial_distance
+from signorini.references.pressure import contact_profile, radial_distance
 from signorini.scenes import build_problem
 from signorini.fem.model import FlatObstacle, FlatObstacle3D, SceneModel
 from signorini.solvers.registry import solve

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 import signorini
-from signorini.diagnose import diagnose, regularise
+from signorini.certification.diagnosis import diagnose, regularise
 from signorini.errors import InputError
-from signorini.kkt import certificate, classify, compare
-from signorini.problem import ContactSolution
+from signorini.certification.kkt import certificate, classify, compare
+from signorini.problem.contact import ContactSolution
 from signorini.scenes import build_problem
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
 from signorini.solvers.registry import solve

@@ -8,7 +8,7 @@ import pytest
 import signorini
 from signorini.cli import main
 from signorini.errors import InputError
-from signorini.pressure import contact_half_width, contact_profile
+from signorini.references.pressure import contact_half_width, contact_profile
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 from signorini.studies.sweep import parse_loads, sweep_loads

@@ -162,7 +162,7 @@ def test_a_picture_shows_both_deformed_bodies_and_the_pressure():
     pytest.importorskip("matplotlib", reason="the picture is drawn with matplotlib")
     from signorini.output.export import candidate_nodes, nodal_displacement
     from signorini.output.plots import deformed_bodies
-    from signorini.pressure import contact_profile
+    from signorini.references.pressure import contact_profile
 
     problem, p = patch()
     result = signorini.solve(problem, "pdas")

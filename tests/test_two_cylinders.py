@@ -4,7 +4,7 @@ import pytest
 
 import signorini
 from signorini.errors import InputError
-from signorini.analytic import hertz_cylinder_load
+from signorini.references.analytic import hertz_cylinder_load
 from signorini.scenes.hertz_two_cylinders import FAMILY, pair_radius
 
 #: coarse meshes, so that each solve takes about a second

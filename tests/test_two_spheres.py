@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import signorini
-from signorini.analytic import hertz_sphere_load
+from signorini.references.analytic import hertz_sphere_load
 from signorini.fem.mortar import GAUSS_POINTS, GAUSS_WEIGHTS, _dual
 
 #: coarse meshes, so that each solve takes about a second

@@ -25,7 +25,7 @@ METHODS = textwrap.dedent("""
 
     import numpy as np
 
-    from signorini.problem import ContactSolution
+    from signorini.problem.contact import ContactSolution
     from signorini.solvers.pdas import solve as pdas
 
 

@@ -31,7 +31,7 @@ import numpy as np
 
 import signorini
 from signorini.files import atomic_write_text, to_json
-from signorini.references import reference_of
+from signorini.references.catalogue import reference_of
 from signorini.scenes import SCENES as SCENE_FAMILIES
 from signorini.scenes.adapt import solve_adaptive
 from signorini.studies.runner import run_tasks

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from signorini.analytic import contact_modulus, hertz_cylinder_load
+from signorini.references.analytic import contact_modulus, hertz_cylinder_load
 from signorini.files import atomic_write_text, to_json
 from signorini.studies.runner import run_tasks
 from signorini.studies.task import Task
@@ -149,7 +149,7 @@ def figure(path: Path = OUT.parent / "cylinders-deformed.png") -> Path:
     from signorini.files import save_figure
     from signorini.output.export import candidate_nodes, nodal_displacement
     from signorini.output.plots import deformed_bodies
-    from signorini.pressure import contact_profile
+    from signorini.references.pressure import contact_profile
 
     result = signorini.solve("hertz-two-cylinders", "pdas", params=PAIRS["different"])
     problem, solution = result.problem, result.solution

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 import signorini
-from signorini.analytic import contact_modulus
-from signorini.pressure import compare_uniform, contact_profile
+from signorini.references.analytic import contact_modulus
+from signorini.references.pressure import compare_uniform, contact_profile
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 

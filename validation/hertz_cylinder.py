@@ -10,8 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import signorini
-from signorini.kkt import compare
-from signorini.pressure import compare_hertz, contact_profile
+from signorini.certification.kkt import compare
+from signorini.references.pressure import compare_hertz, contact_profile
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 

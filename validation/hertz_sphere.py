@@ -26,8 +26,8 @@ import time
 from typing import Any
 
 import signorini
-from signorini.kkt import compare
-from signorini.pressure import compare_hertz_sphere, symmetry_plane_profiles
+from signorini.certification.kkt import compare
+from signorini.references.pressure import compare_hertz_sphere, symmetry_plane_profiles
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 
@@ -70,7 +70,7 @@ plane_profiles = symmetry_plane_profiles(three_d, exact_three_d)
 #: run in a fresh interpreter by :func:`measure`: one model, its cost and its errors as JSON
 _MEASURE_ONE = """
 import json, sys, time
-from signorini.pressure import compare_hertz_sphere
+from signorini.references.pressure import compare_hertz_sphere
 import signorini
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve, methods

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import signorini
 from signorini.errors import InputError
-from signorini.kkt import compare
-from signorini.pressure import compare_hertz
+from signorini.certification.kkt import compare
+from signorini.references.pressure import compare_hertz
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from signorini.studies.convergence import plot_punch_edge, plot_punch_pressure
 from signorini.files import atomic_write_text, save_figure, to_json
-from signorini.pressure import compare_punch
+from signorini.references.pressure import compare_punch
 from signorini.scenes import build_problem
 from signorini.solvers.registry import get_method, methods
 from signorini.studies.suite import TIGHT_TOL, run_one

@@ -68,7 +68,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     # each command loads what it needs (the benchmark's report starts matplotlib)
     from signorini.files import all_or_none, writable_directory
-    from signorini.problem_files import read_problem  # as above
+    from signorini.problem.files import read_problem  # as above
     from signorini.scenes import get_scene  # as above
     from signorini.scenes.size import check_size  # as above
     from signorini.solvers.registry import check_request, methods  # as above

@@ -124,7 +124,7 @@ def input_files(scene: str | None = None, methods: Sequence[str] = ()) -> dict[s
     wait forever); outputs are later checked not to be one of them.
     """
     from signorini.files import check_input_file  # per command (start-up)
-    from signorini.problem_files import is_problem_file, problem_file_paths  # as above
+    from signorini.problem.files import is_problem_file, problem_file_paths  # as above
 
     found = {"scene file": scene} if scene and scene.lower().endswith(".toml") else {}
     if scene and is_problem_file(scene):

@@ -17,8 +17,8 @@ from signorini.solvers.options import guess_value
 def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.api import Result, at_load, build_problem, solve, solve_adaptive  # per command
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
-    from signorini.kkt import certificate  # per command (start-up)
-    from signorini.problem_files import is_problem_file  # per command (start-up)
+    from signorini.certification.kkt import certificate  # per command (start-up)
+    from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
 
     params = pairs(args.set, "--set")

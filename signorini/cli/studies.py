@@ -57,7 +57,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from signorini.files import all_or_none, check_outputs  # as above
     from signorini.output.ci import github_annotations, junit_xml  # as above
     from signorini.output.report import REPORT_FILES, checks_summary, write_suite_report  # as above
-    from signorini.problem_files import problem_file_paths, read_problem  # as above
+    from signorini.problem.files import problem_file_paths, read_problem  # as above
     from signorini.solvers.registry import check_request  # as above
     from signorini.studies.suite import (TIGHT_TOL, problem_case, read_limits, run_suite,
                                          select_cases)  # as above

@@ -26,7 +26,7 @@ by the scene's length L, displacements and gaps by a displacement scale U
 (the largest prescribed displacement, else the largest initial gap), E by
 itself. Contact forces then come in units of E·U per unit thickness in plane
 strain, and of E·U·L (per radian, or for the 3D model) otherwise; weights in
-units of L and L² respectively (see :class:`~signorini.problem.Scales`).
+units of L and L² respectively (see :class:`~signorini.problem.contact.Scales`).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from signorini.fem.model import SceneModel
 from signorini.fem.stiffness import simplex_stiffness
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import volumetric_stiffness
-from signorini.problem import ContactProblem, Discretisation, Push, Scales, Watch
+from signorini.problem.contact import ContactProblem, Discretisation, Push, Scales, Watch
 
 log = logging.getLogger(__name__)
 

@@ -27,7 +27,7 @@ may have a gap below ``-OUTSIDE · length_scale``, and at every candidate on
 a contact facet the obstacle's normal (from the body towards the obstacle)
 must not point into the body. The units must be representable: the force
 unit ``E · U · L^k`` and the weight unit ``L^(k+1)`` of
-:class:`~signorini.problem.Scales`, and a target load, finite and normal.
+:class:`~signorini.problem.contact.Scales`, and a target load, finite and normal.
 """
 
 from __future__ import annotations

@@ -24,8 +24,8 @@ from typing import Any
 import numpy as np
 
 from signorini.fem.topology import facets_on
-from signorini.kkt import active_set
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.certification.kkt import active_set
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 __all__ = ["PressureEstimate", "boundary_normals", "candidate_edges", "candidate_nodes",
            "contact_term", "pressure_estimate", "unit_normals", "zone_and_neighbours"]

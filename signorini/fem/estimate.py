@@ -23,7 +23,7 @@ The contact's parts — the complementarity term at the edge of the contact zone
 contact pressure's estimate — are in :mod:`signorini.fem.contact_estimate`.
 
 Everything here is in the problem's (dimensionless) units: energies in
-``force · displacement`` of :class:`signorini.problem.Scales`, per unit
+``force · displacement`` of :class:`signorini.problem.contact.Scales`, per unit
 thickness in plane strain and per radian in axisymmetric models.
 """
 
@@ -39,7 +39,7 @@ from skfem.quadrature import get_quadrature
 from signorini.fem.contact_estimate import PressureEstimate, candidate_nodes, contact_term, pressure_estimate
 from signorini.fem.stiffness import barycentric_gradients
 from signorini.fem.volumetric import nodal_volumetric_strain, simplex_gradients
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: quadrature order of the element integrals: 2 integrates the plane-strain and 3D ones
 #: exactly (a linear field squared); the axisymmetric ones are rational (the hoop strain

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.discretisation import ReferenceData
+from signorini.problem.discretisation import ReferenceData
 from signorini.fem.checks import check_model
 from signorini.fem.volumetric import resolve
 
@@ -85,7 +85,7 @@ class SceneModel:
     cut_load: CutLoad | None = None
     #: per candidate: in contact by the scene's analytic estimate (load targeting starts there)
     predicted_contact: np.ndarray | None = None
-    #: what to change when the contact outgrows the candidates (signorini.adequacy)
+    #: what to change when the contact outgrows the candidates (signorini.certification.adequacy)
     candidate_remedy: str = "extend the scene's contact candidates or lower the load"
     #: the scene parameter ``volumetric``: element, nodal or auto (signorini.fem.volumetric)
     volumetric_choice: str = "auto"

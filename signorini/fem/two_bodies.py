@@ -26,14 +26,14 @@ import scipy.sparse as sp
 from skfem import MeshTri
 from skfem.models.elasticity import lame_parameters
 
-from signorini.analytic import contact_modulus
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import contact_modulus
+from signorini.problem.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.assembly import lame_stiffness, nodal_dofs
 from signorini.fem.mortar import Face, couple
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import resolve
-from signorini.problem import ContactProblem, Discretisation, Push, Scales
+from signorini.problem.contact import ContactProblem, Discretisation, Push, Scales
 
 log = logging.getLogger(__name__)
 

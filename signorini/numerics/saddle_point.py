@@ -3,7 +3,7 @@
 An active-set method whose rows do not each bound one dof (two bodies' rows on
 the master's dofs, obstacles that meet) solves this system at each step. The
 factorisation of the final active set also serves the certificate
-(:mod:`signorini.kkt`), which would otherwise factorise K once more and solve
+(:mod:`signorini.certification.kkt`), which would otherwise factorise K once more and solve
 it |A| times for the Delassus operator ``N_A K⁻¹ N_Aᵀ``:
 
 - the forward error's Newton steps on A are solves of this very matrix

@@ -39,8 +39,8 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.files import atomic_write, check_output_file
 from signorini.fem.contact_estimate import candidate_nodes as mesh_nodes_at
-from signorini.pressure import contact_profile
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.references.pressure import contact_profile
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 log = logging.getLogger(__name__)
 

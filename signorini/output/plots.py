@@ -9,7 +9,7 @@ from typing import Iterable
 
 import numpy as np
 
-from signorini.analytic import hertz_pressure
+from signorini.references.analytic import hertz_pressure
 
 
 #: markers that go with the ten default colours (eleven: see :func:`series_style`)

@@ -13,11 +13,11 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.api import SCHEMA_VERSION
-from signorini.kkt import certificate
+from signorini.certification.kkt import certificate
 from signorini.output import plots
-from signorini.pressure import contact_profile, load_resultant
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import reference_of
+from signorini.references.pressure import contact_profile, load_resultant
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.references.catalogue import reference_of
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
             "proxsuite", "piqp", "scs", "ecos", "highspy", "daqp", "quadprog", "qpalm", "cvxopt")

@@ -6,7 +6,7 @@ Each step (:func:`solve_adaptive`):
    targeting starts from the last step's contact zone);
 2. when the contact outgrew the candidates (a node beyond them through the
    obstacle, or the outermost candidate in contact: the solution is
-   ``model_inadequate``, :mod:`signorini.adequacy`), widen the candidates by
+   ``model_inadequate``, :mod:`signorini.certification.adequacy`), widen the candidates by
    :data:`GROWTH` on the same mesh and solve again;
 3. estimate the error (:func:`signorini.fem.estimate.estimate`) and stop when
    the estimate of the chosen quantity meets the target: ``"pressure"`` (the
@@ -55,8 +55,8 @@ from signorini.fem.assembly import assemble
 from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.fem.transfer import refined_model, with_candidates
 from signorini.fem.model import SceneModel
-from signorini.kkt import gap_scale
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.certification.kkt import gap_scale
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.scenes.marking import THETA, mark
 from signorini.scenes.registry import FamilyField, get_scene
 from signorini.scenes.scenefile import build_scene_model, family_scene_values

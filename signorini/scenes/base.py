@@ -4,10 +4,10 @@ A scene family declares its parameters (:class:`Param`) and a ``build``
 function that turns checked parameter values into a
 :class:`~signorini.fem.model.SceneModel` in physical units;
 :mod:`signorini.fem.assembly` turns the model into a
-:class:`~signorini.problem.ContactProblem`. The family also owns what else
+:class:`~signorini.problem.contact.ContactProblem`. The family also owns what else
 is known of it (:class:`SceneFamily`): its size model, its coarse rule, how
 refined nodes go back onto a curved boundary, its analytic reference (by
-name, :mod:`signorini.references`) and its validation cases (:class:`Case`).
+name, :mod:`signorini.references.catalogue`) and its validation cases (:class:`Case`).
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Protocol
 
-from signorini.analytic import contact_modulus
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import contact_modulus
+from signorini.problem.discretisation import ReferenceData
 from signorini.errors import InputError, docs_page
 from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel
@@ -295,7 +295,7 @@ class SceneFamily:
     none); ``snap(params)`` gives the function that moves refined boundary
     nodes onto the family's curved boundary, and makes the family rebuild
     itself on each adaptive mesh (its ``build`` takes ``mesh=``);
-    ``reference`` names its analytic reference (:data:`signorini.references.REFERENCES`);
+    ``reference`` names its analytic reference (:data:`signorini.references.catalogue.REFERENCES`);
     ``validation`` its cases in the validation suite; ``convergence_start``
     the coarse mesh a convergence study starts from; ``adaptive_start`` the mesh
     parameters adaptive refinement starts from when none is given (those its dof budgets

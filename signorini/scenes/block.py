@@ -26,8 +26,8 @@ from typing import Any
 import numpy as np
 from skfem import MeshTri
 
-from signorini.analytic import contact_modulus
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import contact_modulus
+from signorini.problem.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble, boundary_weights
 from signorini.fem.model import FlatObstacle, SceneModel
@@ -35,12 +35,12 @@ from signorini.fem.obstacles import ScaledQuery
 from signorini.fem.topology import facets_on
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
-from signorini.problem import ContactProblem, ContactSolution, Scales
+from signorini.problem.contact import ContactProblem, ContactSolution, Scales
 from signorini.scenes.base import (VOLUMETRIC, Case, Param, SceneFamily, at_least, length, poisson_ratio,
                                    positive, scene_params)
 from signorini.scenes.size import CountedSize
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "uniform"
 
 PARAMS = (
@@ -166,7 +166,7 @@ def force_controlled_problem(pressure: float = 0.01, params: dict[str, Any] | No
         p = q at every bottom node,  u_y = −q(1 − ν²) y / E,  u_x = q ν(1 + ν) x / E
 
     (exact for P1, see :func:`force_controlled_exact`). Methods that need
-    ``K⁻¹`` cannot solve it as it stands; :func:`signorini.diagnose.regularise`
+    ``K⁻¹`` cannot solve it as it stands; :func:`signorini.certification.diagnosis.regularise`
     adds a documented small stiffness.
 
     Parameters

@@ -17,9 +17,9 @@ from signorini.fem.assembly import assemble
 from signorini.fem.two_bodies import TwoBodyModel
 from signorini.numerics.arrays import flag_argument
 from signorini.numerics.zone import radial_distance
-from signorini.problem import ContactProblem, Scales
-from signorini.problem_files import is_problem_file, read_problem
-from signorini.references import reference_of
+from signorini.problem.contact import ContactProblem, Scales
+from signorini.problem.files import is_problem_file, read_problem
+from signorini.references.catalogue import reference_of
 from signorini.scenes.base import GRADING_RANGE, LOAD_NAMES, scene_params
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
@@ -66,7 +66,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     :func:`signorini.scene_families`; None: the defaults). ``name`` may be the
     path of a TOML scene file (``*.toml``, see :mod:`signorini.scenes.scenefile`);
     ``params`` then override its parameters. ``name`` may also be a problem
-    file (``.npz`` or Matrix Market, :mod:`signorini.problem_files`): its QP is
+    file (``.npz`` or Matrix Market, :mod:`signorini.problem.files`): its QP is
     read as stored, with no parameters to set. A target load stays pending (load
     control matches it when the problem is solved). ``solved_by`` names the
     method that will solve it, for the size guard (a method that never
@@ -119,7 +119,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
         raise InputError(f"scene family {name!r} declares the reference {declared!r}, but its build "
                          f"hands on {model.reference!r}: give its SceneModel "
                          f"reference=ReferenceData({declared!r}, ...) with the fields that "
-                         "reference reads (signorini.problem.ReferenceData)")
+                         "reference reads (signorini.problem.contact.ReferenceData)")
     mesh_s = time.perf_counter() - start
     problem = (model.assemble(nondimensionalise) if isinstance(model, TwoBodyModel)
                else assemble(model, nondimensionalise=nondimensionalise))

@@ -6,7 +6,7 @@ to :func:`~signorini.scenes.registry.register` from anywhere).
 
 from __future__ import annotations
 
-from signorini.problem_files import is_problem_file
+from signorini.problem.files import is_problem_file
 from signorini.scenes import (block, hertz_cylinder, hertz_sphere, hertz_sphere_3d, hertz_two_cylinders,
                               hertz_two_spheres, punch, reverse_hertz, two_block_patch)
 from signorini.scenes.registry import SCENES, get_scene, register, scene_reference, unregister

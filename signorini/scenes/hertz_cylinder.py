@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.references.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.scenes.base import (
@@ -49,7 +49,7 @@ from signorini.scenes.base import (
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
 from signorini.scenes.size import SizeModel
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "hertz-2d"
 
 PARAMS = (

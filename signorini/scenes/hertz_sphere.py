@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
+from signorini.references.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
 from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.scenes.base import (
@@ -94,7 +94,7 @@ def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float
     return hertz_sphere_load(p["a_over_R"] * R, R, E_star), p["a_over_R"]
 
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "hertz-3d"
 
 def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:

@@ -63,7 +63,7 @@ PARAMS = COMMON_PARAMS + (
 MAX_SIZE = 0.3
 
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "hertz-3d"
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:

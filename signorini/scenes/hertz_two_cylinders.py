@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from signorini.analytic import hertz_cylinder_half_width, hertz_cylinder_load
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.problem.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus
@@ -44,7 +44,7 @@ from signorini.scenes.two_block_patch import DISCRETISATION, materials
 
 __all__ = ["FAMILY", "body", "disc", "pair_load_choice", "pair_modulus", "pair_radius"]
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "hertz-2d"
 
 #: hertz-cylinder's parameters by name: its mesh parameters are this family's, for each disc,

@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from signorini.analytic import hertz_sphere_load, hertz_sphere_radius
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import hertz_sphere_load, hertz_sphere_radius
+from signorini.problem.discretisation import ReferenceData
 from signorini.fem.two_bodies import TwoBodyModel
 from signorini.scenes import hertz_two_cylinders as cylinders
 from signorini.scenes.base import Case, SceneFamily
@@ -33,7 +33,7 @@ from signorini.scenes.size import CountedSize
 
 __all__ = ["FAMILY"]
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "hertz-3d"
 
 #: what differs from the cylinders' parameters: the load's words and a sphere's mesh defaults

@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 from skfem import MeshTri
 
-from signorini.analytic import contact_modulus
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import contact_modulus
+from signorini.problem.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
@@ -223,7 +223,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
         reference=ReferenceData(REFERENCE, E_star=E_star, a=a, corner_radius=r))
 
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "punch"
 
 

@@ -14,7 +14,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
 from signorini.errors import InputError, docs_page
-from signorini.problem_files import is_problem_file
+from signorini.problem.files import is_problem_file
 from signorini.scenes.base import Case, SceneFamily
 
 SCENES: dict[str, SceneFamily] = {}

@@ -21,8 +21,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from signorini.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.problem.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle
@@ -111,7 +111,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
         reference=ReferenceData(REFERENCE, E_star=E_star, R=R))
 
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "reverse-hertz"
 
 

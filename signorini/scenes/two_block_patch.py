@@ -31,8 +31,8 @@ from typing import Any
 import numpy as np
 from skfem import MeshTri
 
-from signorini.analytic import contact_modulus
-from signorini.discretisation import ReferenceData
+from signorini.references.analytic import contact_modulus
+from signorini.problem.discretisation import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.mortar import DISCRETISATIONS
 from signorini.fem.topology import facets_on
@@ -43,7 +43,7 @@ from signorini.scenes.size import CountedSize
 
 __all__ = ["DISCRETISATION", "FAMILY", "compliance", "materials", "patch_pressure"]
 
-#: the analytic reference (signorini.references) this family's problems compare with
+#: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "uniform"
 
 #: how the two contact faces are coupled (signorini.fem.mortar)

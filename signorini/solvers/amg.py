@@ -28,7 +28,7 @@ algebraic multigrid given the rigid-body modes as near-null space
   later step there, so the second step starts the sequence again at ETA_MAX;
 - when the set repeats, CG is driven to a stationarity residual of
   :data:`SAFETY` · tol against the contact forces, and the method stops only
-  when the package's certificate (:func:`signorini.kkt.certificate`) is within
+  when the package's certificate (:func:`signorini.certification.kkt.certificate`) is within
   ``tol``; the duality gap is then computed with this method's own
   AMG-preconditioned solver for K with the final set pinned (:class:`PinnedCG`),
   not a serial factorisation.
@@ -51,13 +51,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.kkt import certificate
+from signorini.certification.kkt import certificate
 from signorini.numerics.factor import selection_dofs
 from signorini.numerics.push import first_contact
 from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg, pinned_matrix, threaded
 from signorini.numerics.work import count
 from signorini.numerics.zone import predict_zone
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import pdas, petsc_
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
 from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
@@ -212,7 +212,7 @@ class PinnedCG:
     active rows' dofs when each row bounds one dof, else none) and
     ``solve(rhs)``: u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``, to the
     relative residual :data:`CERTIFICATE_RTOL` (``exact`` is False: the forward error takes
-    one Newton step with it, :mod:`signorini.forward_error`).
+    one Newton step with it, :mod:`signorini.certification.forward_error`).
     """
 
     exact = False

@@ -17,11 +17,11 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.adequacy import adequacy, warnings
-from signorini.diagnose import explain
+from signorini.certification.adequacy import adequacy, warnings
+from signorini.certification.diagnosis import explain
 from signorini.errors import InputError, install_hint
-from signorini.kkt import Certificate, certificate, shortfall
-from signorini.problem import STATUSES, ContactProblem, ContactSolution
+from signorini.certification.kkt import Certificate, certificate, shortfall
+from signorini.problem.contact import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.defaults import DEFAULT_TOL, MIN_TOL, Defaults, defaults_of, resolved
 from signorini.solvers.options import Option, check_names, guess_value
 
@@ -190,7 +190,7 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
     A method returns a :class:`ContactSolution` whose ``u`` holds n floats and
     ``lam`` m floats (finite when it claims ``converged``; a method without an
     answer returns NaN, :meth:`ContactSolution.failure`), and whose status is
-    one of :data:`signorini.problem.STATUSES`; or the pair ``(u, lam)`` (the same two
+    one of :data:`signorini.problem.contact.STATUSES`; or the pair ``(u, lam)`` (the same two
     arrays), which claims ``converged`` and is judged by the certificate like any
     claim. A user's method that returns anything else cannot be judged, so it
     cannot be ``converged``.
@@ -238,7 +238,7 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
 
     An answer the certificate accepts becomes ``model_inadequate`` when the
     boundary beyond the contact candidates shows that the contact outgrew
-    them (:func:`signorini.adequacy.adequacy`); warnings about the model are
+    them (:func:`signorini.certification.adequacy.adequacy`); warnings about the model are
     appended to the message.
     """
     if solution.status != "converged":

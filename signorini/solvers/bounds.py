@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import SignoriniError
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 
 #: a row entry below this fraction of the row's largest is round-off, not a coupling
 ROUND_OFF = 1e-13

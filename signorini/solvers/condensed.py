@@ -16,11 +16,11 @@ import time
 from typing import Any
 
 from signorini.errors import InputError
-from signorini.forward_error import WithDelassus
+from signorini.certification.forward_error import WithDelassus
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
 from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options

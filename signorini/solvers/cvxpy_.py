@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError, SolverError
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, take_options

@@ -3,7 +3,7 @@
 A method asked for no ``tol`` runs at its row's ``tol`` and its answer is held to it;
 asked for no ``max_iter``, it stops after its row's ``max_iter`` steps. A row is found by
 the method's name, else by its family (:func:`defaults_of`). ``tol`` is the relative KKT
-residual the certificate accepts (:mod:`signorini.kkt`); None leaves a QP backend at its
+residual the certificate accepts (:mod:`signorini.certification.kkt`); None leaves a QP backend at its
 own settings, its answer then held to :data:`DEFAULT_TOL`.
 """
 

@@ -39,11 +39,11 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.kkt import ACTIVE, certificate, classify
+from signorini.certification.kkt import ACTIVE, certificate, classify
 from signorini.numerics.factor import ActiveSetSolver, factorize
 from signorini.numerics.work import counting
 from signorini.numerics.lcp import delassus
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import acceptance
 
 FORMS = ("primal", "shifted", "dual")

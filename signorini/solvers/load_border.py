@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from signorini.numerics.multigrid import Bordered
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 from signorini.solvers.bounds import BoundForm
 
 

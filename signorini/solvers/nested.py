@@ -28,8 +28,8 @@ from signorini.errors import InputError
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import selection_dofs
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.solution import WarmStart
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.problem.solution import WarmStart
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
 from signorini.solvers.defaults import resolved

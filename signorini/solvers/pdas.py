@@ -14,7 +14,7 @@ for CHOLMOD reuses one symbolic analysis for every step)::
 It stops when A repeats; the answer is then exact up to round-off. ``tol`` is the
 accuracy the answer is held to: it stops one solve sooner when the answer on A already
 meets the remaining conditions to ``tol`` (no force on A below ``−tol`` times the force
-scale, no penetration off A beyond ``tol`` times the gap scale, as :mod:`signorini.kkt`
+scale, no penetration off A beyond ``tol`` times the gap scale, as :mod:`signorini.certification.kkt`
 measures them; stationarity and the closed gaps on A hold exactly). A repeating is this
 test at ``tol = 0``. PDAS can
 cycle through active sets when W is not an M-matrix; a set seen before (but
@@ -23,7 +23,7 @@ LCP with Murty's least-index pivoting, which terminates for SPD W. After the
 first step ``c`` no longer matters (closed gaps are zero on A, forces zero
 off A), so ``c`` only weighs a warm start against the gaps. Without one it
 starts cold, from no contact; ``warm_start`` (an earlier answer's λ and u,
-see :class:`signorini.solution.WarmStart`) or ``lam0`` start it elsewhere.
+see :class:`signorini.problem.solution.WarmStart`) or ``lam0`` start it elsewhere.
 
 Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 """
@@ -38,12 +38,12 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.kkt import force_scale, gap_scale
+from signorini.certification.kkt import force_scale, gap_scale
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.factor import ActiveSetSolver, factorize
 from signorini.numerics.lcp import delassus, least_index_lcp
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.solution import WarmStart
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.problem.solution import WarmStart
 from signorini.solvers.base import Method
 from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options

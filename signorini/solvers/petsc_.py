@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import cluster
 from signorini.solvers.base import Method
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form

@@ -10,7 +10,7 @@ multiplier ``z`` of ``Gx ≤ h`` is non-negative and satisfies
 Every backend is one row of :data:`BACKENDS`: which modules it needs, whether
 qpsolvers feeds it dense matrices, how a relative tolerance ``tol`` and an
 iteration limit translate into its own option names, which options it
-accepts, and how its raw status maps to :data:`signorini.problem.STATUSES`.
+accepts, and how its raw status maps to :data:`signorini.problem.contact.STATUSES`.
 The methods are registered by one loop at the bottom of the module.
 """
 
@@ -27,7 +27,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from signorini.errors import BackendNotInstalled, InputError, SolverError, install_hint
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import clarabel_, forms
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare

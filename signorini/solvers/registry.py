@@ -6,7 +6,7 @@ A ``tol`` or ``max_iter`` not asked for is the method's row of
 :mod:`signorini.solvers.defaults` (None for a QP backend: its own settings,
 untouched), which :func:`run` hands every method as numbers. A ``scaled`` method
 gets a view of the problem in units of order one
-(:func:`signorini.scales.scaled_view`); a user's method, and a method given an
+(:func:`signorini.problem.scales.scaled_view`); a user's method, and a method given an
 option in the problem's units (``Option.in_units``: a step, a starting λ, a
 callback), gets the problem as given. Unknown options raise :class:`InputError`.
 """
@@ -19,12 +19,12 @@ import time
 from typing import Any, Callable, NamedTuple
 
 from signorini.errors import BackendNotInstalled, InputError
-from signorini.fingerprint import fingerprint, held_to_problem
-from signorini.kkt import Certificate
+from signorini.certification.fingerprint import fingerprint, held_to_problem
+from signorini.certification.kkt import Certificate
 from signorini.numerics.work import counting, timed
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.scales import Scales, in_problem_units, scaled_view
-from signorini.solution import WarmStart
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.problem.scales import Scales, in_problem_units, scaled_view
+from signorini.problem.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, user, uzawa
 from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, certify, check_max_iter,
                                     check_tol, hold_to_contract, judge)
@@ -183,12 +183,12 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     """Solve ``problem`` with ``method`` and judge the answer with the KKT certificate.
 
     The method's own claim of success becomes ``converged`` only when every
-    relative residual of :func:`signorini.kkt.certificate` is within
+    relative residual of :func:`signorini.certification.kkt.certificate` is within
     ``ACCEPT_FACTOR × tol``; otherwise the status is ``inaccurate`` and the
     message says by how much it missed. A backend exception becomes a
     ``failed`` solution; bad input (unknown options, non-positive tolerances)
     raises :class:`InputError`. ``warm_start`` is where the method starts
-    (see :class:`signorini.solution.WarmStart`); without it every method
+    (see :class:`signorini.problem.solution.WarmStart`); without it every method
     starts cold. A problem whose target load is pending is matched by
     :func:`signorini.solve` (load control), not here.
     """

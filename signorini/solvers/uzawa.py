@@ -44,11 +44,11 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.forward_error import WithDelassus
-from signorini.kkt import certificate, shortfall
+from signorini.certification.forward_error import WithDelassus
+from signorini.certification.kkt import certificate, shortfall
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import Method, acceptance
 from signorini.solvers.defaults import resolved
 from signorini.solvers.options import Option, declare, take_options
@@ -73,7 +73,7 @@ DISTANCE_MARGIN = 0.5
 
 def dual_residuals(problem: ContactProblem, gap_violation: np.ndarray, Nu: np.ndarray,
                    lam: np.ndarray, u_norm: float) -> tuple[float, float]:
-    """Relative primal infeasibility and natural residual (as in :mod:`signorini.kkt`)."""
+    """Relative primal infeasibility and natural residual (as in :mod:`signorini.certification.kkt`)."""
     scale = max(float(np.max(np.abs(Nu))), float(np.max(np.abs(problem.d))), u_norm) or 1.0
     lam_norm = float(np.max(np.abs(lam))) or 1.0
     primal = float(max(gap_violation.max(), 0.0)) / scale
@@ -124,7 +124,7 @@ def _operator(problem: ContactProblem, factor, choice: str):
 
 def _uncertified(problem: ContactProblem, lam: np.ndarray, u: np.ndarray, factor,
                  W: np.ndarray | None, tol: float) -> str | None:
-    """Why the certificate (:func:`signorini.kkt.certificate`, with this factorisation and W)
+    """Why the certificate (:func:`signorini.certification.kkt.certificate`, with this factorisation and W)
     does not back ``(u, λ)`` at ``tol``; None when it does."""
     offered = factor if W is None else WithDelassus(factor, problem.N, W)
     candidate = ContactSolution("uzawa", u, lam, "converged", factor=offered)

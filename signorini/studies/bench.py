@@ -63,7 +63,7 @@ class Run:
     tolerance: str
     #: MPI ranks (petsc methods only; the others run in one process)
     ranks: int = 1
-    #: a problem file (:mod:`signorini.problem_files`) the run solves instead of building ``scene``
+    #: a problem file (:mod:`signorini.problem.files`) the run solves instead of building ``scene``
     source: str | None = None
 
     @property

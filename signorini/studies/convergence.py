@@ -4,7 +4,7 @@ A study solves a scene at levels 0, 1, …, k of uniform refinement (the
 scene's ``refine`` parameter: every element split in four, so the element
 size h halves and the dofs roughly quadruple) with every installed exact
 method, and measures the errors against the scene's analytic reference
-(:attr:`signorini.references.Reference.convergence`). The rate of a metric is the
+(:attr:`signorini.references.catalogue.Reference.convergence`). The rate of a metric is the
 slope s of the least-squares line ``log err = s log h + c``
 (``np.polyfit(np.log(h), np.log(err), 1)``); h is the median distance between
 neighbouring contact candidates (:func:`signorini.studies.problems.candidate_spacing`).
@@ -30,12 +30,12 @@ from typing import Any, Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from signorini.analytic import punch_pressure
+from signorini.references.analytic import punch_pressure
 from signorini.errors import InputError
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-from signorini.pressure import compare_punch, contact_profile
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import REFERENCES
+from signorini.references.pressure import compare_punch, contact_profile
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.references.catalogue import REFERENCES
 from signorini.scenes import SCENES, get_scene, portable_scene, scene_reference
 from signorini.scenes.registry import FamilyField
 from signorini.scenes.size import check_size

@@ -20,12 +20,12 @@ import scipy.sparse as sp
 
 from signorini.fem.estimate import element_energies, estimate, material_units
 from signorini.fem.transfer import uniform_prolongation
-from signorini.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
+from signorini.certification.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
 from signorini.numerics.factor import PardisoFactor, factorize, resolve_backend
 from signorini.numerics.lcp import delassus
-from signorini.pressure import contact_profile
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import reference_of
+from signorini.references.pressure import contact_profile
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.references.catalogue import reference_of
 from signorini.solvers.cluster import mpirun_command
 
 
@@ -79,11 +79,11 @@ def force_error(problem: ContactProblem, reference: ContactSolution,
 
 
 def weak_but_penetrating(problem: ContactProblem, solution: ContactSolution) -> int:
-    """Nodes :func:`signorini.kkt.classify` calls weakly active although they penetrate.
+    """Nodes :func:`signorini.certification.kkt.classify` calls weakly active although they penetrate.
 
     ``classify`` measures the gap as ``(d − Nu)⁺``, so a node with zero force
     that overlaps the obstacle by more than the weak tolerance is labelled
-    weak and left out of :func:`signorini.kkt.compare` — a misclassification
+    weak and left out of :func:`signorini.certification.kkt.compare` — a misclassification
     the comparison does not count. The atlas counts it here.
     """
     if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):

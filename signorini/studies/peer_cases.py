@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 import signorini
-from signorini.analytic import (contact_modulus, hertz_cylinder_load, hertz_cylinder_peak,
+from signorini.references.analytic import (contact_modulus, hertz_cylinder_load, hertz_cylinder_peak,
                                 hertz_sphere_load, hertz_sphere_peak)
 from signorini.errors import InputError
 from signorini.fem.two_bodies import series_modulus

@@ -30,17 +30,17 @@ from typing import Any, Callable
 
 import numpy as np
 
-from signorini.diagnose import regularise
+from signorini.certification.diagnosis import regularise
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.model import FlatObstacle
 from signorini.files import atomic_write_bytes
-from signorini.forward_error import refined_on_active_set
-from signorini.kkt import active_set
+from signorini.certification.forward_error import refined_on_active_set
+from signorini.certification.kkt import active_set
 from signorini.load_control import at_load
 from signorini.numerics.factor import factorize
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.problem_files import read_problem
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.problem.files import read_problem
 from signorini.scenes import block, build_problem, coarse_problem
 from signorini.scenes.base import scene_params
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem
@@ -93,7 +93,7 @@ def build_spec(spec: dict[str, Any]) -> ContactProblem:
     ``{"kind": "force-controlled", "params", "pressure", "regularisation"}``,
     ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`) or
     ``{"kind": "stored", "path"}`` (a problem file: :meth:`ContactProblem.save`'s, plain
-    ``.npz`` or Matrix Market, :mod:`signorini.problem_files`).
+    ``.npz`` or Matrix Market, :mod:`signorini.problem.files`).
     """
     kind = spec["kind"]
     if kind not in PROBLEM_KINDS:

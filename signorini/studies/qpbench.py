@@ -38,7 +38,7 @@ import scipy.sparse as sp
 
 from signorini.api import certificate, scene_families, solve
 from signorini.errors import InputError
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 from signorini.studies import qpbench_files
 
 __all__ = ["DENSE_MAX_DOFS", "FAMILIES", "Entry", "Reference", "entries", "export", "reference"]

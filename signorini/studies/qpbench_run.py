@@ -23,7 +23,7 @@ from typing import Iterable
 import numpy as np
 
 from signorini.api import certificate
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 
 __all__ = ["ACCURACY", "DENSE_SCRIPT", "SCRIPT", "Judged", "judge", "run"]
 

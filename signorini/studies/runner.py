@@ -6,12 +6,12 @@ A :class:`Task` is a method at a tolerance on a problem spec
 answer it is held to. :func:`run_task` runs it and measures one :class:`Row`:
 
 - the method's own word (``claimed_status``) and the package's status;
-- the independent certificate :func:`signorini.kkt.certificate` and whether
+- the independent certificate :func:`signorini.certification.kkt.certificate` and whether
   its worst relative residual is within the accepted tolerance ``τ``
   (:func:`signorini.solvers.base.acceptance`: ``tol``, or ``DEFAULT_TOL`` without one);
 - the distance from the trusted exact answer ``(u*, λ*)``:
   ``‖λ − λ*‖∞ / max(‖λ*‖∞, 1e-5 ‖f‖∞)`` and the misclassified contact
-  nodes (weakly active nodes left out, :func:`signorini.kkt.compare`, plus
+  nodes (weakly active nodes left out, :func:`signorini.certification.kkt.compare`, plus
   nodes with zero force that penetrate, which that comparison misses);
 - the Hertz errors of a and p₀ on Hertz's cylinder;
 - whatever else the task asks for by name in ``measure`` (:data:`MEASURES`).
@@ -43,12 +43,12 @@ import numpy as np
 
 from signorini.api import solve
 from signorini.crosschecking import crosscheck
-from signorini.diagnose import diagnose
+from signorini.certification.diagnosis import diagnose
 from signorini.errors import InputError
 from signorini.files import plain
-from signorini.kkt import compare
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.references import reference_metrics
+from signorini.certification.kkt import compare
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.references.catalogue import reference_metrics
 from signorini.scenes.block import force_controlled_exact
 from signorini.solvers import cluster
 from signorini.solvers.base import Method
@@ -100,7 +100,7 @@ NUMERIC = ("dofs", "candidates", "iterations", "time_s", "kkt_worst", "lam_rel",
            "misclassified", "weak", "misclassified_strict", "weak_penetrating", "a_rel", "p0_rel",
            "pressure_l2_rel", "ref_a_rel", "ref_p0_rel", "ref_pressure_l2_rel", "rho_over_bound",
            "lambda_max", "bound_at_solution", "patch_lam_rel")
-#: the statuses a run can end with besides :data:`signorini.problem.STATUSES`
+#: the statuses a run can end with besides :data:`signorini.problem.contact.STATUSES`
 EXTRA_STATUSES = ("built", "checked", "ran", "refused", "input-error", "raised", "timeout", "crashed")
 
 __all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "COMMAND", "CROSSCHECK", "DEFAULT_TIME_LIMIT",

@@ -31,9 +31,9 @@ import numpy as np
 from signorini.crosschecking import agreement
 from signorini.errors import InputError
 from signorini.files import check_input_file
-from signorini.problem import ContactProblem, ContactSolution
-from signorini.problem_files import is_problem_file
-from signorini.references import reference_metrics, reference_of
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.problem.files import is_problem_file
+from signorini.references.catalogue import reference_metrics, reference_of
 from signorini.scenes import portable_scene
 from signorini.scenes.base import Case
 from signorini.scenes.registry import ValidationCases
@@ -389,7 +389,7 @@ def run_suite(cases: Sequence[Case] = DEFAULT_CASES, method_names: list[str] | N
 
 
 def problem_case(path: str, taken: Sequence[str] = ()) -> Case:
-    """A user's problem file (:mod:`signorini.problem_files`) as a case of the suite.
+    """A user's problem file (:mod:`signorini.problem.files`) as a case of the suite.
 
     Named after the file (its stem, numbered when ``taken`` has the name
     already); its spec reads the file in the worker by its absolute path.

@@ -10,7 +10,7 @@ Every level is judged as ``solve`` judges a method's answer
 (:func:`signorini.solvers.base.judge`): the KKT certificate with the forward error of
 its contact force (the sweep's factorisation and Delassus operator reused: a few
 back-solves, no factorisation), then the boundary beyond the candidates
-(:mod:`signorini.adequacy`): a level whose contact reached the edge of the candidates
+(:mod:`signorini.certification.adequacy`): a level whose contact reached the edge of the candidates
 or beyond is ``model_inadequate``, not ``converged``.
 """
 
@@ -24,13 +24,13 @@ from typing import Callable
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.forward_error import WithDelassus
-from signorini.kkt import certificate
+from signorini.certification.forward_error import WithDelassus
+from signorini.certification.kkt import certificate
 from signorini.numerics.lcp import delassus
 from signorini.numerics.push import push_for_load_condensed
 from signorini.output.plots import axes as _axes
-from signorini.pressure import compare_hertz, contact_half_width, contact_profile
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.references.pressure import compare_hertz, contact_half_width, contact_profile
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import judge
 
 log = logging.getLogger(__name__)

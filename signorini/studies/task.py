@@ -32,14 +32,14 @@ CROSSCHECK = "(crosscheck)"
 COMMAND = "(command)"
 #: what a task may ask to measure besides the row every task gets, and the columns it fills
 MEASURES = {
-    "diagnosis": "what signorini.diagnose finds in the problem (diagnosis)",
+    "diagnosis": "what signorini.certification.diagnosis finds in the problem (diagnosis)",
     "bound": "Uzawa's effective step bound at the exact active set (bound_at_solution)",
     "patch": "λ against the force-controlled patch solution (patch_lam_rel)",
     "profile": "the contact pressure, with the reference's a and p₀ where it draws one (profile)",
     "kkt": "every relative residual of the certificate (kkt)",
     "times": "build, solve and the method's own time, not the certificate's (build_s, solve_s, "
              "method_s)",
-    "vs_reference": "signorini.kkt.compare with the exact answer (vs_reference)",
+    "vs_reference": "signorini.certification.kkt.compare with the exact answer (vs_reference)",
     "reference": "the errors against the analytic reference the problem declares (reference)",
     "estimate": "the a posteriori estimates, energy norm and contact pressure, η and its parts, "
                 "η without the contact term, and its time (estimate)",

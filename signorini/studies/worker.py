@@ -25,7 +25,7 @@ from typing import Any
 
 from signorini.errors import InputError
 from signorini.files import plain
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
 from signorini.solvers import cluster
 from signorini.studies.measures import answer_from

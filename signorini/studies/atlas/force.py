@@ -125,7 +125,7 @@ def headline(rows: Rows) -> str:
             f"λ within {power(worst)} of the exact patch solution), while PDAS (also `pdas-amg`, and "
             "`auto`, which picks one of them), `nested`, the condensed dual and both Uzawas need K⁻¹ "
             "and fail. The handling: "
-            f"`signorini.diagnose.regularise(problem, {power(eps[0]['value'])})` adds "
+            f"`signorini.certification.diagnosis.regularise(problem, {power(eps[0]['value'])})` adds "
             f"{power(eps[0]['value'])} · mean(diag K) to the diagonal; then {len(right(eps))} of "
             f"{len(eps)} methods are right and λ moves by {power(moved, 1)} "
             f"({moved / eps[0]['value']:.0f} ε); Uzawa is not helped (both variants stop at "
@@ -143,11 +143,11 @@ AXIS = Axis(
           f"problem and on `regularise(problem, {REGULARISATION:g})`; PDAS and Clarabel "
           "for ε from 1e-14 to 1e-2.",
     advice="prescribe a displacement where you can (every scene of the package does). "
-           "For a body held only by contact, `signorini.diagnose.regularise(problem, "
+           "For a body held only by contact, `signorini.certification.diagnosis.regularise(problem, "
            "1e-8)` adds ε·mean(diag K) to the diagonal: PDAS, the condensed dual and "
            "the QP backends then solve it with λ within about 100 ε of the exact answer on "
            "the 8 × 8 block; "
            "Uzawa does not (its W gains an eigenvalue of order 1/ε). Run "
-           "`signorini.diagnose.diagnose(problem)` to see whether K is singular.",
+           "`signorini.certification.diagnosis.diagnose(problem)` to see whether K is singular.",
     legend="Cells: status, λ error against the exact patch solution.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline, counts=counts)

@@ -85,7 +85,7 @@ def headline(rows: Rows) -> str:
     unclear = "float division by zero"
     claim(any(unclear in str(r["message"]) for r in penetrated), f"a message says '{unclear}'")
     return ("**Ill-posed input** (axis 8): an empty contact set and a zero-weight candidate are "
-            "refused when the problem is built; `signorini.diagnose.diagnose(problem)` names an "
+            "refused when the problem is built; `signorini.certification.diagnosis.diagnose(problem)` names an "
             "obstacle the Dirichlet data already penetrate (infeasible), a candidate listed twice "
             "(λ not unique) and a singular K. On the penetrated obstacle "
             f"{statuses['infeasible']} methods say `infeasible` and {statuses['failed']} "
@@ -97,8 +97,8 @@ AXIS = Axis(
     "Does every infeasible or ill-posed input end in a clear error or status?",
     setup="The block (4 × 4) made infeasible or ill-posed five ways "
           "(`signorini.studies.problems.ill_posed_problem`); each problem is built and diagnosed "
-          "(`signorini.diagnose.diagnose`), then solved by every method where it builds.",
-    advice="run `signorini.diagnose.diagnose(problem)` on a problem you built yourself: it "
+          "(`signorini.certification.diagnosis.diagnose`), then solved by every method where it builds.",
+    advice="run `signorini.certification.diagnosis.diagnose(problem)` on a problem you built yourself: it "
            "names infeasible candidates, duplicated candidates and a singular K in words. "
            "The package refuses an empty contact set and zero-weight candidates outright.",
     legend="Cells: status.",

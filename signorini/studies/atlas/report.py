@@ -107,7 +107,7 @@ def _header(result: AtlasResult, command: str, info: dict[str, Any], runs: int) 
         "## How to read it", "",
         ("- **own status** (`claimed_status`): what the method said before the package judged "
          "it; **status**: what `signorini.solvers.registry.solve` returned."),
-        ("- **certificate**: the worst relative KKT residual of `signorini.kkt.certificate`; it "
+        ("- **certificate**: the worst relative KKT residual of `signorini.certification.kkt.certificate`; it "
          f"passes when ≤ τ (the tolerance asked for; {DEFAULT_TOL:g} without one)."),
         ("- **exact answer**: PDAS at 1e-9 on the non-dimensionalised problem (or the patch "
          "solution where K is singular). An answer **agrees** when no contact node is "

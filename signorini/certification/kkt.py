@@ -3,7 +3,7 @@
 For ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with multipliers ``λ`` every residual is
 relative, so that the same threshold means the same thing in any units; the forward
 error of λ itself comes from one Newton correction on the active set
-(:mod:`signorini.forward_error`, docs/certificate.md).
+(:mod:`signorini.certification.forward_error`, docs/certificate.md).
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.forward_error import ForwardError, forward_error
+from signorini.certification.forward_error import ForwardError, forward_error
 from signorini.numerics.factor import selection_dofs
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: normalised force and gap below which a node counts as touching with zero force
 WEAK_TOL = 1e-6
@@ -103,7 +103,7 @@ class Certificate:
     - ``force_error_floor``: the force change of a second Newton step: what
       double precision resolves of λ on this system (about ``force_error``
       when the system is too ill-conditioned for the first step to be trusted).
-      See :mod:`signorini.forward_error` (no factorisation when the method
+      See :mod:`signorini.certification.forward_error` (no factorisation when the method
       holds one; NaN when not estimated).
 
     Force norms are floored at ``FORCE_FLOOR · ‖f‖∞`` so that a problem with

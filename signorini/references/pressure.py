@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from signorini.analytic import (
+from signorini.references.analytic import (
     hertz_cylinder_half_width,
     hertz_cylinder_peak,
     hertz_pressure,
@@ -23,8 +23,8 @@ from signorini.analytic import (
     punch_load_between,
     punch_pressure,
 )
-from signorini.kkt import ACTIVE, classify
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.certification.kkt import ACTIVE, classify
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.reprs import short_repr
 
 

@@ -15,7 +15,7 @@ the directional derivative along ``+(df, dd)`` (a node presses when its gap
 would close, and lets go when its force would turn negative), ``"in"`` and
 ``"out"`` keep every weak node in or out of A; every answer lists the weak nodes.
 
-:mod:`signorini.scene_derivatives` differentiates a scene's physical outputs with respect
+:mod:`signorini.derivatives.scene` differentiates a scene's physical outputs with respect
 to its parameters on this system.
 """
 
@@ -27,11 +27,11 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError, SolverError
-from signorini.kkt import ACTIVE, WEAK, classify
+from signorini.certification.kkt import ACTIVE, WEAK, classify
 from signorini.numerics.factor import ActiveSetSolver
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 from signorini.reprs import short_repr
-from signorini.solution import ContactSolution
+from signorini.problem.solution import ContactSolution
 
 SIDES = ("auto", "in", "out")
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: ``K x`` before and after a method agree to this (relative): summation order only
 SAME_PRODUCT_RTOL = 1e-12

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.discretisation import Discretisation, Push, ReferenceData, Watch
+from signorini.problem.discretisation import Discretisation, Push, ReferenceData, Watch
 from signorini.errors import InputError
 from signorini.numerics.arrays import (
     multiplicity_argument,
@@ -33,9 +33,9 @@ from signorini.numerics.arrays import (
     vector_argument,
 )
 from signorini.numerics.factor import factorize
-from signorini import saved_problem
-from signorini.scales import Scales
-from signorini.solution import STATUSES, ContactSolution
+from signorini.problem import saved as saved_problem
+from signorini.problem.scales import Scales
+from signorini.problem.solution import STATUSES, ContactSolution
 
 
 __all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Discretisation", "Push", "ReferenceData",
@@ -130,7 +130,7 @@ class ContactProblem:
         ``.d`` and :meth:`qp` are what you passed, a method of your own is
         handed them, and a :class:`signorini.Result` answers in your units.
         A built-in method that needs numbers of order one works on a scaled
-        view of its own (:func:`signorini.scales.scaled_view`).
+        view of its own (:func:`signorini.problem.scales.scaled_view`).
         """
         K = symmetric_argument(sparse_argument(K, "K"))
         N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")
@@ -359,7 +359,7 @@ class ContactProblem:
         """Store the arrays of this problem (and its mesh) in ``path`` (.npz), atomically.
 
         :meth:`load` gives it back (the cached factorisation is not stored); the format is
-        :mod:`signorini.saved_problem`'s.
+        :mod:`signorini.problem.saved`'s.
         """
         saved_problem.save(self, path)
 

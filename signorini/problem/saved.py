@@ -17,11 +17,11 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.discretisation import Discretisation, Push, ReferenceData
+from signorini.problem.discretisation import Discretisation, Push, ReferenceData
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
 from signorini.numerics.arrays import symmetric_argument
-from signorini.scales import Scales
+from signorini.problem.scales import Scales
 
 log = logging.getLogger(__name__)
 

@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from signorini.errors import InputError, docs_page
 from signorini.files import check_input_file
-from signorini.problem import ContactProblem
+from signorini.problem.contact import ContactProblem
 
 __all__ = ["MATRIX_MARKET_NAMES", "PLAIN_KEYS", "is_problem_file", "problem_file_paths",
            "read_problem"]

@@ -4,7 +4,7 @@ The QP only knows the candidates a scene chose before the solve (for Hertz's
 cylinder, the arc up to ``candidates · a``). An answer can be exact for that
 QP and still wrong for the body: push harder and boundary nodes beyond the
 candidates go through the obstacle, unseen. After every solve the package
-therefore checks the whole boundary (:class:`signorini.problem.Watch`, built
+therefore checks the whole boundary (:class:`signorini.problem.contact.Watch`, built
 at assembly):
 
 - a boundary node that is not a candidate lies on the wrong side of the
@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from signorini.errors import docs_page
-from signorini.kkt import ACTIVE, classify, gap_scale
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.certification.kkt import ACTIVE, classify, gap_scale
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: above this Poisson's ratio P1 triangles lock measurably (docs/accuracy.md: 3–5 × the error)
 LOCKING_NU = 0.45

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.solution import WarmStart
+from signorini.problem.solution import WarmStart
 
 __all__ = ["ORDER_ONE", "Scales", "UnitsFactor", "in_problem_units", "qp_scales", "record_units",
            "scaled_view"]

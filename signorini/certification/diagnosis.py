@@ -19,8 +19,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.kkt import force_scale, gap_scale
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.certification.kkt import force_scale, gap_scale
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: the kinds of failure of a candidate, in the order a message names them
 KINDS = ("penetration", "tension", "complementarity", "stationarity")
@@ -105,7 +105,7 @@ def diagnose(problem: ContactProblem) -> list[str]:
     except (np.linalg.LinAlgError, ArithmeticError, RuntimeError) as exc:
         findings.append(f"K is singular ({exc}): a rigid mode is held only by the contact; pdas, "
                         "uzawa and condensed need K⁻¹ — prescribe a displacement or use "
-                        "signorini.diagnose.regularise(problem, 1e-8)")
+                        "signorini.certification.diagnosis.regularise(problem, 1e-8)")
     return findings
 
 
@@ -126,7 +126,7 @@ def violations(problem: ContactProblem, solution: ContactSolution,
     """The candidates whose own residual exceeds ``accept``, the largest first within each kind.
 
     With ``g = Nu − d``, the gap scale ``L`` and the force scale ``Λ`` of
-    :class:`signorini.kkt.Certificate`: penetration ``gᵢ / L``, tension ``−λᵢ / Λ``,
+    :class:`signorini.certification.kkt.Certificate`: penetration ``gᵢ / L``, tension ``−λᵢ / Λ``,
     complementarity ``|λᵢ gᵢ| / (Λ L)``, and stationarity the largest
     ``|Ku − f + Nᵀλ|`` on the dofs of row i, over the certificate's stationarity scale.
     """

@@ -3,7 +3,7 @@
 Total force, energy, the displacement at a point, nodal pressures and Hertz's fitted p₀
 and a, with respect to E, ν, the load P or push δ and the obstacle's position: each enters
 K, f and d analytically (:func:`change`), and the answer moves by the active-set system of
-:class:`signorini.derivatives.Sensitivity` (:func:`scene_tangent`). The discrete contact
+:class:`signorini.derivatives.implicit.Sensitivity` (:func:`scene_tangent`). The discrete contact
 width is piecewise constant in these data, so it has no derivative; the fitted ``a`` is smooth.
 """
 
@@ -14,17 +14,17 @@ from typing import Any
 
 import numpy as np
 
-from signorini.derivatives import Sensitivity, exact_answer
+from signorini.derivatives.implicit import Sensitivity, exact_answer
 from signorini.errors import InputError
 from signorini.fem.assembly import lame_stiffness, nodal_dofs
 from signorini import load_control
-from signorini.pressure import contact_profile, hertz_fit, hertz_fit_tangent
-from signorini.problem import ContactProblem
+from signorini.references.pressure import contact_profile, hertz_fit, hertz_fit_tangent
+from signorini.problem.contact import ContactProblem
 from signorini.reprs import short_repr
 from signorini.scenes import build_problem
 from signorini.scenes.base import scene_params
 from signorini.scenes.build import coarse_problem
-from signorini.solution import ContactSolution
+from signorini.problem.solution import ContactSolution
 from signorini.solvers.registry import check_request
 
 OUTPUTS = ("total_force", "energy", "displacement", "pressure", "p0", "a")
@@ -225,7 +225,7 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
     ``method``) or a converged :class:`signorini.Result`. ``output`` is one of
     ``total_force``, ``energy`` (the optimal ½uᵀKu − fᵀu), ``displacement``
     (at the mesh node nearest ``at``), ``pressure`` (nodal), ``p0`` and ``a``
-    (Hertz's profile fitted to the pressures, :func:`signorini.pressure.hertz_fit`);
+    (Hertz's profile fitted to the pressures, :func:`signorini.references.pressure.hertz_fit`);
     ``wrt`` one of ``E``, ``nu`` (``E1``, ``E2``, ``nu1``, ``nu2``: each body's of a two-body
     scene), ``P`` (a load-controlled scene's target
     load), ``delta`` (a push-controlled scene's push) and ``obstacle`` (the

@@ -19,7 +19,7 @@ A reference also says its comparison in a solve's summary
 (:func:`summary_lines`) and the claims the validation suite holds an exact
 answer to (:class:`Claim`, with the suite's limits by name).
 
-Formulas: :mod:`signorini.analytic`; comparisons: :mod:`signorini.pressure`.
+Formulas: :mod:`signorini.references.analytic`; comparisons: :mod:`signorini.references.pressure`.
 """
 
 from __future__ import annotations
@@ -29,9 +29,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from signorini.analytic import hertz_cylinder_half_width, hertz_sphere_radius
+from signorini.references.analytic import hertz_cylinder_half_width, hertz_sphere_radius
 from signorini.errors import InputError
-from signorini.pressure import (
+from signorini.references.pressure import (
     compare_hertz,
     compare_hertz_sphere,
     compare_punch,
@@ -40,7 +40,7 @@ from signorini.pressure import (
     contact_profile,
     radial_distance,
 )
-from signorini.problem import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Where a contact problem came from: the scene's mesh and model, and what varies with the push.
 
 :class:`Discretisation` rides beside the QP of a
-:class:`~signorini.problem.ContactProblem`: the mesh, the material, how the
+:class:`~signorini.problem.contact.ContactProblem`: the mesh, the material, how the
 free dofs expand to the full vector, how f, d and the load depend on the push
 (:class:`Push`), the boundary watched beyond the candidates (:class:`Watch`)
 and the typed record a scene hands its analytic reference
@@ -21,10 +21,10 @@ __all__ = ["Discretisation", "Push", "ReferenceData", "Watch"]
 
 @dataclass(frozen=True)
 class ReferenceData:
-    """What an analytic reference (:mod:`signorini.references`) reads of the scene, by field.
+    """What an analytic reference (:mod:`signorini.references.catalogue`) reads of the scene, by field.
 
     Built by the scene family from its checked parameters, in the scene's
-    units: ``name`` is the reference in :data:`signorini.references.REFERENCES`,
+    units: ``name`` is the reference in :data:`signorini.references.catalogue.REFERENCES`,
     ``E_star = E / (1 − ν²)`` the contact modulus, ``R`` the radius of the
     cylinder or sphere (Hertz; the rigid cylinder under a block), ``H`` the
     height of a block (uniform pressure ``E* δ / H``), ``a`` the half-width of
@@ -61,7 +61,7 @@ class Push:
 
     In the scene's units, ``delta`` is the push δ of the loaded boundary at
     ``scale`` and ``P`` the target load of the full body (None: the scene
-    names none); :meth:`ContactProblem.pushed <signorini.problem.ContactProblem.pushed>`
+    names none); :meth:`ContactProblem.pushed <signorini.problem.contact.ContactProblem.pushed>`
     keeps them with the push.
     """
 
@@ -99,7 +99,7 @@ class Watch:
     candidates that share a boundary facet facing the obstacle with one of
     them; ``candidate_gaps`` are the candidates' gaps before any push;
     ``remedy`` says what to change when the contact outgrows the candidates
-    (see :mod:`signorini.adequacy`).
+    (see :mod:`signorini.certification.adequacy`).
     """
 
     rows: sp.csr_matrix
