@@ -131,11 +131,19 @@ def cholmod_ordering(n: int) -> str:
     return "nesdis" if n >= NESTED_DISSECTION_FROM else "amd"
 
 
+#: from this many dofs CHOLMOD factorises by supernodes (dense BLAS blocks); below, the
+#: simplicial factorisation is faster (measured on the Hertz cylinder: 6 against 12 ms at 5k dofs,
+#: 65 against 87 at 21k, 1.18 against 0.78 s at 82k; docs/performance.md)
+SUPERNODAL_FROM = 40_000
+
+
 def cholmod_analysis(K: sp.csc_matrix):
-    """CHOLMOD's symbolic analysis (ordering, supernodes) of the pattern of K."""
+    """CHOLMOD's symbolic analysis (ordering, supernodes or not) of the pattern of K."""
     from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
 
-    return analyze(K, mode="supernodal", ordering_method=cholmod_ordering(K.shape[0]))
+    n = K.shape[0]
+    return analyze(K, mode="supernodal" if n >= SUPERNODAL_FROM else "simplicial",
+                   ordering_method=cholmod_ordering(n))
 
 
 def cholmod_numeric(symbolic, K: sp.csc_matrix):
