@@ -4,7 +4,8 @@
 
 The default cylinder meshed afresh (the graded disc's cache cleared) ``REPEAT`` times, then a load
 slider (:func:`signorini.with_load` on one built problem) and a material slider (``E`` through
-``params``, the mesh kept); the medians of each stage of the record's ``time``.
+``params``, the mesh kept); the medians of each stage of the record's ``time``, and the first as
+docs/performance.md's table.
 """
 
 from __future__ import annotations
@@ -35,6 +36,22 @@ def medians(runs: list[tuple[float, dict[str, float]]]) -> str:
             + ", ".join(f"{key} {value:.3f}" for key, value in stages.items()))
 
 
+#: the record's stages as docs/performance.md names them
+STAGES = {"mesh_s": "mesh (`mesh_s`)", "assemble_s": "assemble", "load_control_s": "load control",
+          "method_s": "method", "certificate_s": "certificate", "estimate_s": "estimate",
+          "output_s": "output (the record)"}
+
+
+def table(runs: list[tuple[float, dict[str, float]]]) -> str:
+    """The medians of each stage as docs/performance.md's table, the wall time's median last."""
+    lines = ["| stage | seconds |", "|---|---:|"]
+    lines += [f"| {name} | {statistics.median(t[key] for _, t in runs):.3f} |"
+              for key, name in STAGES.items()]
+    total = statistics.median(t["total_s"] for _, t in runs)
+    wall = statistics.median(wall for wall, _ in runs)
+    return "\n".join(lines + [f"| **total** (wall, median: {wall:.3f}) | **{total:.3f}** |"])
+
+
 def main() -> None:
     signorini.solve("hertz-cylinder")  # imports and first calls out of the way
     fresh = []
@@ -45,6 +62,7 @@ def main() -> None:
     load = [timed(lambda: signorini.solve(signorini.with_load(problem, a_over_R=a))) for a in LOADS]
     material = [timed(lambda: signorini.solve("hertz-cylinder", params={"E": E})) for E in MODULI]
     print(f"the default cylinder, meshed afresh: {medians(fresh)}")
+    print(table(fresh))
     print(f"a load slider's step (with_load): {medians(load)}")
     print(f"a material slider's step (E, the mesh kept): {medians(material)}")
     print(f"load average {os.getloadavg()[0]:.1f}")
