@@ -12,7 +12,7 @@ from signorini.errors import InputError
 from signorini.scenes.families import SCENES
 from signorini.scenes.size import MEMORY_VARIABLE, SIZE_MODELS, check_size, estimate_dofs
 
-#: the cylinder's coarse gradings on the bisection meshes the models were fitted to: Triangle's
+#: the discs' coarse gradings on the bisection meshes the models were fitted to: Triangle's
 #: (the default) are over-estimated up to 1.8 times there, the safe side, which
 #: tests/test_triangle_mesher.py holds between 1 and 2 (docs/calibration.md)
 VARIANTS = [
@@ -28,7 +28,7 @@ VARIANTS = [
     ("reverse-hertz", {"grading": 0.15}), ("block", {"nx": 40, "ny": 7}),
     # the convergence studies' coarse starts
     ("hertz-cylinder", {"n_contact": 15, "grading": 0.6, "mesher": "bisection"}),
-    ("hertz-sphere", {"n_contact": 12, "grading": 0.6}), ("punch", {"n_contact": 16, "grading": 0.6}),
+    ("hertz-sphere", {"n_contact": 12, "grading": 0.6, "mesher": "bisection"}), ("punch", {"n_contact": 16, "grading": 0.6}),
     ("reverse-hertz", {"n_contact": 16, "grading": 0.6}),
 ]
 
