@@ -266,7 +266,7 @@ def test_the_validation_suite_cross_checks_uzawa_with_osqp_and_clarabel():
     """Every case: uzawa against qp-osqp and qp-clarabel (default form) at the suite's tight
     tolerance; a check that fails when they disagree, or when either did not converge."""
     require("qp-osqp", "qp-clarabel")
-    from signorini.studies import suite
+    from signorini.studies import suite, suite_checks
 
     cases = suite.select_cases(["block"])
     result = suite.run_suite(cases, ["uzawa", "qp-osqp", "qp-clarabel"], isolate=False)
@@ -275,10 +275,10 @@ def test_the_validation_suite_cross_checks_uzawa_with_osqp_and_clarabel():
                                                        "uzawa cross-checked with qp-clarabel"]
     assert all(c.passed for c in crossed) and result.passed
     case = result.results[0]
-    lying = case.solutions[suite.label("qp-clarabel", suite.TIGHT_TOL)]
+    lying = case.solutions[suite_checks.label("qp-clarabel", suite_checks.TIGHT_TOL)]
     lying.lam = 1.01 * lying.lam  # still says converged: the cross-check must catch it
-    checks = suite.cross_checks(case)
+    checks = suite_checks.cross_checks(case)
     assert [c.passed for c in checks] == [True, False]
     assert "λ 9.9e-03" in checks[1].detail  # 0.01 over the larger ‖λ‖∞
-    case.solutions[suite.label("qp-osqp", suite.TIGHT_TOL)].status = "inaccurate"
-    assert not suite.cross_checks(case)[0].passed
+    case.solutions[suite_checks.label("qp-osqp", suite_checks.TIGHT_TOL)].status = "inaccurate"
+    assert not suite_checks.cross_checks(case)[0].passed

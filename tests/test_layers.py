@@ -34,7 +34,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
 
 LAYERS = {
-    "errors": 0, "files": 0, "reprs": 0,
+    "errors": 0, "files": 0, "paths": 0, "reprs": 0,
     "numerics": 1,
     "problem": 2, "certification": 2, "references": 2, "fem": 2,
     "solvers": 3,
