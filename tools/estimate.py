@@ -1,7 +1,7 @@
 """Effectivity of the a posteriori estimate (signorini.fem.estimate) on the Hertz scenes, and
 what adaptive refinement (signorini.scenes.adapt) reaches against uniform and hand-graded meshes.
 
-    .venv/bin/python tools/estimate.py [effectivity] [adaptive] [punch] [start] [meshers]  # adaptive 2.4 min;
+    .venv/bin/python tools/estimate.py [effectivity] [adaptive] [punch] [start]  # adaptive 2.4 min;
                                                                           # writes docs/estimate/runs.json
     .venv/bin/python tools/estimate.py figure                     # adaptive.png from the JSON
 
@@ -191,12 +191,20 @@ def run_start() -> list[dict]:
     return rows
 
 
+#: the columns that end an effectivity table's header, and :func:`effectivity_cells` its rows'
+EFFECTIVITY_HEADER = "| pressure estimate | pressure error | effectivity |"
+
+
+def effectivity_cells(r: dict) -> str:
+    return (f"| {100 * r['pressure_estimate']:.3f} % | {100 * r['pressure_error']:.3f} % "
+            f"| {r['effectivity']:.2f} |")
+
+
 def start_table(rows: list[dict]) -> str:
-    lines = ["| scene | start (n_contact, grading) | step | dofs | pressure estimate | pressure error "
-             "| effectivity |", "|---|---|---:|---:|---:|---:|---:|"]
+    lines = ["| scene | start (n_contact, grading) | step | dofs " + EFFECTIVITY_HEADER,
+             "|---|---|---:|---:|---:|---:|---:|"]
     lines += [f"| {r['scene']} | {r['mesh'].split('from ')[1]} | {r['step']} | {r['dofs']:,} "
-              f"| {100 * r['pressure_estimate']:.3f} % | {100 * r['pressure_error']:.3f} % "
-              f"| {r['effectivity']:.2f} |" for r in rows]
+              + effectivity_cells(r) for r in rows]
     return "\n".join(lines)
 
 
@@ -413,37 +421,6 @@ def adaptive_figure(rows: list[dict], path: Path) -> None:
     save_figure(fig, path)
 
 
-#: the pressure estimate against the true error on each mesher's meshes (ν = 0.3): the coarse
-#: base and a mesh of about the default's dofs, the error against the same mesh two refinements
-#: finer
-MESHER_BASES = {"hertz-cylinder": ((16, 0.2), (24, 0.11)), "hertz-sphere": ((16, 0.2), (36, 0.15))}
-
-
-def run_meshers() -> list[dict]:
-    rows = []
-    for scene in SCENES:
-        for mesher in ("triangle", "bisection", "relaxed"):
-            for n_contact, grading in MESHER_BASES[scene]:
-                coarse, _ = solve(scene, n_contact, grading, 0, mesher=mesher)
-                fine, _ = solve(scene, n_contact, grading, 2, mesher=mesher)
-                error = pressure_error(coarse, fine)
-                rows.append({"scene": scene, "mesher": mesher, "n_contact": n_contact, "grading": grading,
-                             "dofs": coarse.problem.n, "pressure_estimate": coarse.estimate.pressure.relative,
-                             "pressure_error": error,
-                             "effectivity": coarse.estimate.pressure.relative / error})
-                print(rows[-1], file=sys.stderr)
-    return rows
-
-
-def meshers_table(rows: list[dict]) -> str:
-    lines = ["| scene | mesher | mesh (n_contact, grading) | dofs | pressure estimate | pressure error "
-             "| effectivity |", "|---|---|---|---:|---:|---:|---:|"]
-    lines += [f"| {r['scene']} | {r['mesher']} | {r['n_contact']}, {r['grading']:g} | {r['dofs']:,} "
-              f"| {100 * r['pressure_estimate']:.3f} % | {100 * r['pressure_error']:.3f} % "
-              f"| {r['effectivity']:.2f} |" for r in rows]
-    return "\n".join(lines)
-
-
 def load(part: str = "rows") -> list[dict]:
     return json.loads(OUT.read_text()).get(part, [])
 
@@ -462,9 +439,6 @@ if __name__ == "__main__":
         record["punch"] = run_punch()
     if "start" in parts:
         record["start"] = run_start()
-    if "meshers" in parts:
-        record["meshers"] = run_meshers()
-        print(meshers_table(record["meshers"]))
     if parts != ["figure"]:
         atomic_write_text(OUT, to_json(record))
         print(f"written: {OUT}", file=sys.stderr)

@@ -131,9 +131,8 @@ def cholmod_ordering(n: int) -> str:
     return "nesdis" if n >= NESTED_DISSECTION_FROM else "amd"
 
 
-#: from this many dofs CHOLMOD factorises by supernodes (dense BLAS blocks); below, the
-#: simplicial factorisation is faster (measured on the Hertz cylinder: 6 against 12 ms at 5k dofs,
-#: 65 against 87 at 21k, 1.18 against 0.78 s at 82k; docs/performance.md)
+#: from this many dofs CHOLMOD factorises by supernodes; below, simplicially: faster there
+#: (measured on the Hertz cylinder's K, docs/performance.md)
 SUPERNODAL_FROM = 40_000
 
 
@@ -141,9 +140,8 @@ def cholmod_analysis(K: sp.csc_matrix):
     """CHOLMOD's symbolic analysis (ordering, supernodes or not) of the pattern of K."""
     from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
 
-    n = K.shape[0]
-    return analyze(K, mode="supernodal" if n >= SUPERNODAL_FROM else "simplicial",
-                   ordering_method=cholmod_ordering(n))
+    mode = "supernodal" if K.shape[0] >= SUPERNODAL_FROM else "simplicial"
+    return analyze(K, mode=mode, ordering_method=cholmod_ordering(K.shape[0]))
 
 
 def cholmod_numeric(symbolic, K: sp.csc_matrix):
