@@ -149,9 +149,12 @@ def cholmod_numeric(symbolic, K: sp.csc_matrix):
     from sksparse.cholmod import CholmodNotPositiveDefiniteError  # as above
 
     try:
-        return symbolic.cholesky(K)
+        factor = symbolic.cholesky(K)
     except CholmodNotPositiveDefiniteError as exc:
         raise np.linalg.LinAlgError(f"K is not positive definite ({exc})") from exc
+    if not np.all(factor.D() > 0):  # the simplicial factor is LDLᵀ, which an indefinite K passes
+        raise np.linalg.LinAlgError("K is not positive definite (a pivot of its LDLᵀ is not positive)")
+    return factor
 
 
 class CholmodFactor(Factor):
@@ -353,12 +356,13 @@ class ActiveSetSolver:
                 and np.array_equal(np.sort(factor.fixed), np.sort(self._dofs[active])))
 
     def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray,
-              factor: PinnedFactor | None = None) -> tuple[np.ndarray, np.ndarray]:
+              factor: PinnedFactor | SaddlePoint | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k).
 
-        ``factor``, a factorisation of this very system (see :meth:`pins`; for
-        instance the last one a method made on the same active set), is reused:
-        the solve then costs back-solves only.
+        ``factor``, a factorisation of this very system (see :meth:`pins`, or a
+        :class:`SaddlePoint` on this K, N and active set; for instance the last one
+        a method made on the same active set), is reused: the solve then costs
+        back-solves only.
         """
         active = np.asarray(active, dtype=bool)
         f, d = np.asarray(f, float), np.asarray(d, float)
@@ -384,7 +388,9 @@ class ActiveSetSolver:
             return self.factor.solve(f), lam
         if self.saddle_point is None or not np.array_equal(self.saddle_point.active, active):
             self.saddle_point = None  # let go before the next one is made
-            self.saddle_point = SaddlePoint(self.K, self.N, active)
+            given = isinstance(factor, SaddlePoint) and factor.stiffness == 1.0 \
+                and factor.on(self.K, self.N, active)
+            self.saddle_point = factor if given else SaddlePoint(self.K, self.N, active)
         self.factor = self.saddle_point  # the certificate's, on the final active set
         u, lam[active] = self.saddle_point.solve(f, d[active])
         return u, lam

@@ -24,8 +24,8 @@ class WarmStart:
     ``zone_solver`` holds a factorisation of this K around the contact
     ``zone`` (a :class:`~signorini.numerics.zone.ZoneSolver`; ``nested``
     reuses both and costs back-solves only); ``factor`` a factorisation of
-    this K with an active set's dofs pinned (load control's last, a
-    :class:`~signorini.numerics.factor.PinnedFactor`), which ``pdas`` reuses
+    this K with an active set's dofs pinned or of its saddle-point system (load
+    control's last), which ``pdas`` reuses
     when its first active set is that one. A method never reads a warm
     start from anywhere else.
     """
