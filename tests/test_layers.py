@@ -9,7 +9,7 @@ Layers, low to high (a module may import its own layer and the layers below):
 3. ``solvers``                           the registry collects each backend's METHODS
 4. ``load_control``                      load control: the one driver around any method
 5. ``scenes``                            families, meshing, scene files, building problems
-6. ``api``, ``crosschecking``, ``derivatives``, the package: the public Python API
+6. ``api``, ``result``, ``crosschecking``, ``derivatives``, the package: the public Python API
 7. ``studies``, ``output`` one runner and its studies; reports, plots, export
 8. ``cli``                               parsing only
 
@@ -40,7 +40,7 @@ LAYERS = {
     "solvers": 3,
     "load_control": 4,
     "scenes": 5,
-    "api": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "": 6,
+    "api": 6, "result": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "": 6,
     "studies": 7, "output": 7,
     "cli": 8,
 }

@@ -244,7 +244,7 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
                          "derivatives are not provided")
     if isinstance(scene, str):
         request = check_request(method)  # before the scene is built
-        problem = build_problem(scene, params=scene_params(params), solved_by=method)
+        problem = build_problem(scene, params=scene_params(params), solved_by=request.method)
         problem, solution, _ = load_control.solve(problem, request, coarse=coarse_problem,
                                                   keep_factor=True)
         result = None

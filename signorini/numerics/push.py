@@ -22,7 +22,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.numerics.factor import ActiveSetSolver
+from signorini.numerics.active_set import ActiveSetSolver
 from signorini.numerics.work import count
 
 log = logging.getLogger(__name__)

@@ -52,7 +52,7 @@ import scipy.sparse as sp
 
 from signorini.errors import InputError
 from signorini.certification.kkt import certificate
-from signorini.numerics.factor import selection_dofs
+from signorini.numerics.active_set import selection_dofs
 from signorini.numerics.push import first_contact
 from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg, pinned_matrix, threaded
 from signorini.numerics.work import count
@@ -62,7 +62,7 @@ from signorini.solvers import pdas, petsc_
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
 from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
 from signorini.solvers.base import Method
-from signorini.solvers.defaults import resolved
+from signorini.solvers.options import resolved
 from signorini.solvers.options import positive_number, take_options
 
 log = logging.getLogger(__name__)
@@ -207,7 +207,7 @@ class PinnedSystem:
 class PinnedCG:
     """The certificate's K⁻¹ with some contact dofs pinned, by this method's multigrid.
 
-    Has the interface of :class:`~signorini.numerics.factor.PinnedFactor`:
+    Has the interface of :class:`~signorini.numerics.active_set.PinnedFactor`:
     ``matrix`` (the problem's K), ``fixed`` (free-dof indices pinned: the
     active rows' dofs when each row bounds one dof, else none) and
     ``solve(rhs)``: u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``, to the
@@ -402,5 +402,5 @@ METHODS = (
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
            requires=("pyamg",), extra="", options=tuple(DEFAULTS),
            matches_load=lambda problem: border_factor(problem) is not None,
-           prediction="active set", bound_rows=True),
+           prediction="active set", bound_rows=True, factor_free_from=0),
 )

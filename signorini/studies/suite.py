@@ -179,8 +179,8 @@ def select_cases(names: list[str] | None) -> tuple[Case, ...]:
 def portable(method: Method) -> bool:
     """A worker process finds this method by its name: a backend's, or ``module:function``.
 
-    A method :func:`~signorini.solvers.registry.register` added in this
-    process only (a function defined in a notebook) is not.
+    A method known in this process only (a function defined in a notebook, given by
+    :func:`~signorini.solvers.registry.given`) is not.
     """
     return ":" in method.name or any(method.name == m.name for b in BACKENDS for m in b.METHODS)
 
