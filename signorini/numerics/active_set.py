@@ -62,18 +62,21 @@ class ActiveSetSolver:
         self.saddle_point: SaddlePoint | None = None
 
     def pins(self, active: np.ndarray, factor: object) -> bool:
-        """``factor`` is a :class:`PinnedFactor` of this K with exactly the dofs of ``active`` pinned."""
+        """``factor`` is a :class:`PinnedFactor` of this K (or of a copy: a method's view) with
+        exactly the dofs of ``active`` pinned."""
         return (self._dofs is not None and isinstance(factor, PinnedFactor)
-                and factor.matrix is self.K
+                and (factor.matrix is self.K or factor.matrix.shape == self.K.shape
+                     and (factor.matrix != self.K).nnz == 0)
                 and np.array_equal(np.sort(factor.fixed), np.sort(self._dofs[active])))
 
     def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray,
-              factor: PinnedFactor | None = None) -> tuple[np.ndarray, np.ndarray]:
+              factor: PinnedFactor | SaddlePoint | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k).
 
-        ``factor``, a factorisation of this very system (see :meth:`pins`; for
-        instance the last one a method made on the same active set), is reused:
-        the solve then costs back-solves only.
+        ``factor``, a factorisation of this very system (see :meth:`pins`, or a
+        :class:`SaddlePoint` on this K, N and active set; for instance the last one
+        a method made on the same active set), is reused: the solve then costs
+        back-solves only.
         """
         active = np.asarray(active, dtype=bool)
         f, d = np.asarray(f, float), np.asarray(d, float)
@@ -99,7 +102,9 @@ class ActiveSetSolver:
             return self.factor.solve(f), lam
         if self.saddle_point is None or not np.array_equal(self.saddle_point.active, active):
             self.saddle_point = None  # let go before the next one is made
-            self.saddle_point = SaddlePoint(self.K, self.N, active)
+            given = isinstance(factor, SaddlePoint) and factor.stiffness == 1.0 \
+                and factor.on(self.K, self.N, active)
+            self.saddle_point = factor if given else SaddlePoint(self.K, self.N, active)
         self.factor = self.saddle_point  # the certificate's, on the final active set
         u, lam[active] = self.saddle_point.solve(f, d[active])
         return u, lam

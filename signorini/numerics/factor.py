@@ -131,11 +131,17 @@ def cholmod_ordering(n: int) -> str:
     return "nesdis" if n >= NESTED_DISSECTION_FROM else "amd"
 
 
+#: from this many dofs CHOLMOD factorises by supernodes; below, simplicially: faster there
+#: (measured on the Hertz cylinder's K, docs/performance.md)
+SUPERNODAL_FROM = 40_000
+
+
 def cholmod_analysis(K: sp.csc_matrix):
-    """CHOLMOD's symbolic analysis (ordering, supernodes) of the pattern of K."""
+    """CHOLMOD's symbolic analysis (ordering, supernodes or not) of the pattern of K."""
     from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
 
-    return analyze(K, mode="supernodal", ordering_method=cholmod_ordering(K.shape[0]))
+    mode = "supernodal" if K.shape[0] >= SUPERNODAL_FROM else "simplicial"
+    return analyze(K, mode=mode, ordering_method=cholmod_ordering(K.shape[0]))
 
 
 def cholmod_numeric(symbolic, K: sp.csc_matrix):
@@ -143,9 +149,12 @@ def cholmod_numeric(symbolic, K: sp.csc_matrix):
     from sksparse.cholmod import CholmodNotPositiveDefiniteError  # as above
 
     try:
-        return symbolic.cholesky(K)
+        factor = symbolic.cholesky(K)
     except CholmodNotPositiveDefiniteError as exc:
         raise np.linalg.LinAlgError(f"K is not positive definite ({exc})") from exc
+    if not np.all(factor.D() > 0):  # the simplicial factor is LDLᵀ, which an indefinite K passes
+        raise np.linalg.LinAlgError("K is not positive definite (a pivot of its LDLᵀ is not positive)")
+    return factor
 
 
 class CholmodFactor(Factor):

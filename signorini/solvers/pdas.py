@@ -125,7 +125,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         active = new_active
         log.info("pdas step %d: %d candidates in contact, %d changed", iteration,
                  history["active"][-1], changes)
-        u, lam = system.solve(active, problem.f, problem.d)
+        reused = warm.factor if warm is not None and iteration == 1 else None
+        u, lam = system.solve(active, problem.f, problem.d, factor=reused)
     return ContactSolution(method="pdas", u=u, lam=lam, status=status, message=message,
                            iterations=iteration, solve_time=time.perf_counter() - start,
                            history=history, factor=system.factor)
