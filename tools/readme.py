@@ -23,6 +23,7 @@ import derivatives as derivative_cost  # noqa: E402  (tools/derivatives.py: a de
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 import mesher_compare  # noqa: E402  (tools/mesher_compare.py: the Hertz discs' three meshers)
 import mesher_front  # noqa: E402  (tools/mesher_front.py: accuracy against time per mesher)
+import slider_timing  # noqa: E402  (tools/slider_timing.py: a small solve by stage, the sliders)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 import startup  # noqa: E402  (tools/startup.py: whole-process time before the contact)
 import two_bodies  # noqa: E402  (tools/two_bodies.py: the patch test and Hertz between two bodies)
@@ -131,7 +132,9 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
                 "amg": amg_bench.readme_paragraph(amg_bench.read()),
                 "amg-scale": amg_bench.scale_table(amg_bench.read()),
                 "amg-nested-again": amg_bench.nested_again(amg_bench.read()),
-                "budget": budget.table(budget.load())}
+                "budget": budget.table(budget.load()),
+                "slider-stages": slider_timing.table(slider_timing.load()),
+                "slider-steps": slider_timing.steps(slider_timing.load())}
     if document == ACCURACY:
         runs = {}
         for name in ("peer-nu0", "peer-nu045"):  # every run of docs/peer-nu0, docs/peer-nu045

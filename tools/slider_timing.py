@@ -1,21 +1,26 @@
 """What a small solve and a slider's step cost in process, stage by stage (docs/performance.md).
 
-    .venv/bin/python tools/slider_timing.py
+    .venv/bin/python tools/slider_timing.py     # writes docs/speed/slider.json
 
 The default cylinder meshed afresh (the graded disc's cache cleared) ``REPEAT`` times, then a load
 slider (:func:`signorini.with_load` on one built problem) and a material slider (``E`` through
-``params``, the mesh kept); the medians of each stage of the record's ``time``, and the first as
-docs/performance.md's table.
+``params``, the mesh kept). Every run's wall time and record ``time`` are stored; tools/readme.py
+renders docs/performance.md's table (:func:`table`) and the sliders' lines (:func:`steps`) from the
+committed file.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import statistics
+import sys
 import time
+from datetime import datetime, timezone
+from pathlib import Path
 
-import signorini
-from signorini.scenes.meshing import graded_unit_disc
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs" / "speed" / "slider.json"
 
 REPEAT = 7
 LOADS = (0.03, 0.035, 0.04, 0.045, 0.055, 0.06, 0.065, 0.07)
@@ -31,11 +36,8 @@ def timed(solve) -> tuple[float, dict[str, float]]:
     return time.perf_counter() - start, {**record["time"], "cpu_s": time.process_time() - cpu}
 
 
-def medians(runs: list[tuple[float, dict[str, float]]]) -> str:
-    walls = [wall for wall, _ in runs]
-    stages = {key: statistics.median(t[key] for _, t in runs) for key in runs[0][1]}
-    return (f"wall median {statistics.median(walls):.3f} s ({min(walls):.3f}–{max(walls):.3f}); "
-            + ", ".join(f"{key} {value:.3f}" for key, value in stages.items()))
+def median(runs: list, key: str) -> float:
+    return statistics.median(t[key] for _, t in runs)
 
 
 #: the record's stages as docs/performance.md names them
@@ -44,19 +46,42 @@ STAGES = {"mesh_s": "mesh (`mesh_s`)", "assemble_s": "assemble", "load_control_s
           "output_s": "output (the record)"}
 
 
-def table(runs: list[tuple[float, dict[str, float]]]) -> str:
-    """The medians of each stage as docs/performance.md's table, the wall time's median last."""
-    lines = ["| stage | seconds |", "|---|---:|"]
-    lines += [f"| {name} | {statistics.median(t[key] for _, t in runs):.3f} |"
-              for key, name in STAGES.items()]
-    total = statistics.median(t["total_s"] for _, t in runs)
+def table(data: dict) -> str:
+    """The medians of each stage of the fresh solves, the wall time's median last."""
+    runs = data["fresh"]
+    lines = [f"`.venv/bin/python tools/slider_timing.py` ({data['date'][:16].replace('T', ' ')} UTC, "
+             f"the median of {len(runs)} solves each meshed afresh, one-minute load average "
+             f"{data['load_before']:.1f} → {data['load_after']:.1f}):", "",
+             "| stage | seconds |", "|---|---:|"]
+    lines += [f"| {name} | {median(runs, key):.3f} |" for key, name in STAGES.items()]
     wall = statistics.median(wall for wall, _ in runs)
-    cpu = statistics.median(t["cpu_s"] for _, t in runs)
-    return "\n".join(lines + [f"| **total** (wall, median: {wall:.3f}) | **{total:.3f}** |",
-                              f"| the process's CPU time (median) | {cpu:.3f} |"])
+    return "\n".join(lines + [f"| **total** (wall, median: {wall:.3f}) | **{median(runs, 'total_s'):.3f}** |",
+                              f"| the process's CPU time (median) | {median(runs, 'cpu_s'):.3f} |"])
 
 
-def main() -> None:
+def steps(data: dict) -> str:
+    """The two sliders' steps, medians of the same run."""
+    load, material = data["load"], data["material"]
+    walls = [wall for wall, _ in load]
+    return (f"A load slider's step, `signorini.solve(signorini.with_load(problem, a_over_R=a))"
+            f".to_dict()`, took **{statistics.median(walls):.3f} s** of wall time and "
+            f"{median(load, 'cpu_s'):.3f} s of CPU (medians of {len(load)} steps over a/R = "
+            f"{min(LOADS)}…{max(LOADS)}; {min(walls):.3f}–{max(walls):.3f} s): load control "
+            f"{median(load, 'load_control_s'):.3f}, the method {median(load, 'method_s'):.3f}, "
+            f"certificate {median(load, 'certificate_s'):.3f}, estimate "
+            f"{median(load, 'estimate_s'):.3f}. A material slider's step "
+            f"(`signorini.solve(\"hertz-cylinder\", params={{\"E\": E}})`, the mesh kept) took "
+            f"**{statistics.median(w for w, _ in material):.3f} s** of wall time and "
+            f"{median(material, 'cpu_s'):.3f} s of CPU (medians of {len(material)}), of which "
+            f"placing the kept mesh {median(material, 'mesh_s'):.3f} and assembly "
+            f"{median(material, 'assemble_s'):.3f}.")
+
+
+def run() -> dict:
+    import signorini
+    from signorini.scenes.meshing import graded_unit_disc
+
+    load_before = os.getloadavg()[0]
     signorini.solve("hertz-cylinder")  # imports and first calls out of the way
     fresh = []
     for _ in range(REPEAT):
@@ -65,12 +90,22 @@ def main() -> None:
     problem = signorini.build_problem("hertz-cylinder")
     load = [timed(lambda: signorini.solve(signorini.with_load(problem, a_over_R=a))) for a in LOADS]
     material = [timed(lambda: signorini.solve("hertz-cylinder", params={"E": E})) for E in MODULI]
-    print(f"the default cylinder, meshed afresh: {medians(fresh)}")
-    print(table(fresh))
-    print(f"a load slider's step (with_load): {medians(load)}")
-    print(f"a material slider's step (E, the mesh kept): {medians(material)}")
-    print(f"load average {os.getloadavg()[0]:.1f}")
+    return {"command": "python tools/slider_timing.py",
+            "date": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "load_before": load_before, "load_after": os.getloadavg()[0],
+            "fresh": fresh, "load": load, "material": material}
+
+
+def load() -> dict:
+    return json.loads(OUT.read_text())
 
 
 if __name__ == "__main__":
-    main()
+    sys.path.insert(0, str(ROOT))
+    from signorini.files import atomic_write_text, to_json
+
+    data = run()
+    atomic_write_text(OUT, to_json(data))
+    print(table(data))
+    print(steps(data))
+    print(f"written: {OUT}", file=sys.stderr)

@@ -74,12 +74,14 @@ ONE_BODY_DEFAULTS = {"R": 1.0, "E": 1.0, "nu": 0.3, "a_over_R": 0.05}
 CASES = {
     "hertz-cylinder": Case(
         "getfem_hertz.py", ONE_BODY_DEFAULTS, ONE_BODY_LADDER,
-        ({"n_contact": 10}, {"n_contact": 20}, {"n_contact": 40}, {"n_contact": 80},
-         {"n_contact": 80, "refine": 1}), _one_body("cylinder"), "cylinder"),
+        # the scene's default mesh (n_contact 24) is the middle rung
+        ({"n_contact": 8}, {"n_contact": 14}, {"n_contact": 24}, {"n_contact": 48},
+         {"n_contact": 48, "refine": 1}), _one_body("cylinder"), "cylinder"),
     "hertz-sphere": Case(
         "getfem_hertz.py", ONE_BODY_DEFAULTS, ONE_BODY_LADDER,
-        ({"n_contact": 12}, {"n_contact": 25}, {"n_contact": 50}, {"n_contact": 100},
-         {"n_contact": 100, "refine": 1}), _one_body("sphere"), "sphere"),
+        # the scene's default mesh (n_contact 48) is the middle rung
+        ({"n_contact": 12}, {"n_contact": 24}, {"n_contact": 48}, {"n_contact": 96},
+         {"n_contact": 96, "refine": 1}), _one_body("sphere"), "sphere"),
     # the scene's defaults (its mesh: n_contact 48); the slave's size at the contact, the
     # master's 1.25 times coarser on GetFEM's side (the script's master_ratio)
     "hertz-two-cylinders": Case(
