@@ -72,3 +72,28 @@ def test_the_users_qp_touches_in_part():
     u = np.linalg.solve(K.toarray(), f)  # without the obstacle, the middle goes through it
     violated = N @ u > d
     assert violated.any() and not violated.all()
+
+
+def test_a_solve_that_hangs_or_is_refused_is_a_row_not_the_end(monkeypatch):
+    import time
+
+    from signorini.errors import InputError
+
+    monkeypatch.setattr(snapshot, "solve_one", lambda *args: time.sleep(30))  # the forked child sees it
+    assert snapshot.run_forked("block", "pdas", {}, timeout=0.5)["status"] == "timeout"
+
+    def refuse(*args):
+        raise InputError("method 'x' takes no such problem")
+
+    monkeypatch.setattr(snapshot, "solve_one", refuse)
+    row = snapshot.run_forked("block", "pdas", {}, timeout=30)
+    assert row["status"] == "refused" and "no such problem" in row["message"]
+
+
+def test_a_recorded_solve_keeps_the_answer_in_the_problems_units():
+    row = snapshot.run_forked(snapshot.USERS_QP, "pdas", {}, timeout=60)
+    K, f, N, d = snapshot.users_qp()
+    assert row["status"] == "converged" and row["active"]
+    assert np.all(N @ row["u"] <= d + 1e-12 * np.max(np.abs(d)))
+    residual = K @ row["u"] - f + N.T @ row["force"]  # stationarity in the user's units
+    assert np.max(np.abs(residual)) < 1e-6 * np.max(np.abs(f))

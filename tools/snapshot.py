@@ -34,18 +34,16 @@ ROUND_OFF = 1e-10
 #: families whose validation case and convergence start leave them large: a coarse mesh instead
 SMALL = {"hertz-sphere-3d": {"n_contact": 4, "grading": 1.0}}
 USERS_QP = "from_qp"
-#: what a record keeps of where it was made
-PROVENANCE = ("commit", "tree", "date", "machine", "load", "load_after", "sets")
 #: the solves ``speed`` times at the scenes' defaults: (scene, method; None: the default method)
 SPEED_CASES = (("hertz-cylinder", "pdas"), ("hertz-cylinder", None), (USERS_QP, "pdas"),
                ("hertz-two-cylinders", "pdas"))
-#: how ``speed`` times a solve: after a smaller one in the same process, and in a fresh process
-KINDS = ("warm", "cold")
+#: how ``speed`` times a solve: after a smaller one in the same process, and in a fresh process;
+#: with which clocks: the wall's, and the process's CPU time (less sensitive to other jobs' load)
+KINDS, CLOCKS = ("warm", "cold"), ("wall", "cpu")
 
 
 def users_qp(n: int = 200) -> tuple[Any, ...]:
-    """A beam of ``n`` nodes on an elastic foundation in SI-like units, pushed down in its middle
-    onto a parabolic obstacle: ``K`` tridiagonal, ``N = −I`` (u ≥ −gap), so part of it touches."""
+    """A beam of ``n`` nodes on a spring bed (K ~ 1e5) pushed onto a parabola: N = −I, u ≥ −gap."""
     import scipy.sparse as sp
 
     x = np.linspace(0.0, 1.0, n)
@@ -55,8 +53,7 @@ def users_qp(n: int = 200) -> tuple[Any, ...]:
 
 
 def problem_of(scene: str, sets: dict[str, str], small: bool = True) -> tuple[Any, dict | None]:
-    """What ``signorini.solve`` takes for ``scene``: the user's QP, or the name and its params
-    (small or the defaults, with the ``--set`` values the family takes, typed by its Param)."""
+    """The user's QP, or the scene's name and params (small or default, with the ``--set`` ones)."""
     import signorini
 
     if scene == USERS_QP:
@@ -97,9 +94,8 @@ def run_forked(scene: str, method: str, sets: dict[str, str], timeout: float) ->
             status = "refused" if type(error).__name__ == "InputError" else "error"
             send.send({"status": status, "message": f"{type(error).__name__}: {error}"[:200]})
 
-    ctx = multiprocessing.get_context("fork")
-    receive, send = ctx.Pipe(duplex=False)
-    process = ctx.Process(target=child)
+    receive, send = multiprocessing.Pipe(duplex=False)
+    process = multiprocessing.get_context("fork").Process(target=child)
     process.start()
     row = receive.recv() if receive.poll(timeout) else {"status": "timeout", "message": f"over {timeout:g} s"}
     process.terminate()
@@ -194,7 +190,8 @@ def compare_table(a: Path, b: Path) -> str:
     """Markdown: where each record comes from, a row per pair beyond round-off, pairs one lacks."""
     both, only_a, only_b = differences(a, b)
     beyond = [d for d in both if d["differs"]]
-    lines = [f"- {side}: `{path.name}`: " + "; ".join(f"{k} {m[k]}" for k in PROVENANCE if k in m)
+    lines = [f"- {side}: `{path.name}`: " + "; ".join(
+        f"{k} {m[k]}" for k in ("commit", "tree", "date", "machine", "load", "load_after", "sets") if k in m)
              for side, path, m in (("A", a, load(a)[0]), ("B", b, load(b)[0]))]
     lines += ["", f"{len(both)} solves in both records: {len(both) - len(beyond)} agree to "
               f"{ROUND_OFF:g} relative (status, active set, u and λ), {len(beyond)} differ beyond it.", ""]
@@ -211,10 +208,9 @@ def compare_table(a: Path, b: Path) -> str:
 
 
 def time_one(scene: str, method: str | None, sets: dict[str, str], warm: bool) -> None:
-    """One solve at the scene's defaults (or of the user's QP), its seconds as JSON on stdout:
-    timed from before ``import signorini`` (cold), or after the small solve of the same scene and
-    method has loaded what the solve needs (warm; the user's QP solved twice)."""
-    start = time.perf_counter()
+    """Seconds (JSON on stdout) of one solve at the scene's defaults or of the user's QP: from before
+    ``import signorini`` (cold) or after the small solve of the same scene and method (warm)."""
+    start = time.perf_counter(), time.process_time()
     import signorini
 
     def solve(small: bool) -> Any:
@@ -225,15 +221,15 @@ def time_one(scene: str, method: str | None, sets: dict[str, str], warm: bool) -
         return print(json.dumps({"absent": True}))
     if warm:
         solve(small=True)
-        start = time.perf_counter()
+        start = time.perf_counter(), time.process_time()
     status = solve(small=False).status
-    print(json.dumps({"seconds": time.perf_counter() - start, "status": status}))
+    print(json.dumps({"wall": time.perf_counter() - start[0], "cpu": time.process_time() - start[1],
+                      "status": status}))
 
 
 def speed(old: Path, new: Path, rounds: int, sets: dict[str, str]) -> dict[str, Any]:
-    """Each case warm and cold in a fresh process per tree, alternating (new first in odd rounds);
-    a case one tree lacks (its scene) is not timed further."""
-    runs: dict[tuple[str, str, str], list[float]] = {}
+    """Each case warm and cold in a fresh process per tree, alternating (new first in odd rounds)."""
+    runs: dict[tuple[str, str, str], list[dict]] = {}
     meta = {**machine(new), "old": f"{old} ({machine(old)['commit']})", "rounds": rounds, "sets": sets}
     cases = {f"{scene} {method or 'default'}": (scene, method) for scene, method in SPEED_CASES}
     missing: set[str] = set()
@@ -246,21 +242,23 @@ def speed(old: Path, new: Path, rounds: int, sets: dict[str, str]) -> dict[str, 
             out = "" if case in missing else subprocess.run(command, env=env, capture_output=True,
                                                              text=True, check=True).stdout
             row = json.loads(out.splitlines()[-1]) if out else {"absent": True}
-            missing |= {case} if row.get("absent") else set()
-            runs.setdefault((case, side, kind), []).append(row.get("seconds", 0.0))
+            missing |= {case} if row.get("absent") else set()  # a scene one tree lacks: not timed
+            runs.setdefault((case, side, kind), []).append(row)
     meta["load_after"] = [round(x, 2) for x in os.getloadavg()]
-    meta["cases"] = [{"case": case, **{f"{side}_{kind}_s": statistics.median(runs[case, side, kind])
-                                       for side in ("old", "new") for kind in KINDS}}
-                     for case in cases if case not in missing]
+    meta["runs"] = {" ".join(key): rows for key, rows in runs.items() if key[0] not in missing}
+    meta["cases"] = [case for case in cases if case not in missing]
     return meta
 
 
 def speed_table(meta: dict[str, Any]) -> str:
-    lines = ["| solve | warm: old s | new s | new / old | cold: old s | new s | new / old |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
-    lines += [f"| {c['case']} | " + " | ".join(f"{c[f'old_{k}_s']:.3f} | {c[f'new_{k}_s']:.3f} | "
-                                            f"**{c[f'new_{k}_s'] / c[f'old_{k}_s']:.2f}**" for k in KINDS)
-              + " |" for c in meta["cases"]]
+    """Per case and clock, the medians and their ratio new / old, and the range of one round's."""
+    lines = ["| solve | timed | old s | new s | new / old | lowest–highest of one round |",
+             "|---|---|---:|---:|---:|---:|"]
+    for case, kind, clock in itertools.product(meta["cases"], KINDS, CLOCKS):
+        old, new = ([r[clock] for r in meta["runs"][f"{case} {side} {kind}"]] for side in ("old", "new"))
+        each, (o, n) = [n / o for o, n in zip(old, new)], map(statistics.median, (old, new))
+        lines.append(f"| {case} | {kind}, {clock} | {o:.3f} | {n:.3f} | **{n / o:.2f}** | "
+                     f"{min(each):.2f}–{max(each):.2f} |")
     return "\n".join(lines + ["", f"Medians of {meta['rounds']} interleaved rounds; old {meta['old']}, new "
                               f"{meta['tree']} ({meta['commit']}); {meta['machine']}; load average "
                               f"{meta['load'][0]:.1f} before, {meta['load_after'][0]:.1f} after."])
