@@ -5,3 +5,12 @@
 ``diagnosis`` what makes a problem or an answer wrong; ``fingerprint`` that the problem judged
 is the problem given.
 """
+
+from signorini.certification.adequacy import Adequacy
+from signorini.certification.diagnosis import diagnose
+from signorini.certification.fingerprint import Fingerprint
+from signorini.certification.forward_error import ForwardError
+from signorini.certification.kkt import Certificate, active_set, certificate, compare
+
+__all__ = ["Adequacy", "Certificate", "Fingerprint", "ForwardError", "active_set", "certificate",
+           "compare", "diagnose"]

@@ -4,3 +4,12 @@
 ``solution`` what a method returns; ``scales`` a method's private dimensionless view;
 ``files`` and ``saved`` a problem read from or written to a file.
 """
+
+from signorini.problem.contact import ContactProblem
+from signorini.problem.discretisation import Discretisation, Push, ReferenceData, Watch
+from signorini.problem.files import read_problem
+from signorini.problem.scales import Scales
+from signorini.problem.solution import ContactSolution, WarmStart
+
+__all__ = ["ContactProblem", "ContactSolution", "Discretisation", "Push", "ReferenceData", "Scales",
+           "WarmStart", "Watch", "read_problem"]
