@@ -52,7 +52,7 @@ from signorini.certification.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify, co
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import reference_metrics, reference_of
 from signorini.solvers.base import DEFAULT_TOL, check_tol
-from signorini.solvers.registry import get_method
+from signorini.solvers.registry import REGISTRY, get_method, given
 
 #: the methods compared when none are named: the paper's, the two named QP backends,
 #: the modelling layer and the exact reference
@@ -261,8 +261,8 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     if isinstance(methods, str):
         raise InputError(f"methods must be a list of names, got the string {methods!r}: "
                          f"write methods=[{methods!r}, 'pdas']")
-    names = list(DEFAULT_METHODS if methods is None else methods)
-    names = [get_method(name).name for name in names]  # an unknown one fails here, before work
+    chosen = [get_method(name) for name in (DEFAULT_METHODS if methods is None else methods)]
+    names = [method.name for method in chosen]  # an unknown one fails here, before work
     if len(names) < 2:
         raise InputError(f"a cross-check compares at least two methods, got {names}: "
                          "name two or more (--method uzawa --method pdas)")
@@ -291,6 +291,14 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
     elif not isinstance(problem, ContactProblem):
         raise InputError(f"problem must be a ContactProblem or a scene name, got "
                          f"{type(problem).__name__}")
+    with given({method.name: method for method in chosen if method.name not in REGISTRY}):
+        return _crosscheck(problem, names, tol, options, tuple(allow), bool(polish))
+
+
+def _crosscheck(problem: ContactProblem, names: list[str], tol: float | None,
+                options: dict[str, dict[str, Any]], allow: tuple[str, ...],
+                polish: bool) -> CrossCheck:
+    """:func:`crosscheck` once its arguments are checked, every method known by its name."""
     judged_tol = tol if tol is not None else DEFAULT_TOL
     runs: list[MethodRun] = []
     results: dict[str, Result] = {}
@@ -324,8 +332,7 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
             run.polished_status = polished.status
             if reference:
                 run.polished_lam_ref = _against(problem, results[reference], polished)[0]
-    return CrossCheck(problem, judged_tol, runs, pairs, results, tuple(allow), reference,
-                      bool(polish))
+    return CrossCheck(problem, judged_tol, runs, pairs, results, allow, reference, polish)
 
 
 def _raw(name: str, options: dict[str, Any]) -> dict[str, Any]:

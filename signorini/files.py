@@ -12,31 +12,32 @@ Where an output goes decides how it is written:
 
 Within :func:`all_or_none` the outputs are produced under temporary names and
 take their places only when the whole block succeeded; otherwise none does.
-:func:`check_outputs` checks every output path of a command before any work:
-that it can be written, that no two outputs name the same file and that no
-output is one of the command's input files; it makes them absolute, so that
-a method that changes the working folder cannot move them.
+Every output path is checked before any work by :mod:`signorini.paths` (whose names this module
+also exports).
 """
 
 from __future__ import annotations
 
 import contextlib
-import fnmatch
 import json
 import math
 import os
-import stat
 import sys
 import tempfile
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
 from signorini.errors import InputError, OutputError
+from signorini.paths import (STDOUT, check_input_file, check_output_file, check_output_folder,
+                             check_outputs, where)
 
-STDOUT = "-"
-_EXAMPLES = {"--json": "result.json", "--md": "result.md", "--vtk": "result.vtu"}
+__all__ = ["PARTIAL", "STDOUT", "all_or_none", "atomic_write", "atomic_write_bytes",
+           "atomic_write_text", "check_input_file", "check_output_file", "check_output_folder",
+           "check_outputs", "plain", "remove_empty_folders", "remove_partial_files", "save_figure",
+           "to_json", "write_stdout", "writable_directory"]
+
 #: outputs produced inside :func:`all_or_none`, waiting to take their places
 _staged: list[tuple[str | None, Path | int, bytes | None]] | None = None
 #: folders :func:`writable_directory` created (removed again while still empty)
@@ -44,164 +45,6 @@ _created: list[Path] = []
 #: the mark of a file being written under a temporary name (:func:`atomic_write`), and the
 #: folders written into, by this process or by its workers below them (:func:`remove_partial_files`)
 PARTIAL, _written = ".signorini-partial.", set[Path]()
-
-
-def _where(path: str | os.PathLike) -> tuple[str, Path | int]:
-    """``("replace", file)``, ``("through", device)`` or ``("fd", 1 or 2)`` for an output path."""
-    target = Path(os.path.abspath(path))
-    try:
-        found = os.stat(target)  # follows links
-    except OSError:  # a new file, the target of a dangling link (or a name too long, said later)
-        return "replace", Path(os.path.realpath(target))
-    for fd in (1, 2):
-        with contextlib.suppress(OSError):
-            if os.path.samestat(found, os.fstat(fd)):
-                return "fd", fd
-    if stat.S_ISDIR(found.st_mode):
-        return "folder", target
-    if stat.S_ISREG(found.st_mode):
-        return "replace", Path(os.path.realpath(target))
-    return "through", target
-
-
-def _refuse(flag: str, path: Any, why: str, fix: str = "choose another path") -> InputError:
-    return InputError(f"{flag} {str(path)!r} {why}: {fix}")
-
-
-def _probe(folder: Path, flag: str, path: Any) -> None:
-    """InputError unless a file can be created in ``folder`` (a real attempt, removed again)."""
-    try:
-        fd, name = tempfile.mkstemp(prefix=".signorini-probe.", dir=folder)
-    except OSError as exc:
-        raise _refuse(flag, path, f"cannot be written: the folder {str(folder)!r} takes no new "
-                      f"files ({exc.strerror})", "choose a writable path") from None
-    os.close(fd)
-    os.unlink(name)
-
-
-def check_output_file(path: str | os.PathLike, flag: str) -> str:
-    """The absolute path of a file output (``-`` for standard output), or InputError naming ``flag``.
-
-    The folder must exist and take new files, the path must not be a folder,
-    the name must fit the file system's limit and an existing file must be
-    writable; checked before any work.
-    """
-    if str(path) == "":
-        raise _refuse(flag, path, "is empty", f"give a file name, e.g. {flag} {_EXAMPLES.get(flag, 'result')}")
-    if str(path) == STDOUT:
-        return STDOUT
-    kind, target = _where(path)
-    if kind == "fd":
-        return STDOUT if target == 1 else os.path.abspath(path)
-    if kind == "folder":
-        raise _refuse(flag, path, "is a directory",
-                      f"give a file name, e.g. {flag} {Path(path) / _EXAMPLES.get(flag, 'result')}")
-    if kind == "through":
-        if not os.access(target, os.W_OK):
-            raise _refuse(flag, path, "is not writable", "choose a writable path")
-        return os.path.abspath(path)
-    if not target.parent.is_dir():
-        raise _refuse(flag, path, f"cannot be written: the folder {str(target.parent)!r} does not exist",
-                      "create it or choose another path")
-    try:
-        longest = os.pathconf(target.parent, "PC_NAME_MAX")
-    except (OSError, ValueError):
-        longest = 255
-    if len(os.fsencode(target.name)) > longest:
-        raise InputError(f"{flag}: the file name is {len(os.fsencode(target.name))} bytes long, "
-                         f"over this file system's {longest}: choose a shorter name")
-    _probe(target.parent, flag, path)
-    if target.exists():
-        try:  # opened for writing, not truncated: refuses a read-only or immutable file
-            os.close(os.open(target, os.O_WRONLY))
-        except OSError as exc:
-            raise _refuse(flag, path, f"cannot be replaced ({exc.strerror})",
-                          "choose a writable path") from None
-    return os.path.abspath(path)
-
-
-def check_output_folder(path: str | os.PathLike, flag: str = "--out") -> str:
-    """The absolute path of an output folder, or InputError naming ``flag``; nothing is created.
-
-    An existing folder must take new files; a new one must be creatable in the
-    nearest folder that exists.
-    """
-    if str(path) == "":
-        raise _refuse(flag, path, "is empty", f"give a folder, e.g. {flag} report")
-    folder = Path(os.path.abspath(path))
-    existing = next(p for p in (folder, *folder.parents) if p.exists() or p.is_symlink())
-    if not existing.is_dir():
-        raise _refuse(flag, path, f"cannot be a folder: {str(existing)!r} is a file",
-                      "choose a writable folder")
-    _probe(existing, flag, path)
-    return str(folder)
-
-
-def check_input_file(path: str, what: str, missing: str = "") -> None:
-    """InputError when ``path`` exists but is not a regular file (a FIFO would wait forever), or
-    with ``missing`` (the fix) when it does not exist."""
-    if missing and not os.path.exists(path):
-        raise InputError(f"{what} {path} does not exist: {missing}")
-    if os.path.exists(path) and not os.path.isfile(path):
-        raise InputError(f"{what} {path!r} is not a regular file (a folder, FIFO or device): "
-                         "give a file")
-
-
-def _same(path: str, other: str) -> bool:
-    """Whether two paths name one file (a device or FIFO can take several outputs)."""
-    def identity(name: str) -> tuple:
-        try:
-            found = os.stat(name)
-            return found.st_dev, found.st_ino
-        except OSError:
-            return (os.path.realpath(name),)
-
-    return identity(path) == identity(other) and _where(path)[0] != "through"
-
-
-def check_outputs(files: Mapping[str, str | None] = {}, folders: Mapping[str, str | None] = {},
-                  inputs: Mapping[str, str | None] = {},
-                  fills: Mapping[str, tuple[str, ...]] = {}) -> dict[str, str | None]:
-    """Every output of a command checked before any work: flag → absolute path (None when not given).
-
-    ``files`` and ``folders`` map flags to output paths, ``inputs`` names to
-    the command's input files, ``fills`` a folder's flag to the names (glob
-    patterns) of the files it will hold. InputError, naming both, when two
-    outputs are one file (or a folder's), or an output is an input; a device
-    (``/dev/null``) may take several.
-    """
-    given = {**files, **folders}
-    out = {flag: None if path is None else check_output_file(path, flag)
-           for flag, path in files.items()}
-    out.update({flag: None if path is None else check_output_folder(path, flag)
-                for flag, path in folders.items()})
-    named = [(flag, path) for flag, path in out.items() if path is not None]
-    for i, (flag, path) in enumerate(named):
-        for other, there in named[:i]:
-            if path == there == STDOUT or STDOUT not in (path, there) and _same(path, there):
-                raise InputError(f"{other} {given[other]!r} and {flag} {given[flag]!r} are the "
-                                 "same file: give them different paths")
-        for folder, patterns in fills.items():
-            if flag != folder and _fills(out.get(folder), patterns, path):
-                raise InputError(f"{flag} {given[flag]!r} is a file that {folder} "
-                                 f"{given[folder]!r} writes ({', '.join(patterns)}): give "
-                                 f"{flag} another name or folder")
-        for name, source in inputs.items():
-            if source and path != STDOUT and os.path.exists(source) and _same(path, source):
-                raise InputError(f"{flag} {given[flag]!r} is the {name}: writing it would destroy "
-                                 f"an input; choose another path for {flag}")
-    for folder, patterns in fills.items():
-        taken = [name for name, source in inputs.items() if _fills(out.get(folder), patterns, source)]
-        if taken:
-            raise InputError(f"{folder} {given[folder]!r} would write over the {taken[0]}: "
-                             f"choose another folder for {folder}")
-    return out
-
-
-def _fills(folder: str | None, patterns: tuple[str, ...], path: str | None) -> bool:
-    """Whether ``path`` is one of the files named by ``patterns`` in ``folder``."""
-    inside = bool(folder and path and path != STDOUT) and os.path.dirname(os.path.abspath(path)) == folder
-    return inside and any(fnmatch.fnmatch(os.path.basename(path), p) for p in patterns)
 
 
 def writable_directory(path: str | os.PathLike) -> Path:
@@ -212,7 +55,7 @@ def writable_directory(path: str | os.PathLike) -> Path:
     """
     directory = Path(path)
     if str(path) == "":
-        raise _refuse("--out", path, "is empty", "give a folder, e.g. --out report")
+        raise InputError(f"--out {str(path)!r} is empty: give a folder, e.g. --out report")
     missing = [p for p in (directory, *directory.parents) if not p.exists()]
     try:
         directory.mkdir(parents=True, exist_ok=True)
@@ -253,10 +96,7 @@ def all_or_none() -> Iterator[None]:
         raise
     finally:
         _staged = outer
-    if outer is not None:
-        outer.extend(staged)
-    else:
-        _place(staged)
+    _place_or_stage(staged)  # into the enclosing block's outputs, or in their places
 
 
 def _discard(staged: list) -> None:
@@ -312,7 +152,7 @@ def atomic_write(path: str | os.PathLike, produce: Callable[[str], None], suffix
     OutputError (nothing left behind) when the file cannot be produced, e.g.
     on a full disk.
     """
-    kind, target = _where(path)
+    kind, target = where(path)
     if kind == "folder":
         raise InputError(f"cannot write {str(path)!r}: it is a directory; give a file name")
     folder = target.parent if kind == "replace" else None

@@ -20,9 +20,10 @@ driver that finds it, whatever the method:
   problem's pending load itself (:attr:`Method.matches_load`, e.g. a bordered
   load unknown of each CG system: no factorisation is ever made).
 
-:func:`solve` is the pipeline: load control, then the method
-(:func:`signorini.solvers.registry.run`: its answer held to the contract and
-certified once). What a method can use is what it declares on its
+:func:`solve` is the part of the pipeline (:func:`signorini.solve`) that runs when there is
+something to do before the method: load control, or the scene's prediction for a method that
+takes one; then the method (:func:`signorini.solvers.registry.run`: its answer held to the
+contract and certified once). What a method can use is what it declares on its
 :class:`~signorini.solvers.base.Method`, never its name: the scene's
 ``prediction`` of the contact (a zone, or a first active set) and whether it
 takes load control's answer as an explicit warm start (``warm_from_load``);
@@ -219,7 +220,9 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
           coarse: CoarseModel | None = None, keep_factor: bool = False) -> Solved:
     """Solve ``problem`` as ``request`` says (checked by
     :func:`~signorini.solvers.registry.check_request`), matching its target load first when it
-    has one and the method does not match it itself.
+    has one and the method does not match it itself, and handing a method that takes the
+    scene's prediction of the contact that prediction (:func:`signorini.solve` comes here only
+    then; any other problem goes to the method's run directly).
 
     ``coarse`` (from the scene: a coarser model of the same scene) feeds the
     predictions of the zone kernel and of the methods that take one;
@@ -239,8 +242,11 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
             matched = match(problem, zone)
         stages["load_control"] = matched.work
         problem = matched.problem
-    if matched is not None and start is None and request.method.warm_from_load:
-        start = matched.warm_start  # load control's answer, taken as an explicit warm start
+    if matched is not None and start is None and request.method.warm_from_load and (
+            runs.prediction != "zone" or matched.warm_start.zone_solver is not None):
+        # load control's answer, taken as an explicit warm start (by a method that predicts a
+        # zone, only with K factorised around one: else it takes the scene's prediction)
+        start = matched.warm_start
     elif runs.prediction:  # a method that starts cold, from the scene's predictions only
         with counting() as work, timed(seconds, "prediction"):
             options = {**_predictions(problem, runs.prediction, options, coarse, zone), **options}

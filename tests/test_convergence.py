@@ -10,18 +10,9 @@ from signorini.cli import main
 from signorini.errors import InputError
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
-from signorini.studies.convergence import (
-    LABELS,
-    dofs_for_error,
-    fitted_rate,
-    grading_comparison,
-    plot_convergence,
-    plot_grading,
-    plot_punch_edge,
-    plot_punch_pressure,
-    run_study,
-    write_study,
-)
+from signorini.output.plots import plot_punch_edge, plot_punch_pressure
+from signorini.studies.convergence import LABELS, dofs_for_error, fitted_rate, grading_comparison, run_study
+from signorini.studies.convergence_report import plot_convergence, plot_grading, write_study
 
 # a/R = 0.05: at 0.2 Hertz's half-space theory itself is ~1 % off the exact cylinder (docs/accuracy.md)
 TINY = {"a_over_R": 0.05, "n_contact": 6, "grading": 0.8}

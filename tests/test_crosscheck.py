@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from types import MappingProxyType
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from signorini.cli import main
 from signorini.crosschecking import AGREE_FACTOR, DEFAULT_METHODS, agreement
 from signorini.errors import InputError
 from signorini.solvers.base import Method
+from signorini.solvers import registry
 from signorini.solvers.registry import REGISTRY, get_method
 
 #: a method that says converged with a perturbed λ (pdas's answer, λ on the contact zone 1 % up)
@@ -179,14 +181,11 @@ def test_agreement_judges_claims_and_leaves_weak_nodes_apart():
     assert agreement(problem, exact.solution, far.solution, 1e-8, 1e-8).verdict == "not judged"
 
 
-def test_a_missing_backend_is_a_row_not_an_error():
+def test_a_missing_backend_is_a_row_not_an_error(monkeypatch):
     fake = Method(name="qp-nowhere", function=lambda problem, **_: None, summary="not here",
                   requires=("no_such_module_anywhere",))
-    REGISTRY[fake.name] = fake
-    try:
-        check = signorini.crosscheck(small_problem(), ["pdas", "uzawa", "qp-nowhere"], tol=1e-10)
-    finally:
-        del REGISTRY[fake.name]
+    monkeypatch.setattr(registry, "REGISTRY", MappingProxyType({**REGISTRY, fake.name: fake}))
+    check = signorini.crosscheck(small_problem(), ["pdas", "uzawa", "qp-nowhere"], tol=1e-10)
     assert [run.status for run in check.runs] == ["converged", "converged", "not installed"]
     assert len(check.pairs) == 1 and check.failures == ["qp-nowhere not installed"]
 
@@ -266,7 +265,7 @@ def test_the_validation_suite_cross_checks_uzawa_with_osqp_and_clarabel():
     """Every case: uzawa against qp-osqp and qp-clarabel (default form) at the suite's tight
     tolerance; a check that fails when they disagree, or when either did not converge."""
     require("qp-osqp", "qp-clarabel")
-    from signorini.studies import suite
+    from signorini.studies import suite, suite_checks
 
     cases = suite.select_cases(["block"])
     result = suite.run_suite(cases, ["uzawa", "qp-osqp", "qp-clarabel"], isolate=False)
@@ -275,10 +274,10 @@ def test_the_validation_suite_cross_checks_uzawa_with_osqp_and_clarabel():
                                                        "uzawa cross-checked with qp-clarabel"]
     assert all(c.passed for c in crossed) and result.passed
     case = result.results[0]
-    lying = case.solutions[suite.label("qp-clarabel", suite.TIGHT_TOL)]
+    lying = case.solutions[suite_checks.label("qp-clarabel", suite_checks.TIGHT_TOL)]
     lying.lam = 1.01 * lying.lam  # still says converged: the cross-check must catch it
-    checks = suite.cross_checks(case)
+    checks = suite_checks.cross_checks(case)
     assert [c.passed for c in checks] == [True, False]
     assert "λ 9.9e-03" in checks[1].detail  # 0.01 over the larger ‖λ‖∞
-    case.solutions[suite.label("qp-osqp", suite.TIGHT_TOL)].status = "inaccurate"
-    assert not suite.cross_checks(case)[0].passed
+    case.solutions[suite_checks.label("qp-osqp", suite_checks.TIGHT_TOL)].status = "inaccurate"
+    assert not suite_checks.cross_checks(case)[0].passed

@@ -19,7 +19,7 @@ FILE_ENDINGS = (".py", ".toml", ".json", ".md", ".msh", ".png", ".csv", ".vtu", 
 
 def sources() -> list[Path]:
     return ([ROOT / "README.md"] + sorted((ROOT / "docs").rglob("*.md"))
-            + sorted((ROOT / "docs" / "tutorials").glob("*.ipynb"))
+            + sorted((ROOT / "docs" / "tutorials").rglob("*.ipynb"))  # the tutorials and their solutions
             + sorted((ROOT / "signorini").rglob("*.py")))
 
 

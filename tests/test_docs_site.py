@@ -27,16 +27,13 @@ def mkdocs_build(config: Path, site: Path) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.slow
-def test_the_site_builds_strictly(tmp_path):
-    pytest.importorskip("mkdocs")
-    pytest.importorskip("material")
-    pytest.importorskip("mkdocstrings_handlers.python")
-    built = mkdocs_build(ROOT / "mkdocs.yml", tmp_path / "site")
+def test_the_site_builds_strictly(docs_site):
+    built, site = docs_site
     assert built.returncode == 0, built.stderr[-4000:]
-    api = (tmp_path / "site" / "api" / "index.html").read_text(encoding="utf-8")
+    api = (site / "api" / "index.html").read_text(encoding="utf-8")
     for name in ("solve", "build_problem", "certificate", "crosscheck", "Result"):
         assert f'id="signorini.{name}"' in api, f"the API reference lacks signorini.{name}"
-    assert (tmp_path / "site" / "tutorials" / "01-two-contact-points.ipynb").is_file()
+    assert (site / "tutorials" / "01-two-contact-points" / "01-two-contact-points.ipynb").is_file()
 
 
 @pytest.mark.slow
@@ -55,10 +52,32 @@ def test_a_broken_link_fails_the_strict_build(tmp_path):
     assert built.returncode != 0 and "no-such-page.md" in built.stderr
 
 
+@pytest.mark.slow
+def test_a_notebook_cell_that_raises_fails_the_build(tmp_path):
+    """The check can fail: a notebook page whose cell raises, built as mkdocs.yml builds the tutorials."""
+    for module in ("mkdocs", "material", "mkdocs_jupyter", "nbformat"):
+        pytest.importorskip(module, reason=f"the docs extra builds the site ({module})")
+    import nbformat
+
+    plugin = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    assert "execute: !ENV [SIGNORINI_DOCS_EXECUTE, true]" in plugin and "allow_errors: false" in plugin
+    docs = tmp_path / "docs"
+    docs.mkdir()
+    cell = nbformat.v4.new_code_cell("raise ValueError('a tutorial that no longer runs')")
+    nbformat.write(nbformat.v4.new_notebook(cells=[cell], metadata={"kernelspec": {
+        "name": "python3", "display_name": "Python 3", "language": "python"}}), docs / "broken.ipynb")
+    config = tmp_path / "mkdocs.yml"
+    config.write_text("site_name: probe\ntheme:\n  name: material\nnav:\n  - Broken: broken.ipynb\n"
+                      "plugins:\n  - mkdocs-jupyter:\n      execute: true\n      allow_errors: false\n"
+                      "      cache: false\n", encoding="utf-8")
+    built = mkdocs_build(config, tmp_path / "site")
+    assert built.returncode != 0 and "a tutorial that no longer runs" in built.stderr
+
+
 def test_every_nav_entry_is_a_page():
     """mkdocs.yml's nav names only pages that exist (--strict fails on one that does not)."""
     nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8").split("\nnav:\n", 1)[1]
-    pages = re.findall(r"^\s*- [^:#]+: (\S+\.md)$", nav, flags=re.M)
+    pages = re.findall(r"^\s*- [^#\n]+: (\S+\.(?:md|ipynb))$", nav, flags=re.M)
     assert "index.md" in pages and "api.md" in pages
     missing = [page for page in pages if not (ROOT / "docs" / page).is_file()]
     assert not missing, f"nav entries without a page: {missing}"
@@ -84,3 +103,13 @@ def test_the_pages_the_readme_moved_out_are_in_the_nav():
     nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
     for page in ("guide.md", "maths.md", "methods.md", "results.md", "performance.md", "tutorials.md"):
         assert f": {page}\n" in nav, page
+
+
+def test_mathjax_reads_the_notebooks_dollar_maths():
+    """Notebook pages keep Jupyter's $ $ maths (arithmatex converts only the Markdown pages'):
+    MathJax 3 must be configured for it before it loads, or the tutorials show raw TeX."""
+    config = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    scripts = config.split("extra_javascript:\n", 1)[1].split("\n")
+    assert scripts[0].startswith("  - javascripts/mathjax.js") and "mathjax@3" in scripts[1]
+    mathjax = (ROOT / "docs" / "javascripts" / "mathjax.js").read_text(encoding="utf-8")
+    assert '["$", "$"]' in mathjax and '["$$", "$$"]' in mathjax

@@ -218,6 +218,11 @@ def test_hertz_sliders_re_solve(explorer):
     assert page.locator("#hertz-figure").get_attribute("src") != before
     move(page, "E", 2.0)
     wait_for_number(page, expect, "hertz-a_ref", lessons.hertz_lesson(0.01, 2.0).a_ref)
+    move(page, "nu", 0.25)
+    lesson = lessons.hertz_lesson(0.01, 2.0, 0.25)
+    wait_for_number(page, expect, "hertz-a_ref", lesson.a_ref)
+    wait_for_number(page, expect, "hertz-a", lesson.a)
+    assert shown(page, "hertz-status") == lesson.result.status
 
 
 def test_prices_slider_re_solves(explorer):
@@ -228,7 +233,14 @@ def test_prices_slider_re_solves(explorer):
     wait_for_number(page, expect, "prices-force2", lesson.force[1])
     assert float(shown(page, "prices-price2")) == pytest.approx(lesson.prices[1], rel=1e-5)
     assert float(shown(page, "prices-miss")) < 1e-6
+    assert shown(page, "prices-status") == lesson.result.status
     assert page.locator("#prices-figure").get_attribute("src") != before
+    move(page, "gap", 2.2)  # the rail lowered under wheel 2 until the wheel lifts off: no force, no price
+    lesson = lessons.prices_lesson(2.2)
+    assert lesson.force[1] == 0
+    wait_for_number(page, expect, "prices-force2", lesson.force[1])
+    assert float(shown(page, "prices-price2")) == pytest.approx(0.0, abs=1e-6 * lesson.force[0])
+    assert shown(page, "prices-status") == lesson.result.status
 
 
 def test_race_slider_re_solves(explorer):
@@ -236,12 +248,14 @@ def test_race_slider_re_solves(explorer):
     picked = [re.sub(r"^race-", "", row.get_attribute("id"))
               for row in page.locator("#race-table tr[id]").all()]
     assert "pdas" in picked
+    before = page.locator("#race-figure").get_attribute("src")
     move(page, "tol", -5)
     rows = lessons.race_lesson(picked, 1e-5)
     for row in rows:
         expect(page.locator(f"#race-{row.method}-iterations")).to_have_text(str(row.iterations),
                                                                              timeout=WAIT_MS)
         assert shown(page, f"race-{row.method}-status") == row.status
+    assert page.locator("#race-figure").get_attribute("src") != before
 
 
 def test_the_page_asks_nothing_of_the_network(explorer):

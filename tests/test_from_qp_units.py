@@ -121,33 +121,30 @@ def test_outputs_are_in_the_users_units_and_meet_the_users_kkt():
 
 def test_the_problem_a_built_in_method_sees_is_of_order_one():
     """The problem holds the user's arrays; a built-in method is handed a scaled view of them,
-    made per run (the problem keeps no scaled copy)."""
-    from signorini.solvers.registry import register
-
+    made per run (the problem keeps no scaled copy). A :class:`Method` given to solve is run
+    as declared (here a scaled one), without entering any table."""
     seen = []
 
     def spy(problem, *, tol, max_iter, **options):
         seen.append(problem)
         return get_method("pdas").function(problem, tol=tol, max_iter=max_iter)
 
-    spec = register(Method(name="spy-of-order-one", function=spy, summary="records its problem",
-                           family="active set"))
-    try:
-        for _, length, E in UNITS:
-            problem, (K, f, N, d) = user_problem(length, E)
-            assert problem.K is not None and (problem.K != sp.csr_matrix(K)).nnz == 0
-            assert problem.scales == signorini.Scales()
-            result = signorini.solve(problem, spec.name, tol=TOL)
-            view = seen[-1]
-            assert view is not problem and result.converged
-            assert np.mean(view.K.diagonal()) == pytest.approx(1.0)
-            assert 0.1 <= max(np.abs(view.d).max(), np.abs(view.f).max()) <= 10
-            assert np.mean(view.weights) == pytest.approx(1.0)
-            # the answer is mapped back: the user's own KKT conditions hold
-            assert np.max(np.abs(K @ result.u - f + N.T @ result.force)) <= \
-                1e-9 * np.max(np.abs(N.T @ result.force))
-    finally:
-        REGISTRY.pop(spec.name)
+    spec = Method(name="spy-of-order-one", function=spy, summary="records its problem",
+                  family="active set")
+    for _, length, E in UNITS:
+        problem, (K, f, N, d) = user_problem(length, E)
+        assert problem.K is not None and (problem.K != sp.csr_matrix(K)).nnz == 0
+        assert problem.scales == signorini.Scales()
+        result = signorini.solve(problem, spec, tol=TOL)
+        view = seen[-1]
+        assert view is not problem and result.converged and result.method == spec.name
+        assert np.mean(view.K.diagonal()) == pytest.approx(1.0)
+        assert 0.1 <= max(np.abs(view.d).max(), np.abs(view.f).max()) <= 10
+        assert np.mean(view.weights) == pytest.approx(1.0)
+        # the answer is mapped back: the user's own KKT conditions hold
+        assert np.max(np.abs(K @ result.u - f + N.T @ result.force)) <= \
+            1e-9 * np.max(np.abs(N.T @ result.force))
+    assert spec.name not in REGISTRY
 
 
 def test_the_qp_survives_save_and_load(tmp_path):

@@ -161,6 +161,6 @@ def test_a_fifo_among_a_scenes_or_problems_files_is_refused_by_the_api(tmp_path)
     with pytest.raises(InputError, match="f.mtx' is not a regular file"):
         signorini.solve(str(folder))
     with pytest.raises(InputError, match="limits file .* is not a regular file"):
-        from signorini.studies.suite import read_limits
+        from signorini.studies.suite_checks import read_limits
 
         read_limits(str(fifo(tmp_path / "limits.toml")))

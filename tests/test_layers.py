@@ -9,7 +9,7 @@ Layers, low to high (a module may import its own layer and the layers below):
 3. ``solvers``                           the registry collects each backend's METHODS
 4. ``load_control``                      load control: the one driver around any method
 5. ``scenes``                            families, meshing, scene files, building problems
-6. ``api``, ``crosschecking``, ``derivatives``, the package: the public Python API
+6. ``api``, ``result``, ``crosschecking``, ``derivatives``, the package: the public Python API
 7. ``studies``, ``output`` one runner and its studies; reports, plots, export
 8. ``cli``                               parsing only
 
@@ -34,13 +34,13 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "signorini"
 
 LAYERS = {
-    "errors": 0, "files": 0, "reprs": 0,
+    "errors": 0, "files": 0, "paths": 0, "reprs": 0,
     "numerics": 1,
     "problem": 2, "certification": 2, "references": 2, "fem": 2,
     "solvers": 3,
     "load_control": 4,
     "scenes": 5,
-    "api": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "": 6,
+    "api": 6, "result": 6, "crosschecking": 6, "crosscheck_tables": 6, "derivatives": 6, "": 6,
     "studies": 7, "output": 7,
     "cli": 8,
 }

@@ -276,3 +276,26 @@ def test_band_columns_beyond_the_memory_budget_keep_only_what_the_lcp_reads(scen
                                atol=1e-12 * np.abs(whole.solution.lam).max())
     np.testing.assert_allclose(slim.solution.u, whole.solution.u, rtol=1e-9,
                                atol=1e-12 * np.abs(whole.solution.u).max())
+
+
+def test_named_nested_takes_load_controls_factorisation():
+    """Named, nested costs what auto's route does: load control factorises K once around the
+    predicted zone and nested solves on that factorisation by back-solves only."""
+    problem = build_problem("hertz-cylinder", params={"refine": 1, "n_contact": 60})
+    assert problem.pending and problem.discretisation.prescribed.size >= load_control.ZONE_FROM_DOFS
+    named = signorini.solve(problem, method="nested")
+    assert named.method == "nested" and named.status == "converged"
+    assert named.solution.work["load_control"]["factorisations"] == 1
+    assert "factorisations" not in named.solution.work["method"]
+    assert_same_answer(named.problem, solve(named.problem, "pdas"), named.solution)
+
+
+def test_nested_predicts_the_zone_from_a_warm_answer():
+    """A warm start holding an answer alone (no factorisation): the zone is that answer's
+    contact, and nested factorises once and agrees with pdas."""
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"refine": 1}))
+    earlier = solve(problem, "pdas")
+    nested = solve(problem, "nested", warm_start=signorini.WarmStart.of(earlier))
+    assert nested.status == "converged" and "the warm start's contact" in nested.message
+    assert "1 factorisation(s)" in nested.message
+    assert_same_answer(problem, earlier, nested)

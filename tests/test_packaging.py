@@ -172,7 +172,8 @@ def installed(dists, tmp_path_factory) -> Path:
 def test_the_sdist_holds_the_examples_the_tutorials_and_the_licence(dists):
     with tarfile.open(dists["sdist"]) as sdist:
         names = {name.split("/", 1)[1] for name in sdist.getnames() if "/" in name}
-    wanted = {str(p.relative_to(ROOT)) for folder in ("examples", "docs/tutorials")
+    folders = ("examples", "docs/tutorials", "docs/tutorials/solutions")
+    wanted = {str(p.relative_to(ROOT)) for folder in folders
               for p in (ROOT / folder).iterdir() if p.is_file() and p.suffix in {".toml", ".msh", ".py",
                                                                                  ".ipynb"}}
     assert wanted and wanted <= names, wanted - names

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from signorini.scenes import build_problem
-from signorini.solvers.registry import REGISTRY, Method, get_method
+from signorini.solvers.registry import REGISTRY, Method, get_method, given
 from signorini.studies import suite
 from signorini.studies.problems import (REFERENCE_POLICIES, exact_attempt, reference_solution,
                                         trusted)
@@ -90,16 +90,17 @@ def test_the_suite_runs_in_a_worker_and_in_process_alike():
     assert "uzawa@1e-09 converged: λ agrees with pdas" in names
 
 
-def test_a_method_registered_here_only_keeps_the_suite_in_this_process(monkeypatch):
+def test_a_method_known_here_only_keeps_the_suite_in_this_process():
     def pdas_again(problem, *, tol=None, max_iter=None, **options):
         return get_method("pdas").function(problem, tol=tol, max_iter=max_iter, **options)
 
-    mine = Method(name="test-pdas-here", function=pdas_again, summary="pdas, registered here",
+    mine = Method(name="test-pdas-here", function=pdas_again, summary="pdas, known here",
                   family="user")
-    monkeypatch.setitem(REGISTRY, mine.name, mine)  # registered here, gone after the test
     assert not suite.portable(mine) and suite.portable(get_method("pdas"))
     cases = tuple(c for c in suite.DEFAULT_CASES if c.name == "block")
-    result = suite.run_suite(cases, ["test-pdas-here"])
+    with given({mine.name: mine}):  # known by its name in this block only
+        result = suite.run_suite(cases, ["test-pdas-here"])
+    assert mine.name not in REGISTRY
     assert result.passed and result.runs[0]["status"] == "converged"
     answer = result.results[0].solutions["test-pdas-here@1e-09"]
     np.testing.assert_allclose(answer.lam, result.results[0].reference.lam, rtol=1e-10)

@@ -17,7 +17,7 @@ from signorini.errors import InputError
 from signorini.references.pressure import compare_uniform, contact_profile
 from signorini.problem.contact import ReferenceData
 from signorini.scenes import build_problem
-from signorini.scenes.scenefile import read_mesh
+from signorini.scenes.mesh_scene import read_mesh
 from signorini.solvers.registry import solve
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -25,7 +25,8 @@ from signorini.studies.atlas import AXES, atlas_methods, run_atlas, select_axes
 from signorini.studies.atlas.report import write_report
 from signorini.studies.atlas.summary import wrapper_record
 from signorini.studies.problems import ill_posed_problem
-from signorini.studies.runner import BUILD_ONLY, Task, _verdict, run_task, run_tasks
+from signorini.studies.runner import BUILD_ONLY, Task, run_task, run_tasks
+from signorini.studies.task import verdict
 
 TINY_HERTZ = {"n_contact": 8, "grading": 0.5}
 TINY_BLOCK = {"nx": 4, "ny": 4}
@@ -88,17 +89,17 @@ def test_osqp_at_its_defaults_claims_success_and_is_caught(hertz):
 
 def test_verdict_flags_a_converged_status_with_a_wrong_answer():
     task = Task("test", "made up", 0, {}, "pdas")
-    wrong = _verdict({"status": "converged", "claimed_status": "converged", "cert_ok": True,
-                      "exact_ok": False}, task)
+    wrong = verdict({"status": "converged", "claimed_status": "converged", "cert_ok": True,
+                     "exact_ok": False}, task)
     assert not wrong["wrapper_right"] and wrong["outcome"] == "wrong" and not wrong["claim_correct"]
-    caught = _verdict({"status": "inaccurate", "claimed_status": "converged", "cert_ok": False,
-                       "exact_ok": False}, task)
+    caught = verdict({"status": "inaccurate", "claimed_status": "converged", "cert_ok": False,
+                      "exact_ok": False}, task)
     assert caught["wrapper_right"] and caught["outcome"] == "caught"
-    conservative = _verdict({"status": "inaccurate", "claimed_status": "converged",
-                             "cert_ok": False, "exact_ok": True}, task)
+    conservative = verdict({"status": "inaccurate", "claimed_status": "converged",
+                            "cert_ok": False, "exact_ok": True}, task)
     assert conservative["wrapper_right"] and conservative["outcome"] == "conservative"
-    raised = _verdict({"status": "raised", "claimed_status": "converged", "cert_ok": True,
-                       "exact_ok": True}, task)
+    raised = verdict({"status": "raised", "claimed_status": "converged", "cert_ok": True,
+                      "exact_ok": True}, task)
     assert not raised["wrapper_right"]
 
 

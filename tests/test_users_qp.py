@@ -21,7 +21,7 @@ import scipy.sparse as sp
 import signorini
 from signorini.cli import main
 from signorini.solvers import condensed, pdas
-from signorini.solvers.defaults import DEFAULT_TOL, TABLE
+from signorini.solvers.options import DEFAULT_TOL, TABLE
 from signorini.solvers.registry import get_method
 
 SOLVERS = Path(signorini.__file__).parent / "solvers"
@@ -153,9 +153,9 @@ def default_tolerance_literals(path: Path) -> list[str]:
 
 def test_no_default_tolerance_outside_the_table():
     where = {p.name: default_tolerance_literals(p) for p in sorted(SOLVERS.glob("*.py"))
-             if p.name != "defaults.py"}
+             if p.name != "options.py"}
     assert {name: hits for name, hits in where.items() if hits} == {}
-    assert default_tolerance_literals(SOLVERS / "defaults.py")  # the scan finds the table's
+    assert default_tolerance_literals(SOLVERS / "options.py")  # the scan finds the table's
 
 
 def test_the_scan_finds_a_default_tolerance(tmp_path):

@@ -5,7 +5,7 @@
 Every run is a task of the studies' runner (signorini.studies.runner): pdas at tol 1e-10 on
 the scene as signorini.solve builds it (its load matched with the answer), measured against
 the scene's reference; p₀ and a are Hertz's profile fitted to the nodal pressures
-(signorini.references.pressure.hertz_fit).
+(signorini.references.profile.hertz_fit).
 docs/accuracy.md quotes the tables that ``tables`` renders from the JSON
 (tools/readme.py writes them there; tests/test_readme_numbers.py holds them).
 """

@@ -178,7 +178,7 @@ def backends() -> dict:
 
 def crossover() -> dict:
     from signorini.scenes import build_problem
-    from signorini.solvers.registry import solve
+    from signorini.solvers.registry import get_method, solve
 
     rows = []
     for params in ({"delta": 0.0025}, {"n_contact": 16, "delta": 0.0025},
@@ -200,7 +200,7 @@ def petsc_350k(params: dict = SPHERE_350K, method: str = "pdas-amg") -> dict:
     from signorini.scenes import build_problem
     from signorini.solvers.registry import solve
 
-    problem = build_problem("hertz-sphere-3d", params=params, solved_by=method)
+    problem = build_problem("hertz-sphere-3d", params=params, solved_by=get_method(method))
     before = load()
     matched = solve_scene(problem, method)  # a target load matched with the answer
     problem, ours = matched.problem, matched.solution
@@ -318,10 +318,11 @@ def readme_paragraph(data: dict) -> str:
     if "whole-largest-load" in data and data["whole-largest-load"]["record"] is not None:
         from signorini.scenes import SCENES
         from signorini.scenes.size import bytes_per_dof, estimate_dofs
+        from signorini.solvers.registry import get_method
 
         params = SCENES["hertz-sphere-3d"].parse(SPHERE_LARGEST_LOAD)
         dofs, dim = estimate_dofs("hertz-sphere-3d", params)
-        need = dofs * bytes_per_dof(dim, dofs, params, "auto")
+        need = dofs * bytes_per_dof(dim, dofs, params, get_method("auto"))
         machine_gb = data.get("machine", {}).get("memory_gb", float("nan"))
         lines.append(f"- The finest default the size guard lets through on this machine (refine=3: "
                      f"estimated {dofs / 1e6:.1f}M dofs and {need / 1e9:.1f} GB, the limit ¾ of "

@@ -5,10 +5,14 @@
     .venv/bin/python tools/budget.py --parts 3d-1m   # one case's in-process parts, printed only
 
 2D: the 10⁶-dof cylinder command, whole process (start to exit, ``/usr/bin/time -v`` for its
-peak memory), the fastest of ``--repeat`` runs; then, in one process, its parts: the model
+peak memory), the fastest of ``--repeat`` runs, and the same command with ``--method nested``
+(time and memory against the default's); then, in one process, its parts: the model
 built (meshing and assembly), the solve through the API, the certificate and the estimate, and
 the same K factorised by PARDISO (SPD, the package's settings) and solved once, which no
-method can do without. 3D: the command's whole process, at 350k and at 10⁶ dofs, and at 10⁶ its
+method can do without; that factorisation is also timed in a process of its own between the
+whole commands (the reference the command is held to). Each stage of the command's own record (its JSON ``time``) is reported
+against its budget (:data:`BUDGETS_2D`, shares of that factorisation); in 3D against
+:data:`BUDGETS_3D`, shares of the method's own time. 3D: the command's whole process, at 350k and at 10⁶ dofs, and at 10⁶ its
 parts in one process: the model built, the solve through the API, the estimate, and the one
 multigrid solve of K no method without a factorisation can avoid (:func:`in_process_amg`).
 docs/speed.md quotes the JSON (tests/test_readme_numbers.py holds it).
@@ -38,18 +42,32 @@ CASES = {
 }
 
 
-def said(scene: str, params: dict) -> str:
+#: what each stage of the 2D command may take, as a share of one PARDISO factorisation and solve
+#: of its K: they sum to the goal, 1.5× it (``startup`` is the wall time outside the record's
+#: stages: imports, parsing, exit)
+BUDGETS_2D = {"startup": 0.07, "mesh": 0.10, "assemble": 0.10, "load_control": 1.10,
+              "prediction": 0.0, "method": 0.03, "certificate": 0.05, "estimate": 0.04,
+              "output": 0.01}
+#: what each stage of the 3D command outside its method may take, as a share of the method's own
+#: time: they sum to the goal, 0.30 of it
+BUDGETS_3D = {"startup": 0.03, "mesh": 0.05, "assemble": 0.10, "load_control": 0.0,
+              "prediction": 0.0, "certificate": 0.05, "estimate": 0.05, "output": 0.02}
+
+
+def said(scene: str, params: dict, method: str | None = None) -> str:
     """The command as a user types it."""
-    return " ".join(["signorini solve", scene, *(f"--set {k}={v}" for k, v in params.items())])
+    return " ".join(["signorini solve", scene, *(f"--set {k}={v}" for k, v in params.items()),
+                     *(["--method", method] if method else [])])
 
 
-def whole_process(scene: str, params: dict) -> dict:
+def whole_process(scene: str, params: dict, method: str | None = None) -> dict:
     """One run of ``signorini solve`` in its own process: wall time, peak memory, its record."""
     with tempfile.TemporaryDirectory() as folder:
         record = Path(folder) / "result.json"
         argv = [sys.executable, "-m", "signorini.cli", "solve", scene, "--json", str(record)]
         for key, value in params.items():
             argv += ["--set", f"{key}={value}"]
+        argv += ["--method", method] if method else []
         start = time.perf_counter()
         done = subprocess.run(["/usr/bin/time", "-v", *argv], capture_output=True, text=True,
                               cwd=ROOT)
@@ -58,9 +76,61 @@ def whole_process(scene: str, params: dict) -> dict:
             raise SystemExit(f"{' '.join(argv)} failed:\n{done.stderr[-2000:]}")
         peak = re.search(r"Maximum resident set size \(kbytes\): (\d+)", done.stderr)
         result = json.loads(record.read_text())
-    return {"command": said(scene, params), "wall_s": wall,
+    return {"command": said(scene, params, method), "wall_s": wall,
             "peak_gb": int(peak.group(1)) / 1e6 if peak else None, "status": result["status"],
-            "dofs": result["dofs"], "time": result["time"], "hertz": result.get("hertz")}
+            "dofs": result["dofs"], "time": result["time"], "hertz": result.get("hertz"),
+            "method": result.get("method")}
+
+
+def stages(command: dict) -> dict:
+    """The command's stages in seconds from its record (``time``), and ``startup``: the wall
+    time outside them."""
+    time_ = command["time"]
+    found = {key[:-2]: value for key, value in time_.items()
+             if key.endswith("_s") and key[:-2] in BUDGETS_2D and key != "startup_s"}
+    found["startup"] = command["wall_s"] - time_["total_s"]
+    return found
+
+
+def stage_rows(command: dict, reference: float, budgets: dict, skip: tuple = ()) -> list[str]:
+    """A table of the command's stages against their budgets (shares of ``reference`` s)."""
+    rows = ["| stage (the command's record) | seconds | budget | within |", "|---|---:|---:|:---:|"]
+    for stage, seconds in stages(command).items():
+        if stage in skip or (seconds < 0.005 and not budgets.get(stage)):
+            continue
+        allowed = budgets.get(stage, 0.0) * reference
+        rows.append(f"| {stage.replace('_', ' ')} | {seconds:.2f} | {allowed:.2f} | "
+                    f"{'yes' if seconds <= allowed else '**no**'} |")
+    return rows
+
+
+def factorisation_process(scene: str, params: dict) -> dict:
+    """PARDISO's factorisation and one solve of the command's K, timed in a process of its own
+    (run between the commands: the same machine, the same moment)."""
+    argv = [sys.executable, str(Path(__file__).resolve()), "--factor", scene, json.dumps(params)]
+    done = subprocess.run(argv, capture_output=True, text=True, cwd=ROOT)
+    if done.returncode != 0:
+        raise SystemExit(f"{' '.join(argv)} failed:\n{done.stderr[-2000:]}")
+    return json.loads(done.stdout.splitlines()[-1])
+
+
+def factorised(scene: str, params: dict) -> dict:
+    """The scene's K (built, not solved: the load does not change it) factorised by PARDISO with
+    the package's settings and solved once, timed."""
+    import numpy as np
+
+    from signorini.numerics.factor import PardisoFactor
+    from signorini.scenes.build import build_problem
+
+    problem = build_problem(scene, params)
+    K, f = problem.K, np.asarray(problem.f, dtype=float)
+    del problem
+    start = time.perf_counter()
+    factor = PardisoFactor(K)
+    parts = {"pardiso_factorise_s": time.perf_counter() - start}
+    factor.solve(f)
+    parts["pardiso_factorise_and_solve_s"] = time.perf_counter() - start
+    return parts
 
 
 def built_and_solved(scene: str, params: dict, solved_by: str | None = None, **options):
@@ -69,9 +139,11 @@ def built_and_solved(scene: str, params: dict, solved_by: str | None = None, **o
     and the result."""
     import signorini
     from signorini.scenes.build import build_problem
+    from signorini.solvers.registry import get_method
 
     start = time.perf_counter()
-    problem = build_problem(scene, params, solved_by=solved_by)
+    method = None if solved_by is None else get_method(solved_by)
+    problem = build_problem(scene, params, solved_by=method)
     parts = {"dofs": problem.n, "build_s": time.perf_counter() - start}
     del problem
     start = time.perf_counter()
@@ -120,11 +192,12 @@ def in_process_amg(scene: str, params: dict) -> dict:
     from signorini.numerics.multigrid import pinned_cg, pinned_matrix
     from signorini.solvers import amg
     from signorini.solvers.bounds import bound_form
+    from signorini.solvers.defaults import resolved
 
     parts, result = built_and_solved(scene, params, solved_by="auto")  # as the command builds it
     extras = result.solution.extras
     parts.update(method=result.method, status=result.status,
-                 method_s=extras["method_s"], steps=result.iterations,
+                 method_s=result.solution.seconds["method"], steps=result.iterations,
                  hierarchy_s=extras["hierarchy_s"], cg_iterations=extras["cg_iterations"])
     problem, lam = result.problem, result.solution.lam
     del result
@@ -134,7 +207,7 @@ def in_process_amg(scene: str, params: dict) -> dict:
     free = system.pin(active, problem.d, x)
     force = max(float(np.max(np.abs(lam * system.coef), initial=0.0)),
                 1e-5 * float(np.max(np.abs(problem.f), initial=0.0)))
-    target = amg.SAFETY * amg.DEFAULT_TOL * force
+    target = amg.SAFETY * resolved("pdas-amg", "active set", None, None)[0] * force
     start = time.perf_counter()
     pinned, modes = pinned_matrix(system.K, ~free), system.form.rigid_modes()
     parts["amg_pin_s"] = time.perf_counter() - start  # the pinned matrix and the rigid modes
@@ -159,29 +232,52 @@ def table(record: dict) -> str:
     """docs/performance.md's block: the 2D command against one factorisation, and its parts."""
     two = record["2d"]
     command, parts = two["command"], two["in_process"]
-    wall, once = command["wall_s"], parts["pardiso_factorise_and_solve_s"]
+    wall, once = command["wall_s"], two["factorisation"]["pardiso_factorise_and_solve_s"]
     lines = [f"`{command['command']}` ({command['dofs']:,} dofs, {command['status']}), fastest of "
              f"{record['repeat']} whole processes: **{wall:.1f} s**, {command['peak_gb']:.2f} GB peak; "
-             f"PARDISO's factorisation and one solve of the same K, in the same run: "
-             f"**{once:.1f} s**, so the command is **{wall / once:.2f}×** one factorisation.", "",
+             f"PARDISO's factorisation and one solve of the same K, each in a process of its own "
+             f"between the commands, fastest of {record['repeat']}: **{once:.1f} s**, so the "
+             f"command is **{wall / once:.2f}×** one factorisation.", "",
              *part_rows(parts, wall, (
                  (BUILT, "build_s"), (SOLVED, "solve_s"),
                  ("the certificate, once more alone (the method's factorisation)",
                   "certificate_s"),
                  ("the error estimate", "estimate_s"),
                  ("PARDISO: factorise K", "pardiso_factorise_s"),
-                 ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s")))]
+                 ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s"))),
+             "", f"Each stage of the command's own record (its JSON `time`; *startup* is the wall "
+                 f"time outside them: imports, parsing, exit) against its budget, a share of that "
+                 f"factorisation (`tools/budget.py`'s `BUDGETS_2D`, summing to 1.5×):", "",
+             *stage_rows(command, once, BUDGETS_2D)]
+    if "2d-nested" in record:
+        nested = record["2d-nested"]["command"]
+        lines += ["", f"`{nested['command']}`: **{nested['wall_s']:.1f} s**, "
+                      f"{nested['peak_gb']:.2f} GB peak, so **{nested['wall_s'] / wall:.2f}×** the "
+                      f"default's time and **{nested['peak_gb'] / command['peak_gb']:.2f}×** its "
+                      "memory."]
     for case in ("3d", "3d-1m"):
         if case in record:
             three = record[case]["command"]
             lines += ["", f"3D, `{three['command']}` ({three['dofs']:,} dofs, {three['status']}): "
                           f"**{three['wall_s']:.1f} s** whole process, {three['peak_gb']:.2f} GB peak."]
+            method = three["time"].get("method_s")
+            if method:
+                outside = three["wall_s"] - method
+                lines += ["", f"Outside its method (`{three.get('method') or 'pdas-amg'}`, "
+                              f"{method:.1f} s in the command's record): **{outside:.1f} s**, "
+                              f"**{100 * outside / method:.0f} %** of the method's time (goal "
+                              f"≤ 30 %); each stage against its budget, a share of the method's "
+                              f"time (`BUDGETS_3D`):", "",
+                          *stage_rows(three, method, BUDGETS_3D, skip=("method",))]
             if "in_process" in record[case]:
                 lines += ["", *amg_lines(three["wall_s"], record[case]["in_process"])]
     machine = record["machine"]
+    load = record.get("load_average")
     lines += ["", f"Measured {record['date'][:10]} on {machine['cores']} cores "
-                  f"({machine['processor']}, Python {machine['python']}) by `tools/budget.py`; the "
-                  "run is `docs/speed/budget.json`."]
+                  f"({machine['processor']}, Python {machine['python']}) by `tools/budget.py`"
+                  + (f", load average {load[0]:.1f} at the start and {load[1]:.1f} at the end "
+                     "(a shared machine: ratios within the run are what compare)" if load else "")
+                  + "; the run is `docs/speed/budget.json`."]
     return "\n".join(lines)
 
 
@@ -219,9 +315,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--3d", dest="three", action="store_true")
+    parser.add_argument("--repeat-3d", type=int, help="whole processes per 3D case (default: "
+                        "--repeat)")
+    parser.add_argument("--factor", nargs=2, metavar=("SCENE", "PARAMS"),
+                        help=argparse.SUPPRESS)  # one factorisation_process, its JSON printed
     parser.add_argument("--parts", choices=["3d-1m"], help="only this case's in-process parts, "
                         "printed (budget.json is not written)")
     args = parser.parse_args()
+    if args.factor:
+        print(json.dumps(factorised(args.factor[0], json.loads(args.factor[1]))))
+        return
     if args.parts:
         print(json.dumps(in_process_amg(*CASES[args.parts]), indent=1))
         return
@@ -229,22 +332,37 @@ def main() -> None:
                        "processor": platform.processor() or platform.machine(),
                        "cores": os.cpu_count()},
            "date": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-           "repeat": args.repeat}
+           "repeat": args.repeat, "repeat_3d": args.repeat_3d or args.repeat}
+    start_load = os.getloadavg()[0]
     scene, params = CASES["2d"]
-    runs = [whole_process(scene, params) for _ in range(args.repeat)]
+    runs, nested, factors = [], [], []
+    for _ in range(args.repeat):  # interleaved: the routes and the reference see the same machine
+        runs.append(whole_process(scene, params))
+        factors.append(factorisation_process(scene, params))
+        nested.append(whole_process(scene, params, "nested"))
     out["2d"] = {"command": min(runs, key=lambda r: r["wall_s"]),
                  "walls_s": [r["wall_s"] for r in runs],
+                 "factorisation": min(factors, key=lambda r: r["pardiso_factorise_and_solve_s"]),
+                 "factorisations_s": [r["pardiso_factorise_and_solve_s"] for r in factors],
                  "in_process": in_process(scene, params)}
+    out["2d-nested"] = {"command": min(nested, key=lambda r: r["wall_s"]),
+                        "walls_s": [r["wall_s"] for r in nested]}
+    OUT.write_text(json.dumps(out, indent=1) + "\n")  # kept case by case: a later one may fail
     for case in ("3d", "3d-1m") if args.three else ():
         scene, params = CASES[case]
-        runs = [whole_process(scene, params) for _ in range(args.repeat)]
+        runs = [whole_process(scene, params) for _ in range(args.repeat_3d or args.repeat)]
         out[case] = {"command": min(runs, key=lambda r: r["wall_s"]),
                      "walls_s": [r["wall_s"] for r in runs]}
+        OUT.write_text(json.dumps(out, indent=1) + "\n")
         if case == "3d-1m":
-            out[case]["in_process"] = in_process_amg(scene, params)
+            try:
+                out[case]["in_process"] = in_process_amg(scene, params)
+            except Exception as exc:  # noqa: BLE001 - the whole processes above are kept
+                out[case]["in_process_error"] = f"{type(exc).__name__}: {exc}"
+    out["load_average"] = [start_load, os.getloadavg()[0]]
     OUT.write_text(json.dumps(out, indent=1) + "\n")
     two = out["2d"]
-    once = two["in_process"]["pardiso_factorise_and_solve_s"]
+    once = two["factorisation"]["pardiso_factorise_and_solve_s"]
     print(f"2D: {two['command']['wall_s']:.1f} s whole process, PARDISO's factorisation and solve "
           f"{once:.1f} s: {two['command']['wall_s'] / once:.2f}x")
 

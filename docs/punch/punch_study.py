@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from signorini.studies.convergence import plot_punch_edge, plot_punch_pressure
+from signorini.output.plots import plot_punch_edge, plot_punch_pressure
 from signorini.files import atomic_write_text, save_figure, to_json
 from signorini.references.pressure import compare_punch
 from signorini.scenes import build_problem

@@ -8,7 +8,7 @@ from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, SCENE_HELP, add_comm
                                   method_options, pairs, parse_tol, stdout_to_stderr,
                                   user_methods_in_workers, write_output)
 from signorini.errors import InputError
-from signorini.solvers.defaults import DEFAULT_TOL
+from signorini.solvers.options import DEFAULT_TOL
 from signorini.solvers.options import guess_value
 
 

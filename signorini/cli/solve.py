@@ -10,8 +10,7 @@ from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, SCENE_HELP, add_comm
                                   method_options, pairs, parse_time_limit, parse_tol, stdout_to_stderr,
                                   write_output)
 from signorini.errors import InputError
-from signorini.solvers.defaults import DEFAULT_TOL
-from signorini.solvers.options import guess_value
+from signorini.solvers.options import DEFAULT_TOL, guess_value
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
@@ -35,8 +34,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
                              f"solved as stored: drop {given[0]}")
     # every option read as its declared kind and checked before the scene is built
     method = get_method(args.method)
-    options = method.parse_options(texts)
-    check_request(args.method, tol, max_iter, options)
+    request = check_request(method, tol, max_iter, method.parse_options(texts))  # once: solve takes it
     time_limit = parse_time_limit(args.time_limit)
     if time_limit is not None and args.target_error is not None:
         raise InputError("--time-limit runs one solve in a worker process and --target-error "
@@ -62,18 +60,17 @@ def cmd_solve(args: argparse.Namespace) -> int:
         if args.target_error is not None:  # adaptive refinement (signorini.scenes.adapt)
             if args.raw_units:
                 raise InputError("--target-error refines a non-dimensionalised scene: drop --raw-units")
-            result = solve_adaptive(args.scene, args.target_error, args.method, tol=tol,
-                                    max_iter=max_iter, params=params, max_dofs=args.max_dofs,
-                                    target_on=args.target_on, **options)
+            result = solve_adaptive(args.scene, args.target_error, request, params=params,
+                                    max_dofs=args.max_dofs, target_on=args.target_on)
             problem = result.problem
         else:
             problem = build_problem(args.scene, params=params, nondimensionalise=not args.raw_units,
-                                    solved_by=args.method)
+                                    solved_by=method)
             if vtk_path and problem.mesh is None:
                 raise InputError(f"--vtk writes the mesh, and {args.scene!r} holds none (a QP "
                                  "given as arrays): drop --vtk, or save the problem of a scene")
             if time_limit is None:
-                result = solve(problem, args.method, tol=tol, max_iter=max_iter, **options)
+                result = solve(problem, request)
                 problem = result.problem
             else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
                 from signorini.studies.runner import solve_within  # per command (start-up)
@@ -83,7 +80,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
                     {"kind": "scene", "scene": args.scene, "params": params,
                      "nondimensionalise": not args.raw_units}
                 solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
-                                        max_iter=max_iter, options=options)
+                                        max_iter=max_iter, options=request.options)
                 result = Result(problem, solution, certificate(problem, solution))
     record = result.to_dict()
     finite = record["contact"] is not None

@@ -16,7 +16,8 @@ from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, PROBLEM_FILES, add_c
 def cmd_converge(args: argparse.Namespace) -> int:
     # each command loads what it needs (the studies start matplotlib)
     from signorini.files import all_or_none
-    from signorini.studies.convergence import check_study, grading_comparison, run_study, study_table, write_study  # as above
+    from signorini.studies.convergence import check_study, grading_comparison, run_study  # as above
+    from signorini.studies.convergence_report import study_table, write_study  # as above
 
     if args.levels < 0 or args.levels > 6:
         raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
@@ -59,8 +60,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from signorini.output.report import REPORT_FILES, checks_summary, write_suite_report  # as above
     from signorini.problem.files import problem_file_paths, read_problem  # as above
     from signorini.solvers.registry import check_request  # as above
-    from signorini.studies.suite import (TIGHT_TOL, problem_case, read_limits, run_suite,
-                                         select_cases)  # as above
+    from signorini.studies.suite import problem_case, run_suite, select_cases  # as above
+    from signorini.studies.suite_checks import TIGHT_TOL, read_limits  # as above
 
     time_limit = parse_time_limit(args.time_limit)
     tol = TIGHT_TOL if args.tol is None else parse_tol(args.tol)

@@ -18,7 +18,7 @@ from signorini.derivatives.implicit import Sensitivity, exact_answer
 from signorini.errors import InputError
 from signorini.fem.assembly import lame_stiffness, nodal_dofs
 from signorini import load_control
-from signorini.references.pressure import contact_profile, hertz_fit, hertz_fit_tangent
+from signorini.references.profile import contact_profile, hertz_fit, hertz_fit_tangent
 from signorini.problem.contact import ContactProblem
 from signorini.reprs import short_repr
 from signorini.scenes import build_problem
@@ -225,7 +225,7 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
     ``method``) or a converged :class:`signorini.Result`. ``output`` is one of
     ``total_force``, ``energy`` (the optimal ½uᵀKu − fᵀu), ``displacement``
     (at the mesh node nearest ``at``), ``pressure`` (nodal), ``p0`` and ``a``
-    (Hertz's profile fitted to the pressures, :func:`signorini.references.pressure.hertz_fit`);
+    (Hertz's profile fitted to the pressures, :func:`signorini.references.profile.hertz_fit`);
     ``wrt`` one of ``E``, ``nu`` (``E1``, ``E2``, ``nu1``, ``nu2``: each body's of a two-body
     scene), ``P`` (a load-controlled scene's target
     load), ``delta`` (a push-controlled scene's push) and ``obstacle`` (the
@@ -244,7 +244,7 @@ def derivative(scene: Any, output: str, wrt: str, *, params: dict[str, Any] | No
                          "derivatives are not provided")
     if isinstance(scene, str):
         request = check_request(method)  # before the scene is built
-        problem = build_problem(scene, params=scene_params(params), solved_by=method)
+        problem = build_problem(scene, params=scene_params(params), solved_by=request.method)
         problem, solution, _ = load_control.solve(problem, request, coarse=coarse_problem,
                                                   keep_factor=True)
         result = None

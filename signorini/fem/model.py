@@ -14,26 +14,20 @@ from signorini.fem.volumetric import resolve
 
 @dataclass
 class FlatObstacle:
-    """A rigid flat ``y = height``, approached from above (normal (0, −1))."""
+    """A rigid flat ``y = height`` (``z = height`` under a 3D body), approached from above: the
+    normal is minus the points' last axis, (0, −1) or (0, 0, −1)."""
 
     height: float = 0.0
 
     def normals_and_gaps(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Unit outward normal of the body towards the obstacle and the initial gap per point."""
-        normals = np.tile([0.0, -1.0], (len(points), 1))
-        return normals, points[:, 1] - self.height
+        normals = np.zeros((len(points), points.shape[1]))
+        normals[:, -1] = -1.0
+        return normals, points[:, -1] - self.height
 
 
-@dataclass
-class FlatObstacle3D:
-    """A rigid flat ``z = height`` under a 3D body, approached from above (normal (0, 0, −1))."""
-
-    height: float = 0.0
-
-    def normals_and_gaps(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Unit outward normal of the body towards the obstacle and the initial gap per point."""
-        normals = np.tile([0.0, 0.0, -1.0], (len(points), 1))
-        return normals, points[:, 2] - self.height
+#: the flat under a 3D body (the name its scenes use)
+FlatObstacle3D = FlatObstacle
 
 
 @dataclass(frozen=True)

@@ -206,19 +206,57 @@ def simplex_stiffness(mesh: Any, Lambda: float, Mu: float,
     for i, j in product(range(dim), repeat=2):
         D[i, j] = D[j, i] if j < i else -np.bincount(ends, np.concatenate([M[i, j], M[j, i]]),
                                                      minlength=nodes)
-    blocks = np.empty((indices.size, dim, dim))
-    for summed, at, mirrored in ((M, upper, lower), (D, diagonal, None)):
-        # the block is V (λ gₐ g_bᵀ + μ g_b gₐᵀ + μ (gₐ · g_b) I) summed
-        block = (Lambda * summed + Mu * summed.swapaxes(0, 1)
-                 + Mu * np.trace(summed) * np.eye(dim)[:, :, None])
-        if axisymmetric:
-            block += (hoop_sums[..., :count] + hoop_sums[..., count:2 * count].swapaxes(0, 1)
-                      if mirrored is not None else hoop_sums[..., 2 * count:])
-        blocks[at] = block.transpose(2, 0, 1)
-        if mirrored is not None:  # each (high, low) block: its (low, high)'s transpose
-            blocks[mirrored] = block.transpose(2, 1, 0)
-    K = sp.bsr_matrix((blocks, indices, indptr), shape=(dim * nodes, dim * nodes)).tocsr()
+    if axisymmetric:  # the hoop sums of each edge, as (low, high), and of each node's own pair
+        M_hoop = hoop_sums[..., :count] + hoop_sums[..., count:2 * count].swapaxes(0, 1)
+        D_hoop = hoop_sums[..., 2 * count:]
+    traces = np.trace(M), np.trace(D)
+    K = _csr_from_blocks(dim, nodes, indptr, indices, lambda i, j: (
+        # the block is V (λ gₐ g_bᵀ + μ g_b gₐᵀ + μ (gₐ · g_b) I) summed: of each edge as
+        # (low, high) at ``upper``, its transpose at ``lower``, and of each node at ``diagonal``
+        [(upper, _block(Lambda, Mu, M, traces[0], i, j, M_hoop if axisymmetric else None)),
+         (lower, _block(Lambda, Mu, M, traces[0], j, i, M_hoop if axisymmetric else None)),
+         (diagonal, _block(Lambda, Mu, D, traces[1], i, j, D_hoop if axisymmetric else None))]))
     K.eliminate_zeros()  # the blocks' structural zeros (a pattern as scikit-fem's)
+    return K
+
+
+def _block(Lambda: float, Mu: float, summed: np.ndarray, trace: np.ndarray, i: int, j: int,
+           hoop: np.ndarray | None) -> np.ndarray:
+    """Entry (i, j) of ``λ S + μ Sᵀ + μ tr(S) I`` (plus the hoop sums) over the last axis of the
+    summed ``S`` (dim, dim, ·)."""
+    value = Lambda * summed[i, j] + Mu * summed[j, i]
+    if i == j:
+        value += Mu * trace
+    if hoop is not None:
+        value += hoop[i, j]
+    return value
+
+
+def _csr_from_blocks(dim: int, nodes: int, indptr: np.ndarray, indices: np.ndarray,
+                     entries) -> sp.csr_matrix:
+    """The dof matrix (dofs dim·i + c) of a node pattern (``indptr``, ``indices``, sorted) whose
+    dim × dim blocks ``entries(c, c')`` gives entry by entry, as (pattern positions, values)
+    pairs: written straight into CSR, no block matrix. Entry (c, c') of the q-th block of node
+    row i sits at ``dim·(dim·indptr[i] + q) + c·dim·len(i) + c'``, ``len(i)`` the blocks of
+    row i; for one (c, c') those positions increase along the pattern."""
+    lengths = np.diff(indptr)
+    row_of = np.repeat(np.arange(nodes), lengths)
+    corner = dim * (np.arange(indices.size) + (dim - 1) * np.take(indptr, row_of))
+    stride = dim * np.take(lengths, row_of)
+    size = dim * dim * indices.size
+    kind = np.int32 if max(size, dim * nodes) < 2 ** 31 else np.int64
+    data, columns = np.empty(size), np.empty(size, dtype=kind)
+    value = np.empty(indices.size)
+    for c, c_ in product(range(dim), repeat=2):
+        for where, part in entries(c, c_):
+            value[where] = part
+        slots = corner + (c * stride + c_)
+        data[slots] = value
+        columns[slots] = dim * indices + c_
+    starts = dim * dim * indptr[:-1, None] + dim * np.arange(dim) * lengths[:, None]
+    K = sp.csr_matrix((data, columns, np.append(starts.ravel(), size).astype(kind)),
+                      shape=(dim * nodes, dim * nodes))
+    K.has_sorted_indices = True  # within a row: the pattern's sorted nodes, c' fastest
     return K
 
 

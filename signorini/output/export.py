@@ -39,7 +39,7 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.files import atomic_write, check_output_file
 from signorini.fem.estimate import candidate_nodes as mesh_nodes_at
-from signorini.references.pressure import contact_profile
+from signorini.references.profile import contact_profile
 from signorini.problem.contact import ContactProblem, ContactSolution
 
 log = logging.getLogger(__name__)
@@ -188,7 +188,7 @@ def check_vtk_path(path: str | os.PathLike) -> tuple[str, str]:
     """``(absolute path, meshio format)`` of an export target, checked before any work.
 
     InputError for an empty path, a bad suffix, a directory or a path that
-    cannot be written (see :func:`signorini.files.check_output_file`).
+    cannot be written (see :func:`signorini.paths.check_output_file`).
     """
     file_format = FORMATS.get(Path(path).suffix.lower())
     if str(path) and file_format is None:

@@ -9,7 +9,9 @@ from typing import Iterable
 
 import numpy as np
 
-from signorini.references.analytic import hertz_pressure
+from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.references.analytic import hertz_pressure, punch_pressure
+from signorini.references.pressure import compare_punch, contact_profile
 
 
 #: markers that go with the ten default colours (eleven: see :func:`series_style`)
@@ -254,5 +256,56 @@ def deformed_bodies(points: np.ndarray, elements: np.ndarray, displacement: np.n
     ax.figure.colorbar(dots, ax=ax, label="contact pressure")
     ax.set_aspect("equal")
     ax.set_title(f"deformed (displacements × {magnify:.3g})", fontsize=9)
+    ax.legend(fontsize=7)
+    return ax
+
+
+# --- the punch's edge ---------------------------------------------------------------------
+
+
+def _punch(problem: ContactProblem, solution: ContactSolution):
+    """The punch comparison, the pressure profile and the pressure unit ``P/(πa)``."""
+    comparison = compare_punch(problem, solution)
+    return comparison, contact_profile(problem, solution), comparison.load / (np.pi * comparison.a)
+
+
+def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=None):
+    """Nodal pressure under the punch against ``P/(π√(a² − x²))``, in units of ``P/(πa)``."""
+    ax = axes(ax)
+    comparison, profile, scale = _punch(problem, solution)
+    a, P = comparison.a, comparison.load
+    x, p = np.abs(profile.x), profile.pressure
+    order = np.argsort(x)
+    grid = np.linspace(0.0, a * (1 - 1e-4), 2000)
+    ax.plot(grid / a, punch_pressure(grid, a, P) / scale, "k-", lw=1.2, label="P / (π√(a² − x²))")
+    ax.plot(x[order] / a, p[order] / scale, "o", ms=3, mfc="none", label=f"{solution.method}")
+    ax.axvspan(0, comparison.inner, color="0.9", zorder=0, label=f"compared (|x| ≤ {comparison.inner:g}a)")
+    ax.set_xlabel("x / a")
+    ax.set_ylabel("p / (P / πa)")
+    ax.set_ylim(0, max(4.0, float(np.max(p) / scale) * 1.05))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return ax
+
+
+def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None):
+    """Pressure against the distance ``a − |x|`` to the edge (log–log): slope −½ is the singularity."""
+    ax = axes(ax)
+    comparison, profile, scale = _punch(problem, solution)
+    a, P = comparison.a, comparison.load
+    distance = a - np.abs(profile.x)
+    under = distance >= -1e-12 * a
+    grid = np.geomspace(1e-4 * a, a, 400)
+    ax.loglog(grid / a, punch_pressure(a - grid, a, P) / scale, "k-", lw=1.2, label="P / (π√(a² − x²))")
+    positive = under & (distance > 0)
+    ax.loglog(distance[positive] / a, profile.pressure[positive] / scale, "o", ms=3, mfc="none",
+              label=f"{solution.method}, h = {comparison.edge_h / a:.2g} a")
+    edge = under & (distance <= 1e-12 * a)
+    if np.any(edge):
+        ax.axhline(float(profile.pressure[edge][0]) / scale, color="C3", lw=0.8, ls="--",
+                   label="edge node (x = a)")
+    ax.set_xlabel("(a − |x|) / a")
+    ax.set_ylabel("p / (P / πa)")
+    ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     return ax

@@ -15,8 +15,7 @@ from signorini.files import atomic_write_text, save_figure, to_json, writable_di
 from signorini.api import SCHEMA_VERSION
 from signorini.certification.kkt import certificate
 from signorini.output import plots
-from signorini.references.pressure import contact_profile, load_resultant
-from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.references.profile import contact_profile
 from signorini.references.catalogue import reference_of
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",

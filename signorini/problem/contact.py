@@ -130,7 +130,7 @@ class ContactProblem:
         ``.d`` and :meth:`qp` are what you passed, a method of your own is
         handed them, and a :class:`signorini.Result` answers in your units.
         A built-in method that needs numbers of order one works on a scaled
-        view of its own (:func:`signorini.problem.scales.scaled_view`).
+        view of its own (:func:`signorini.solvers.registry.scaled_view`).
         """
         K = symmetric_argument(sparse_argument(K, "K"))
         N = sparse_argument(N if sp.issparse(N) or np.ndim(N) != 1 else np.atleast_2d(N), "N")

@@ -1,31 +1,18 @@
-"""The units that make a contact problem dimensionless (:class:`Scales`), how they are chosen
-for a QP given as arrays (:func:`qp_scales`), and a method's private view of a problem in them.
+"""The units that make a contact problem dimensionless (:class:`Scales`), and the units of a
+solve record (:func:`record_units`).
 
 A problem holds its QP in the units it was given (:meth:`ContactProblem.from_qp`
-keeps the user's arrays). A method with absolute thresholds inside (a QP backend's
-``eps_abs``, a step length, a pivot tolerance) needs numbers of order one; the registry
-hands it a view (:func:`scaled_view`) with ``K̂ = K/k``, ``f̂ = f/(kU)``, ``d̂ = d/U`` and
-``ŵ = w/W`` (:func:`qp_scales` chooses k, U and W), whose ``scales`` say how to go back,
-and maps its answer back (``u = U û``, ``λ = kU λ̂``, :func:`in_problem_units`) before it is
-judged. The view is made per run and never stored on the problem. A problem a model made
-dimensionless already (its ``scales`` are not the identity: a scene's), or whose numbers are
-of order one already (every scale within a factor :data:`ORDER_ONE` of 1), is its own view:
-scaling it would change its round-off and nothing else.
+keeps the user's arrays); a scene's model makes its QP dimensionless and says how to go back
+in its ``scales``. A method that needs numbers of order one is handed a private view of a
+problem in such units when it runs (:func:`signorini.solvers.registry.scaled_view`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-import scipy.sparse as sp
-
-from signorini.problem.solution import WarmStart
-
-__all__ = ["ORDER_ONE", "Scales", "UnitsFactor", "in_problem_units", "qp_scales", "record_units",
-           "scaled_view"]
+__all__ = ["Scales", "record_units"]
 
 
 @dataclass(frozen=True)
@@ -55,99 +42,6 @@ class Scales:
     @property
     def pressure(self) -> float:
         return self.force / self.weight
-
-
-def qp_scales(K: sp.spmatrix, f: np.ndarray, d: np.ndarray,
-              weights: np.ndarray | None = None) -> Scales:
-    """The units that make a QP given as arrays dimensionless, by a scene's rule.
-
-    A scene divides K by its stiffness ``E·L^k`` and displacements by its
-    largest prescribed displacement, else its largest gap. A QP given as arrays
-    has its prescribed displacements lifted into f and d, so: the stiffness
-    ``k`` is the mean of K's diagonal, the displacement ``U`` the larger of
-    ``‖d‖∞`` and ``‖f‖∞ / k`` (the gaps, and how far the load moves one dof),
-    the force ``k·U`` (so that ``K̂ = K/k``, ``f̂ = f/(k·U)``, ``d̂ = d/U`` and
-    ``λ̂ = λ/(k·U)``) and the weight the mean weight. A scale that comes out
-    zero is 1; lengths keep the user's unit.
-    """
-    diagonal = np.abs(K.diagonal())
-    stiffness = float(np.mean(diagonal)) if diagonal.size else 0.0
-    stiffness = stiffness if np.isfinite(stiffness) and stiffness > 0 else 1.0
-    largest = max(float(np.max(np.abs(d), initial=0.0)),
-                  float(np.max(np.abs(f), initial=0.0)) / stiffness)
-    displacement = largest if np.isfinite(largest) and largest > 0 else 1.0
-    weight = float(np.mean(weights)) if weights is not None and weights.size else 1.0
-    return Scales(length=1.0, displacement=displacement, force=stiffness * displacement,
-                  weight=weight)
-
-
-#: a scale within this factor of 1 is of order one
-ORDER_ONE = 10.0
-
-
-def scaled_view(problem: Any, options: dict[str, Any]) -> tuple[Any, Scales]:
-    """``(view, scales)``: ``problem`` in units of order one and the units that undo it; the
-    options' warm start (an earlier answer in the problem's units) is moved into the view."""
-    if problem.scales != Scales():
-        return problem, Scales()
-    s = qp_scales(problem.K, problem.f, problem.d, problem.weights)
-    if all(1 / ORDER_ONE <= value <= ORDER_ONE for value in (s.displacement, s.force, s.weight)):
-        return problem, Scales()
-    view = dataclasses.replace(
-        problem, K=problem.K * (s.displacement / s.force), f=problem.f / s.force,
-        d=problem.d / s.displacement, scales=s,
-        weights=None if problem.weights is None else problem.weights / s.weight)
-    warm = options.get("warm_start")
-    if isinstance(warm, WarmStart):
-        options["warm_start"] = dataclasses.replace(
-            warm, lam=None if warm.lam is None else np.asarray(warm.lam) / s.force,
-            u=None if warm.u is None else np.asarray(warm.u) / s.displacement)
-    return view, s
-
-
-def in_problem_units(problem: Any, solution: Any, scales: Scales) -> Any:
-    """``solution`` of the view made with ``scales``, as an answer of ``problem`` itself."""
-    if scales == Scales():
-        return solution
-    solution.u = solution.u * scales.displacement
-    solution.lam = solution.lam * scales.force
-    stiffness = scales.force / scales.displacement
-    in_units = getattr(solution.factor, "in_units", None)  # a saddle-point system's own
-    if solution.factor is not None:
-        solution.factor = (in_units(problem.K, stiffness) if in_units is not None
-                           else UnitsFactor(solution.factor, problem.K, stiffness))
-    return solution
-
-
-class UnitsFactor:
-    """A factorisation of the view's ``K̂ = K/k`` that solves with the problem's ``K``.
-
-    ``solve(rhs)`` gives u with ``(K u)[free] = rhs[free]`` and ``u[fixed] = rhs[fixed]``
-    (the pinned dofs of the factorisation, none for a plain one): the loads are divided
-    by k, the prescribed values kept. ``matrix`` is the problem's K, so that the
-    certificate reuses it; the Delassus operator a factorisation carries is ``Ŵ/k``.
-    """
-
-    def __init__(self, factor: Any, K: Any, stiffness: float):
-        self.factor, self.matrix, self.stiffness = factor, K, stiffness
-        self.fixed = np.asarray(getattr(factor, "fixed", np.zeros(0, dtype=int)), dtype=int)
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.factor, name)
-
-    @property
-    def delassus(self) -> Any:
-        W = getattr(self.factor, "delassus", None)
-        return None if W is None else W / self.stiffness
-
-    def solve(self, rhs: np.ndarray) -> np.ndarray:
-        scaled = np.array(rhs, dtype=float) / self.stiffness
-        scaled[self.fixed] = np.asarray(rhs, dtype=float)[self.fixed]
-        return self.factor.solve(scaled)
-
-    def fixed_rows(self, u: np.ndarray) -> np.ndarray:
-        """``(K u)[fixed]``."""
-        return self.stiffness * self.factor.fixed_rows(u)
 
 
 def record_units(problem: Any) -> dict[str, str]:

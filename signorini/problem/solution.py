@@ -65,7 +65,7 @@ class ContactSolution:
     ``u`` and ``lam`` are in the units of the problem's arrays: dimensionless for
     a scene built with ``nondimensionalise=True`` (the default; multiply by
     ``problem.scales``), the user's own for a QP given as arrays; a
-    :class:`signorini.api.Result` gives displacements, gaps, forces and
+    :class:`signorini.result.Result` gives displacements, gaps, forces and
     pressures in the problem's physical units.
     """
 

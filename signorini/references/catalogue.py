@@ -46,7 +46,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 @dataclass(frozen=True)
 class Claim:
     """One claim about an answer against its reference: ``value`` at most the suite's limit
-    named ``limit`` (:data:`signorini.studies.suite.LIMITS`), or, with ``limit`` None, true."""
+    named ``limit`` (:data:`signorini.studies.suite_checks.LIMITS`), or, with ``limit`` None, true."""
 
     name: str
     value: float | bool

@@ -62,7 +62,7 @@ from signorini.certification.kkt import gap_scale
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.scenes.registry import FamilyField, get_scene
 from signorini.scenes.scenefile import build_scene_model, family_scene_values
-from signorini.scenes.size import MEMORY_VARIABLE, check_size, over_limit
+from signorini.scenes.size import MEMORY_VARIABLE, Solver, check_size, over_limit
 
 log = logging.getLogger(__name__)
 
@@ -208,7 +208,7 @@ class _Scene:
         return refined_model(model, mesh, solution.lam > 0, self.snap)
 
 
-def _scene(name: str, values: dict[str, Any], solved_by: str | None = None) -> _Scene:
+def _scene(name: str, values: dict[str, Any], solved_by: Solver | None = None) -> _Scene:
     """The scene ``name`` (a family or a ``.toml`` scene file) ready for the loop; a family's
     mesh too big for the memory limit is refused before it is made."""
     if name.lower().endswith(".toml"):
@@ -289,7 +289,7 @@ Solver = Callable[[ContactProblem], "tuple[ContactProblem, ContactSolution]"]
 
 def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Solver, *,
                    max_dofs: int | None = None, theta: float = THETA, quantity: str | None = None,
-                   solved_by: str | None = None,
+                   solved_by: Solver | None = None,
                    on_step: Callable[[ContactProblem, ContactSolution, ErrorEstimate | None], None]
                    | None = None) -> AdaptiveRun:
     """Refine scene ``name`` (a family, or the path of a ``.toml`` scene file) adaptively until
@@ -378,7 +378,7 @@ def _memory_params(model: SceneModel) -> dict[str, Any]:
     return {**model.params, "nu": model.nu, "volumetric": model.volumetric}
 
 
-def _check_first(scene: _Scene, solved_by: str | None) -> None:
+def _check_first(scene: _Scene, solved_by: Solver | None) -> None:
     """InputError when the first model (a mesh scene file's, say) is already over the memory limit."""
     over = over_limit(scene.model.mesh.p.size, 2, _memory_params(scene.model), solved_by)
     if over is not None:
@@ -388,7 +388,7 @@ def _check_first(scene: _Scene, solved_by: str | None) -> None:
 
 
 def _limit_reached(dofs: int, max_dofs: int, model: SceneModel,
-                   solved_by: str | None) -> tuple[str, str, str] | None:
+                   solved_by: Solver | None) -> tuple[str, str, str] | None:
     """``(action, what was reached, the next mesh)`` when a refined mesh of ``dofs`` dofs
     exceeds ``max_dofs`` or the memory limit (before its model is assembled); None when it fits."""
     if dofs > max_dofs:

@@ -23,7 +23,7 @@ from signorini.references.catalogue import reference_of
 from signorini.scenes.base import GRADING_RANGE, LOAD_NAMES, scene_params
 from signorini.scenes.families import SCENES, get_scene
 from signorini.scenes.scenefile import build_scene_model
-from signorini.scenes.size import check_size
+from signorini.scenes.size import Solver, check_size
 
 log = logging.getLogger(__name__)
 
@@ -59,7 +59,7 @@ def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
 
 
 def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensionalise: bool = True,
-                  solved_by: str | None = None) -> ContactProblem:
+                  solved_by: Solver | None = None) -> ContactProblem:
     """Build scene ``name`` with parameters ``params`` and assemble its contact problem.
 
     ``params`` maps the scene's parameter names to values in its units (see
@@ -68,7 +68,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     ``params`` then override its parameters. ``name`` may also be a problem
     file (``.npz`` or Matrix Market, :mod:`signorini.problem.files`): its QP is
     read as stored, with no parameters to set. A target load stays pending (load
-    control matches it when the problem is solved). ``solved_by`` names the
+    control matches it when the problem is solved). ``solved_by`` is the
     method that will solve it, for the size guard (a method that never
     factorises needs less memory). The problem's ``discretisation.mesh_s`` is
     the time spent up to assembly (checking, meshing, the model) and
@@ -80,7 +80,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     if not isinstance(name, str):
         raise InputError(f"scene must be a name or the path of a .toml scene file (a string), got "
                          f"{type(name).__name__}: e.g. build_problem('hertz-cylinder')")
-    if is_problem_file(name):  # a problem file: read, not built
+    if name not in SCENES and is_problem_file(name):  # a problem file: read, not built
         if values:
             raise InputError(f"problem file {name!r} has no scene parameters to set "
                              f"({', '.join(values)}): drop params (--set)")

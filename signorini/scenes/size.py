@@ -22,9 +22,8 @@ exactly (:class:`CountedSize`).
 Memory is the peak resident size of building the scene and solving it, in
 bytes per dof: :data:`BYTES_PER_DOF` with a factorising method;
 :data:`BYTES_PER_DOF_3D_PUSHED` in 3D without one (a prescribed push, or a
-target load that ``pdas-amg`` matches itself: the method ``auto`` picks from
-:data:`~signorini.numerics.multigrid.AMG_FROM_DOFS` 3D dofs, see
-:mod:`signorini.load_control`); a 3D factorisation's fill grows like n^⅓ per dof
+target load matched by a method that declares it factorises nothing from that many dofs on,
+``Method.factor_free_from``: :class:`Solver`); a 3D factorisation's fill grows like n^⅓ per dof
 from :data:`FILL_GROWS_FROM` dofs on; :data:`NODAL_MEMORY` scales it all when
 the volumetric strain is averaged at the nodes. The constants were chosen
 from measurements (docs/calibration.md).
@@ -39,14 +38,13 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Protocol
 
 import numpy as np
 
 from signorini.errors import InputError
 from signorini.fem.volumetric import resolve
 from signorini.numerics.factor import gigabytes_from
-from signorini.numerics.multigrid import AMG_FROM_DOFS
 from signorini.scenes.meshing import MAX_ELEMENTS, MAX_TRIANGLES
 from signorini.scenes.registry import SCENES, FamilyField
 
@@ -72,8 +70,16 @@ ELEMENT_NAMES = {2: "triangles", 3: "tetrahedra"}
 NODAL_MEMORY = {2: 2.2, 3: 2.6}
 
 
+class Solver(Protocol):
+    """What the size guard asks of the method that will solve a scene (a
+    :class:`signorini.solvers.base.Method` declares it): from how many dofs it solves a 3D model
+    with a target load without any factorisation (None: it factorises at every size)."""
+
+    factor_free_from: float | None
+
+
 def bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
-                  solved_by: str | None = None) -> float:
+                  solved_by: Solver | None = None) -> float:
     """Memory per dof of building and solving a scene (see the module's docstring) with the
     method ``solved_by`` (None: load targeting factorises)."""
     return _plain_bytes_per_dof(dim, dofs, params, solved_by) * (
@@ -82,12 +88,13 @@ def bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
 
 
 def _plain_bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
-                         solved_by: str | None = None) -> float:
+                         solved_by: Solver | None = None) -> float:
     if dim == 2:
         return BYTES_PER_DOF[2]
     if params.get("delta") is not None and params.get("P") is None:
         return BYTES_PER_DOF_3D_PUSHED
-    if solved_by == "pdas-amg" or solved_by == "auto" and dofs >= AMG_FROM_DOFS:
+    free_from = None if solved_by is None else solved_by.factor_free_from
+    if free_from is not None and dofs >= free_from:
         return BYTES_PER_DOF_3D_PUSHED  # the method matches the load: no factorisation
     return BYTES_PER_DOF[3] * max(1.0, dofs / FILL_GROWS_FROM) ** (1 / 3)
 
@@ -189,7 +196,7 @@ def memory_limit() -> float:
     return 0.75 * total if math.isfinite(total) else math.inf
 
 
-def check_size(family: str, params: dict[str, Any], solved_by: str | None = None) -> None:
+def check_size(family: str, params: dict[str, Any], solved_by: Solver | None = None) -> None:
     """InputError, with the estimate, the limit and how to raise it, when the scene is too big
     to solve with the method ``solved_by`` (see :func:`bytes_per_dof`)."""
     found = estimate_dofs(family, params)
@@ -217,7 +224,7 @@ def _check_graded(family: str, params: dict[str, Any], dim: int) -> None:
 
 
 def over_limit(dofs: float, dim: int, params: dict[str, Any],
-               solved_by: str | None = None) -> tuple[float, float] | None:
+               solved_by: Solver | None = None) -> tuple[float, float] | None:
     """``(bytes needed, limit)`` when building and solving a model of ``dofs`` dofs with the
     method ``solved_by`` would exceed :func:`memory_limit`; None when it fits. ``params`` needs
     only ``nu`` and ``volumetric`` (and for 3D ``P`` and ``delta``), as :func:`bytes_per_dof`."""
@@ -226,7 +233,7 @@ def over_limit(dofs: float, dim: int, params: dict[str, Any],
 
 
 def _check_memory(family: str, params: dict[str, Any], dofs: float, dim: int,
-                  solved_by: str | None) -> None:
+                  solved_by: Solver | None) -> None:
     """InputError when building and solving the scene would exceed :func:`memory_limit`."""
     over = over_limit(dofs, dim, params, solved_by)
     if over is None:

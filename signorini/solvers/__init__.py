@@ -6,7 +6,7 @@ Each backend module (``pdas``, ``nested``, ``condensed``, ``uzawa``, ``qp``, ``c
 by the KKT certificate.
 
 Its names load the registry (every backend module) at first use, so that a command reading
-:mod:`~signorini.solvers.defaults` or :mod:`~signorini.solvers.options` imports no method.
+:mod:`~signorini.solvers.options` (the options and the table of default tolerances) imports no method.
 """
 
 import importlib
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from signorini.solvers.base import Method
-    from signorini.solvers.registry import REGISTRY, get_method, methods, register
+    from signorini.solvers.registry import REGISTRY, get_method, methods
 
 
 def __getattr__(name: str) -> Any:
@@ -25,4 +25,4 @@ def __getattr__(name: str) -> Any:
     return getattr(importlib.import_module(home), name)
 
 
-__all__ = ["Method", "REGISTRY", "get_method", "methods", "register"]
+__all__ = ["Method", "REGISTRY", "get_method", "methods"]

@@ -62,7 +62,7 @@ from signorini.solvers import pdas, petsc_
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
 from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
 from signorini.solvers.base import Method
-from signorini.solvers.defaults import resolved
+from signorini.solvers.options import resolved
 from signorini.solvers.options import positive_number, take_options
 
 log = logging.getLogger(__name__)
@@ -402,5 +402,5 @@ METHODS = (
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
            requires=("pyamg",), extra="", options=tuple(DEFAULTS),
            matches_load=lambda problem: border_factor(problem) is not None,
-           prediction="active set", bound_rows=True),
+           prediction="active set", bound_rows=True, factor_free_from=0),
 )

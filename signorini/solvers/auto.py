@@ -90,7 +90,7 @@ METHODS = (
     Method(name="auto", function=solve, family="auto", exact=True,
            summary="picks nested (K factorised by load control), pdas (2D, small 3D) or pdas-amg "
                    "(large 3D) and says why",
-           warm_from_load=True,
+           warm_from_load=True, factor_free_from=AMG_FROM_DOFS,
            chooses=lambda problem, options, warm_start: CHOICES[choose(problem, options,
                                                                        warm_start)[0]],
            options=tuple(sorted(set(pdas.DEFAULTS) | set(amg.DEFAULTS) | set(nested.DEFAULTS)))),

@@ -10,6 +10,7 @@ success becomes ``converged`` only when the KKT certificate backs it
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
@@ -22,8 +23,8 @@ from signorini.certification.diagnosis import explain
 from signorini.errors import InputError, install_hint
 from signorini.certification.kkt import Certificate, certificate, shortfall
 from signorini.problem.contact import STATUSES, ContactProblem, ContactSolution
-from signorini.solvers.defaults import DEFAULT_TOL, MIN_TOL, Defaults, defaults_of, resolved
-from signorini.solvers.options import Option, check_names, guess_value
+from signorini.solvers.options import (DEFAULT_TOL, MIN_TOL, Defaults, Option, check_names,
+                                       defaults_of, guess_value, resolved)
 
 SolverFunction = Callable[..., ContactSolution]
 
@@ -47,7 +48,7 @@ class Method:
     pip extra that installs them. ``dense`` methods build dense matrices and
     refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
     answer up to round-off when they converge. ``options`` names the options
-    it takes; its :attr:`defaults` (the row of :mod:`signorini.solvers.defaults`) are the
+    it takes; its :attr:`defaults` (the row of :mod:`signorini.solvers.options`) are the
     tolerance it runs at and is held to when none is asked for and its iteration limit;
     ``typed_options`` declares their kinds and ranges
     (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
@@ -68,7 +69,9 @@ class Method:
     user's) is handed the problem as it was given. A ``bound_rows`` method takes each contact
     row as a bound on dofs of its own (:mod:`signorini.solvers.bounds`): it refuses, by
     :meth:`check_rows`, a problem whose rows share a dof (two bodies' rows on the master's
-    dofs, obstacles that meet at a node).
+    dofs, obstacles that meet at a node). ``factor_free_from`` is the size (dofs) from which it
+    solves a 3D model with a target load without any factorisation (None: it factorises at
+    every size), which a scene's memory estimate reads (:mod:`signorini.scenes.size`).
     """
 
     name: str
@@ -87,6 +90,7 @@ class Method:
     chooses: Callable[..., "Method"] | None = None
     scaled: bool = True
     bound_rows: bool = False
+    factor_free_from: float | None = None
 
     @property
     def defaults(self) -> Defaults:
@@ -223,6 +227,77 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
     return solution
 
 
+# -- the problem a method is judged on is the problem it was given ------------------------
+# The certificate judges (u, λ) against the problem's K, f, N and d: a method that changed them
+# (problem.f *= 0.5) would have its answer judged against its own question. So the data are
+# fingerprinted before the method runs and checked after: f and d by a hash of their bytes, K
+# and N by their product with a fixed random vector (equal up to summation order) and their
+# shapes. The package itself pushes a pending problem to the push a load-matching method
+# reports, so no method can hand in another problem to be judged on.
+
+#: ``K x`` before and after a method agree to this (relative): summation order only
+SAME_PRODUCT_RTOL = 1e-12
+#: what each array is, for the message
+MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps"}
+
+
+def _digest(array: np.ndarray) -> str:
+    return hashlib.blake2b(np.ascontiguousarray(array).view(np.uint8), digest_size=16).hexdigest()
+
+
+def _probe(n: int) -> np.ndarray:
+    return np.random.default_rng(1).uniform(0.5, 1.5, n)
+
+
+@dataclass(frozen=True)
+class Fingerprint:
+    """What :func:`fingerprint` keeps of a problem's data (a few vectors, no copy of K)."""
+
+    shapes: tuple
+    f: str
+    d: str
+    K: np.ndarray
+    N: np.ndarray
+
+
+def fingerprint(problem: ContactProblem) -> Fingerprint:
+    """Hashes of f and d, ``K x`` and ``N x`` for a fixed random x, and the shapes."""
+    x = _probe(problem.K.shape[1])
+    return Fingerprint((problem.K.shape, problem.N.shape, problem.f.shape, problem.d.shape),
+                       _digest(problem.f), _digest(problem.d), problem.K @ x, problem.N @ x)
+
+
+def changed(problem: ContactProblem, before: Fingerprint) -> list[str]:
+    """The names of the arrays of ``problem`` that differ from ``before`` (none: unchanged)."""
+    now = (problem.K.shape, problem.N.shape, np.shape(problem.f), np.shape(problem.d))
+    if now != before.shapes:
+        return [name for name, a, b in zip("KNfd", now, before.shapes) if a != b]
+    x = _probe(problem.K.shape[1])
+    out = []
+    for name, product, kept in (("K", problem.K @ x, before.K), ("N", problem.N @ x, before.N)):
+        if not np.allclose(product, kept, rtol=SAME_PRODUCT_RTOL, atol=0.0):
+            out.append(name)
+    out += [name for name, value, kept in (("f", problem.f, before.f), ("d", problem.d, before.d))
+            if _digest(np.asarray(value, dtype=float)) != kept]
+    return sorted(out, key="KfNd".index)
+
+
+def held_to_problem(problem: ContactProblem, before: Fingerprint, solution: ContactSolution,
+                    method: str) -> ContactSolution:
+    """``solution``, or a ``failed`` one when the method changed ``problem``.
+
+    ``before`` is :func:`fingerprint` of ``problem`` taken before the method ran.
+    """
+    touched = changed(problem, before)
+    if touched:
+        names = ", ".join(f"{name} ({MEANING[name]})" for name in touched)
+        return ContactSolution.failure(
+            method, problem, "failed",
+            f"the method changed the problem it was given: {names}; a method must not change "
+            "K, f, N or d (copy them first), so its answer cannot be judged")
+    return solution
+
+
 def certify(problem: ContactProblem, solution: ContactSolution) -> Certificate:
     """The certificate of ``solution``; without the duality gap when K is singular (no dual)."""
     try:
@@ -239,7 +314,7 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
     An answer the certificate accepts becomes ``model_inadequate`` when the
     boundary beyond the contact candidates shows that the contact outgrew
     them (:func:`signorini.certification.adequacy.adequacy`); warnings about the model are
-    appended to the message.
+    appended to the message. A problem no model made (a QP given as arrays) has neither.
     """
     if solution.status != "converged":
         return solution
@@ -253,6 +328,8 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
         solution.claimed_status = "converged"
         solution.status = "inaccurate"
         solution.message = f"{solution.message}; {reason}".lstrip("; ")
+        return solution
+    if problem.discretisation is None:  # a QP given as arrays: no model to judge
         return solution
     found = adequacy(problem, solution, accept)
     if found is not None:

@@ -22,7 +22,7 @@ from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
-from signorini.solvers.defaults import resolved
+from signorini.solvers.options import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 DEFAULTS = declare(

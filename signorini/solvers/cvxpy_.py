@@ -26,7 +26,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, take_options
-from signorini.solvers.qp import BACKEND_BY_NAME, COMMON_TYPES
+from signorini.solvers.qp_backends import BACKEND_BY_NAME, COMMON_TYPES
 
 log = logging.getLogger(__name__)
 
@@ -164,20 +164,13 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     raw_status = str(model.status)
     status = STATUS_MAP.get(raw_status, "failed")
     iterations = model.solver_stats.num_iters if model.solver_stats is not None else None
-    extras = {"raw_status": raw_status, "solver": solver, "backend_warnings": caught,
-              "form": qp.name, "form_work": qp.work, "form_s": qp.seconds,
-              "form_note": note or qp.note}
-    common = dict(message=f"cvxpy/{solver}: {raw_status}" + forms.said(qp.name, extras),
-                  iterations=int(iterations or 0), build_time=build_time, solve_time=solve_time,
-                  extras=extras)
-    if x.value is None or (contact.dual_value is None and not qp.bounds):
-        return ContactSolution.failure(METHOD, problem, "failed" if status == "converged"
-                                       else status, **common)
-    z = None if qp.bounds else np.reshape(contact.dual_value, problem.m)
-    u, lam = qp.answer(problem, x.value, z)
-    solution = ContactSolution(method=METHOD, u=u, lam=lam, status=status, factor=qp.factor,
-                               **common)
-    return forms.polish(problem, qp, solution, tol) if polishing else solution
+    z = None if qp.bounds or contact.dual_value is None else np.reshape(contact.dual_value, problem.m)
+    return forms.solution_from(problem, qp, METHOD, status, x.value, z,
+                               said_by=f"cvxpy/{solver}: {raw_status}",
+                               extras={"raw_status": raw_status, "solver": solver,
+                                       "backend_warnings": caught},
+                               note=note, iterations=iterations, build_time=build_time,
+                               solve_time=solve_time, tol=tol, polishing=polishing)
 
 
 METHODS = (

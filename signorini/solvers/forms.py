@@ -266,3 +266,23 @@ def polish(problem: ContactProblem, form: Formulation, raw: ContactSolution,
                    f"{raw_worst:.1e} → {new_worst:.1e}): the polished answer" + \
                    ("" if certified else f", still {raw.status} (above {acceptance(tol):.0e})")
     return raw
+
+
+def solution_from(problem: ContactProblem, form: Formulation, method: str, status: str, x: Any,
+                  z: Any, *, said_by: str, extras: dict[str, Any], note: str | None,
+                  iterations: Any, build_time: float, solve_time: float, tol: float | None,
+                  polishing: bool) -> ContactSolution:
+    """A backend's ``x`` and ``z`` in ``form`` as the problem's solution: a failure when it gave
+    none, polished on its active set when ``polishing``; the message opens with ``said_by`` and
+    ``extras`` gain the form's record."""
+    extras = {**extras, "form": form.name, "form_work": form.work, "form_s": form.seconds,
+              "form_note": note or form.note}
+    common = dict(message=said_by + said(form.name, extras), iterations=int(iterations or 0),
+                  build_time=build_time, solve_time=solve_time, extras=extras)
+    if x is None or (z is None and not form.bounds):
+        return ContactSolution.failure(method, problem, "failed" if status == "converged" else status,
+                                       **common)
+    u, lam = form.answer(problem, x, z)
+    solution = ContactSolution(method=method, u=u, lam=lam, status=status, factor=form.factor,
+                               **common)
+    return polish(problem, form, solution, tol) if polishing else solution

@@ -10,8 +10,10 @@ amends the prediction until every KKT condition holds, so the answer is
 exact whatever the prediction. Cost: one factorisation of K and a
 back-solve per band node.
 
-A ``warm_start`` holding a zone solver for this K (load control leaves one)
-is reused: the solve then costs back-solves only. Problems with no
+A ``warm_start`` holding a zone solver for this K (load control leaves one,
+and hands it on: the method takes load control's answer) is reused: the
+solve then costs back-solves only; one holding an answer alone predicts the
+zone from that answer's contact. Problems with no
 prediction, or whose rows of N do not each bound one dof (curved
 obstacles), are solved by ``pdas``; the message says so.
 """
@@ -32,7 +34,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
-from signorini.solvers.defaults import resolved
+from signorini.solvers.options import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 log = logging.getLogger(__name__)
@@ -84,16 +86,20 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     opts = take_options("nested", options, DEFAULTS)
     tol, max_iter = resolved("nested", "active set", tol, max_iter)
     start = time.perf_counter()
-    warm = opts["warm_start"]
-    system = None if warm is None else warm.zone_solver
-    if system is not None and opts["zone"] is None and opts["coarse"] is None:
+    warm, given = opts["warm_start"], opts["zone"] is not None or opts["coarse"] is not None
+    system = None if warm is None or given else warm.zone_solver
+    if system is not None and opts["backend"] not in (None, "auto", system.backend):
+        system = None  # factorised by another backend than the one asked for
+    if system is not None:
         zone, source = warm.zone, "the warm start's zone and factorisation"
+    elif selection_dofs(problem.N) is None:
+        zone, source = None, ""
+    elif not given and warm is not None and warm.lam is not None:
+        points = problem.contact_points
+        zone = predict_zone(points, points, warm.lam > 0, opts["neighbours"])
+        source = "the warm start's contact"
     else:
-        system = None
-        if selection_dofs(problem.N) is None:
-            zone, source = None, ""
-        else:
-            zone, source = _prediction(problem, opts, tol)
+        zone, source = _prediction(problem, opts, tol)
     if zone is None:
         solution = pdas.solve(problem, tol=tol, max_iter=max_iter)
         solution.method = "nested"
@@ -119,6 +125,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="nested", function=solve, family="active set", exact=True,
            summary="predicted contact zone (the scene's); one factorisation + exact band LCP",
-           options=tuple(DEFAULTS),
-           typed_options=DEFAULTS, prediction="zone"),
+           options=tuple(DEFAULTS), typed_options=DEFAULTS, prediction="zone",
+           warm_from_load=True),
 )

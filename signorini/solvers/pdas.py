@@ -45,8 +45,7 @@ from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
 from signorini.solvers.base import Method
-from signorini.solvers.defaults import resolved
-from signorini.solvers.options import Option, declare, take_options
+from signorini.solvers.options import Option, declare, resolved, take_options
 
 log = logging.getLogger(__name__)
 

@@ -40,7 +40,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import cluster
 from signorini.solvers.base import Method
 from signorini.solvers.bounds import BoundForm, NoBoundForm, bound_form
-from signorini.solvers.defaults import resolved
+from signorini.solvers.options import resolved
 from signorini.solvers.options import Option, declare, take_options
 
 KSP_CHOICES = ("auto", "mumps", "gamg")

@@ -19,7 +19,7 @@ import sysconfig
 import traceback
 from pathlib import Path
 from types import TracebackType
-from typing import Any, Callable
+from typing import Any, Callable, Mapping
 
 from signorini.errors import InputError
 from signorini.solvers.base import Method
@@ -75,7 +75,7 @@ def load(spec: str) -> Method:
     return _method(spec, func)
 
 
-def of_callable(function: Callable[..., Any], taken: dict[str, Method]) -> Method:
+def of_callable(function: Callable[..., Any], taken: Mapping[str, Method]) -> Method:
     """A callable as a method, named by its ``__name__`` (``module:qualname`` when a different
     method already has that name in ``taken``, the registry)."""
     name = getattr(function, "__name__", type(function).__name__)

@@ -18,7 +18,8 @@ its spec, and λ is compared with the first converged method's in this process.
 (the scene with ``grading`` → 0, i.e. the contact size everywhere) at equal
 dofs, and estimates how many dofs each needs for a given error by
 interpolating ``log err`` against ``log dofs`` (extrapolating with the fitted
-rate when a series does not reach it).
+rate when a series does not reach it). The figures and files of a study:
+:mod:`signorini.studies.convergence_report`.
 """
 
 from __future__ import annotations
@@ -28,13 +29,8 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Callable
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from signorini.references.analytic import punch_pressure
 from signorini.errors import InputError
-from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-from signorini.references.pressure import compare_punch, contact_profile
-from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import REFERENCES
 from signorini.scenes import SCENES, get_scene, portable_scene, scene_reference
 from signorini.scenes.registry import FamilyField
@@ -42,6 +38,10 @@ from signorini.scenes.size import check_size
 from signorini.solvers.registry import get_method
 from signorini.solvers.registry import methods as registered_methods
 from signorini.studies.runner import Row, Task, run_tasks
+
+__all__ = ["COARSE_START", "ESTIMATES", "LABELS", "ConvergenceStudy", "GradingComparison", "LevelResult",
+           "check_study", "dofs_for_error", "exact_methods", "fitted_rate", "grading_comparison",
+           "level_results", "level_task", "run_study"]
 
 log = logging.getLogger(__name__)
 
@@ -325,170 +325,3 @@ def grading_comparison(scene: str, graded: ConvergenceStudy, uniform_levels: int
     slope = float(np.polyfit(np.log(u_dofs), np.log(u_err), 1)[0]) if u_dofs.size >= 2 else float("nan")
     return GradingComparison(scene, metric, target, graded, uniform, graded_dofs, graded_how,
                              uniform_dofs, uniform_how, slope)
-
-
-# --- figures (each takes ax=None and returns the Axes) ---------------------------------------
-
-
-def _axes(ax):
-    if ax is None:
-        ax = Figure(figsize=(6.4, 4.4), layout="constrained").add_subplot()
-    return ax
-
-
-def plot_convergence(study: ConvergenceStudy, ax=None, metrics: tuple[str, ...] | None = None):
-    """Errors against h on log–log axes, one line per metric and exact method, rates in the legend."""
-    ax = _axes(ax)
-    markers = "osd^v"
-    for i, metric in enumerate(metrics or study.metrics):
-        for j, method in enumerate(study.methods[:1] if metric in ESTIMATES else study.methods):
-            h, _, err = study.series(method, metric)
-            if h.size == 0:
-                continue
-            rate = study.rates.get(method, {}).get(metric, float("nan"))
-            style = ":" if metric in ESTIMATES else "-" if j == 0 else "--"
-            ax.loglog(h, np.abs(err), style, color=f"C{i}", marker=markers[i % len(markers)],
-                      ms=5 if j == 0 else 9, mfc="none" if j else None,
-                      label=f"{LABELS.get(metric, metric)} ({method}): rate {rate:.2f}")
-    ax.set_xlabel("h (spacing of the contact candidates)")
-    ax.set_ylabel("relative error" if "edge_over_centre" not in (metrics or study.metrics)
-                  else "relative error; edge pressure / (P/πa)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
-    ax.set_title(f"{study.scene}: convergence under uniform refinement", fontsize=9)
-    return ax
-
-
-def plot_grading(comparison: GradingComparison, ax=None):
-    """The error of the graded and the uniform series against dofs, with the target line."""
-    ax = _axes(ax)
-    for name, study, marker in (("graded", comparison.graded, "o"),
-                                ("uniform", comparison.uniform, "s")):
-        _, dofs, err = study.series("pdas", comparison.metric)
-        ax.loglog(dofs, err, "-", marker=marker, label=name)
-    ax.axhline(comparison.target, color="k", lw=0.8, ls=":",
-               label=f"{100 * comparison.target:g} % target")
-    for dofs, how, color in ((comparison.graded_dofs, comparison.graded_how, "C0"),
-                             (comparison.uniform_dofs, comparison.uniform_how, "C1")):
-        if np.isfinite(dofs):
-            ax.plot([dofs], [comparison.target], "x", color=color, ms=10,
-                    label=f"{dofs:,.0f} dofs ({how})")
-    ax.set_xlabel("dofs")
-    ax.set_ylabel(LABELS.get(comparison.metric, comparison.metric))
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
-    ax.set_title(f"{comparison.scene}: graded against uniform meshes "
-                 f"(grading saves {comparison.saving:,.0f}× the dofs)", fontsize=9)
-    return ax
-
-
-# --- the punch's edge ---------------------------------------------------------------------
-
-
-def _punch(problem: ContactProblem, solution: ContactSolution):
-    """The punch comparison, the pressure profile and the pressure unit ``P/(πa)``."""
-    comparison = compare_punch(problem, solution)
-    return comparison, contact_profile(problem, solution), comparison.load / (np.pi * comparison.a)
-
-
-def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=None):
-    """Nodal pressure under the punch against ``P/(π√(a² − x²))``, in units of ``P/(πa)``."""
-    ax = _axes(ax)
-    comparison, profile, scale = _punch(problem, solution)
-    a, P = comparison.a, comparison.load
-    x, p = np.abs(profile.x), profile.pressure
-    order = np.argsort(x)
-    grid = np.linspace(0.0, a * (1 - 1e-4), 2000)
-    ax.plot(grid / a, punch_pressure(grid, a, P) / scale, "k-", lw=1.2, label="P / (π√(a² − x²))")
-    ax.plot(x[order] / a, p[order] / scale, "o", ms=3, mfc="none", label=f"{solution.method}")
-    ax.axvspan(0, comparison.inner, color="0.9", zorder=0, label=f"compared (|x| ≤ {comparison.inner:g}a)")
-    ax.set_xlabel("x / a")
-    ax.set_ylabel("p / (P / πa)")
-    ax.set_ylim(0, max(4.0, float(np.max(p) / scale) * 1.05))
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    return ax
-
-
-def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None):
-    """Pressure against the distance ``a − |x|`` to the edge (log–log): slope −½ is the singularity."""
-    ax = _axes(ax)
-    comparison, profile, scale = _punch(problem, solution)
-    a, P = comparison.a, comparison.load
-    distance = a - np.abs(profile.x)
-    under = distance >= -1e-12 * a
-    grid = np.geomspace(1e-4 * a, a, 400)
-    ax.loglog(grid / a, punch_pressure(a - grid, a, P) / scale, "k-", lw=1.2, label="P / (π√(a² − x²))")
-    positive = under & (distance > 0)
-    ax.loglog(distance[positive] / a, profile.pressure[positive] / scale, "o", ms=3, mfc="none",
-              label=f"{solution.method}, h = {comparison.edge_h / a:.2g} a")
-    edge = under & (distance <= 1e-12 * a)
-    if np.any(edge):
-        ax.axhline(float(profile.pressure[edge][0]) / scale, color="C3", lw=0.8, ls="--",
-                   label="edge node (x = a)")
-    ax.set_xlabel("(a − |x|) / a")
-    ax.set_ylabel("p / (P / πa)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
-    return ax
-
-
-# --- writing a study --------------------------------------------------------------------------
-
-
-def study_table(study: ConvergenceStudy) -> list[str]:
-    """Markdown table of a study: one row per level and method."""
-    metrics = list(study.metrics)
-    lines = ["| level | method | status | dofs | candidates | h | " +
-             " | ".join(LABELS.get(m, m) for m in metrics) + " | λ vs first | solve [s] |",
-             "|---:|---|---|---:|---:|---:|" + "---:|" * len(metrics) + "---:|---:|"]
-    for r in study.rows:
-        values = " | ".join(f"{r.errors[m]:.3e}" if m in r.errors else "–" for m in metrics)
-        lam = f"{r.lam_rel_vs_first:.1e}" if np.isfinite(r.lam_rel_vs_first) else "–"
-        lines.append(f"| {r.level} | {r.method} | {r.status} | {r.dofs} | {r.candidates} | "
-                     f"{r.h:.3g} | {values} | {lam} | {r.solve_s:.2f} |")
-    lines += ["", "Fitted rates (slope of log error against log h"
-              + (f", levels ≥ {study.fit_from}" if study.fit_from else "") + "):", "",
-              "| method | " + " | ".join(LABELS.get(m, m) for m in metrics) + " |",
-              "|---|" + "---:|" * len(metrics)]
-    for method, rates in study.rates.items():
-        lines.append(f"| {method} | " + " | ".join(f"{rates.get(m, float('nan')):.2f}" for m in metrics)
-                     + " |")
-    return lines
-
-
-def write_study(study: ConvergenceStudy, out, command: str,
-                comparison: GradingComparison | None = None) -> dict[str, Any]:
-    """Write ``convergence-<scene>.md``, ``.json`` and ``.png`` (and the grading figure) to ``out``."""
-    directory = writable_directory(out)
-    stem = f"convergence-{study.scene}"
-    paths = {}
-    ax = plot_convergence(study)
-    save_figure(ax.figure, directory / f"{stem}.png")
-    paths["figure"] = directory / f"{stem}.png"
-    md = [f"# Convergence: {study.scene}", "", f"Command: `{command}`  ",
-          "Parameters: " + ", ".join(f"{k}={v}" for k, v in study.params.items()), "",
-          f"Largest λ difference between exact methods: {study.max_disagreement():.1e}", ""]
-    md += study_table(study)
-    md += ["", f"![convergence]({stem}.png)"]
-    payload: dict[str, Any] = {"command": command, "study": study.as_dict()}
-    if comparison is not None:
-        ax = plot_grading(comparison)
-        save_figure(ax.figure, directory / f"grading-{study.scene}.png")
-        paths["grading"] = directory / f"grading-{study.scene}.png"
-        md += ["", "## Graded against uniform meshes", "",
-               f"{LABELS.get(comparison.metric, comparison.metric)} of {100 * comparison.target:g} %: "
-               f"graded {comparison.graded_dofs:,.0f} dofs ({comparison.graded_how}), uniform "
-               f"{comparison.uniform_dofs:,.0f} dofs ({comparison.uniform_how}; uniform error ∝ "
-               f"dofs^{comparison.uniform_rate_per_dof:.2f}): grading saves "
-               f"{comparison.saving:,.0f}× the dofs.", ""]
-        md += study_table(comparison.uniform)
-        md += ["", f"![grading](grading-{study.scene}.png)"]
-        payload["grading"] = {k: v for k, v in comparison.as_dict().items()
-                              if k not in ("graded", "uniform")}
-        payload["uniform"] = comparison.uniform.as_dict()
-    atomic_write_text(directory / f"{stem}.md", "\n".join(md) + "\n")
-    atomic_write_text(directory / f"{stem}.json", to_json(payload))
-    paths["markdown"] = directory / f"{stem}.md"
-    paths["json"] = directory / f"{stem}.json"
-    return paths

@@ -23,7 +23,7 @@ from signorini.fem.transfer import uniform_prolongation
 from signorini.certification.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
 from signorini.numerics.factor import PardisoFactor, factorize, resolve_backend
 from signorini.numerics.lcp import delassus
-from signorini.references.pressure import contact_profile
+from signorini.references.profile import contact_profile
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import reference_of
 from signorini.solvers.cluster import mpirun_command

@@ -37,7 +37,7 @@ from typing import Any, Callable
 import numpy as np
 
 import signorini
-from signorini.references.pressure import hertz_fit
+from signorini.references.profile import hertz_fit
 from signorini.studies.peer_cases import CASES, ONE_BODY, SCENES, hertz_reference, ladder_of
 from signorini.studies.peer_report import NAMES, TARGETS, at_accuracy, peer_table, write_peer
 
@@ -55,7 +55,7 @@ INSTALL = "apt-get install python3-getfem python3-gmsh"
 def fit_hertz(x, p, rel: float = 1e-9) -> tuple[float, float, int]:
     """Hertz's p0 and a from nodal pressures, the same way for both codes.
 
-    :func:`signorini.references.pressure.hertz_fit` (least squares of p² = p0²(1 − x²/a²)
+    :func:`signorini.references.profile.hertz_fit` (least squares of p² = p0²(1 − x²/a²)
     over the active nodes but the outermost) with the nodes counted active by
     their pressure alone, p > rel · max p, since GetFEM returns no active set.
     Returns (p0, a, active nodes). The GetFEM script carries the same formula

@@ -51,7 +51,6 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import reference_metrics
 from signorini.scenes.block import force_controlled_exact
 from signorini.solvers import cluster
-from signorini.solvers.base import Method
 from signorini.solvers.base import acceptance
 from signorini.solvers.registry import get_method
 from signorini.studies.measures import (
@@ -100,14 +99,10 @@ NUMERIC = ("dofs", "candidates", "iterations", "time_s", "kkt_worst", "lam_rel",
            "misclassified", "weak", "misclassified_strict", "weak_penetrating", "a_rel", "p0_rel",
            "pressure_l2_rel", "ref_a_rel", "ref_p0_rel", "ref_pressure_l2_rel", "rho_over_bound",
            "lambda_max", "bound_at_solution", "patch_lam_rel")
-#: the statuses a run can end with besides :data:`signorini.problem.contact.STATUSES`
-EXTRA_STATUSES = ("built", "checked", "ran", "refused", "input-error", "raised", "timeout", "crashed")
 
 __all__ = ["AGREE_CAP", "AGREE_FACTOR", "ATLAS_TOL", "BUILD_ONLY", "COMMAND", "CROSSCHECK", "DEFAULT_TIME_LIMIT",
-           "EXTRA_STATUSES", "ITERATION_CAPS", "MEASURES", "NEAR_FACTOR", "NUMERIC", "Row", "Task",
+           "ITERATION_CAPS", "MEASURES", "NEAR_FACTOR", "NUMERIC", "Row", "Task",
            "Worker", "in_worker", "measure_answer", "run_on", "run_task", "run_tasks", "serve_worker", "solve_within", "task_row"]
-#: the verdicts on a row (the name the tests know)
-_verdict = verdict
 
 
 class _Cache:

@@ -1,0 +1,117 @@
+"""A convergence study's report: its figures, its markdown table and its files."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
+from signorini.output.plots import axes
+from signorini.studies.convergence import ESTIMATES, LABELS, ConvergenceStudy, GradingComparison
+
+__all__ = ["plot_convergence", "plot_grading", "study_table", "write_study"]
+
+
+def plot_convergence(study: ConvergenceStudy, ax=None, metrics: tuple[str, ...] | None = None):
+    """Errors against h on log–log axes, one line per metric and exact method, rates in the legend."""
+    ax = axes(ax)
+    markers = "osd^v"
+    for i, metric in enumerate(metrics or study.metrics):
+        for j, method in enumerate(study.methods[:1] if metric in ESTIMATES else study.methods):
+            h, _, err = study.series(method, metric)
+            if h.size == 0:
+                continue
+            rate = study.rates.get(method, {}).get(metric, float("nan"))
+            style = ":" if metric in ESTIMATES else "-" if j == 0 else "--"
+            ax.loglog(h, np.abs(err), style, color=f"C{i}", marker=markers[i % len(markers)],
+                      ms=5 if j == 0 else 9, mfc="none" if j else None,
+                      label=f"{LABELS.get(metric, metric)} ({method}): rate {rate:.2f}")
+    ax.set_xlabel("h (spacing of the contact candidates)")
+    ax.set_ylabel("relative error" if "edge_over_centre" not in (metrics or study.metrics)
+                  else "relative error; edge pressure / (P/πa)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    ax.set_title(f"{study.scene}: convergence under uniform refinement", fontsize=9)
+    return ax
+
+
+def plot_grading(comparison: GradingComparison, ax=None):
+    """The error of the graded and the uniform series against dofs, with the target line."""
+    ax = axes(ax)
+    for name, study, marker in (("graded", comparison.graded, "o"),
+                                ("uniform", comparison.uniform, "s")):
+        _, dofs, err = study.series("pdas", comparison.metric)
+        ax.loglog(dofs, err, "-", marker=marker, label=name)
+    ax.axhline(comparison.target, color="k", lw=0.8, ls=":",
+               label=f"{100 * comparison.target:g} % target")
+    for dofs, how, color in ((comparison.graded_dofs, comparison.graded_how, "C0"),
+                             (comparison.uniform_dofs, comparison.uniform_how, "C1")):
+        if np.isfinite(dofs):
+            ax.plot([dofs], [comparison.target], "x", color=color, ms=10,
+                    label=f"{dofs:,.0f} dofs ({how})")
+    ax.set_xlabel("dofs")
+    ax.set_ylabel(LABELS.get(comparison.metric, comparison.metric))
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    ax.set_title(f"{comparison.scene}: graded against uniform meshes "
+                 f"(grading saves {comparison.saving:,.0f}× the dofs)", fontsize=9)
+    return ax
+
+
+def study_table(study: ConvergenceStudy) -> list[str]:
+    """Markdown table of a study: one row per level and method."""
+    metrics = list(study.metrics)
+    lines = ["| level | method | status | dofs | candidates | h | " +
+             " | ".join(LABELS.get(m, m) for m in metrics) + " | λ vs first | solve [s] |",
+             "|---:|---|---|---:|---:|---:|" + "---:|" * len(metrics) + "---:|---:|"]
+    for r in study.rows:
+        values = " | ".join(f"{r.errors[m]:.3e}" if m in r.errors else "–" for m in metrics)
+        lam = f"{r.lam_rel_vs_first:.1e}" if np.isfinite(r.lam_rel_vs_first) else "–"
+        lines.append(f"| {r.level} | {r.method} | {r.status} | {r.dofs} | {r.candidates} | "
+                     f"{r.h:.3g} | {values} | {lam} | {r.solve_s:.2f} |")
+    lines += ["", "Fitted rates (slope of log error against log h"
+              + (f", levels ≥ {study.fit_from}" if study.fit_from else "") + "):", "",
+              "| method | " + " | ".join(LABELS.get(m, m) for m in metrics) + " |",
+              "|---|" + "---:|" * len(metrics)]
+    for method, rates in study.rates.items():
+        lines.append(f"| {method} | " + " | ".join(f"{rates.get(m, float('nan')):.2f}" for m in metrics)
+                     + " |")
+    return lines
+
+
+def write_study(study: ConvergenceStudy, out, command: str,
+                comparison: GradingComparison | None = None) -> dict[str, Any]:
+    """Write ``convergence-<scene>.md``, ``.json`` and ``.png`` (and the grading figure) to ``out``."""
+    directory = writable_directory(out)
+    stem = f"convergence-{study.scene}"
+    paths = {}
+    ax = plot_convergence(study)
+    save_figure(ax.figure, directory / f"{stem}.png")
+    paths["figure"] = directory / f"{stem}.png"
+    md = [f"# Convergence: {study.scene}", "", f"Command: `{command}`  ",
+          "Parameters: " + ", ".join(f"{k}={v}" for k, v in study.params.items()), "",
+          f"Largest λ difference between exact methods: {study.max_disagreement():.1e}", ""]
+    md += study_table(study)
+    md += ["", f"![convergence]({stem}.png)"]
+    payload: dict[str, Any] = {"command": command, "study": study.as_dict()}
+    if comparison is not None:
+        ax = plot_grading(comparison)
+        save_figure(ax.figure, directory / f"grading-{study.scene}.png")
+        paths["grading"] = directory / f"grading-{study.scene}.png"
+        md += ["", "## Graded against uniform meshes", "",
+               f"{LABELS.get(comparison.metric, comparison.metric)} of {100 * comparison.target:g} %: "
+               f"graded {comparison.graded_dofs:,.0f} dofs ({comparison.graded_how}), uniform "
+               f"{comparison.uniform_dofs:,.0f} dofs ({comparison.uniform_how}; uniform error ∝ "
+               f"dofs^{comparison.uniform_rate_per_dof:.2f}): grading saves "
+               f"{comparison.saving:,.0f}× the dofs.", ""]
+        md += study_table(comparison.uniform)
+        md += ["", f"![grading](grading-{study.scene}.png)"]
+        payload["grading"] = {k: v for k, v in comparison.as_dict().items()
+                              if k not in ("graded", "uniform")}
+        payload["uniform"] = comparison.uniform.as_dict()
+    atomic_write_text(directory / f"{stem}.md", "\n".join(md) + "\n")
+    atomic_write_text(directory / f"{stem}.json", to_json(payload))
+    paths["markdown"] = directory / f"{stem}.md"
+    paths["json"] = directory / f"{stem}.json"
+    return paths
