@@ -43,7 +43,8 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.certification.kkt import Certificate
-from signorini.numerics.factor import FactorTooLarge, selection_dofs
+from signorini.numerics.active_set import ActiveSetSolver, selection_dofs
+from signorini.numerics.factor import FactorTooLarge
 from signorini.numerics.push import calibrate_push
 from signorini.numerics.work import counting, timed
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
@@ -160,10 +161,12 @@ def _matched(problem: ContactProblem, zone: Zone | None) -> tuple[ContactProblem
             raise  # a refusal, not a failed prediction: the full active set would factorise too
         except (ValueError, ArithmeticError) as exc:
             log.info("load control on the predicted zone failed (%s): full active set", exc)
+    system = ActiveSetSolver(problem.K, problem.N)
     scale, lam, u = calibrate_push(problem.K, problem.N, pu.f1, pu.d0, pu.d1, pu.target,
                                    problem.force_multiplicity, f0=f0,
-                                   start=disc.predicted_contact, weights=pu.resultant)
-    return problem.pushed(scale), WarmStart(lam=lam, u=u), "full active set"
+                                   start=disc.predicted_contact, weights=pu.resultant, system=system)
+    return (problem.pushed(scale), WarmStart(lam=lam, u=u, factor=system.factor),
+            "full active set")
 
 
 def at_load(problem: ContactProblem, coarse: CoarseModel | None = None) -> ContactProblem:

@@ -11,7 +11,8 @@ from skfem import MeshTri
 
 import signorini
 from signorini.errors import InputError
-from signorini.scenes.adapt import contact_weights, dorfler, parse_target
+from signorini.scenes.adapt import parse_target
+from signorini.scenes.marking import contact_weights, dorfler
 from signorini.scenes.families import get_scene
 from signorini.scenes.meshing import graded_quarter_disc, quarter_disc_on
 

@@ -17,7 +17,7 @@ from signorini.certification.kkt import certificate, compare
 from signorini.numerics import multigrid
 from signorini.numerics.work import counting
 from signorini.scenes import build_problem
-from signorini.solvers import amg, auto
+from signorini.solvers import amg, amg_system, auto
 from signorini.solvers.bounds import bound_form
 from signorini.solvers.registry import solve
 from synthetic import random_problem
@@ -138,8 +138,8 @@ def test_the_gamg_hierarchy_reads_the_matrix_in_place_with_its_node_blocks(probl
     pytest.importorskip("petsc4py", reason="PETSc's GAMG needs petsc4py (extra 'petsc')")
     form = bound_form(problems["hertz-sphere-3d"])
     A = multigrid.pinned_matrix(sp.csr_matrix(form.K), form.lower == form.upper)
-    first = amg.GamgHierarchy(A, form.rigid_modes(), form.block)
-    second = amg.GamgHierarchy(A.copy(), form.rigid_modes(), form.block)
+    first = amg_system.GamgHierarchy(A, form.rigid_modes(), form.block)
+    second = amg_system.GamgHierarchy(A.copy(), form.rigid_modes(), form.block)
     assert form.block == 3 and first._A.getBlockSize() == 3
     indptr, indices, data = first._A.getValuesCSR()
     assert np.array_equal(indptr, A.indptr) and np.array_equal(indices, A.indices)
@@ -269,10 +269,10 @@ def test_pdas_amg_with_threaded_products_gives_the_same_answer_to_the_bit(proble
     monkeypatch.setattr(multigrid, "THREADS", 2)
     monkeypatch.setattr(multigrid, "THREADED_FROM", 10 ** 15)
     plain = solve(problem, "pdas-amg", amg="petsc")
-    assert not isinstance(amg.PinnedSystem(bound_form(problem)).product, multigrid.RowBlocks)
+    assert not isinstance(amg_system.PinnedSystem(bound_form(problem)).product, multigrid.RowBlocks)
     monkeypatch.setattr(multigrid, "THREADED_FROM", 0)
-    assert isinstance(amg.PinnedSystem(bound_form(problem)).product, multigrid.RowBlocks)
-    assert len(amg.PinnedSystem(bound_form(problem)).product.blocks) == 2
+    assert isinstance(amg_system.PinnedSystem(bound_form(problem)).product, multigrid.RowBlocks)
+    assert len(amg_system.PinnedSystem(bound_form(problem)).product.blocks) == 2
     split = solve(problem, "pdas-amg", amg="petsc")
     assert split.status == plain.status == "converged"
     assert split.u.tobytes() == plain.u.tobytes() and split.lam.tobytes() == plain.lam.tobytes()

@@ -23,10 +23,15 @@ def _from_qp_in_mm() -> signorini.Result:
     return signorini.solve(qp, "pdas")
 
 
+RELAXED = {"hertz-cylinder": {"mesher": "relaxed", "n_contact": 40, "grading": 0.15},
+           "hertz-sphere": {"mesher": "relaxed", "n_contact": 60, "grading": 0.15}}
+
+
 @pytest.fixture(scope="module")
 def results() -> dict[str, signorini.Result]:
-    found = {scene: signorini.solve(scene, "pdas") for scene in ("hertz-cylinder", "hertz-sphere",
-                                                                 "block")}
+    # the Hertz discs on the relaxed meshes docs/derivatives.md measured the fitted a's slope on
+    found = {scene: signorini.solve(scene, "pdas", params=RELAXED.get(scene, {}))
+             for scene in ("hertz-cylinder", "hertz-sphere", "block")}
     found["from_qp"] = _from_qp_in_mm()
     assert all(result.converged for result in found.values())
     return found

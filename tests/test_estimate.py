@@ -13,9 +13,9 @@ from skfem.models.elasticity import lame_parameters
 import signorini
 from signorini.fem.assembly import axisymmetric_elasticity
 from signorini.fem.stiffness import plane_strain_stiffness
-from signorini.fem.estimate import (_by_quadrature, _constant_strains, contact_term, element_energies,
-                                    estimate, lame, material_units, quadrature, recover, strains,
-                                    zone_and_neighbours)
+from signorini.fem.contact_estimate import contact_term, zone_and_neighbours
+from signorini.fem.estimate import (_by_quadrature, _constant_strains, element_energies, estimate, lame,
+                                    material_units, quadrature, recover, strains)
 from signorini.fem.transfer import uniform_prolongation
 from signorini.files import to_json
 from signorini.scenes.meshing import refine_uniformly
@@ -142,7 +142,7 @@ def test_a_uniform_pressure_has_no_pressure_error():
 
 
 def test_the_body_normals_follow_the_arc():
-    from signorini.fem.estimate import boundary_normals, candidate_nodes
+    from signorini.fem.contact_estimate import boundary_normals, candidate_nodes
 
     problem = signorini.build_problem("hertz-cylinder")
     nodes = candidate_nodes(problem.mesh, problem.contact_points)
@@ -160,7 +160,7 @@ def test_the_body_normals_follow_the_arc():
 def test_candidate_nodes_are_found_by_coordinates(mesh):
     """Points at nodes (exactly, or within a relative 1e-9) give those nodes; any other point is
     an error, not the nearest node."""
-    from signorini.fem.estimate import candidate_nodes
+    from signorini.fem.contact_estimate import candidate_nodes
 
     nodes = np.random.default_rng(0).permutation(mesh.p.shape[1])[:20]
     points = mesh.p[:, nodes].T
@@ -170,12 +170,21 @@ def test_candidate_nodes_are_found_by_coordinates(mesh):
         candidate_nodes(mesh, points + 0.01)
 
 
-def test_the_pressure_estimate_shrinks_with_the_mesh_and_tracks_the_error():
-    coarse = signorini.solve("hertz-cylinder", params=COARSE)
-    fine = signorini.solve("hertz-cylinder", params={**COARSE, "refine": 1})
+#: the pressure estimate over the true error on the coarse cylinder, by mesher (docs/estimate.md):
+#: near 1 on the relaxed meshes adaptive refinement starts from; on Triangle's meshes the recovered
+#: stress at the boundary is rougher than the pressure, and the estimate over-estimates
+PRESSURE_EFFECTIVITY = {"relaxed": (0.5, 3.0), "triangle": (1.0, 5.0)}
+
+
+@pytest.mark.parametrize("mesher", sorted(PRESSURE_EFFECTIVITY))
+def test_the_pressure_estimate_shrinks_with_the_mesh_and_tracks_the_error(mesher):
+    params = {**COARSE, "mesher": mesher}
+    coarse = signorini.solve("hertz-cylinder", params=params)
+    fine = signorini.solve("hertz-cylinder", params={**params, "refine": 1})
     assert fine.estimate.pressure.relative < 0.7 * coarse.estimate.pressure.relative
     error = tool.pressure_error(coarse, fine)  # the finer mesh's pressure as the reference
-    assert 0.5 < coarse.estimate.pressure.relative / error < 3.0
+    low, high = PRESSURE_EFFECTIVITY[mesher]
+    assert low < coarse.estimate.pressure.relative / error < high
 
 
 def _adaptive(rows, scene, nu, mesh="adaptive"):

@@ -21,7 +21,8 @@ from signorini.certification.kkt import (
     compare,
     gap_scale,
 )
-from signorini.numerics.factor import factorize, selection_dofs
+from signorini.numerics.active_set import selection_dofs
+from signorini.numerics.factor import factorize
 from signorini.numerics.work import counting
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.scenes import build as scene_build

@@ -4,13 +4,8 @@ import numpy as np
 import pytest
 
 from signorini.errors import InputError
-from signorini.numerics.factor import (
-    ActiveSetSolver,
-    available_backends,
-    factorize,
-    resolve_backend,
-    selection_dofs,
-)
+from signorini.numerics.active_set import ActiveSetSolver, selection_dofs
+from signorini.numerics.factor import available_backends, factorize, resolve_backend
 from signorini.scenes import build_problem
 from synthetic import random_problem
 

@@ -12,7 +12,8 @@ from signorini import load_control
 from signorini.fem.assembly import assemble
 from signorini.certification.kkt import certificate, compare
 from signorini.references.catalogue import reference_of
-from signorini.numerics.factor import PinnedFactor, factorize
+from signorini.numerics.active_set import PinnedFactor
+from signorini.numerics.factor import factorize
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.scenes import build as scenes
 from signorini.scenes import build_problem, coarse_values, get_scene

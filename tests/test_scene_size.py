@@ -13,9 +13,12 @@ from signorini.scenes.families import SCENES
 from signorini.scenes.size import MEMORY_VARIABLE, SIZE_MODELS, check_size, estimate_dofs
 from signorini.solvers.registry import get_method
 
+#: the discs' coarse gradings on the bisection meshes the models were fitted to: Triangle's
+#: (the default) are over-estimated up to 1.8 times there, the safe side, which
+#: tests/test_triangle_mesher.py holds between 1 and 2 (docs/calibration.md)
 VARIANTS = [
     ("hertz-cylinder", {}), ("hertz-cylinder", {"n_contact": 20}),
-    ("hertz-cylinder", {"n_contact": 120}), ("hertz-cylinder", {"grading": 0.3}),
+    ("hertz-cylinder", {"n_contact": 120}), ("hertz-cylinder", {"grading": 0.3, "mesher": "bisection"}),
     ("hertz-cylinder", {"a_over_R": 0.01}), ("hertz-cylinder", {"refine": 1}),
     ("hertz-sphere", {}), ("hertz-sphere", {"n_contact": 30}), ("hertz-sphere", {"grading": 0.1}),
     ("hertz-sphere-3d", {}), ("hertz-sphere-3d", {"n_contact": 5}),
@@ -25,8 +28,8 @@ VARIANTS = [
     ("reverse-hertz", {}), ("reverse-hertz", {"n_contact": 64}),
     ("reverse-hertz", {"grading": 0.15}), ("block", {"nx": 40, "ny": 7}),
     # the convergence studies' coarse starts
-    ("hertz-cylinder", {"n_contact": 15, "grading": 0.6}),
-    ("hertz-sphere", {"n_contact": 12, "grading": 0.6}), ("punch", {"n_contact": 16, "grading": 0.6}),
+    ("hertz-cylinder", {"n_contact": 15, "grading": 0.6, "mesher": "bisection"}),
+    ("hertz-sphere", {"n_contact": 12, "grading": 0.6, "mesher": "bisection"}), ("punch", {"n_contact": 16, "grading": 0.6}),
     ("reverse-hertz", {"n_contact": 16, "grading": 0.6}),
 ]
 
@@ -47,7 +50,7 @@ def test_the_estimate_is_within_a_factor_1_5_of_the_mesh_built(family, values):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["hertz-cylinder", "--set", "refine=5"], ["refine=5", "5,87", "dofs", "GB"]),
+    (["hertz-cylinder", "--set", "refine=5"], ["refine=5", "7,41", "dofs", "GB"]),
     (["hertz-sphere-3d", "--set", "refine=3", "--set", "n_contact=20"], ["refine=3", "dofs", "GB"]),
     (["hertz-cylinder", "--set", "grading=0.01", "--set", "n_contact=100", "--set", "refine=3"],
      ["grading=0.01", "coarser"]),
@@ -65,8 +68,8 @@ def test_a_scene_too_big_is_refused_in_one_line_with_the_way_to_raise_the_limit(
 
 
 def test_the_variable_raises_and_lowers_the_limit(monkeypatch):
-    params = SCENES["hertz-cylinder"].parse({"refine": 4})  # about 1.2M dofs, 5 GB
-    monkeypatch.setenv(MEMORY_VARIABLE, "6")
+    params = SCENES["hertz-cylinder"].parse({"refine": 4})  # about 1.9M dofs, 7.4 GB
+    monkeypatch.setenv(MEMORY_VARIABLE, "9")
     check_size("hertz-cylinder", params)
     monkeypatch.setenv(MEMORY_VARIABLE, "2")
     with pytest.raises(InputError, match="over the limit of 2.0 GB"):
@@ -90,7 +93,7 @@ def test_a_nearly_uniform_mesh_is_estimated_by_the_uniform_bound(family, values,
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["hertz-cylinder", "--set", "n_contact=8", "--set", "grading=1e-6"],
+    (["hertz-cylinder", "--set", "n_contact=8", "--set", "grading=1e-6", "--set", "mesher=relaxed"],
      ["could not be meshed", "grading=1e-6"]),
     (["punch", "--set", "n_contact=16", "--set", "grading=1e-6"],  # refused before meshing
      ["grading=1e-06", "triangles", "mesher's 800,000"]),

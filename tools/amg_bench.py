@@ -8,7 +8,7 @@ Parts (each one a key of the JSON, re-run alone with --part):
 - ``backends``: one multigrid set-up and one CG solve of K (the bound form with the
   prescribed dofs pinned, no contact) to a relative residual of 1e-10, on the 350k-dof
   sphere: pyamg's smoothed aggregation, PETSc GAMG as the package sets it up
-  (``signorini.solvers.amg.GAMG_OPTIONS``) and with PETSc's own coarsest level and smoothing;
+  (``signorini.solvers.amg_system.GAMG_OPTIONS``) and with PETSc's own coarsest level and smoothing;
 - ``crossover``: pdas against pdas-amg (method time) at 7k, 12k and 47k dofs;
 - ``whole-350k`` and ``whole-1m``: the default command, ``/usr/bin/time -v signorini solve
   hertz-sphere-3d ... --json``, whole process (wall time, peak memory, the record);
@@ -120,7 +120,7 @@ def whole(params: dict, method: str | None = None, options: tuple[str, ...] = ()
             "record": None if record is None else {k: record.get(k) for k in keep if k in record}}
 
 
-#: PETSc's own values of the options signorini.solvers.amg.GAMG_OPTIONS changes
+#: PETSc's own values of the options signorini.solvers.amg_system.GAMG_OPTIONS changes
 PETSC_DEFAULTS = {"pc_gamg_coarse_eq_limit": "50", "mg_levels_ksp_max_it": "2"}
 
 
@@ -128,13 +128,13 @@ def _gamg_with(values: dict, A, modes, block: int):
     """signorini's GAMG hierarchy with some of its options set otherwise (then unset again)."""
     from petsc4py import PETSc
 
-    from signorini.solvers import amg
+    from signorini.solvers import amg, amg_system
 
     options = PETSc.Options("signorini_amg_")
     for name, value in values.items():
         options.setValue(name, value)
     try:
-        return amg.GamgHierarchy(A, modes, block)
+        return amg_system.GamgHierarchy(A, modes, block)
     finally:
         for name in values:
             options.delValue(name)
@@ -144,7 +144,7 @@ def backends() -> dict:
     """One set-up + one CG solve of K per multigrid, on the 350k-dof sphere's bound form."""
     from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg, pinned_matrix
     from signorini.scenes import build_problem
-    from signorini.solvers import amg
+    from signorini.solvers import amg, amg_system
     from signorini.solvers.bounds import bound_form
 
     problem = build_problem("hertz-sphere-3d", params=SPHERE_350K)
@@ -154,7 +154,7 @@ def backends() -> dict:
     modes = form.rigid_modes()
     rows = {}
     variants = {"pyamg (smoothed aggregation)": lambda: PyamgHierarchy(A, modes, form.block),
-                "petsc GAMG (plain aggregation)": lambda: amg.GamgHierarchy(A, modes, form.block),
+                "petsc GAMG (plain aggregation)": lambda: amg_system.GamgHierarchy(A, modes, form.block),
                 "petsc GAMG, PETSc's coarsest level and smoothing":
                     lambda: _gamg_with(PETSC_DEFAULTS, A, modes, form.block)}
     for name, make in variants.items():
@@ -219,14 +219,14 @@ def one_amg_solve(params: dict, rtol: float = AMG_RTOL) -> dict:
     the least an exact method without a factorisation can spend (run in a process of its own)."""
     from signorini.numerics.multigrid import pinned_cg, pinned_matrix
     from signorini.scenes import build_problem
-    from signorini.solvers import amg
+    from signorini.solvers import amg, amg_system
     from signorini.solvers.bounds import bound_form
 
     problem = build_problem("hertz-sphere-3d", params=params)
     form = bound_form(problem)
     pinned = form.lower == form.upper
     A = pinned_matrix(form.K, pinned)
-    hierarchy = amg.GamgHierarchy(A, form.rigid_modes(), form.block)
+    hierarchy = amg_system.GamgHierarchy(A, form.rigid_modes(), form.block)
     setup = hierarchy.setup_s  # PETSc's import is not the hierarchy's
     f = np.where(pinned, 0.0, form.f)
     target = rtol * np.linalg.norm(f)

@@ -183,14 +183,14 @@ def in_process_amg(scene: str, params: dict) -> dict:
     (``pdas-amg``: its method time, steps, hierarchy set-up and CG iterations), the estimate,
     and one multigrid solve of K: K of the solved problem (at the push found) with the
     prescribed dofs and the answer's active set pinned, a GAMG hierarchy of it set up with
-    the package's options (:class:`~signorini.solvers.amg.GamgHierarchy`), and CG
+    the package's options (:class:`~signorini.solvers.amg_system.GamgHierarchy`), and CG
     (:func:`~signorini.numerics.multigrid.pinned_cg`, with the method's products by K) from the
     pinned values and zero elsewhere to the stationarity residual pdas-amg's final solve stops
     at (``SAFETY · tol ·`` the largest contact force, in the max norm)."""
     import numpy as np
 
     from signorini.numerics.multigrid import pinned_cg, pinned_matrix
-    from signorini.solvers import amg
+    from signorini.solvers import amg, amg_system
     from signorini.solvers.bounds import bound_form
     from signorini.solvers.defaults import resolved
 
@@ -201,7 +201,7 @@ def in_process_amg(scene: str, params: dict) -> dict:
                  hierarchy_s=extras["hierarchy_s"], cg_iterations=extras["cg_iterations"])
     problem, lam = result.problem, result.solution.lam
     del result
-    system = amg.PinnedSystem(bound_form(problem))
+    system = amg_system.PinnedSystem(bound_form(problem))
     active = lam > 0
     x = np.zeros(system.form.n)
     free = system.pin(active, problem.d, x)
@@ -211,7 +211,7 @@ def in_process_amg(scene: str, params: dict) -> dict:
     start = time.perf_counter()
     pinned, modes = pinned_matrix(system.K, ~free), system.form.rigid_modes()
     parts["amg_pin_s"] = time.perf_counter() - start  # the pinned matrix and the rigid modes
-    hierarchy = amg.GamgHierarchy(pinned, modes, system.form.block)
+    hierarchy = amg_system.GamgHierarchy(pinned, modes, system.form.block)
     parts["amg_setup_s"] = hierarchy.setup_s  # as the method's hierarchy_s: GAMG's set-up
     del pinned
     start = time.perf_counter()

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from signorini.numerics.factor import selection_dofs
+from signorini.numerics.active_set import selection_dofs
 from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: a factorisation offered to the certificate is one of the problem's K when ``K x`` by both
@@ -80,7 +80,7 @@ def primal_dual_gap(problem: ContactProblem, u: np.ndarray, lam: np.ndarray, fac
     ``D(μ) = min_v L(v, μ)`` is the dual function; for any ``μ ≥ 0``,
     ``D(μ) ≤ J* ≤ J(u)``. The dual point is ``λ̂ = λ⁺`` with its entries on
     the *pinned* rows ``C`` of a factorisation of K the method already holds
-    (:class:`~signorini.numerics.factor.PinnedFactor`: each such row bounds
+    (:class:`~signorini.numerics.active_set.PinnedFactor`: each such row bounds
     one dof, pinned; a plain factorisation of K pins none) replaced by their
     best values, those that maximise ``D`` over ``λ_C`` with the others fixed.
     Then, with ``r = Ku − f + N_Rᵀλ_R⁺`` (the stationarity residual without

@@ -23,7 +23,7 @@ of the size of the noise. ``floor = ‖δλ₂‖∞ / ‖λ‖`` is what double
 vouch for on this system; the certificate vouches for λ to ``max(force, floor)``.
 
 Cost: no factorisation. ``M`` is solved by the factorisation the method holds
-(:class:`~signorini.numerics.factor.PinnedFactor` or any object with its
+(:class:`~signorini.numerics.active_set.PinnedFactor` or any object with its
 interface: ``matrix``, ``fixed``, ``solve``), or the problem's cached one of K.
 A factorisation with the dofs of A pinned solves M in one back-solve; each row in
 which its pinned set and A differ costs one more back-solve (a bordered Schur
@@ -47,7 +47,7 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.numerics.factor import selection_dofs
+from signorini.numerics.active_set import selection_dofs
 
 #: the certificate borders a factorisation with at most this many rows (back-solves) to reach
 #: the active set's system; beyond, the forward error is not estimated

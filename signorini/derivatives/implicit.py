@@ -28,7 +28,7 @@ import numpy as np
 
 from signorini.errors import InputError, SolverError
 from signorini.certification.kkt import ACTIVE, WEAK, classify
-from signorini.numerics.factor import ActiveSetSolver
+from signorini.numerics.active_set import ActiveSetSolver
 from signorini.problem.contact import ContactProblem
 from signorini.reprs import short_repr
 from signorini.problem.solution import ContactSolution

@@ -7,13 +7,15 @@
 - :mod:`~signorini.fem.stiffness`: that stiffness in closed form on triangles and tetrahedra,
   summed into K's pattern from the mesh's edges;
 - :mod:`~signorini.fem.estimate`: the a posteriori error estimate in the energy norm (ZZ
-  recovery and a contact term), per element;
+  recovery and a contact term), per element; :mod:`~signorini.fem.contact_estimate` its contact
+  term and the contact pressure's estimate;
 - :mod:`~signorini.fem.transfer`: P1 fields carried onto a refined mesh (midpoint parents).
 """
 
 from signorini.fem.assembly import assemble
 from signorini.fem.checks import check_model
-from signorini.fem.estimate import ErrorEstimate, PressureEstimate, estimate
+from signorini.fem.contact_estimate import PressureEstimate
+from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.fem.model import CutLoad, FlatObstacle, FlatObstacle3D, SceneModel
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, Obstacle, SignedDistance
 

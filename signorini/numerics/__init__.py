@@ -1,7 +1,9 @@
 """Numerical kernels that know nothing of meshes or scenes.
 
 - :mod:`~signorini.numerics.factor`: sparse Cholesky/LU backends behind one interface
-  (PARDISO, CHOLMOD, SuperLU), pinned factorisations and active-set systems;
+  (PARDISO, CHOLMOD, SuperLU);
+- :mod:`~signorini.numerics.active_set`: pinned factorisations and the active-set systems on
+  them;
 - :mod:`~signorini.numerics.lcp`: the Delassus operator ``W = N K⁻¹ Nᵀ``, the dense
   linear complementarity problem on it, power iteration for ``λ_max(W)``;
 - :mod:`~signorini.numerics.zone`: exact contact around a predicted contact zone on one
@@ -11,7 +13,8 @@
   the linear algebra of ``pdas-amg``.
 """
 
-from signorini.numerics.factor import ActiveSetSolver, PinnedFactor, available_backends, factorize
+from signorini.numerics.active_set import ActiveSetSolver, PinnedFactor
+from signorini.numerics.factor import available_backends, factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue, solve_lcp
 from signorini.numerics.push import push_for_load
 from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg

@@ -1,4 +1,5 @@
-"""Sparse linear algebra: factorise once, solve many; and the active-set systems of PDAS.
+"""Sparse linear algebra: factorise once, solve many (the active-set systems built on it are
+:mod:`signorini.numerics.active_set`'s).
 
 Backends for the SPD stiffness (one interface, ``factorize(K).solve(b)``):
 
@@ -29,7 +30,6 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.errors import BackendNotInstalled, InputError, install_hint
-from signorini.numerics.saddle_point import SaddlePoint
 from signorini.numerics.work import count
 
 log = logging.getLogger(__name__)
@@ -131,11 +131,17 @@ def cholmod_ordering(n: int) -> str:
     return "nesdis" if n >= NESTED_DISSECTION_FROM else "amd"
 
 
+#: from this many dofs CHOLMOD factorises by supernodes; below, simplicially: faster there
+#: (measured on the Hertz cylinder's K, docs/performance.md)
+SUPERNODAL_FROM = 40_000
+
+
 def cholmod_analysis(K: sp.csc_matrix):
-    """CHOLMOD's symbolic analysis (ordering, supernodes) of the pattern of K."""
+    """CHOLMOD's symbolic analysis (ordering, supernodes or not) of the pattern of K."""
     from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
 
-    return analyze(K, mode="supernodal", ordering_method=cholmod_ordering(K.shape[0]))
+    mode = "supernodal" if K.shape[0] >= SUPERNODAL_FROM else "simplicial"
+    return analyze(K, mode=mode, ordering_method=cholmod_ordering(K.shape[0]))
 
 
 def cholmod_numeric(symbolic, K: sp.csc_matrix):
@@ -143,9 +149,12 @@ def cholmod_numeric(symbolic, K: sp.csc_matrix):
     from sksparse.cholmod import CholmodNotPositiveDefiniteError  # as above
 
     try:
-        return symbolic.cholesky(K)
+        factor = symbolic.cholesky(K)
     except CholmodNotPositiveDefiniteError as exc:
         raise np.linalg.LinAlgError(f"K is not positive definite ({exc})") from exc
+    if not np.all(factor.D() > 0):  # the simplicial factor is LDLᵀ, which an indefinite K passes
+        raise np.linalg.LinAlgError("K is not positive definite (a pivot of its LDLᵀ is not positive)")
+    return factor
 
 
 class CholmodFactor(Factor):
@@ -231,6 +240,18 @@ def _pypardiso():
     return pypardiso
 
 
+def upper_csr(K: sp.spmatrix) -> sp.csr_matrix:
+    """The upper triangle of K in CSR (PARDISO's input), cut from a CSR K's own arrays."""
+    if K.format != "csr":
+        return sp.triu(K, format="csr")
+    K = K if K.has_sorted_indices else K.sorted_indices()
+    row = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+    keep = K.indices >= row
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(row[keep], minlength=K.shape[0]))])
+    return sp.csr_matrix((K.data[keep], K.indices[keep], indptr.astype(K.indptr.dtype)),
+                         shape=K.shape)
+
+
 class PardisoFactor(Factor):
     """MKL PARDISO's symmetric positive definite solver (pypardiso).
 
@@ -244,7 +265,7 @@ class PardisoFactor(Factor):
     def __init__(self, K: sp.spmatrix, upper: sp.csr_matrix | None = None):
         pypardiso = _pypardiso()
         self.matrix, self.shape = K, K.shape
-        self._upper = _upper_csr(K) if upper is None else upper
+        self._upper = upper_csr(K) if upper is None else upper
         self._solver = solver = pypardiso.PyPardisoSolver(mtype=2)
         os.environ.setdefault("PYPARDISO_MKL_RT", solver.libmkl._name)  # where it found MKL
         for index, value in PARDISO_IPARM.items():
@@ -293,189 +314,3 @@ _CLASSES = {"superlu": Factor, "cholmod": CholmodFactor, "pardiso": PardisoFacto
 def factorize(K: sp.spmatrix, backend: str | None = None) -> Factor:
     """Factorise the SPD matrix ``K`` once for repeated solves."""
     return _CLASSES[resolve_backend(backend, K.shape[0], K.nnz)](K)
-
-
-def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
-    """The dof of each row when every row of N has one nonzero on its own dof, else None: then
-    each constraint bounds one dof (a flat obstacle, or dofs rotated into each node's normal
-    frame) and an active set is a Dirichlet condition."""
-    N = sp.csr_matrix(N, copy=True)
-    N.eliminate_zeros()
-    N.sort_indices()
-    if not np.all(np.diff(N.indptr) == 1):
-        return None
-    dofs = N.indices.copy()
-    return dofs if np.unique(dofs).size == dofs.size else None
-
-
-class ActiveSetSolver:
-    """Solutions of ``Ku + N_Aᵀλ_A = f, N_A u = d`` (``λ`` zero off A), active set after active set.
-
-    When each row of N bounds one dof, the active dofs are pinned
-    (:class:`PinnedFactor`: a fixed dof's row and column become the
-    identity's, so every active set has K's sparsity pattern; with CHOLMOD
-    the symbolic analysis, the fill-reducing ordering, is done once and only
-    the numeric factorisation repeated). Otherwise the saddle-point matrix, with
-    its constraint rows scaled by ``s = mean |diag K|`` (both blocks of one
-    size in any units; ``λ = s μ``), is factorised by LU.
-
-    ``factor`` is the factorisation of K (with the last active set's dofs
-    pinned, or none) or the saddle-point system
-    (:class:`~signorini.numerics.saddle_point.SaddlePoint`) that the last solve used, for the
-    certificate to reuse. It is let go before the next one is made, so that two never live at
-    once.
-    """
-
-    def __init__(self, K: sp.csr_matrix, N: sp.csr_matrix, backend: str | None = None):
-        self.K = K if sp.issparse(K) else sp.csr_matrix(K)
-        self.N = sp.csr_matrix(N, copy=True)
-        self.N.eliminate_zeros()
-        self.n, self.m = self.K.shape[0], self.N.shape[0]
-        self.backend = resolve_backend(backend, self.n, self.K.nnz)
-        self._dofs = selection_dofs(self.N)
-        self._coef = self.N.data if self._dofs is not None else None
-        self._pinning: Pinning | None = None  # made at the first pinning (CHOLMOD's analysis)
-        self.factor: Factor | PinnedFactor | None = None
-        self.saddle_point: SaddlePoint | None = None
-
-    def pins(self, active: np.ndarray, factor: object) -> bool:
-        """``factor`` is a :class:`PinnedFactor` of this K with exactly the dofs of ``active`` pinned."""
-        return (self._dofs is not None and isinstance(factor, PinnedFactor)
-                and factor.matrix is self.K
-                and np.array_equal(np.sort(factor.fixed), np.sort(self._dofs[active])))
-
-    def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray,
-              factor: PinnedFactor | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k).
-
-        ``factor``, a factorisation of this very system (see :meth:`pins`; for
-        instance the last one a method made on the same active set), is reused:
-        the solve then costs back-solves only.
-        """
-        active = np.asarray(active, dtype=bool)
-        f, d = np.asarray(f, float), np.asarray(d, float)
-        lam = np.zeros((self.m,) + f.shape[1:])
-        if self._dofs is not None:
-            fixed = self._dofs[active]
-            coef = self._coef[active] if f.ndim == 1 else self._coef[active][:, None]
-            rhs = np.array(f)
-            rhs[fixed] = d[active] / coef
-            if factor is None or not self.pins(active, factor):
-                self.factor = None  # let go before the next one is made
-                if self._pinning is None:
-                    self._pinning = Pinning(self.K, self.backend)
-                factor = PinnedFactor(self.K, fixed, self.backend, self._pinning)
-            self.factor = factor
-            u = factor.solve(rhs)
-            lam[active] = (f[fixed] - factor.fixed_rows(u)) / coef
-            return u, lam
-        self.factor = None
-        N_A = self.N[active]
-        if N_A.shape[0] == 0:
-            self.factor = factorize(self.K, self.backend)
-            return self.factor.solve(f), lam
-        if self.saddle_point is None or not np.array_equal(self.saddle_point.active, active):
-            self.saddle_point = None  # let go before the next one is made
-            self.saddle_point = SaddlePoint(self.K, self.N, active)
-        self.factor = self.saddle_point  # the certificate's, on the final active set
-        u, lam[active] = self.saddle_point.solve(f, d[active])
-        return u, lam
-
-
-class Pinning:
-    """Factors of K with some dofs pinned, in the layout the backend reads, made without copying K.
-
-    A pinned dof's row and column are replaced by the identity's, so every set
-    of pinned dofs gives a matrix of K's sparsity pattern: the layout is cut
-    once (K's upper triangle in CSR for PARDISO, all of K in CSC otherwise) and
-    each pinning only rewrites its values; CHOLMOD's symbolic analysis (the
-    ordering, most of a large factorisation's cost beyond the numeric work)
-    is computed once too: a pinning costs no copy of K (docs/speed.md, §4).
-    """
-
-    def __init__(self, K: sp.spmatrix, backend: str = "cholmod"):
-        self.K = K  # kept by reference: the certificate recognises its problem's K
-        self.n = K.shape[0]
-        self.backend = backend
-        if backend == "pardiso":
-            layout = _upper_csr(K)
-        else:
-            layout = sp.csc_matrix(K, copy=not sp.isspmatrix_csc(K) or not K.has_sorted_indices)
-            layout.sort_indices()
-        self._layout = layout
-        self._major = np.repeat(np.arange(self.n), np.diff(layout.indptr))
-        self._diagonal = (self._major == layout.indices).astype(float)
-        self._symbolic = cholmod_analysis(layout) if backend == "cholmod" else None
-
-    def matrix(self, fixed: np.ndarray) -> sp.csc_matrix | sp.csr_matrix:
-        """K (its upper triangle in CSR for PARDISO) with the ``fixed`` dofs' rows and columns
-        made the identity's (same pattern)."""
-        layout = self._layout
-        pinned = np.zeros(self.n, dtype=bool)
-        pinned[fixed] = True
-        touched = pinned[self._major] | pinned[layout.indices]
-        data = np.where(touched, self._diagonal, layout.data)
-        return type(layout)((data, layout.indices, layout.indptr), shape=layout.shape)
-
-    def factor(self, fixed: np.ndarray) -> Factor:
-        """The backend's factor of K with the ``fixed`` dofs' rows and columns made the identity's."""
-        matrix = self.matrix(fixed)
-        if self.backend == "cholmod":
-            return CholmodFactor(matrix, self._symbolic)
-        if self.backend == "pardiso":
-            return PardisoFactor(self.K, upper=matrix)
-        return Factor(matrix)
-
-
-def _upper_csr(K: sp.spmatrix) -> sp.csr_matrix:
-    """The upper triangle of K in CSR (PARDISO's input), cut from a CSR K's own arrays."""
-    if K.format != "csr":
-        return sp.triu(K, format="csr")
-    K = K if K.has_sorted_indices else K.sorted_indices()
-    row = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-    keep = K.indices >= row
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(row[keep], minlength=K.shape[0]))])
-    return sp.csr_matrix((K.data[keep], K.indices[keep], indptr.astype(K.indptr.dtype)),
-                         shape=K.shape)
-
-
-def _columns(K: sp.spmatrix, dofs: np.ndarray) -> sp.spmatrix:
-    """``K[:, dofs]`` of a symmetric K, sliced along its storage's fast axis."""
-    return K[dofs].T if K.format == "csr" else sp.csc_matrix(K)[:, dofs]
-
-
-class PinnedFactor:
-    """Solutions of K u = f with the ``fixed`` dofs prescribed: ``solve(rhs)`` takes their
-    values from ``rhs[fixed]`` and the load on the other dofs from the rest of ``rhs``.
-
-    The pinned matrix (K with the fixed dofs' rows and columns made the
-    identity's, K's own pattern) is factorised: CHOLMOD on a shared
-    :class:`Pinning`'s symbolic analysis, other backends from scratch.
-    ``matrix`` is K itself (unpinned). With no dof fixed it solves as a
-    :class:`Factor` of K does.
-    """
-
-    def __init__(self, K: sp.spmatrix, fixed: np.ndarray, backend: str | None = None,
-                 pinning: Pinning | None = None):
-        self.n = K.shape[0]
-        self.fixed = np.asarray(fixed, dtype=int)
-        if pinning is None:
-            pinning = Pinning(K, resolve_backend(backend, self.n, K.nnz))
-        self.backend = pinning.backend
-        self.matrix = pinning.K
-        self._coupling = _columns(pinning.K, self.fixed)
-        self._factor = pinning.factor(self.fixed).solve
-        #: by dof, (the solution for a value c on that free dof, c), kept by its solver
-        self.kept: dict[int, tuple[np.ndarray, float]] = {}
-
-    def solve(self, rhs: np.ndarray) -> np.ndarray:
-        """u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``."""
-        rhs = np.array(rhs, dtype=float)
-        values = rhs[self.fixed]
-        rhs -= self._coupling @ values
-        rhs[self.fixed] = values
-        return self._factor(rhs)
-
-    def fixed_rows(self, u: np.ndarray) -> np.ndarray:
-        """``(K u)[fixed]`` (for u of length n, or n × k), from the columns :meth:`solve` uses."""
-        return self._coupling.T @ u

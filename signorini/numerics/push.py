@@ -22,7 +22,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.numerics.factor import ActiveSetSolver
+from signorini.numerics.active_set import ActiveSetSolver
 from signorini.numerics.work import count
 
 log = logging.getLogger(__name__)
@@ -101,16 +101,19 @@ def condensed_pair(W: np.ndarray, b_pair: np.ndarray) -> PairSolve:
 def calibrate_push(K: sp.csr_matrix, N: sp.csr_matrix, f1: np.ndarray, d0: np.ndarray,
                    d1: np.ndarray, target: float, multiplicity: float = 1.0,
                    f0: np.ndarray | None = None, start: np.ndarray | None = None,
-                   weights: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray]:
+                   weights: np.ndarray | None = None,
+                   system: ActiveSetSolver | None = None) -> tuple[float, np.ndarray, np.ndarray]:
     """The push on the full sparse system (one factorisation per active set); λ and u then.
 
     The load is ``s f1 + f0`` (``f0``, e.g. a traction, does not change with the
     push). The iteration starts from the active set ``start`` (e.g. the zone an
     analytic estimate predicts: a good guess leaves one or two steps) or from
     the first point(s) of contact. The load is the forces' resultant along the
-    push (:func:`summed` with the candidates' ``weights``).
+    push (:func:`summed` with the candidates' ``weights``). ``system`` (an
+    :class:`ActiveSetSolver` of K and N) is the caller's to keep: its ``factor`` is then the
+    last active set's factorisation, for a method to reuse.
     """
-    system = ActiveSetSolver(K, N)
+    system = ActiveSetSolver(K, N) if system is None else system
     f_pair = np.column_stack([f1, np.zeros_like(f1) if f0 is None else f0])
     d_pair = np.column_stack([d1, d0])
     last: dict[str, np.ndarray] = {}

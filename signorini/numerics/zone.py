@@ -32,7 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.numerics.factor import PinnedFactor, Pinning, resolve_backend, selection_dofs
+from signorini.numerics.active_set import PinnedFactor, Pinning, selection_dofs
+from signorini.numerics.factor import resolve_backend
 from signorini.numerics.lcp import solve_lcp
 from signorini.numerics.push import condensed_pair, push_for_load
 

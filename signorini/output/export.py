@@ -38,7 +38,7 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.files import atomic_write, check_output_file
-from signorini.fem.estimate import candidate_nodes as mesh_nodes_at
+from signorini.fem.contact_estimate import candidate_nodes as mesh_nodes_at
 from signorini.references.profile import contact_profile
 from signorini.problem.contact import ContactProblem, ContactSolution
 

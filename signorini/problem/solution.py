@@ -23,7 +23,10 @@ class WarmStart:
     (``pdas`` starts from both, ``pdas-amg`` from the active set of ``lam``);
     ``zone_solver`` holds a factorisation of this K around the contact
     ``zone`` (a :class:`~signorini.numerics.zone.ZoneSolver`; ``nested``
-    reuses both and costs back-solves only). A method never reads a warm
+    reuses both and costs back-solves only); ``factor`` a factorisation of
+    this K with an active set's dofs pinned or of its saddle-point system (load
+    control's last), which ``pdas`` reuses
+    when its first active set is that one. A method never reads a warm
     start from anywhere else.
     """
 
@@ -31,6 +34,7 @@ class WarmStart:
     u: np.ndarray | None = None
     zone_solver: Any = None
     zone: Any = None
+    factor: Any = None
 
     @classmethod
     def of(cls, earlier: Any) -> "WarmStart":

@@ -11,18 +11,13 @@ Each step (:func:`solve_adaptive`):
 3. estimate the error (:func:`signorini.fem.estimate.estimate`) and stop when
    the estimate of the chosen quantity meets the target: ``"pressure"`` (the
    default where the model has contact pressures: the relative L² error of
-   the contact pressure, :class:`signorini.fem.estimate.PressureEstimate`) or
+   the contact pressure, :class:`signorini.fem.contact_estimate.PressureEstimate`) or
    ``"energy"`` (``η / ‖u_h‖_E``);
-4. mark the fewest elements that carry a fraction :data:`THETA` of η²
-   (Dörfler's bulk criterion: W. Dörfler, "A convergent adaptive algorithm
-   for Poisson's equation", SINUM 33 (1996) 1106–1124) — for the pressure,
-   the fewest candidates carrying :data:`THETA` of its estimate, with every
-   element within :data:`REACH` element sizes of them, and the elements
-   carrying :data:`THETA_BULK` of η² weighted by their nearness to the
-   contact zone (:func:`contact_weights`), so that the body under and around
-   the contact keeps up with its surface (without that weight the bulk share
-   went to the far field and the true pressure error stalled at 0.2 % on
-   Hertz's cylinder while the estimate fell: docs/estimate.md) —
+4. mark by Dörfler's bulk criterion (:func:`signorini.scenes.marking.mark`:
+   for the pressure, the candidates that carry most of its estimate and the
+   body near the contact, weighted so that it keeps up with its surface;
+   without that weight the bulk share went to the far field and the true
+   pressure error stalled at 0.2 % on Hertz's cylinder: docs/estimate.md),
    refine them conformingly (scikit-fem's red-green-blue
    ``MeshTri.refined(marked)``), move new boundary nodes onto the curved
    boundary, and stop instead when the refined mesh would exceed ``max_dofs``
@@ -31,7 +26,9 @@ Each step (:func:`solve_adaptive`):
    dof of the method that solves it, under ``SIGNORINI_MAX_MEMORY_GB``); the
    last step's answer is returned, its message saying the target was not met.
 
-The first mesh is sized before it is made (:func:`signorini.scenes.size.check_size`).
+The first mesh is sized before it is made (:func:`signorini.scenes.size.check_size`). Given no
+mesh parameter, a family starts from its ``adaptive_start`` (the Hertz scenes: the relaxed mesh
+the budgets and the estimate's effectivity were measured on, :class:`~signorini.scenes.base.SceneFamily`).
 
 Every 2D and axisymmetric scene and scene file takes part. A family whose
 ``build`` accepts ``mesh=`` and that has a ``snap`` (:data:`CURVED`: the Hertz scenes)
@@ -60,17 +57,13 @@ from signorini.fem.transfer import refined_model, with_candidates
 from signorini.fem.model import SceneModel
 from signorini.certification.kkt import gap_scale
 from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.scenes.marking import THETA, mark
 from signorini.scenes.registry import FamilyField, get_scene
 from signorini.scenes.scenefile import build_scene_model, family_scene_values
 from signorini.scenes.size import MEMORY_VARIABLE, Solver, check_size, over_limit
 
 log = logging.getLogger(__name__)
 
-#: Dörfler's bulk parameter: refine the fewest elements that carry this fraction of η²
-THETA = 0.5
-#: for the pressure: the fraction of η² refined besides the contact's neighbourhood, and the
-#: neighbourhood's radius around a marked candidate in units of its largest element edge
-THETA_BULK, REACH = 0.3, 3.0
 QUANTITIES = ("pressure", "energy")
 #: the candidates widen by this factor when the contact outgrows them
 GROWTH = 1.5
@@ -105,61 +98,6 @@ def parse_target(value: Any) -> float:
     if not 0.0 < target < 1.0:
         raise InputError(f"target error {value!r} must be in (0, 1), or a percentage in (0 %, 100 %)")
     return target
-
-
-def dorfler(indicators: np.ndarray, theta: float = THETA) -> np.ndarray:
-    """The fewest elements whose squared indicators sum to ``theta`` of the total (largest first)."""
-    squares = indicators ** 2
-    order = np.argsort(squares)[::-1]
-    cumulative = np.cumsum(squares[order])
-    count = int(np.searchsorted(cumulative, theta * cumulative[-1])) + 1
-    return np.sort(order[:min(count, len(order))])
-
-
-def node_sizes(mesh: Any) -> np.ndarray:
-    """The longest edge at each node of a triangle mesh."""
-    sizes = np.zeros(mesh.p.shape[1])
-    for a, b in ((0, 1), (1, 2), (0, 2)):
-        length = np.linalg.norm(mesh.p[:, mesh.t[a]] - mesh.p[:, mesh.t[b]], axis=0)
-        np.maximum.at(sizes, mesh.t[a], length)
-        np.maximum.at(sizes, mesh.t[b], length)
-    return sizes
-
-
-def elements_near(mesh: Any, nodes: np.ndarray, radius: np.ndarray) -> np.ndarray:
-    """Elements with a vertex within ``radius[i]`` of ``nodes[i]``, for some i."""
-    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
-
-    near = np.zeros(mesh.p.shape[1], dtype=bool)
-    for found in cKDTree(mesh.p.T).query_ball_point(mesh.p[:, nodes].T, radius):
-        near[found] = True
-    return np.nonzero(near[mesh.t].any(axis=0))[0]
-
-
-def mark(mesh: Any, found: ErrorEstimate, quantity: str, theta: float = THETA) -> np.ndarray:
-    """The elements to refine for ``quantity`` (see the module's docstring)."""
-    if quantity == "energy":
-        return dorfler(found.elements, theta)
-    pressure = found.pressure
-    nodes = pressure.nodes[dorfler(np.sqrt(pressure.indicators), theta)]
-    near = elements_near(mesh, nodes, REACH * node_sizes(mesh)[nodes])
-    weighted = found.elements * contact_weights(mesh, pressure.nodes[pressure.active])
-    return np.union1d(near, dorfler(weighted, THETA_BULK))
-
-
-def contact_weights(mesh: Any, zone: np.ndarray) -> np.ndarray:
-    """Each element's weight ``(ℓ / max(d, ℓ))²`` for the pressure's bulk marking: ``d`` the
-    distance from its centroid to the nearest node in contact (``zone``), ``ℓ`` the contact
-    zone's extent (the diagonal of the box around ``zone``, at least its largest element edge)."""
-    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
-
-    if zone.size == 0:
-        return np.ones(mesh.t.shape[1])
-    points = mesh.p[:, zone]
-    extent = max(float(np.linalg.norm(points.max(axis=1) - points.min(axis=1))),
-                 float(node_sizes(mesh)[zone].max()))
-    distance, _ = cKDTree(points.T).query(mesh.p[:, mesh.t].mean(axis=1).T)
-    return (extent / np.maximum(distance, extent)) ** 2
 
 
 def measured(found: ErrorEstimate, quantity: str) -> float:
@@ -218,6 +156,8 @@ def _scene(name: str, values: dict[str, Any], solved_by: Solver | None = None) -
             return _checked(_Scene(scene, model))
         name, values = found
     family = get_scene(name)
+    if not set(values) & set(family.adaptive_start):  # no mesh given: the measured start
+        values = {**family.adaptive_start, **values}
     params = family.parse(values)
     check_size(name, params, solved_by)
     model = family.build(params, set(values))
@@ -264,16 +204,17 @@ def beyond_candidates(model: SceneModel, problem: ContactProblem,
 
 
 def _steeper_than_measured(scene: _Scene) -> str:
-    """A warning when a Hertz scene starts graded more steeply than its default: from there the
+    """A warning when a Hertz scene starts graded more steeply than its adaptive start: from there the
     pressure estimate was measured at half the true error (docs/estimate.md, "the start matters")."""
     if scene.family is None:
         return ""
-    default = next(p.default for p in scene.family.params if p.name == "grading")
+    default = scene.family.adaptive_start.get(
+        "grading", next(p.default for p in scene.family.params if p.name == "grading"))
     if scene.params["grading"] <= default:
         return ""
     return (f"; warning: the mesh started graded at {scene.params['grading']:g}, more steeply than "
-            f"the default {default:g}: from there the pressure estimate was measured below the true "
-            f"error ({docs_page('estimate')}); start from the default grading or finer")
+            f"the adaptive start's {default:g}: from there the pressure estimate was measured below the true "
+            f"error ({docs_page('estimate')}); start from that grading or finer")
 
 
 def _checked(scene: _Scene) -> _Scene:

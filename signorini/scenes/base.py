@@ -125,12 +125,13 @@ LOADING = Param("loading", "traction",
                 check=one_of("traction", "displacement"))
 
 
-#: how the Hertz scenes mesh their disc (signorini.scenes.meshing.graded_quarter_disc)
-MESHER = Param("mesher", MESHERS[0],
-               "relaxed: the graded mesh's nodes moved into near-equilateral triangles (more "
-               f"accurate per dof: {docs_page('accuracy')}); bisection: the graded mesh as refined; "
-               "triangle: Shewchuk's Triangle, much faster meshing, but at equal dofs less "
-               f"accurate than relaxed on the default cylinder ({docs_page('mesher')})",
+#: how the Hertz scenes mesh their disc (signorini.scenes.meshing.graded_quarter_disc); each
+#: scene sets its own default, chosen on the accuracy-time front (docs/mesher.md)
+MESHER = Param("mesher", "triangle",
+               "triangle: Shewchuk's Triangle, near-equilateral and fast; bisection: the graded "
+               "mesh as refined (right-angled triangles); relaxed: the bisection mesh's nodes "
+               "moved into near-equilateral triangles (slow to mesh) "
+               f"({docs_page('mesher')} compares them)",
                kind=str, check=one_of(*MESHERS))
 
 #: how every scene's K integrates λ (tr ε)² (signorini.fem.volumetric)
@@ -296,7 +297,9 @@ class SceneFamily:
     itself on each adaptive mesh (its ``build`` takes ``mesh=``);
     ``reference`` names its analytic reference (:data:`signorini.references.catalogue.REFERENCES`);
     ``validation`` its cases in the validation suite; ``convergence_start``
-    the coarse mesh a convergence study starts from.
+    the coarse mesh a convergence study starts from; ``adaptive_start`` the mesh
+    parameters adaptive refinement starts from when none is given (those its dof budgets
+    and the error estimate's effectivity were measured from).
     """
 
     name: str
@@ -312,6 +315,8 @@ class SceneFamily:
     snap: Callable[[dict[str, Any]], Callable] | None = None
     validation: tuple[Case, ...] = ()
     convergence_start: Mapping[str, Any] = field(default_factory=dict)
+    adaptive_start: Mapping[str, Any] = field(default_factory=dict)
+
     def parse(self, values: dict[str, Any]) -> dict[str, Any]:
         """Defaults overridden by ``values``; unknown names, bad values and loads the family
         cannot model raise InputError (before any mesh is made)."""

@@ -73,7 +73,7 @@ PARAMS = (
           "at the first point of contact) or master (each master segment's: docs/two-bodies.md)",
           kind=str, check=one_of("vertical", "master")),
     LOADING,
-    MESHER,
+    dataclasses.replace(MESHER, default="relaxed"),  # closer to Hertz than Triangle here
 )
 
 

@@ -5,8 +5,8 @@ uniform and fine where the pressure varies, growing linearly away from it.
 Elements longer than the target are split (conforming red-green-blue
 refinement of triangles, longest-edge bisection of tetrahedra) until none is;
 nodes created on a curved boundary are moved onto it after every pass. The
-Hertz scenes' quarter disc is then relaxed into near-equilateral triangles
-(:mod:`signorini.scenes.relax`), or meshed by Triangle instead
+Hertz scenes' quarter disc is kept so, or relaxed into near-equilateral
+triangles (:mod:`signorini.scenes.relax`), or meshed by Triangle instead
 (:mod:`signorini.scenes.triangulated`): :func:`graded_quarter_disc`'s ``mesher``.
 """
 
@@ -33,7 +33,8 @@ log = logging.getLogger(__name__)
 MAX_PASSES = 40
 #: the most triangles a graded 2D mesh may reach (before any uniform refinement)
 MAX_TRIANGLES = 400_000
-#: the meshers of the Hertz scenes' quarter disc (:func:`graded_quarter_disc`), the default first
+#: the meshers of the Hertz scenes' quarter disc (:func:`graded_quarter_disc`); each scene picks its
+#: default (its ``mesher`` parameter)
 MESHERS = ("relaxed", "bisection", "triangle")
 
 

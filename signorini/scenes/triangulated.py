@@ -7,9 +7,9 @@ equilateral triangle of the local size and no angle is below
 :data:`MIN_ANGLE` (Shewchuk, "Delaunay refinement algorithms for triangular
 mesh generation", Comput. Geom. 22, 2002), through the ``triangle`` binding.
 This is ``mesher=triangle`` of the Hertz scenes
-(:func:`signorini.scenes.meshing.graded_quarter_disc`): much faster than
-bisection followed by the node relaxation, with near-equilateral triangles,
-but not the default (docs/mesher.md compares the three meshers).
+(:func:`signorini.scenes.meshing.graded_quarter_disc`), the cylinder's default:
+much faster than bisection followed by the node relaxation, with
+near-equilateral triangles (docs/mesher.md compares the three meshers).
 """
 
 from __future__ import annotations

@@ -40,7 +40,8 @@ import scipy.sparse as sp
 
 from signorini.errors import InputError
 from signorini.certification.kkt import ACTIVE, certificate, classify
-from signorini.numerics.factor import ActiveSetSolver, factorize
+from signorini.numerics.active_set import ActiveSetSolver
+from signorini.numerics.factor import factorize
 from signorini.numerics.work import counting
 from signorini.numerics.lcp import delassus
 from signorini.problem.contact import ContactProblem, ContactSolution

@@ -27,8 +27,8 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.numerics.active_set import selection_dofs
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
-from signorini.numerics.factor import selection_dofs
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart

@@ -5,7 +5,7 @@ guesses the active set ``A = {i : λᵢ + c (Nu − d)ᵢ > 0}`` and solves the
 equality-constrained system on it (when every row of N bounds one dof, as
 for a flat obstacle, by fixing the active dofs and factorising the SPD
 ``K_FF``; otherwise the saddle-point matrix by LU; see
-:class:`signorini.numerics.factor.ActiveSetSolver`, which
+:class:`signorini.numerics.active_set.ActiveSetSolver`, which
 for CHOLMOD reuses one symbolic analysis for every step)::
 
     [ K    N_Aᵀ ] [ u   ]   [ f   ]
@@ -40,7 +40,8 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.certification.kkt import force_scale, gap_scale
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
-from signorini.numerics.factor import ActiveSetSolver, factorize
+from signorini.numerics.active_set import ActiveSetSolver
+from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
@@ -124,7 +125,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         active = new_active
         log.info("pdas step %d: %d candidates in contact, %d changed", iteration,
                  history["active"][-1], changes)
-        u, lam = system.solve(active, problem.f, problem.d)
+        reused = warm.factor if warm is not None and iteration == 1 else None
+        u, lam = system.solve(active, problem.f, problem.d, factor=reused)
     return ContactSolution(method="pdas", u=u, lam=lam, status=status, message=message,
                            iterations=iteration, solve_time=time.perf_counter() - start,
                            history=history, factor=system.factor)

@@ -1,0 +1,197 @@
+"""The active-set systems of PDAS and of load control, on one factorisation backend.
+
+``Ku + N_Aᵀλ_A = f, N_A u = d`` for one active set after another (:class:`ActiveSetSolver`):
+where each row of N bounds one dof (:func:`selection_dofs`) the active dofs are pinned in a
+factorisation of K's own sparsity (:class:`Pinning`, :class:`PinnedFactor`); otherwise the
+scaled saddle-point system is factorised. The backends are :mod:`signorini.numerics.factor`'s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from signorini.numerics.factor import (CholmodFactor, Factor, PardisoFactor, cholmod_analysis,
+                                       factorize, resolve_backend, upper_csr)
+from signorini.numerics.saddle_point import SaddlePoint
+
+__all__ = ["ActiveSetSolver", "PinnedFactor", "Pinning", "selection_dofs"]
+
+
+def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
+    """The dof of each row when every row of N has one nonzero on its own dof, else None: then
+    each constraint bounds one dof (a flat obstacle, or dofs rotated into each node's normal
+    frame) and an active set is a Dirichlet condition."""
+    N = sp.csr_matrix(N, copy=True)
+    N.eliminate_zeros()
+    N.sort_indices()
+    if not np.all(np.diff(N.indptr) == 1):
+        return None
+    dofs = N.indices.copy()
+    return dofs if np.unique(dofs).size == dofs.size else None
+
+
+class ActiveSetSolver:
+    """Solutions of ``Ku + N_Aᵀλ_A = f, N_A u = d`` (``λ`` zero off A), active set after active set.
+
+    When each row of N bounds one dof, the active dofs are pinned
+    (:class:`PinnedFactor`: a fixed dof's row and column become the
+    identity's, so every active set has K's sparsity pattern; with CHOLMOD
+    the symbolic analysis, the fill-reducing ordering, is done once and only
+    the numeric factorisation repeated). Otherwise the saddle-point matrix, with
+    its constraint rows scaled by ``s = mean |diag K|`` (both blocks of one
+    size in any units; ``λ = s μ``), is factorised by LU.
+
+    ``factor`` is the factorisation of K (with the last active set's dofs
+    pinned, or none) or the saddle-point system
+    (:class:`~signorini.numerics.saddle_point.SaddlePoint`) that the last solve used, for the
+    certificate to reuse. It is let go before the next one is made, so that two never live at
+    once.
+    """
+
+    def __init__(self, K: sp.csr_matrix, N: sp.csr_matrix, backend: str | None = None):
+        self.K = K if sp.issparse(K) else sp.csr_matrix(K)
+        self.N = sp.csr_matrix(N, copy=True)
+        self.N.eliminate_zeros()
+        self.n, self.m = self.K.shape[0], self.N.shape[0]
+        self.backend = resolve_backend(backend, self.n, self.K.nnz)
+        self._dofs = selection_dofs(self.N)
+        self._coef = self.N.data if self._dofs is not None else None
+        self._pinning: Pinning | None = None  # made at the first pinning (CHOLMOD's analysis)
+        self.factor: Factor | PinnedFactor | None = None
+        self.saddle_point: SaddlePoint | None = None
+
+    def pins(self, active: np.ndarray, factor: object) -> bool:
+        """``factor`` is a :class:`PinnedFactor` of this K (or of a copy: a method's view) with
+        exactly the dofs of ``active`` pinned."""
+        return (self._dofs is not None and isinstance(factor, PinnedFactor)
+                and (factor.matrix is self.K or factor.matrix.shape == self.K.shape
+                     and (factor.matrix != self.K).nnz == 0)
+                and np.array_equal(np.sort(factor.fixed), np.sort(self._dofs[active])))
+
+    def solve(self, active: np.ndarray, f: np.ndarray, d: np.ndarray,
+              factor: PinnedFactor | SaddlePoint | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(u, λ)`` on ``active`` for load ``f`` (n or n × k) and gaps ``d`` (m or m × k).
+
+        ``factor``, a factorisation of this very system (see :meth:`pins`, or a
+        :class:`SaddlePoint` on this K, N and active set; for instance the last one
+        a method made on the same active set), is reused: the solve then costs
+        back-solves only.
+        """
+        active = np.asarray(active, dtype=bool)
+        f, d = np.asarray(f, float), np.asarray(d, float)
+        lam = np.zeros((self.m,) + f.shape[1:])
+        if self._dofs is not None:
+            fixed = self._dofs[active]
+            coef = self._coef[active] if f.ndim == 1 else self._coef[active][:, None]
+            rhs = np.array(f)
+            rhs[fixed] = d[active] / coef
+            if factor is None or not self.pins(active, factor):
+                self.factor = None  # let go before the next one is made
+                if self._pinning is None:
+                    self._pinning = Pinning(self.K, self.backend)
+                factor = PinnedFactor(self.K, fixed, self.backend, self._pinning)
+            self.factor = factor
+            u = factor.solve(rhs)
+            lam[active] = (f[fixed] - factor.fixed_rows(u)) / coef
+            return u, lam
+        self.factor = None
+        N_A = self.N[active]
+        if N_A.shape[0] == 0:
+            self.factor = factorize(self.K, self.backend)
+            return self.factor.solve(f), lam
+        if self.saddle_point is None or not np.array_equal(self.saddle_point.active, active):
+            self.saddle_point = None  # let go before the next one is made
+            given = isinstance(factor, SaddlePoint) and factor.stiffness == 1.0 \
+                and factor.on(self.K, self.N, active)
+            self.saddle_point = factor if given else SaddlePoint(self.K, self.N, active)
+        self.factor = self.saddle_point  # the certificate's, on the final active set
+        u, lam[active] = self.saddle_point.solve(f, d[active])
+        return u, lam
+
+
+class Pinning:
+    """Factors of K with some dofs pinned, in the layout the backend reads, made without copying K.
+
+    A pinned dof's row and column are replaced by the identity's, so every set
+    of pinned dofs gives a matrix of K's sparsity pattern: the layout is cut
+    once (K's upper triangle in CSR for PARDISO, all of K in CSC otherwise) and
+    each pinning only rewrites its values; CHOLMOD's symbolic analysis (the
+    ordering, most of a large factorisation's cost beyond the numeric work)
+    is computed once too: a pinning costs no copy of K (docs/speed.md, §4).
+    """
+
+    def __init__(self, K: sp.spmatrix, backend: str = "cholmod"):
+        self.K = K  # kept by reference: the certificate recognises its problem's K
+        self.n = K.shape[0]
+        self.backend = backend
+        if backend == "pardiso":
+            layout = upper_csr(K)
+        else:
+            layout = sp.csc_matrix(K, copy=not sp.isspmatrix_csc(K) or not K.has_sorted_indices)
+            layout.sort_indices()
+        self._layout = layout
+        self._major = np.repeat(np.arange(self.n), np.diff(layout.indptr))
+        self._diagonal = (self._major == layout.indices).astype(float)
+        self._symbolic = cholmod_analysis(layout) if backend == "cholmod" else None
+
+    def matrix(self, fixed: np.ndarray) -> sp.csc_matrix | sp.csr_matrix:
+        """K (its upper triangle in CSR for PARDISO) with the ``fixed`` dofs' rows and columns
+        made the identity's (same pattern)."""
+        layout = self._layout
+        pinned = np.zeros(self.n, dtype=bool)
+        pinned[fixed] = True
+        touched = pinned[self._major] | pinned[layout.indices]
+        data = np.where(touched, self._diagonal, layout.data)
+        return type(layout)((data, layout.indices, layout.indptr), shape=layout.shape)
+
+    def factor(self, fixed: np.ndarray) -> Factor:
+        """The backend's factor of K with the ``fixed`` dofs' rows and columns made the identity's."""
+        matrix = self.matrix(fixed)
+        if self.backend == "cholmod":
+            return CholmodFactor(matrix, self._symbolic)
+        if self.backend == "pardiso":
+            return PardisoFactor(self.K, upper=matrix)
+        return Factor(matrix)
+
+
+def _columns(K: sp.spmatrix, dofs: np.ndarray) -> sp.spmatrix:
+    """``K[:, dofs]`` of a symmetric K, sliced along its storage's fast axis."""
+    return K[dofs].T if K.format == "csr" else sp.csc_matrix(K)[:, dofs]
+
+
+class PinnedFactor:
+    """Solutions of K u = f with the ``fixed`` dofs prescribed: ``solve(rhs)`` takes their
+    values from ``rhs[fixed]`` and the load on the other dofs from the rest of ``rhs``.
+
+    The pinned matrix (K with the fixed dofs' rows and columns made the
+    identity's, K's own pattern) is factorised: CHOLMOD on a shared
+    :class:`Pinning`'s symbolic analysis, other backends from scratch.
+    ``matrix`` is K itself (unpinned). With no dof fixed it solves as a
+    :class:`Factor` of K does.
+    """
+
+    def __init__(self, K: sp.spmatrix, fixed: np.ndarray, backend: str | None = None,
+                 pinning: Pinning | None = None):
+        self.n = K.shape[0]
+        self.fixed = np.asarray(fixed, dtype=int)
+        if pinning is None:
+            pinning = Pinning(K, resolve_backend(backend, self.n, K.nnz))
+        self.backend = pinning.backend
+        self.matrix = pinning.K
+        self._coupling = _columns(pinning.K, self.fixed)
+        self._factor = pinning.factor(self.fixed).solve
+        #: by dof, (the solution for a value c on that free dof, c), kept by its solver
+        self.kept: dict[int, tuple[np.ndarray, float]] = {}
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``."""
+        rhs = np.array(rhs, dtype=float)
+        values = rhs[self.fixed]
+        rhs -= self._coupling @ values
+        rhs[self.fixed] = values
+        return self._factor(rhs)
+
+    def fixed_rows(self, u: np.ndarray) -> np.ndarray:
+        """``(K u)[fixed]`` (for u of length n, or n × k), from the columns :meth:`solve` uses."""
+        return self._coupling.T @ u
