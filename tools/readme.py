@@ -24,6 +24,7 @@ import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimat
 import mesher_compare  # noqa: E402  (tools/mesher_compare.py: the Hertz discs' three meshers)
 import mesher_front  # noqa: E402  (tools/mesher_front.py: accuracy against time per mesher)
 import slider_timing  # noqa: E402  (tools/slider_timing.py: a small solve by stage, the sliders)
+import snapshot  # noqa: E402  (tools/snapshot.py: the same answers and the time across one door)
 import stability  # noqa: E402  (tools/stability.py: the stability atlas's blocks)
 import startup  # noqa: E402  (tools/startup.py: whole-process time before the contact)
 import two_bodies  # noqa: E402  (tools/two_bodies.py: the patch test and Hertz between two bodies)
@@ -42,8 +43,9 @@ CONVERGENCE = ROOT / "docs" / "convergence.md"
 DERIVATIVES = ROOT / "docs" / "derivatives.md"
 MESHER = ROOT / "docs" / "mesher.md"
 TWO_BODIES = ROOT / "docs" / "two-bodies.md"
+ONE_DOOR = ROOT / "docs" / "one-door.md"
 DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE, DERIVATIVES, MESHER,
-             TWO_BODIES)
+             TWO_BODIES, ONE_DOOR)
 #: the contact half-width of each convergence study's scene at its defaults (h / a in the tables)
 STUDY_A = {"hertz-cylinder": 0.05, "hertz-sphere": 0.05, "reverse-hertz": 0.02, "punch": 1.0}
 STUDY_COLUMNS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
@@ -177,6 +179,10 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
     if document == TWO_BODIES:
         return {**{f"two-bodies-{name}": table for name, table in two_bodies.tables(two_bodies.load()).items()},
                 "two-bodies-cost": two_bodies.cost_table(json.loads(two_bodies.COST.read_text()))}
+    if document == ONE_DOOR:
+        runs = ROOT / "docs" / "one-door"
+        return {"one-door-compare": snapshot.compare_table(runs / "old.npz", runs / "new.npz"),
+                "one-door-speed": snapshot.speed_table(json.loads((runs / "speed.json").read_text()))}
     raise ValueError(f"no generated blocks for {document}")
 
 
