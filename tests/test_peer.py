@@ -289,7 +289,7 @@ def test_docs_peer_reading_is_the_committed_run():
         return max(abs(r["p0_rel"]), abs(r["a_rel"]))
 
     cylinder = [r for r in rows if r["scene"] == "hertz-cylinder"]
-    (default,) = [r for r in cylinder if r["code"] == "signorini" and r["mesh"] == "n_contact=40"]
+    (default,) = [r for r in cylinder if r["code"] == "signorini" and r["mesh"] == "n_contact=24"]
     getfem = [r for r in cylinder if r["code"] == "getfem"]
     assert worst(default) < min(worst(r) for r in getfem)  # the default beats every GetFEM rung
     coarser = [r for r in cylinder if r["code"] == "signorini" and r["dofs"] < default["dofs"]]
@@ -303,6 +303,13 @@ def test_docs_peer_reading_is_the_committed_run():
     assert 1.25 * getfem - floor < 0.1  # no route through SciPy meets 1.25x GetFEM
     assert fastest[tool.STEEL] - floor > 0.15 and fastest[tool.STEEL] > 1.25 * getfem  # not met
     assert fastest[tool.DEFAULT_SOLVE] - fastest[tool.DEFAULT_MESH] < 0.1  # the rest is small
+
+
+# ---- two bodies: hertz-two-cylinders, GetFEM's contact between non-matching meshes ----
+
+TWO = "hertz-two-cylinders"
+#: different cylinders in SI units: steel on a larger aluminium cylinder
+SI_PAIR = {"R1": 0.01, "R2": 0.025, "E1": 2.1e11, "nu1": 0.3, "E2": 7e10, "nu2": 0.33, "a_over_R": 0.05}
 
 
 def test_a_mesher_is_set_on_the_package_s_rungs_only():
@@ -319,47 +326,6 @@ def test_a_mesher_is_set_on_the_package_s_rungs_only():
     from signorini.cli import main
 
     assert main(["solve", "hertz-cylinder", "--json", "/dev/null", *ours[0].settings]) == 0
-
-
-def test_docs_peer_triangle_reading_is_the_committed_run():
-    """docs/peer.md's reading of docs/peer-triangle: faster in process at every accuracy GetFEM
-    reaches, slower as a whole process, and closer to Hertz than the relaxed meshes on the coarse
-    rungs but not on the cylinder's default."""
-    from pathlib import Path
-
-    from signorini.studies.peer import TARGETS, at_accuracy
-
-    root = Path(__file__).resolve().parents[1]
-    triangle = json.loads((root / "docs" / "peer-triangle" / "peer.json").read_text())["rows"]
-    relaxed = json.loads((root / "docs" / "peer" / "peer.json").read_text())["rows"]
-    compared = 0
-    for scene in ("hertz-cylinder", "hertz-sphere"):
-        for target in TARGETS:
-            inside, whole = (at_accuracy(triangle, scene, target, by)
-                             for by in ("in_process_s", "wall_s"))
-            if inside["getfem"] is None:
-                continue
-            compared += 1
-            assert inside["signorini"]["in_process_s"] < inside["getfem"]["in_process_s"]
-            assert whole["signorini"]["wall_s"] > whole["getfem"]["wall_s"]
-    assert compared == 3
-
-    def worst(rows, scene, n_contact):
-        (row,) = [r for r in rows if r["scene"] == scene and r["code"] == "signorini"
-                  and r["mesh"].startswith(f"n_contact={n_contact}") and "refine" not in r["mesh"]]
-        return max(abs(row["p0_rel"]), abs(row["a_rel"]))
-
-    for scene, coarse in (("hertz-cylinder", (10, 20)), ("hertz-sphere", (12, 25, 50))):
-        assert all(worst(triangle, scene, n) < worst(relaxed, scene, n) for n in coarse)
-    assert all(worst(triangle, "hertz-cylinder", n) > worst(relaxed, "hertz-cylinder", n)
-               for n in (40, 80))
-
-
-# ---- two bodies: hertz-two-cylinders, GetFEM's contact between non-matching meshes ----
-
-TWO = "hertz-two-cylinders"
-#: different cylinders in SI units: steel on a larger aluminium cylinder
-SI_PAIR = {"R1": 0.01, "R2": 0.025, "E1": 2.1e11, "nu1": 0.3, "E2": 7e10, "nu2": 0.33, "a_over_R": 0.05}
 
 
 def load_two_body_script(monkeypatch):

@@ -146,8 +146,6 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
         return {**accuracy.tables(accuracy.load()), **runs}
     if document == PEER:
         peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
-        triangle = peer_table(json.loads((ROOT / "docs" / "peer-triangle" / "peer.json")
-                                         .read_text())["rows"])  # --set mesher=triangle
         two = peer_table(json.loads((ROOT / "docs" / "peer-two" / "peer.json").read_text())["rows"])
         return {"peer-runs": "\n".join(peer[:peer.index("")]),
                 "peer-two-runs": "\n".join(two[:two.index("")]),  # hertz-two-cylinders
@@ -155,8 +153,6 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
                 "peer-two-matching": "\n".join(matching_table(json.loads(
                     (ROOT / "docs" / "peer-two" / "master-ratio.json").read_text())["rows"])),
                 "peer-summary": "\n".join(peer[peer.index("") + 1:]),
-                "peer-triangle-runs": "\n".join(triangle[:triangle.index("")]),
-                "peer-triangle-summary": "\n".join(triangle[triangle.index("") + 1:]),
                 "startup": startup.table(startup.load()), "startup-reading": startup.reading(startup.load())}
     if document == CONVERGENCE:
         return {**{f"convergence-{scene}": convergence_table(
