@@ -47,13 +47,25 @@ GRADED = [
     *[(family, {"grading": 0.1, "n_contact": 10}) for family in ("hertz-cylinder", "hertz-sphere", "punch",
                                                                 "reverse-hertz")],
     ("punch", {"half": 0}), ("punch", {"size": 200}),
+    # the relaxed mesher at the sizes its model was measured on (Triangle's are the default now)
+    *[(family, {"grading": g, "mesher": "relaxed", "n_contact": n})
+      for family, n in (("hertz-cylinder", 40), ("hertz-sphere", 60)) for g in (0.1, 0.3, 0.6, 1.0, 2.0)],
 ]
+#: Triangle's Hertz discs follow the grading less regularly than the relaxed ones: the size model
+#: (the relaxed meshes' times TRIANGLE_DOFS) bounds them from above within this factor, not 1.3
+TRIANGLE_OVER = 1.8
 SLOW = [
     ("hertz-sphere-3d", {"grading": 0.05}), ("hertz-sphere-3d", {"grading": 0.1}),
     ("hertz-sphere-3d", {"refine": 1, "grading": 0.2}),
     ("hertz-sphere-3d", {"refine": 1, "grading": 0.1, "n_contact": 5}),
     *[(family, {"grading": 0.05}) for family in ("hertz-cylinder", "hertz-sphere", "punch", "reverse-hertz")],
 ]
+
+
+def over(family, values, tight):
+    """How far above the mesh built the estimate may be."""
+    triangle = family in ("hertz-cylinder", "hertz-sphere") and values.get("mesher", "triangle") == "triangle"
+    return max(tight, TRIANGLE_OVER) if triangle else tight
 
 
 def _built_and_estimated(family, values):
@@ -65,14 +77,14 @@ def _built_and_estimated(family, values):
 @pytest.mark.parametrize("family, values", GRADED, ids=[f"{f}-{v}" for f, v in GRADED])
 def test_the_estimate_bounds_the_graded_mesh_built_from_above(family, values):
     built, estimate = _built_and_estimated(family, values)
-    assert built <= estimate <= 1.3 * built, (estimate, built)
+    assert built <= estimate <= over(family, values, 1.3) * built, (estimate, built)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("family, values", SLOW, ids=[f"{f}-{v}" for f, v in SLOW])
 def test_the_estimate_bounds_the_finely_graded_meshes_built_from_above(family, values):
     built, estimate = _built_and_estimated(family, values)
-    assert built <= estimate <= 1.3 * built, (estimate, built)
+    assert built <= estimate <= over(family, values, 1.3) * built, (estimate, built)
 
 
 def test_the_sphere_refused_at_one_gb_for_its_grading_is_sized_over_what_it_builds(monkeypatch):
@@ -92,7 +104,7 @@ def test_the_sphere_refused_at_one_gb_for_its_grading_is_sized_over_what_it_buil
 ])
 def test_the_estimate_follows_the_parameters_that_change_the_mesh(family, values):
     built, estimate = _built_and_estimated(family, values)
-    assert built <= estimate <= 1.5 * built, (estimate, built)
+    assert built <= estimate <= over(family, values, 1.5) * built, (estimate, built)
 
 
 def test_the_first_adaptive_mesh_is_sized_before_it_is_made(monkeypatch):
