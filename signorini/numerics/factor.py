@@ -136,6 +136,12 @@ def cholmod_ordering(n: int) -> str:
 SUPERNODAL_FROM = 40_000
 
 
+#: a pivot of the simplicial LDLᵀ at most this fraction of the largest is round-off: the pivot a
+#: singular K leaves (a rigid mode held by nothing gave 1.3e-16 of the largest), far below the
+#: smallest of a positive definite stiffness at any condition number a double can solve
+PIVOT_ROUNDOFF = 1e-13
+
+
 def cholmod_analysis(K: sp.csc_matrix):
     """CHOLMOD's symbolic analysis (ordering, supernodes or not) of the pattern of K."""
     from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
@@ -152,8 +158,10 @@ def cholmod_numeric(symbolic, K: sp.csc_matrix):
         factor = symbolic.cholesky(K)
     except CholmodNotPositiveDefiniteError as exc:
         raise np.linalg.LinAlgError(f"K is not positive definite ({exc})") from exc
-    if not np.all(factor.D() > 0):  # the simplicial factor is LDLᵀ, which an indefinite K passes
-        raise np.linalg.LinAlgError("K is not positive definite (a pivot of its LDLᵀ is not positive)")
+    pivots = factor.D()  # the simplicial factor is LDLᵀ, which an indefinite or singular K passes
+    if not np.all(pivots > PIVOT_ROUNDOFF * pivots.max(initial=0.0)):
+        raise np.linalg.LinAlgError("K is not positive definite (a pivot of its LDLᵀ is not above "
+                                    "round-off: K is singular or indefinite)")
     return factor
 
 
