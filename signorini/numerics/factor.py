@@ -136,9 +136,8 @@ def cholmod_ordering(n: int) -> str:
 SUPERNODAL_FROM = 40_000
 
 
-#: a pivot of the simplicial LDLᵀ at most this fraction of the largest is round-off: the pivot a
-#: singular K leaves (a rigid mode held by nothing gave 1.3e-16 of the largest), far below the
-#: smallest of a positive definite stiffness at any condition number a double can solve
+#: a pivot of the simplicial LDLᵀ at most this fraction of its row's diagonal entry of K is
+#: round-off: the pivot a singular K leaves (a rigid mode held by nothing gave 1.1e-16 of it)
 PIVOT_ROUNDOFF = 1e-13
 
 
@@ -158,8 +157,9 @@ def cholmod_numeric(symbolic, K: sp.csc_matrix):
         factor = symbolic.cholesky(K)
     except CholmodNotPositiveDefiniteError as exc:
         raise np.linalg.LinAlgError(f"K is not positive definite ({exc})") from exc
-    pivots = factor.D()  # the simplicial factor is LDLᵀ, which an indefinite or singular K passes
-    if not np.all(pivots > PIVOT_ROUNDOFF * pivots.max(initial=0.0)):
+    # the simplicial factor is LDLᵀ, which an indefinite or singular K passes: each pivot is
+    # judged against its own row's diagonal entry (the materials' contrast divides out)
+    if not np.all(factor.D() > PIVOT_ROUNDOFF * np.abs(K.diagonal()[factor.P()])):
         raise np.linalg.LinAlgError("K is not positive definite (a pivot of its LDLᵀ is not above "
                                     "round-off: K is singular or indefinite)")
     return factor
