@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from signorini.cli import main
+from signorini.cli import app, main
 
 SMALL_HERTZ = ["--set", "n_contact=16", "--set", "grading=0.4"]
 
@@ -144,3 +144,35 @@ def test_installed_entry_point_exits_2_without_traceback():
                            "--set", "nu=0.5"], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr and "nu" in proc.stderr
+
+
+@pytest.mark.parametrize("json_to", ["-", "file"])
+def test_the_process_ends_with_every_output_written(tmp_path, json_to):
+    # `python -m signorini.cli` ends by os._exit, past the interpreter's teardown: what it printed
+    # into a block-buffered file and the JSON it wrote must be whole, and the code its own
+    record = tmp_path / "r.json"
+    with open(tmp_path / "out.txt", "w") as out:
+        proc = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "block", "--set",
+                               "nx=4", "--set", "ny=4", "--json",
+                               "-" if json_to == "-" else str(record)],
+                              stdout=out, stderr=subprocess.PIPE, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    printed = (tmp_path / "out.txt").read_text()
+    if json_to == "-":
+        assert json.loads(printed)["status"] == "converged"
+    else:
+        assert json.loads(record.read_text())["status"] == "converged"
+        assert printed.rstrip().splitlines()[-1].lstrip().startswith("units:"), printed
+
+
+def test_run_skips_the_teardown_only_as_the_one_process(monkeypatch):
+    ended, handlers = [], []
+    monkeypatch.setattr(app.os, "_exit", ended.append)
+    monkeypatch.setattr(app.atexit, "_run_exitfuncs", lambda: handlers.append(True))
+    app.run(["methods"])
+    assert ended == [0] and handlers == [True]  # the exit handlers ran, then the process ended
+    monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")  # under mpirun: MPI ends the ranks as usual
+    monkeypatch.setattr(app, "main", lambda argv: 0)
+    with pytest.raises(SystemExit) as stopped:
+        app.run(["methods"])
+    assert stopped.value.code == 0 and ended == [0]

@@ -271,6 +271,28 @@ def test_a_folded_tetrahedral_mesh_is_named_alike_given_its_facets_or_not():
     assert said[0] == said[1]
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_sound_mesh_given_its_facets_is_accepted_without_sorting_them(dim, monkeypatch):
+    """Given the facets found, a sound mesh (its elements' nodes in any order, so of either
+    orientation) is passed by two sums over its facets; the sort that names a fault never runs."""
+    from skfem import MeshTet, MeshTri
+
+    from signorini.fem import checks
+    from signorini.fem.topology import with_topology
+
+    mesh = (MeshTri if dim == 2 else MeshTet)().refined(3 if dim == 2 else 2)
+    rng = np.random.default_rng(1)
+    t = np.take_along_axis(mesh.t, np.argsort(rng.random(mesh.t.shape), axis=0), axis=0)
+    shuffled = with_topology(type(mesh)(mesh.p, t, sort_t=False))
+    monkeypatch.setattr(checks, "_first_equal_neighbours", lambda *a: pytest.fail("sorted"))
+    check_mesh(mesh.p, t, facet_ids=checks.opposite_facets(shuffled))
+    inner = np.setdiff1d(np.arange(mesh.p.shape[1]), mesh.boundary_nodes())[0]
+    p = mesh.p.copy()
+    p[:, inner] += 0.3  # pushed through its neighbours' facets: two elements on one side
+    volume = checks.signed_measures(p, t)
+    assert not checks._facets_sound(t, np.sign(volume), checks.opposite_facets(shuffled))
+
+
 def test_a_mesh_of_either_orientation_is_accepted():
     check_mesh(SQUARE_P, SQUARE_T)
     check_mesh(SQUARE_P, SQUARE_T[[0, 2, 1]])  # both clockwise

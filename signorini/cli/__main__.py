@@ -1,7 +1,5 @@
 """``python -m signorini.cli``: the ``signorini`` command."""
 
-import sys
+from signorini.cli.app import run
 
-from signorini.cli.app import main
-
-sys.exit(main())
+run()
