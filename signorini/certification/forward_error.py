@@ -144,8 +144,10 @@ def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.
     border = np.concatenate([Q, P])
     k = border.size
 
+    K = sp.csr_matrix(K)
+    K_Q, K_rows = K[Q], K[dofs]  # the rows of K x it reads, not all of K x
     B, Z = _blocks(lambda j: _unit_solutions(solve, border[j], n), k, n,
-                   lambda Z: np.vstack([(K @ Z)[Q], Z[P]]))
+                   lambda Z: np.vstack([K_Q @ Z, Z[P]]))
     lu = _inverse(B) if k else None  # k ≤ MAX_BORDER, dense and small
     if k and lu is None:
         return None, k
@@ -157,13 +159,13 @@ def _pinned_system(K: sp.spmatrix, solve: Callable, fixed: np.ndarray, dofs: np.
         rhs[fixed] = value[fixed]
         x = solve(rhs)
         if k:
-            miss = np.concatenate([-r[Q] - (K @ x)[Q], value[P] - x[P]])
+            miss = np.concatenate([-r[Q] - K_Q @ x, value[P] - x[P]])
             if Z is None:
                 rhs[border] += lu @ miss
                 x = solve(rhs)
             else:  # the border's columns were kept: the correction is a product, not a solve
                 x = x + Z @ (lu @ miss)
-        return x, (-r - K @ x)[dofs] / coef
+        return x, (-r[dofs] - K_rows @ x) / coef
 
     return apply, k
 
@@ -229,12 +231,14 @@ def _system(K: sp.spmatrix, N: sp.csr_matrix, rows: np.ndarray, solve: _Counted)
 
 
 def forward_error(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray, u: np.ndarray,
-                  lam: np.ndarray, active: np.ndarray, factor, scale: float) -> ForwardError:
+                  lam: np.ndarray, active: np.ndarray, factor, scale: float,
+                  Ku: np.ndarray | None = None) -> ForwardError:
     """Two Newton steps on the active set ``active`` from ``(u, λ)`` with ``factor`` (see module;
     one when ``factor`` is an iterative solve).
 
     ``factor`` is a factorisation of K (plain or pinned on rows of N that bound
-    one dof each); ``scale`` the force λ's error is measured against.
+    one dof each); ``scale`` the force λ's error is measured against; ``Ku`` is K u when
+    the caller has it.
     """
     solve = _Counted(factor)
     rows = np.flatnonzero(active)
@@ -245,10 +249,10 @@ def forward_error(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray
     lam_bar = np.zeros_like(lam)
     lam_bar[rows] = lam[rows]
 
-    def residuals(x, mu):
-        return K @ x - f + N_A.T @ mu, N_A @ x - d_A
+    def residuals(x, mu, Kx=None):
+        return (K @ x if Kx is None else Kx) - f + N_A.T @ mu, N_A @ x - d_A
 
-    du, dlam = apply(*residuals(u, lam_bar[rows]))
+    du, dlam = apply(*residuals(u, lam_bar[rows], Ku))
     u1, lam1 = u + du, lam_bar[rows] + dlam
     floor = float("nan")
     if getattr(factor, "exact", True):  # an iterative solve's second step measures its own stop

@@ -187,7 +187,7 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:
         offers = Offers(problem, solution)
-        forward = _forward(problem, solution, lam_norm, offers)
+        forward = _forward(problem, solution, lam_norm, offers, Ku)
         energy = float(0.5 * u @ Ku - problem.f @ u)
         absolute = primal_dual_gap(problem, u, lam, offers(), Ku)
         if not solution.keep_factor:  # used: a kept solution no longer keeps a factorisation alive
@@ -198,7 +198,7 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
 
 
 def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
-             offers: Offers | None = None) -> ForwardError:
+             offers: Offers | None = None, Ku: np.ndarray | None = None) -> ForwardError:
     """The forward error on the certificate's active set, by the first usable factorisation.
 
     The method's (its pinned set checked as for the duality gap), else the
@@ -215,7 +215,7 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
     if not offered:
         return ForwardError.unknown()
     return forward_error(problem.K, problem.f, problem.N, problem.d, solution.u, solution.lam,
-                         active, offered[0], scale)
+                         active, offered[0], scale, Ku)
 
 
 #: what the certificate says when it cannot vouch for the contact force, by the error's name

@@ -224,8 +224,8 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     # applied load = −Σ reactions on the loaded dofs (a push towards the obstacle is positive)
     load_full = -model.force_multiplicity * np.asarray(K_full[load_dofs].sum(axis=0)).ravel()
 
-    K_free = K_full[free]  # the free rows, once: then their free and their fixed columns
-    K_II, K_ID = K_free[:, free], K_free[:, fixed]
+    K_free = K_full[free]  # the free rows, once: then their free columns
+    K_II = K_free[:, free]
     N_free = N_full[:, free].tocsr()
     target = None if model.target_load is None else model.target_load / force_unit
     f_load, offset_load = cut_traction(model, mesh, dof_table, load_dofs)
@@ -236,7 +236,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
         u_D = prescribed[fixed] * scale
         full = np.zeros(n_full)
         full[fixed] = u_D
-        f = -(K_ID @ u_D)
+        f = -(K_free @ full)  # K_ID u_D, the same sums: the free columns add exact zeros
         offset = float(load_full[fixed] @ u_D)
         if f_load is not None:  # the traction of the target load (fixed while the push varies)
             f = f + target * f_load[free]
