@@ -161,8 +161,14 @@ def test_the_process_ends_with_every_output_written(tmp_path, json_to):
     if json_to == "-":
         assert json.loads(printed)["status"] == "converged"
     else:
-        assert json.loads(record.read_text())["status"] == "converged"
+        written = json.loads(record.read_text())
+        assert written["status"] == "converged"
         assert printed.rstrip().splitlines()[-1].lstrip().startswith("units:"), printed
+        # the process's start-up is a stage of its record (in process, below, it is not)
+        assert 0 < written["time"]["startup_s"] < written["time"]["total_s"]
+        assert main(["solve", "block", "--set", "nx=4", "--set", "ny=4", "--json",
+                     str(record)]) == 0
+        assert json.loads(record.read_text())["time"]["startup_s"] == 0
 
 
 def test_run_skips_the_teardown_only_as_the_one_process(monkeypatch):
@@ -172,7 +178,7 @@ def test_run_skips_the_teardown_only_as_the_one_process(monkeypatch):
     app.run(["methods"])
     assert ended == [0] and handlers == [True]  # the exit handlers ran, then the process ended
     monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")  # under mpirun: MPI ends the ranks as usual
-    monkeypatch.setattr(app, "main", lambda argv: 0)
+    monkeypatch.setattr(app, "main", lambda argv, process: 0)
     with pytest.raises(SystemExit) as stopped:
         app.run(["methods"])
     assert stopped.value.code == 0 and ended == [0]

@@ -83,13 +83,19 @@ def whole_process(scene: str, params: dict, method: str | None = None) -> dict:
 
 
 def stages(command: dict) -> dict:
-    """The command's stages in seconds from its record (``time``), and ``startup``: the wall
-    time outside them."""
+    """The command's stages in seconds from its record (``time``); ``startup`` is the record's
+    (the interpreter, imports, parsing) and the wall time outside the record (writing, exit)."""
     time_ = command["time"]
     found = {key[:-2]: value for key, value in time_.items()
              if key.endswith("_s") and key[:-2] in BUDGETS_2D and key != "startup_s"}
-    found["startup"] = command["wall_s"] - time_["total_s"]
+    found["startup"] = time_.get("startup_s", 0.0) + command["wall_s"] - time_["total_s"]
     return found
+
+
+def accounted(command: dict) -> str:
+    """How much of the command's wall time its record's ``time`` accounts for."""
+    return (f"{command['time']['total_s']:.1f} s in all, "
+            f"{100 * command['time']['total_s'] / command['wall_s']:.0f} % of the wall time")
 
 
 def stage_rows(command: dict, reference: float, budgets: dict, skip: tuple = ()) -> list[str]:
@@ -245,8 +251,9 @@ def table(record: dict) -> str:
                  ("the error estimate", "estimate_s"),
                  ("PARDISO: factorise K", "pardiso_factorise_s"),
                  ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s"))),
-             "", f"Each stage of the command's own record (its JSON `time`; *startup* is the wall "
-                 f"time outside them: imports, parsing, exit) against its budget, a share of that "
+             "", f"Each stage of the command's own record (its JSON `time`: {accounted(command)}; "
+                 f"*startup* is its `startup_s`, the interpreter, imports and parsing, and the wall "
+                 f"time after the record: writing, exit) against its budget, a share of that "
                  f"factorisation (`tools/budget.py`'s `BUDGETS_2D`, summing to 1.5×):", "",
              *stage_rows(command, once, BUDGETS_2D)]
     if "2d-nested" in record:
@@ -264,7 +271,8 @@ def table(record: dict) -> str:
             if method:
                 outside = three["wall_s"] - method
                 lines += ["", f"Outside its method (`{three.get('method') or 'pdas-amg'}`, "
-                              f"{method:.1f} s in the command's record): **{outside:.1f} s**, "
+                              f"{method:.1f} s in the command's record of {accounted(three)}): "
+                              f"**{outside:.1f} s**, "
                               f"**{100 * outside / method:.0f} %** of the method's time (goal "
                               f"≤ 30 %); each stage against its budget, a share of the method's "
                               f"time (`BUDGETS_3D`):", "",

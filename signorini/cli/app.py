@@ -78,12 +78,14 @@ def _check_distributed(args: argparse.Namespace, ranks: int) -> None:
                          "without mpirun")
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None, *, process: bool = False) -> int:
+    """Run one command; its exit code. ``process``: this call is the whole process
+    (:func:`run`), so a solve's record counts the process's start-up among its stages."""
     from signorini.solvers import cluster  # per command (start-up)
 
     if cluster.launched_size() > 1:
         return _main_ranks(argv)
-    return _main(argv)
+    return _main(argv, process=process)
 
 
 def run(argv: Sequence[str] | None = None) -> NoReturn:
@@ -94,7 +96,7 @@ def run(argv: Sequence[str] | None = None) -> NoReturn:
     which frees every object one by one (at 10⁶ dofs, gigabytes of arrays and a
     factorisation). Under ``mpirun``, or when the output cannot be flushed, it exits as usual.
     """
-    code = main(argv)
+    code = main(argv, process=True)
     from signorini.solvers import cluster  # per command (start-up)
 
     if cluster.launched_size() > 1:
@@ -139,12 +141,12 @@ def _stop(signum: int, frame) -> None:
     raise Stopped(signum)
 
 
-def _main(argv: Sequence[str] | None, ranks: int = 1) -> int:
+def _main(argv: Sequence[str] | None, ranks: int = 1, process: bool = False) -> int:
     handled = (signal.SIGTERM, signal.SIGHUP)
     main_thread = threading.current_thread() is threading.main_thread()
     before = {s: signal.signal(s, _stop) for s in handled} if main_thread else {}
     try:
-        return _run(argv, ranks)
+        return _run(argv, ranks, process)
     finally:
         _clean_up()
         for number, handler in before.items():
@@ -200,12 +202,13 @@ def _reader_gone() -> bool:
         return False
 
 
-def _run(argv: Sequence[str] | None, ranks: int) -> int:
+def _run(argv: Sequence[str] | None, ranks: int, process: bool = False) -> int:
     try:
         if _stdout_closed():  # nothing printed would be seen, and fd 1 could be a file's
             raise InputError("standard output is closed: run with it open (> /dev/null "
                              "discards what is printed)")
         args = build_parser().parse_args(argv)
+        args.process = process
         set_up_logging(args)
         if ranks > 1:
             _check_distributed(args, ranks)

@@ -7,6 +7,7 @@ import contextlib
 import os
 import sys
 import textwrap
+import time
 from typing import Any, Iterator, Sequence
 
 from signorini.errors import DOCS_SITE, InputError
@@ -169,6 +170,18 @@ def stdout_to_stderr(active: bool = True) -> Iterator[None]:
         os.dup2(saved, 1)
         os.close(saved)
         sys.stdout = real
+
+
+def process_seconds() -> float | None:
+    """Wall seconds since this process started: its start in ``/proc/self/stat`` (to the clock
+    tick) against the boot-time clock; None where the system does not say (not Linux)."""
+    try:
+        with open("/proc/self/stat", "rb") as stat_file:
+            fields = stat_file.read().rsplit(b")", 1)[1].split()  # from the 3rd field on
+        started = int(fields[19]) / os.sysconf("SC_CLK_TCK")  # field 22: the start, in ticks
+        return max(time.clock_gettime(time.CLOCK_BOOTTIME) - started, 0.0)
+    except (OSError, ValueError, IndexError, AttributeError):
+        return None
 
 
 def parse_sizes(text: str) -> list[int]:

@@ -7,19 +7,22 @@ import os
 import sys
 
 from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, SCENE_HELP, add_command, input_files,
-                                  method_options, pairs, parse_time_limit, parse_tol, stdout_to_stderr,
-                                  write_output)
+                                  method_options, pairs, parse_time_limit, parse_tol, process_seconds,
+                                  stdout_to_stderr, write_output)
 from signorini.errors import InputError
 from signorini.solvers.options import DEFAULT_TOL, guess_value
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.api import Result, at_load, build_problem, solve, solve_adaptive  # per command
+    from signorini.api import (Result, at_load, build_problem, solve, solve_adaptive,  # per command
+                               solve_summary)
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
     from signorini.certification.kkt import certificate  # per command (start-up)
     from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
 
+    # the process's start-up (interpreter, imports, parsing), when this command is the process
+    startup = process_seconds() if getattr(args, "process", False) else None
     params = pairs(args.set, "--set")
     texts = method_options(args.opt, [args.method]).get(args.method, {})
     max_iter = guess_value(texts.pop("max_iter")) if "max_iter" in texts else None
@@ -82,6 +85,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
                 solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
                                         max_iter=max_iter, options=request.options)
                 result = Result(problem, solution, certificate(problem, solution))
+    if startup is not None:
+        result.solution.seconds["startup"] = startup
     record = result.to_dict()
     finite = record["contact"] is not None
     with all_or_none():  # every output, or none of them
@@ -92,7 +97,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
             export_vtk(problem, result.solution, vtk_path)
     if json_path != STDOUT:
-        print(result.summary())
+        print(solve_summary(record))
     if vtk_path and not finite:
         print(f"signorini: no finite answer, {args.vtk} not written", file=sys.stderr)
         return EXIT_FAILED

@@ -76,9 +76,10 @@ def count(kind: str, amount: int = 1) -> None:
         setattr(work, kind, getattr(work, kind) + amount)
 
 
-#: the stages of a solve, in the order they run (the solve record's ``time``)
-STAGES = ("mesh", "assemble", "load control", "prediction", "method", "certificate", "estimate",
-          "output")
+#: the stages of a solve, in the order they run (the solve record's ``time``); ``startup`` is the
+#: command's process before it builds the scene (interpreter, imports, parsing): 0 in a library call
+STAGES = ("startup", "mesh", "assemble", "load control", "prediction", "method", "certificate",
+          "estimate", "output")
 
 
 def stage_key(stage: str) -> str:
