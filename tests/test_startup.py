@@ -51,6 +51,17 @@ def test_the_default_cylinder_is_factorised_without_pardiso():
     assert answer["loaded"] == []
 
 
+def test_a_2d_contact_zone_is_predicted_without_scipy_spatial():
+    """scipy.spatial (a second of imports on a loaded machine) finds 3D candidates' spacing only."""
+    answer = fresh(loaded_after(
+        "import numpy as np\n"
+        "from signorini.numerics.zone import zone_around_points\n"
+        "x = np.linspace(0.0, 1.0, 200)\n"
+        "assert zone_around_points(np.column_stack([x, 0 * x]), 0.3, 0.3) is not None",
+        modules=("scipy.spatial",)))
+    assert answer["loaded"] == []
+
+
 def test_methods_lists_what_is_installed_without_importing_it():
     answer = fresh(
         "import contextlib, io, json, sys\n"

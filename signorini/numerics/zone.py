@@ -129,12 +129,12 @@ def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | No
     radial distances crowd together, so the gap between sorted ones says nothing), and the band
     stops at ``a + margin·a``: a ring of candidates costs a back-solve each, and a node beyond it
     that touches joins it for one back-solve more (docs/calibration.md)."""
-    from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
-
     points = np.atleast_2d(np.asarray(points, dtype=float))
     rho = radial_distance(points)
     if points.shape[1] == 2:
         return zone_around(rho, a, margin)
+    from scipy.spatial import cKDTree  # in 3D only: scipy.spatial is slow to import
+
     near = points[np.abs(rho - a) < 0.25 * a]
     if len(near) < 3:
         return None
