@@ -397,6 +397,27 @@ def test_the_certificate_costs_a_few_back_solves_of_the_method_factorisation(zon
     assert spent(lambda: certificate(zoned, solution))[0] == {"factorisations": 0, "back_solves": 0}
 
 
+def test_the_forward_error_multiplies_by_all_of_k_once_given_k_u(zoned):
+    """On a pinned factorisation each Newton step reads only the rows of K x it needs (the
+    border's, the active set's): given K u, the one product by the whole K is the second
+    step's residual."""
+    from signorini.certification.forward_error import forward_error
+
+    class Counted(sp.csr_matrix):
+        products = 0
+
+        def __matmul__(self, other):
+            Counted.products += 1
+            return super().__matmul__(other)
+
+    solution = registry.get_method("nested").function(zoned)
+    u, lam = solution.u, solution.lam
+    found = forward_error(Counted(zoned.K), zoned.f, zoned.N, zoned.d, u, lam,
+                          active_set(zoned, solution), solution.factor,
+                          kkt.force_scale(zoned, lam, u), Ku=zoned.K @ u)
+    assert Counted.products == 1 and found.back_solves == 2 and found.force < 1e-10
+
+
 def test_the_forward_error_reads_back_the_band_columns_the_zone_solver_kept(zoned, monkeypatch):
     """A zone whose core misses the contact's edge: the band nodes that come into contact are
     rows where the pinned set and the active set differ, and the zone solver has already solved
