@@ -102,9 +102,13 @@ def check_mesh(p: np.ndarray, t: np.ndarray, what: str = "the scene's mesh",
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is a degenerate element
         rows = np.ascontiguousarray(p.T)
         corners = [np.take(rows, t[i], axis=0) for i in range(dim + 1)]
-        edges = {(i, j): corners[j] - corners[i] for i, j in combinations(range(dim + 1), 2)}
-        longest = np.sqrt(np.max([np.einsum("ij,ij->i", e, e) for e in edges.values()], axis=0))
-        volume = _determinants([edges[0, i] for i in range(1, dim + 1)])  # signed_measures
+        spokes = [corner - corners[0] for corner in corners[1:]]  # the edges from corner 0
+        longest = np.zeros(t.shape[1])  # the longest edge squared, one edge at a time
+        for i, j in combinations(range(dim + 1), 2):
+            edge = spokes[j - 1] if i == 0 else corners[j] - corners[i]
+            np.maximum(longest, np.einsum("ij,ij->i", edge, edge), out=longest)
+        longest = np.sqrt(longest)
+        volume = _determinants(spokes)  # signed_measures
         degenerate = ~(np.abs(volume) > DEGENERATE * longest ** dim)
     if np.any(degenerate):
         element = int(np.argmax(degenerate))
