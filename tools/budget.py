@@ -198,7 +198,7 @@ def in_process_amg(scene: str, params: dict) -> dict:
     from signorini.numerics.multigrid import pinned_cg, pinned_matrix
     from signorini.solvers import amg, amg_system
     from signorini.solvers.bounds import bound_form
-    from signorini.solvers.defaults import resolved
+    from signorini.solvers.options import resolved
 
     parts, result = built_and_solved(scene, params, solved_by="auto")  # as the command builds it
     extras = result.solution.extras
