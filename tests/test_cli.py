@@ -173,6 +173,7 @@ def test_the_process_ends_with_every_output_written(tmp_path, json_to):
 
 def test_run_skips_the_teardown_only_as_the_one_process(monkeypatch):
     ended, handlers = [], []
+    monkeypatch.setattr(app, "keep_freed_memory", lambda: None)  # this process's allocator stays
     monkeypatch.setattr(app.os, "_exit", ended.append)
     monkeypatch.setattr(app.atexit, "_run_exitfuncs", lambda: handlers.append(True))
     app.run(["methods"])
@@ -182,3 +183,20 @@ def test_run_skips_the_teardown_only_as_the_one_process(monkeypatch):
     with pytest.raises(SystemExit) as stopped:
         app.run(["methods"])
     assert stopped.value.code == 0 and ended == [0]
+
+
+def test_the_process_keeps_the_memory_it_frees():
+    # what run() sets for the command's process, in a fresh one: NumPy's huge-page requests off,
+    # and arrays larger than glibc's mmap threshold still allocate, free and come back
+    code = ("import numpy as np\n"
+            "from numpy._core.multiarray import _get_madvise_hugepage\n"
+            "from signorini.cli.app import keep_freed_memory\n"
+            "keep_freed_memory()\n"
+            "for _ in range(3):\n"
+            "    a = np.ones(2 ** 23)\n"
+            "    assert a.sum() == 2 ** 23\n"
+            "    del a\n"
+            "print(_get_madvise_hugepage())")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "False"

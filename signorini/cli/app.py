@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import atexit
 import contextlib
+import ctypes
 import errno
 import logging
 import os
@@ -96,6 +97,7 @@ def run(argv: Sequence[str] | None = None) -> NoReturn:
     which frees every object one by one (at 10⁶ dofs, gigabytes of arrays and a
     factorisation). Under ``mpirun``, or when the output cannot be flushed, it exits as usual.
     """
+    keep_freed_memory()
     code = main(argv, process=True)
     from signorini.solvers import cluster  # per command (start-up)
 
@@ -109,6 +111,28 @@ def run(argv: Sequence[str] | None = None) -> NoReturn:
         sys.exit(code)
     atexit._run_exitfuncs()  # logging's flush and whatever a library registered
     os._exit(code)
+
+
+#: glibc's ``mallopt`` parameters (malloc.h): the most blocks served by ``mmap``, and the free
+#: memory at the heap's top beyond which it is given back to the system
+M_MMAP_MAX, M_TRIM_THRESHOLD = -4, -1
+
+
+def keep_freed_memory() -> None:
+    """This process (the command alone) reuses the memory it frees: glibc serves every block
+    from its heap and gives none back (``mallopt``), and NumPy asks for no transparent huge
+    pages. A large solve allocates and frees arrays of hundreds of megabytes again and again;
+    served by ``mmap`` each is mapped afresh, and each first touch of a page is a fault (with
+    huge pages, a compaction on a busy machine). The peak memory grows a little (the heap
+    fragments). Elsewhere than glibc, or with another NumPy, nothing changes."""
+    with contextlib.suppress(OSError, AttributeError, TypeError):
+        libc = ctypes.CDLL(None)
+        libc.mallopt(M_MMAP_MAX, 0)
+        libc.mallopt(M_TRIM_THRESHOLD, 2 ** 31 - 1)
+    with contextlib.suppress(ImportError, AttributeError):
+        from numpy._core.multiarray import _set_madvise_hugepage  # per process (its entry)
+
+        _set_madvise_hugepage(False)
 
 
 def _main_ranks(argv: Sequence[str] | None) -> int:
