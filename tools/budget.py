@@ -125,9 +125,11 @@ def factorised(scene: str, params: dict) -> dict:
     the package's settings and solved once, timed."""
     import numpy as np
 
+    from signorini.cli.app import keep_freed_memory
     from signorini.numerics.factor import PardisoFactor
     from signorini.scenes.build import build_problem
 
+    keep_freed_memory()  # as the command's process does: the same allocator for both
     problem = build_problem(scene, params)
     K, f = problem.K, np.asarray(problem.f, dtype=float)
     del problem
