@@ -59,15 +59,17 @@ from signorini.solvers import pdas
 from signorini.solvers.bounds import NoBoundForm, bound_form
 from signorini.solvers.amg_system import CG_MAX_ITER, PinnedCG, PinnedSystem
 from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
+from signorini.problem.solution import WarmStart
 from signorini.solvers.base import Method
-from signorini.solvers.options import resolved
-from signorini.solvers.options import positive_number, take_options
+from signorini.solvers.options import Option, declare, per_candidate, resolved, take_options
 
 log = logging.getLogger(__name__)
 
-AMG_CHOICES = ("auto", "petsc", "pyamg")
-DEFAULTS = {"amg": "auto", "c": 1.0, "active0": None, "coarse": None, "callback": None,
-            "warm_start": None, "push0": None}
+DEFAULTS = declare(
+    Option("amg", "choice", "auto", choices=("auto", "petsc", "pyamg")), Option("c", "positive", 1.0),
+    Option("active0", "vector"), Option("coarse", "object", types=(ContactProblem,)),
+    Option("callback", "callable"), Option("warm_start", "object", types=(WarmStart,)),
+    Option("push0", "number"))
 #: stationarity is driven to SAFETY · tol so that the certificate's other residuals have room
 SAFETY = 0.1
 #: Eisenstat–Walker: γ, the exponent, the largest and smallest forcing terms (the first step's
@@ -83,10 +85,7 @@ MAX_CYCLES = 2
 def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.ndarray, str]:
     """The first active set and where it came from."""
     if opts["active0"] is not None:
-        active = np.asarray(opts["active0"], dtype=bool)
-        if active.shape != (problem.m,):
-            raise InputError(f"method 'pdas-amg': option active0 must be {problem.m} booleans")
-        return active, "given"
+        return per_candidate("pdas-amg", "active0", opts["active0"], problem.m) != 0, "given"
     warm = opts["warm_start"]
     if warm is not None and warm.lam is not None:
         return warm.lam > 0, "the warm start"
@@ -119,10 +118,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
           **options: Any) -> ContactSolution:
     """PDAS with each pinned system solved by CG + algebraic multigrid (see module doc)."""
     opts = take_options("pdas-amg", options, DEFAULTS)
-    if opts["amg"] not in AMG_CHOICES:
-        raise InputError(f"method 'pdas-amg': option amg={opts['amg']!r} is not one of "
-                         f"{', '.join(AMG_CHOICES)}")
-    c = positive_number("pdas-amg", "c", opts["c"])
+    c = opts["c"]
     tol, max_iter = resolved("pdas-amg", "active set", tol, max_iter)
     start = time.perf_counter()
     if problem.pending and border_factor(problem) is None:
@@ -235,7 +231,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="pdas-amg", function=solve, family="active set", exact=True,
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
-           requires=("pyamg",), extra="", options=tuple(DEFAULTS),
+           requires=("pyamg",), extra="", typed_options=DEFAULTS,
            matches_load=lambda problem: border_factor(problem) is not None,
            prediction="active set", bound_rows=True, factor_free_from=0),
 )

@@ -28,7 +28,7 @@ from signorini.numerics.multigrid import AMG_FROM_DOFS
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
 from signorini.solvers import amg, nested, pdas
-from signorini.solvers.base import Method
+from signorini.solvers.base import Method, rows_share_dofs
 
 #: a 3D model with a mesh and nothing to match (a push) goes to pdas-amg from this many dofs
 PUSHED_AMG_FROM_DOFS = 10_000
@@ -41,11 +41,6 @@ def dimension(problem: ContactProblem) -> int:
     if problem.mesh is not None:
         return int(problem.mesh.p.shape[0])
     return int(np.atleast_2d(problem.contact_points).shape[1])
-
-
-def _rows_share_a_dof(problem: ContactProblem) -> bool:
-    N = problem.N.tocsr()
-    return bool(N.nnz and np.bincount(N.indices[N.data != 0], minlength=problem.n).max() > 1)
 
 
 def choose(problem: ContactProblem, options: Any = (),
@@ -67,7 +62,7 @@ def choose(problem: ContactProblem, options: Any = (),
         return "pdas", f"3D model of {n:,} dofs < {least:,}: pdas (a factorisation is cheap)"
     if importlib.util.find_spec("pyamg") is None:
         return "pdas", f"3D model of {n:,} dofs, but pyamg is not installed (pip install pyamg): pdas"
-    if _rows_share_a_dof(problem):
+    if rows_share_dofs(problem.N):
         return "pdas", f"3D model of {n:,} dofs whose contact rows share dofs (no bound form): pdas"
     return "pdas-amg", (f"3D model of {n:,} dofs ≥ {least:,}: pdas-amg "
                         "(CG + multigrid, no factorisation to fill in)")
@@ -93,5 +88,5 @@ METHODS = (
            warm_from_load=True, factor_free_from=AMG_FROM_DOFS,
            chooses=lambda problem, options, warm_start: CHOICES[choose(problem, options,
                                                                        warm_start)[0]],
-           options=tuple(sorted(set(pdas.DEFAULTS) | set(amg.DEFAULTS) | set(nested.DEFAULTS)))),
+           typed_options={**nested.DEFAULTS, **amg.DEFAULTS, **pdas.DEFAULTS}),
 )

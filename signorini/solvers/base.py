@@ -24,7 +24,7 @@ from signorini.errors import InputError, install_hint
 from signorini.certification.kkt import Certificate, certificate, shortfall
 from signorini.problem.contact import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.options import (DEFAULT_TOL, MIN_TOL, Defaults, Option, check_names,
-                                       defaults_of, guess_value, resolved)
+                                       checked, defaults_of, guess_value, resolved)
 
 SolverFunction = Callable[..., ContactSolution]
 
@@ -44,34 +44,26 @@ def acceptance(tol: float | None) -> float:
 class Method:
     """A registered method.
 
-    ``requires`` lists the Python modules it imports; ``extra`` is the
-    pip extra that installs them. ``dense`` methods build dense matrices and
-    refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
-    answer up to round-off when they converge. ``options`` names the options
-    it takes; its :attr:`defaults` (the row of :mod:`signorini.solvers.options`) are the
-    tolerance it runs at and is held to when none is asked for and its iteration limit;
-    ``typed_options`` declares their kinds and ranges
-    (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
-    refuses a bad value before any work.
+    ``requires`` lists the Python modules it imports and ``extra`` the pip extra that installs
+    them. ``dense`` methods build dense matrices; ``exact`` ones reach the answer up to
+    round-off when they converge. ``typed_options`` declares the options it takes, their kinds
+    and ranges (:class:`~signorini.solvers.options.Option`: :meth:`check_options` refuses a
+    bad value before any work); :attr:`defaults` is its row of
+    :data:`~signorini.solvers.options.TABLE`, the ``tol`` and ``max_iter`` it runs at when none
+    is asked for.
 
-    What it offers load control (:mod:`signorini.load_control`), which asks and
-    never branches on a name: ``matches_load(problem)`` says it matches that
-    problem's pending target load itself (``problem.pending``; e.g. the push as
-    a bordered unknown), any other problem is matched first; ``prediction``
-    the kind of prediction of the contact it takes from the scene (``"zone"``:
-    the option ``zone``; ``"active set"``: ``active0``, and ``push0`` for a
-    pending load); ``warm_from_load`` that it takes load control's answer as
-    its warm start (else it starts cold). ``chooses(problem, options,
-    warm_start)`` returns the method it runs instead (a method that picks one),
-    whose capabilities are then the ones asked (:meth:`runs`). A ``scaled`` method is
-    handed a view of the problem in units that make its numbers of order one (its answer
-    mapped back to the problem's units before it is judged); a method that is not scaled (a
-    user's) is handed the problem as it was given. A ``bound_rows`` method takes each contact
-    row as a bound on dofs of its own (:mod:`signorini.solvers.bounds`): it refuses, by
-    :meth:`check_rows`, a problem whose rows share a dof (two bodies' rows on the master's
-    dofs, obstacles that meet at a node). ``factor_free_from`` is the size (dofs) from which it
-    solves a 3D model with a target load without any factorisation (None: it factorises at
-    every size), which a scene's memory estimate reads (:mod:`signorini.scenes.size`).
+    What it offers load control, which asks and never branches on a name:
+    ``matches_load(problem)``, that it matches that problem's pending target load itself (the
+    push as a bordered unknown); ``prediction``, the kind of prediction of the contact it takes
+    from the scene (``"zone"``: the option ``zone``; ``"active set"``: ``active0``, and
+    ``push0`` for a pending load); ``warm_from_load``, that it takes load control's answer as
+    its warm start. ``chooses(problem, options, warm_start)`` returns the method it runs
+    instead (:meth:`runs`). A ``scaled`` method is handed a view of the problem in units of
+    order one, its answer mapped back before it is judged; a user's is not. A ``bound_rows``
+    method takes each contact row as a bound on dofs of its own and refuses rows that share a
+    dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
+    model with a target load without a factorisation (None: never), for a scene's memory
+    estimate (:mod:`signorini.scenes.size`).
     """
 
     name: str
@@ -82,7 +74,6 @@ class Method:
     dense: bool = False
     exact: bool = False
     family: str = ""
-    options: tuple[str, ...] = field(default=())
     typed_options: Mapping[str, Option] = field(default_factory=dict)
     matches_load: Callable[[ContactProblem], bool] | None = None
     prediction: str = ""
@@ -91,6 +82,11 @@ class Method:
     scaled: bool = True
     bound_rows: bool = False
     factor_free_from: float | None = None
+
+    @property
+    def options(self) -> tuple[str, ...]:
+        """The names of the options it takes."""
+        return tuple(self.typed_options)
 
     @property
     def defaults(self) -> Defaults:
@@ -132,24 +128,16 @@ class Method:
         return self.matches_load is not None and bool(self.matches_load(problem))
 
     def check_options(self, given: Mapping[str, Any]) -> dict[str, Any]:
-        """``given`` with every declared option checked and converted; InputError otherwise.
-
-        Unknown names are refused for every method that lists its options (a
-        user's method lists none and takes what its function takes).
-        """
-        if self.family == "user":
-            return dict(given)
-        check_names(self.name, given, self.options)
-        return {name: self.typed_options[name].check(self.name, value)
-                if name in self.typed_options else value for name, value in given.items()}
+        """``given`` with every declared option checked and converted; InputError otherwise (a
+        user's method declares none and takes what its function takes)."""
+        return dict(given) if self.family == "user" else checked(self.name, given, self.typed_options)
 
     def parse_options(self, texts: Mapping[str, str]) -> dict[str, Any]:
         """``--opt name=text`` pairs read as each option's declared kind, and checked."""
-        if self.family != "user":
-            check_names(self.name, texts, self.options)
-        return {name: self.typed_options[name].parse(self.name, text)
-                if name in self.typed_options else guess_value(text)
-                for name, text in texts.items()}
+        if self.family == "user":
+            return {name: guess_value(text) for name, text in texts.items()}
+        check_names(self.name, texts, self.typed_options)
+        return {name: self.typed_options[name].parse(self.name, text) for name, text in texts.items()}
 
 
 def rows_share_dofs(N: Any) -> bool:

@@ -57,5 +57,5 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="condensed", function=solve, family="active set", exact=True,
            summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
-           options=tuple(DEFAULTS), typed_options=DEFAULTS),
+           typed_options=DEFAULTS),
 )

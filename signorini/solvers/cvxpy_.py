@@ -39,7 +39,6 @@ DEFAULT_FORM = "primal"
 DEFAULT_POLISH = True
 #: the options, by kind (the solver is checked against cvxpy's installed ones when it runs)
 TYPED_OPTIONS = {"solver": Option("solver", "text", DEFAULT_SOLVER), **COMMON_TYPES}
-OPTIONS = tuple(TYPED_OPTIONS)
 
 #: cvxpy status → ours (anything else is ``failed``)
 STATUS_MAP = {"optimal": "converged", "optimal_inaccurate": "inaccurate",
@@ -121,10 +120,9 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         is cvxpy's status.
     """
     options = take_options(METHOD, options, TYPED_OPTIONS)
-    limit = forms.dense_limit(options["max_dense_dofs"])
-    form, note = forms.resolve(METHOD, problem, options["form"], DEFAULT_FORM, limit)
-    polishing = forms.check_polish(METHOD, DEFAULT_POLISH if options["polish"] is None
-                                   else options["polish"])
+    form, note = forms.resolve(METHOD, problem, options["form"], DEFAULT_FORM,
+                               options["max_dense_dofs"])
+    polishing = DEFAULT_POLISH if options["polish"] is None else options["polish"]
     import cvxpy as cp  # as above
 
     solver = _check_solver(options["solver"])
@@ -176,6 +174,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name=METHOD, function=solve,
            summary="the QP as a cvxpy model (Clarabel by default; option solver)",
-           requires=("cvxpy",), extra="", family="cvxpy", exact=False, options=OPTIONS,
+           requires=("cvxpy",), extra="", family="cvxpy", exact=False,
            typed_options=TYPED_OPTIONS),
 )

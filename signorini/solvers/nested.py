@@ -125,6 +125,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="nested", function=solve, family="active set", exact=True,
            summary="predicted contact zone (the scene's); one factorisation + exact band LCP",
-           options=tuple(DEFAULTS), typed_options=DEFAULTS, prediction="zone",
+           typed_options=DEFAULTS, prediction="zone",
            warm_from_load=True),
 )

@@ -30,6 +30,7 @@ Extra PETSc options go through ``petsc_options`` ("-snes_monitor -ksp_view …")
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Any
 
@@ -48,14 +49,21 @@ DEFAULTS = declare(Option("ksp", "choice", "auto", choices=KSP_CHOICES),
                    Option("petsc_options", "text", ""))
 #: ``ksp=auto`` uses GAMG for 3D problems of at least this many dofs (MUMPS below, and in 2D)
 GAMG_FROM_DOFS = 20_000
-#: PETSc type of each method
-KINDS = {"petsc-vi": ("snes", "vinewtonrsls"), "petsc-tron": ("tao", "tron"),
-         "petsc-gpcg": ("tao", "gpcg")}
+#: each method's PETSc solver kind and type, and its summary
+KINDS = {
+    "petsc-vi": ("snes", "vinewtonrsls", "PETSc SNES vinewtonrsls (semismooth Newton on the "
+                                         "bounds), MUMPS or CG+GAMG; MPI"),
+    "petsc-tron": ("tao", "tron", "PETSc TAO tron (trust-region Newton on the bounds), MUMPS or "
+                                  "CG+GAMG; MPI"),
+    "petsc-gpcg": ("tao", "gpcg", "PETSc TAO gpcg (gradient projection + CG on the bounds); MPI"),
+}
 
-def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: int | None,
-           options: dict[str, Any]) -> ContactSolution:
+
+def solve(problem: ContactProblem, method: str, *, tol: float | None = None,
+          max_iter: int | None = None, **options: Any) -> ContactSolution:
+    """PETSc's solver of ``method`` (a key of :data:`KINDS`) on the bound form."""
     opts = take_options(method, options, DEFAULTS)
-    kind, petsc_type = KINDS[method]
+    kind, petsc_type, _ = KINDS[method]
     tol, max_iter = resolved(method, "petsc", tol, max_iter)
     ksp = opts["ksp"]
     start = time.perf_counter()
@@ -103,25 +111,8 @@ def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: in
                            extras=extras)
 
 
-def _make(method: str):
-    def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
-              **options: Any) -> ContactSolution:
-        return _solve(method, problem, tol, max_iter, options)
-
-    solve.__name__ = method.replace("-", "_")
-    solve.__doc__ = f"PETSc {KINDS[method][1]} on the bound form (MUMPS or CG + GAMG)."
-    return solve
-
-
-SUMMARIES = {
-    "petsc-vi": "PETSc SNES vinewtonrsls (semismooth Newton on the bounds), MUMPS or CG+GAMG; MPI",
-    "petsc-tron": "PETSc TAO tron (trust-region Newton on the bounds), MUMPS or CG+GAMG; MPI",
-    "petsc-gpcg": "PETSc TAO gpcg (gradient projection + CG on the bounds); MPI",
-}
-
 METHODS = tuple(
-    Method(name=name, function=_make(name), summary=SUMMARIES[name],
+    Method(name=name, function=functools.partial(solve, method=name), summary=KINDS[name][2],
            requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
-           exact=name == "petsc-vi", options=tuple(DEFAULTS),
-           typed_options=DEFAULTS, bound_rows=True)
+           exact=name == "petsc-vi", typed_options=DEFAULTS, bound_rows=True)
     for name in KINDS)

@@ -14,11 +14,12 @@ registered by one loop at the bottom of the module.
 from __future__ import annotations
 
 import contextlib
+import functools
 import importlib.util
 import logging
 import time
 import warnings
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -27,25 +28,13 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
 from signorini.solvers.backend_output import c_output_discarded, silence_highs_banner
-from signorini.solvers.qp_backends import (BACKEND_BY_NAME, BACKENDS, COMMON_OPTIONS, COMMON_TYPES,
+from signorini.solvers.options import checked
+from signorini.solvers.qp_backends import (BACKEND_BY_NAME, BACKENDS, COMMON_TYPES,
                                            DEFAULT_MAX_DENSE_DOFS, FAILED, MAX_ITER, Backend)
-from signorini.solvers.qp_options import typed
 
 __all__ = ["METHODS", "solve_qp"]
 
 log = logging.getLogger(__name__)
-
-
-def _check_options(backend: Backend, options: Mapping[str, Any]) -> dict[str, Any]:
-    """Refuse options the backend does not accept or values of the wrong kind; the checked ones."""
-    unknown = sorted(set(options) - set(backend.accepted_options))
-    if unknown:
-        raise InputError(
-            f"method {backend.method_name!r} does not accept option(s) "
-            f"{', '.join(repr(name) for name in unknown)}; accepted options: "
-            f"{', '.join(backend.accepted_options)}")
-    kinds = typed(backend.options, COMMON_TYPES)
-    return {name: kinds[name].check(backend.method_name, value) for name, value in options.items()}
 
 
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
@@ -82,11 +71,11 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         The backend raised (re-raised ``from`` its exception).
     """
     spec = BACKEND_BY_NAME[backend]
-    options = _check_options(spec, options)
-    max_dense_dofs = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
+    options = checked(spec.method_name, options, spec.typed_options)
+    max_dense_dofs = options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS)
     form, note = forms.resolve(spec.method_name, problem, options.get("form"), spec.form,
                                max_dense_dofs)
-    polishing = forms.check_polish(spec.method_name, options.get("polish", spec.polish))
+    polishing = spec.polish if options.get("polish") is None else options["polish"]
     dense_n = spec.dense and problem.n > max_dense_dofs
     if form != "dual" and dense_n:
         raise InputError(
@@ -102,7 +91,7 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
             f"available: {', '.join(qpsolvers.available_solvers)}): "
             f"{install_hint(spec.extra, missing)}")
     settings = {**spec.settings(tol, max_iter), **spec.fixed,
-                **{k: v for k, v in options.items() if k not in COMMON_OPTIONS}}
+                **{k: v for k, v in options.items() if k not in COMMON_TYPES}}
     if spec.nest is not None:
         settings = spec.nest(settings)
 
@@ -123,7 +112,7 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
     except qpsolvers.ParamError as exc:
         raise InputError(f"{spec.label}: bad option: {exc}") from exc
     except Exception as exc:
-        passed = {k: v for k, v in options.items() if k not in COMMON_OPTIONS}
+        passed = {k: v for k, v in options.items() if k not in COMMON_TYPES}
         hint = f" (with the options {passed})" if passed else ""
         raise SolverError(f"{spec.label} raised {type(exc).__name__}: {exc}{hint}") from exc
     elapsed = time.perf_counter() - start - build_time
@@ -147,21 +136,9 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
                                solve_time=elapsed, tol=tol, polishing=polishing)
 
 
-def _method_function(backend: Backend) -> Callable[..., ContactSolution]:
-    def solve(problem: ContactProblem, *, tol: float | None = None,
-              max_iter: int | None = None, **options: Any) -> ContactSolution:
-        return solve_qp(problem, backend.name, tol=tol, max_iter=max_iter, **options)
-
-    solve.__name__ = f"solve_{backend.name}"
-    solve.__qualname__ = solve.__name__
-    solve.__doc__ = f"{backend.summary}: see :func:`solve_qp`."
-    return solve
-
-
 METHODS = tuple(
-    Method(name=backend.method_name, function=_method_function(backend),
+    Method(name=backend.method_name, function=functools.partial(solve_qp, backend=backend.name),
            summary=backend.summary, requires=("qpsolvers", *backend.modules),
            extra=backend.extra, dense=backend.dense, exact=False, family="qp",
-           options=backend.accepted_options,
-           typed_options=typed(backend.options, COMMON_TYPES))
+           typed_options=backend.typed_options)
     for backend in BACKENDS)

@@ -14,10 +14,11 @@ import numpy as np
 
 from signorini.solvers import clarabel_, forms
 from signorini.solvers.options import Option, declare
+from signorini.solvers.qp_options import typed
 from signorini.solvers.qp_reports import (Reader, read_clarabel, read_cvxopt, read_ecos, read_found,
                                           read_gurobi, read_info, read_quadprog, read_scs)
 
-__all__ = ["BACKENDS", "BACKEND_BY_NAME", "COMMON_OPTIONS", "COMMON_TYPES", "DEFAULT_MAX_DENSE_DOFS",
+__all__ = ["BACKENDS", "BACKEND_BY_NAME", "COMMON_TYPES", "DEFAULT_MAX_DENSE_DOFS",
            "Backend"]
 
 log = logging.getLogger(__name__)
@@ -25,9 +26,8 @@ log = logging.getLogger(__name__)
 #: dense backends refuse problems with more free dofs than this (option ``max_dense_dofs``)
 DEFAULT_MAX_DENSE_DOFS = 3000
 
-#: options every ``qp-*`` method accepts besides its backend's own
-COMMON_OPTIONS = ("max_dense_dofs", "form", "polish")
-#: their kinds (None: the backend's default form and polish)
+#: the options every ``qp-*`` method takes besides its backend's own (None: the backend's
+#: default form and polish)
 COMMON_TYPES = declare(Option("max_dense_dofs", "positive_count", DEFAULT_MAX_DENSE_DOFS),
                        Option("form", "choice", None, choices=(None, *forms.FORMS)),
                        Option("polish", "bool", None))
@@ -79,8 +79,9 @@ class Backend:
         return f"qp-{self.name}"
 
     @property
-    def accepted_options(self) -> tuple[str, ...]:
-        return tuple(sorted(set(self.options) | set(COMMON_OPTIONS)))
+    def typed_options(self) -> dict[str, Option]:
+        """Every option its method takes, by name, with its kind."""
+        return typed(self.options, COMMON_TYPES)
 
     def settings(self, tol: float | None, max_iter: int | None) -> dict[str, Any]:
         """Backend options meaning "relative KKT tolerance ``tol``, at most ``max_iter``"."""

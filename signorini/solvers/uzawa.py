@@ -252,9 +252,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 METHODS = (
     Method(name="uzawa", function=solve, family="dual", exact=False,
            summary="the paper's Uzawa iteration: projected gradient ascent on the dual",
-           options=tuple(DEFAULTS), typed_options=DEFAULTS),
+           typed_options=DEFAULTS),
     Method(name="uzawa-nesterov", function=solve_nesterov, family="dual", exact=False,
            summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
-           options=tuple(NESTEROV_DEFAULTS),
            typed_options=NESTEROV_DEFAULTS),
 )
