@@ -24,7 +24,7 @@ from signorini.errors import InputError, install_hint
 from signorini.certification.kkt import Certificate, certificate, shortfall
 from signorini.problem.contact import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.options import (DEFAULT_TOL, MIN_TOL, Defaults, Option, check_names,
-                                       checked, defaults_of, guess_value, resolved)
+                                       checked, defaults_of, finite_number, guess_value, resolved)
 
 SolverFunction = Callable[..., ContactSolution]
 
@@ -151,13 +151,13 @@ def check_tol(tol: Any, name: str = "tol") -> float | None:
     """``tol`` as a float, or InputError naming ``name`` (the API's argument or the CLI's option)."""
     if tol is None:
         return None
-    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
-            or not (np.isfinite(tol) and 0 < tol < 1):
+    number = finite_number(tol)
+    if number is None or not 0 < number < 1:
         raise InputError(f"{name} must be a number in (0, 1), got {tol!r}: e.g. {name} 1e-9")
-    if tol < MIN_TOL:
+    if number < MIN_TOL:
         raise InputError(f"{name} {tol:g} is below what double precision can certify (relative "
                          f"residuals of order 1e-16 times the conditioning): give {name} ≥ {MIN_TOL:g}")
-    return float(tol)
+    return number
 
 
 #: the largest iteration limit: every backend's counter holds it (a C int)
@@ -165,15 +165,14 @@ MAX_ITER = 2 ** 31 - 1
 
 
 def check_max_iter(max_iter: Any) -> int | None:
+    """``max_iter`` as an int in [1, :data:`MAX_ITER`], or InputError."""
     if max_iter is None:
         return None
-    ok = isinstance(max_iter, (int, np.integer)) and not isinstance(max_iter, bool)
-    ok = ok or (isinstance(max_iter, (float, np.floating)) and np.isfinite(max_iter)
-                and float(max_iter).is_integer())
-    if not ok or not 1 <= max_iter <= MAX_ITER:
+    number = finite_number(max_iter)
+    if number is None or not number.is_integer() or not 1 <= number <= MAX_ITER:
         raise InputError(f"max_iter must be a positive integer up to {MAX_ITER} (2³¹ − 1, what "
                          f"every backend's counter holds), got {max_iter!r}")
-    return int(max_iter)
+    return int(number)
 
 
 def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> ContactSolution:
@@ -229,48 +228,29 @@ SAME_PRODUCT_RTOL = 1e-12
 MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps"}
 
 
-def _digest(array: np.ndarray) -> str:
-    return hashlib.blake2b(np.ascontiguousarray(array).view(np.uint8), digest_size=16).hexdigest()
+def fingerprint(problem: ContactProblem) -> dict[str, tuple]:
+    """Of each of K, f, N and d: its shape, and ``K x`` and ``N x`` for a fixed random x, or a
+    hash of the bytes of f and d (a few vectors, no copy of K)."""
+    x = np.random.default_rng(1).uniform(0.5, 1.5, problem.K.shape[1])
+    arrays = {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d}
+    return {name: (np.shape(a), a @ x if name in "KN" else hashlib.blake2b(
+        np.ascontiguousarray(a, dtype=float).view(np.uint8), digest_size=16).hexdigest())
+        for name, a in arrays.items()}
 
 
-def _probe(n: int) -> np.ndarray:
-    return np.random.default_rng(1).uniform(0.5, 1.5, n)
+def changed(problem: ContactProblem, before: dict[str, tuple]) -> list[str]:
+    """The names of the arrays of ``problem`` that differ from their ``before`` fingerprint."""
+    shapes = {"K": problem.K.shape, "f": np.shape(problem.f), "N": problem.N.shape,
+              "d": np.shape(problem.d)}
+    if any(shapes[name] != kept[0] for name, kept in before.items()):
+        return [name for name, kept in before.items() if shapes[name] != kept[0]]
+    now = fingerprint(problem)
+    return [name for name, (_, kept) in before.items() if not (
+        np.allclose(now[name][1], kept, rtol=SAME_PRODUCT_RTOL, atol=0.0) if name in "KN"
+        else now[name][1] == kept)]
 
 
-@dataclass(frozen=True)
-class Fingerprint:
-    """What :func:`fingerprint` keeps of a problem's data (a few vectors, no copy of K)."""
-
-    shapes: tuple
-    f: str
-    d: str
-    K: np.ndarray
-    N: np.ndarray
-
-
-def fingerprint(problem: ContactProblem) -> Fingerprint:
-    """Hashes of f and d, ``K x`` and ``N x`` for a fixed random x, and the shapes."""
-    x = _probe(problem.K.shape[1])
-    return Fingerprint((problem.K.shape, problem.N.shape, problem.f.shape, problem.d.shape),
-                       _digest(problem.f), _digest(problem.d), problem.K @ x, problem.N @ x)
-
-
-def changed(problem: ContactProblem, before: Fingerprint) -> list[str]:
-    """The names of the arrays of ``problem`` that differ from ``before`` (none: unchanged)."""
-    now = (problem.K.shape, problem.N.shape, np.shape(problem.f), np.shape(problem.d))
-    if now != before.shapes:
-        return [name for name, a, b in zip("KNfd", now, before.shapes) if a != b]
-    x = _probe(problem.K.shape[1])
-    out = []
-    for name, product, kept in (("K", problem.K @ x, before.K), ("N", problem.N @ x, before.N)):
-        if not np.allclose(product, kept, rtol=SAME_PRODUCT_RTOL, atol=0.0):
-            out.append(name)
-    out += [name for name, value, kept in (("f", problem.f, before.f), ("d", problem.d, before.d))
-            if _digest(np.asarray(value, dtype=float)) != kept]
-    return sorted(out, key="KfNd".index)
-
-
-def held_to_problem(problem: ContactProblem, before: Fingerprint, solution: ContactSolution,
+def held_to_problem(problem: ContactProblem, before: dict[str, tuple], solution: ContactSolution,
                     method: str) -> ContactSolution:
     """``solution``, or a ``failed`` one when the method changed ``problem``.
 

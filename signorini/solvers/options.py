@@ -117,7 +117,8 @@ class Option:
 _BAD = object()
 
 
-def _number(value: Any) -> float | None:
+def finite_number(value: Any) -> float | None:
+    """``value`` as a float when it is a finite real number (not a bool), else None."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer,
                                                                       np.floating)):
         return None
@@ -133,7 +134,7 @@ _INTEGERS = {"integer": -math.inf, "count": 0, "positive_count": 1}
 
 def _convert(option: Option, value: Any) -> Any:
     kind = option.kind
-    number = _number(value)
+    number = finite_number(value)
     if kind in _NUMBERS:
         return number if number is not None and _NUMBERS[kind](number) else _BAD
     if kind in _INTEGERS:
@@ -263,4 +264,4 @@ def resolved(name: str, family: str, tol: float | None,
 
 
 __all__ = ["DEFAULT_TOL", "EXACT_TOL", "KINDS", "MIN_TOL", "Defaults", "Option", "TABLE", "check_names", "checked",
-           "declare", "defaults_of", "guess_value", "per_candidate", "resolved", "take_options"]
+           "declare", "defaults_of", "finite_number", "guess_value", "per_candidate", "resolved", "take_options"]
