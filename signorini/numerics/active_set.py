@@ -34,19 +34,11 @@ def selection_dofs(N: sp.csr_matrix) -> np.ndarray | None:
 class ActiveSetSolver:
     """Solutions of ``Ku + N_Aᵀλ_A = f, N_A u = d`` (``λ`` zero off A), active set after active set.
 
-    When each row of N bounds one dof, the active dofs are pinned
-    (:class:`PinnedFactor`: a fixed dof's row and column become the
-    identity's, so every active set has K's sparsity pattern; with CHOLMOD
-    the symbolic analysis, the fill-reducing ordering, is done once and only
-    the numeric factorisation repeated). Otherwise the saddle-point matrix, with
-    its constraint rows scaled by ``s = mean |diag K|`` (both blocks of one
-    size in any units; ``λ = s μ``), is factorised by LU.
-
-    ``factor`` is the factorisation of K (with the last active set's dofs
-    pinned, or none) or the saddle-point system
-    (:class:`~signorini.numerics.saddle_point.SaddlePoint`) that the last solve used, for the
-    certificate to reuse. It is let go before the next one is made, so that two never live at
-    once.
+    When each row of N bounds one dof the active dofs are pinned (:class:`PinnedFactor`, on one
+    :class:`Pinning`); otherwise the saddle-point matrix is factorised
+    (:class:`~signorini.numerics.saddle_point.SaddlePoint`). ``factor`` is the factorisation
+    the last solve used, for the certificate to reuse; it is let go before the next one is
+    made, so that two never live at once.
     """
 
     def __init__(self, K: sp.csr_matrix, N: sp.csr_matrix, backend: str | None = None):
@@ -113,12 +105,10 @@ class ActiveSetSolver:
 class Pinning:
     """Factors of K with some dofs pinned, in the layout the backend reads, made without copying K.
 
-    A pinned dof's row and column are replaced by the identity's, so every set
-    of pinned dofs gives a matrix of K's sparsity pattern: the layout is cut
-    once (K's upper triangle in CSR for PARDISO, all of K in CSC otherwise) and
-    each pinning only rewrites its values; CHOLMOD's symbolic analysis (the
-    ordering, most of a large factorisation's cost beyond the numeric work)
-    is computed once too: a pinning costs no copy of K (docs/speed.md, §4).
+    A pinned dof's row and column are replaced by the identity's, so every set of pinned dofs
+    gives a matrix of K's sparsity pattern: the layout is cut once (K's upper triangle in CSR
+    for PARDISO, all of K in CSC otherwise) and each pinning only rewrites its values;
+    CHOLMOD's symbolic analysis (the ordering) is computed once too (docs/speed.md, §4).
     """
 
     def __init__(self, K: sp.spmatrix, backend: str = "cholmod"):
@@ -164,11 +154,8 @@ class PinnedFactor:
     """Solutions of K u = f with the ``fixed`` dofs prescribed: ``solve(rhs)`` takes their
     values from ``rhs[fixed]`` and the load on the other dofs from the rest of ``rhs``.
 
-    The pinned matrix (K with the fixed dofs' rows and columns made the
-    identity's, K's own pattern) is factorised: CHOLMOD on a shared
-    :class:`Pinning`'s symbolic analysis, other backends from scratch.
-    ``matrix`` is K itself (unpinned). With no dof fixed it solves as a
-    :class:`Factor` of K does.
+    The pinned matrix of a :class:`Pinning` is factorised; ``matrix`` is K itself (unpinned).
+    With no dof fixed it solves as a :class:`Factor` of K does.
     """
 
     def __init__(self, K: sp.spmatrix, fixed: np.ndarray, backend: str | None = None,

@@ -30,7 +30,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.errors import BackendNotInstalled, InputError, install_hint
-from signorini.numerics.work import count
+from signorini.numerics.work import count, count_solves
 
 log = logging.getLogger(__name__)
 
@@ -40,12 +40,6 @@ _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
 EXTRAS = {"cholmod": "fast", "pardiso": "pardiso"}
 
 NO_DOFS = np.zeros(0, dtype=int)
-
-
-def _count_solve(b: np.ndarray) -> np.ndarray:
-    b = np.asarray(b, dtype=float)  # counted, one per right-hand side
-    count("back_solves", 1 if b.ndim == 1 else b.shape[1])
-    return b
 
 
 def available_backends() -> list[str]:
@@ -117,7 +111,7 @@ class Factor:
                              options={"SymmetricMode": True})
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._lu.solve(_count_solve(b))
+        return self._lu.solve(count_solves(b))
 
 
 #: from this many dofs CHOLMOD orders by nested dissection (METIS) instead of AMD: below it AMD
@@ -177,7 +171,7 @@ class CholmodFactor(Factor):
         self._factor = cholmod_numeric(cholmod_analysis(K) if symbolic is None else symbolic, K)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._factor(_count_solve(b))
+        return self._factor(count_solves(b))
 
 
 #: PARDISO's settings (iparm, counted from 1 as its manual does): 1 — these, not its defaults;
@@ -303,7 +297,7 @@ class PardisoFactor(Factor):
     def solve(self, b: np.ndarray) -> np.ndarray:
         # PARDISO's solve phase on the factorisation made above (pypardiso's solve() hashes K)
         self._solver.set_phase(33)
-        return self._solver._call_pardiso(self._upper, np.asfortranarray(_count_solve(b)))
+        return self._solver._call_pardiso(self._upper, np.asfortranarray(count_solves(b)))
 
     def __del__(self) -> None:
         # MKL keeps a factorisation until told to drop it: without this every PARDISO factor

@@ -24,15 +24,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from signorini.numerics.work import count
+from signorini.numerics.work import count, count_solves
 
 __all__ = ["SaddlePoint"]
-
-
-def _counted(b: np.ndarray) -> np.ndarray:
-    b = np.asarray(b, dtype=float)  # counted, one per right-hand side
-    count("back_solves", 1 if b.ndim == 1 else b.shape[1])
-    return b
 
 
 class SaddlePoint:
@@ -55,7 +49,7 @@ class SaddlePoint:
     def solve(self, f: np.ndarray, d_A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(u, λ_A)`` with ``K u + N_Aᵀ λ_A = f`` and ``N_A u = d_A`` (n × k, |A| × k alike)."""
         k = self.stiffness
-        solution = self._lu.solve(_counted(np.concatenate([np.asarray(f) / k, self.scale * d_A])))
+        solution = self._lu.solve(count_solves(np.concatenate([np.asarray(f) / k, self.scale * d_A])))
         return solution[:self.n], k * self.scale * solution[self.n:]
 
     def in_units(self, K: Any, stiffness: float) -> "SaddlePoint":
