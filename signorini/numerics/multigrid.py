@@ -16,7 +16,8 @@ Two hierarchies, one interface (``apply(r) -> z``, ``backend``, ``setup_s``):
 :func:`pinned_cg` is preconditioned CG on the free dofs only: the pinned dofs
 keep their values, the preconditioner's output is zeroed on them (so the
 operator CG sees, ``P M P`` on the free subspace, stays SPD whatever pinned
-set the hierarchy was built for). Hierarchies built and CG iterations are counted into the stage's work record (:mod:`signorini.numerics.work`).
+set the hierarchy was built for). Hierarchies built and CG iterations are counted into the
+stage's work record (:mod:`signorini.numerics.work`).
 """
 
 from __future__ import annotations

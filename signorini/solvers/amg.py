@@ -1,44 +1,32 @@
 """Exact contact without a factorisation: PDAS with CG + algebraic multigrid (``pdas-amg``).
 
-The primal-dual active set / semismooth Newton iteration of :mod:`~signorini.solvers.pdas`
-(Hintermüller, Ito & Kunisch 2002) on the bound form of the problem
-(:mod:`~signorini.solvers.bounds`: each contact row one bound ``aᵢ v_j ≤ dᵢ``
-on the node's rotated dofs, prescribed dofs kept as fixed rows so that node
-blocks stay whole). An active set pins its bounded dofs at ``dᵢ/aᵢ``; the
-pinned SPD system is solved by conjugate gradients preconditioned with
-algebraic multigrid given the rigid-body modes as near-null space
+The primal-dual active set iteration of :mod:`~signorini.solvers.pdas` on the bound form of the
+problem (:mod:`~signorini.solvers.bounds`: each contact row one bound ``aᵢ v_j ≤ dᵢ`` on the
+node's rotated dofs, prescribed dofs kept as fixed rows so that node blocks stay whole). An
+active set pins its bounded dofs at ``dᵢ/aᵢ``; the pinned SPD system is solved by CG
+preconditioned with algebraic multigrid, the rigid-body modes as near-null space
 (:mod:`signorini.numerics.multigrid`), never factorised. Then:
 
-- the first active set is given (``active0``: ``signorini.solve`` passes the
-  candidates inside the reference's contact radius when the scene has one at its
-  target load, Hertz's, else the set a coarser model of the scene predicts), or
-  comes from a warm start's forces or from a coarse QP (``coarse``), so that few
-  steps remain;
-- a target load that is still pending (``problem.pending``: load control,
-  :mod:`signorini.load_control`, leaves it to this method: ``Method.matches_load``) is
-  matched with the answer: the push is one more unknown of every CG system, preconditioned
-  by block elimination (:mod:`signorini.solvers.load_border`), so no factorisation of K is
-  ever made; the push found is ``solution.extras["push"]`` (``push0`` the first guess);
-- **one hierarchy** is built, for K with the first active set pinned; later
-  sets differ in a few rows and CG pays for them in iterations;
-- CG starts from the last step's displacement, and its tolerance follows
-  Eisenstat & Walker (1996, choice 2) while the active set still moves:
-  ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²``, ``γ = 0.9``, in [:data:`ETA_MIN`, :data:`ETA_MAX`]:
-  the first solve, from far, at ETA_MIN; the ratio against it would hold every
-  later step there, so the second step starts the sequence again at ETA_MAX;
-- when the set repeats, CG is driven to a stationarity residual of
-  :data:`SAFETY` · tol against the contact forces, and the method stops only
-  when the package's certificate (:func:`signorini.certification.kkt.certificate`) is within
-  ``tol``; the duality gap is then computed with this method's own
-  AMG-preconditioned solver for K with the final set pinned
-  (:class:`~signorini.solvers.amg_system.PinnedCG`),
-  not a serial factorisation.
+- the first active set is given (``active0``: ``signorini.solve`` passes the scene's
+  prediction), or comes from a warm start's forces or from a coarse QP (``coarse``);
+- a pending target load (``problem.pending``, left to this method by load control:
+  ``Method.matches_load``) is matched with the answer: the push is one more unknown of every
+  CG system (:mod:`signorini.solvers.load_border`); the push found is
+  ``solution.extras["push"]`` (``push0`` the first guess);
+- **one hierarchy** is built, for K with the first active set pinned; later sets differ in a
+  few rows and CG pays for them in iterations;
+- CG starts from the last step's displacement, and its tolerance follows Eisenstat & Walker
+  (1996, choice 2) while the active set still moves: ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²`` in
+  [:data:`ETA_MIN`, :data:`ETA_MAX`], the first solve at ETA_MIN and the second starting the
+  sequence again at ETA_MAX;
+- when the set repeats, CG is driven to a stationarity residual of :data:`SAFETY` · tol against
+  the contact forces, and the method stops only when the package's certificate is within
+  ``tol``; the duality gap is computed with this method's own multigrid solver for K with the
+  final set pinned (:class:`~signorini.solvers.amg_system.PinnedCG`).
 
-Multigrid: ``amg=petsc`` (PETSc's GAMG, plain aggregation, through petsc4py,
-set up by :data:`~signorini.solvers.amg_system.GAMG_OPTIONS`), ``amg=pyamg`` (smoothed aggregation) or
-``auto``: GAMG when petsc4py is installed. One set-up and a CG solve to 1e-10
-of the 350k-dof pushed ``hertz-sphere-3d``'s K, each way, are in docs/amg/bench.md
-(``tools/amg_bench.py run --part backends``).
+Multigrid: ``amg=petsc`` (PETSc's GAMG through petsc4py,
+:data:`~signorini.solvers.amg_system.GAMG_OPTIONS`), ``amg=pyamg`` (smoothed aggregation) or
+``auto``: GAMG when petsc4py is installed (docs/amg/bench.md compares them).
 """
 
 from __future__ import annotations

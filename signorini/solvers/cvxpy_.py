@@ -14,9 +14,7 @@ unpacking the result.
 
 from __future__ import annotations
 
-import logging
 import time
-import warnings
 from typing import Any
 
 import numpy as np
@@ -27,8 +25,6 @@ from signorini.solvers import forms
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, take_options
 from signorini.solvers.qp_backends import BACKEND_BY_NAME, COMMON_TYPES
-
-log = logging.getLogger(__name__)
 
 METHOD = "cvxpy"
 DEFAULT_SOLVER = "CLARABEL"
@@ -134,8 +130,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     contact = x >= 0 if qp.bounds else qp.G @ x <= qp.h
     model = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, qp.P, assume_PSD=True) + qp.q @ x),
                        [contact])
-    with warnings.catch_warnings(record=True) as record:
-        warnings.simplefilter("always")
+    with forms.warned(f"cvxpy/{solver}") as caught:
         try:
             data, chain, inverse_data = model.get_problem_data(solver, solver_opts=opts)
         except Exception as exc:
@@ -151,9 +146,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         except Exception as exc:
             raise SolverError(f"cvxpy/{solver} raised {type(exc).__name__}: {exc}") from exc
         solve_time = time.perf_counter() - start - build_time
-    caught = [str(w.message) for w in record]
-    for message in caught:
-        log.debug("cvxpy/%s warned: %s", solver, message)
     if solver_error:
         return ContactSolution.failure(
             METHOD, problem, "failed", f"cvxpy/{solver}: solver_error",

@@ -30,9 +30,12 @@ is better than the backend's; ``extras["polish"]`` records both.
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import time
+import warnings
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 import scipy.linalg as sla
@@ -46,6 +49,8 @@ from signorini.numerics.work import counting
 from signorini.numerics.lcp import delassus
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import acceptance
+
+log = logging.getLogger(__name__)
 
 FORMS = ("primal", "shifted", "dual")
 #: ``‖K K⁻¹f − f‖∞ / ‖f‖∞`` above this means K is singular (SuperLU does not say so itself)
@@ -91,6 +96,21 @@ class Formulation:
             return self.factor.solve(problem.f - problem.N.T @ x), x
         z = np.asarray(z, dtype=float).copy()
         return (x + self.u0 if self.name == "shifted" else x), z
+
+
+@contextlib.contextmanager
+def warned(label: str) -> Iterator[list[str]]:
+    """The messages of the warnings the block raised (every one, each logged at debug level),
+    in the list it is given once the block ends: a backend's warnings travel with its answer."""
+    caught: list[str] = []
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        try:
+            yield caught
+        finally:
+            caught += [str(w.message) for w in record]
+    for message in caught:
+        log.debug("%s warned: %s", label, message)
 
 
 def resolve(method: str, problem: ContactProblem, given: str | None, default: str,

@@ -1,13 +1,8 @@
 """A pending target load as one more unknown of ``pdas-amg``'s CG systems: no factorisation.
 
-A scene pushed towards a target load P (``problem.pending``) whose pushed
-dofs move together has a load row parallel to the push's forces, so the
-push ``s`` joins the displacement as one more unknown of a symmetric
-system, SPD once the contact holds the body (:class:`LoadBorder`). CG
-preconditions it by block elimination with the method's multigrid
-(:func:`border_preconditioner`). :class:`Unknowns` is what CG solves for at
-each active-set step, with the border or without: the Newton loop of
-:mod:`signorini.solvers.amg` reads the same either way.
+:class:`Unknowns` is what CG solves for at each active-set step, with the border
+(:class:`LoadBorder`) or without: the Newton loop of :mod:`signorini.solvers.amg` reads the same
+either way.
 """
 
 from __future__ import annotations
@@ -25,13 +20,11 @@ from signorini.solvers.bounds import BoundForm
 class LoadBorder:
     """Load targeting without a factorisation: the push ``s`` as one more unknown.
 
-    The pushed dofs move together, so the load row is parallel to the push's
-    forces, ``ℓ = β f₁``, and the target ``ℓ·u + s·o₁ + o₀ = P`` is the last
-    row of the symmetric system ``[[K, −f₁], [−f₁ᵀ, −o₁/β]] [u; s] = [f₀;
-    −(P − o₀)/β]``: K of the body with the pushed dofs as one more unknown,
-    SPD once the contact holds it (:class:`~signorini.numerics.multigrid.Bordered`).
-    CG preconditions it by block elimination (:func:`border_preconditioner`).
-    Arrays are the bound form's (rotated, full length).
+    The pushed dofs move together, so the load row is parallel to the push's forces,
+    ``ℓ = β f₁``, and the target ``ℓ·u + s·o₁ + o₀ = P`` is the last row of the symmetric system
+    ``[[K, −f₁], [−f₁ᵀ, −o₁/β]] [u; s] = [f₀; −(P − o₀)/β]``, SPD once the contact holds the
+    body (:class:`~signorini.numerics.multigrid.Bordered`), which CG preconditions by block
+    elimination (:func:`border_preconditioner`). Arrays are the bound form's (rotated).
     """
 
     g: np.ndarray  # the push's forces f₁

@@ -24,11 +24,8 @@ SAFETY = 1e-5
 #: SNES-VI's stationarity target relative to the requested tolerance
 SAFETY_RELATIVE = 0.1
 PREFIX = "signorini_"
-#: the stopping test never asks for less than this relative residual: round-off sits there
-#: (reverse-hertz with MUMPS: the residual stalls at 3e-14 ‖f‖ after the last active-set change;
-#: at 1e-13 GPCG on the axisymmetric hertz-sphere ran its 2000 iterations with the projected
-#: gradient just above the floor once its start moved by 1e-17 — 1e-12 ends it in 7, stationarity
-#: 6.6e-12, well inside any tolerance the certificate is asked for)
+#: the stopping test never asks for less than this relative residual: round-off sits there, and
+#: a test just below it can run a solver to its iteration limit (docs/petsc.md)
 ROUND_OFF_FLOOR = 1e-12
 
 

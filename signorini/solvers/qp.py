@@ -16,9 +16,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import importlib.util
-import logging
 import time
-import warnings
 from typing import Any
 
 import numpy as np
@@ -33,8 +31,6 @@ from signorini.solvers.qp_backends import (BACKEND_BY_NAME, BACKENDS, COMMON_TYP
                                            DEFAULT_MAX_DENSE_DOFS, FAILED, MAX_ITER, Backend)
 
 __all__ = ["METHODS", "solve_qp"]
-
-log = logging.getLogger(__name__)
 
 
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
@@ -105,8 +101,7 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         silence_highs_banner()
     quiet = c_output_discarded() if spec.prints else contextlib.nullcontext()
     try:
-        with warnings.catch_warnings(record=True) as record, quiet:
-            warnings.simplefilter("always")
+        with forms.warned(spec.label) as caught, quiet:
             result = (qpsolvers.solve_problem(qp, spec.name, verbose=False, **settings)
                       if spec.call is None else spec.call(qp, **settings))
     except qpsolvers.ParamError as exc:
@@ -116,9 +111,6 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         hint = f" (with the options {passed})" if passed else ""
         raise SolverError(f"{spec.label} raised {type(exc).__name__}: {exc}{hint}") from exc
     elapsed = time.perf_counter() - start - build_time
-    caught = [str(w.message) for w in record]
-    for message in caught:
-        log.debug("%s warned: %s", spec.label, message)
 
     report = spec.read(result, caught)
     status = spec.status(report.raw_status)

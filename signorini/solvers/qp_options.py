@@ -1,14 +1,9 @@
 """The kinds of the QP backends' own options (:mod:`signorini.solvers.qp`), checked before a run.
 
-Each backend option a ``qp-*`` method passes through to qpsolvers is
-declared here by kind (:class:`signorini.solvers.options.Option`), so that
-``--opt time_limit=-1`` or ``--opt eps_abs=abc`` is refused with one line
-before the problem is handed to the backend (OSQP had printed its own
-error and the run ended ``failed``; Clarabel had taken a negative time
-limit and stopped at once). The kinds follow each backend's documentation:
-tolerances, step sizes and penalties are positive; iteration counts, thread
-counts and refinement steps are integers ≥ 0; switches are booleans;
-solver and ordering choices are strings or integer codes.
+Each backend option a ``qp-*`` method passes through to qpsolvers is declared here by kind
+(:class:`signorini.solvers.options.Option`), so that ``--opt time_limit=-1`` or
+``--opt eps_abs=abc`` is refused with one line before the problem reaches the backend. The
+kinds follow each backend's documentation.
 """
 
 from __future__ import annotations
