@@ -19,6 +19,7 @@ from signorini.numerics.work import count
 from signorini.problem.contact import ContactProblem
 from signorini.solvers import petsc_piece
 from signorini.solvers.bounds import BoundForm
+from signorini.solvers.load_border import rotated
 
 __all__ = ["CERTIFICATE_RTOL", "CG_MAX_ITER", "GAMG_OPTIONS", "GamgHierarchy", "PinnedCG",
            "PinnedSystem"]
@@ -64,18 +65,9 @@ class GamgHierarchy:
         self._A.setBlockSize(block)  # A's arrays not copied: petsc4py holds them for the Mat
         self._A.setOption(PETSc.Mat.Option.SPD, True)
         if modes is not None:
-            vectors = []
-            for column in modes.T:
-                vector = self._A.createVecLeft()
-                vector.setArray(column)
-                vectors.append(vector)
-            self._A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=comm))
-        options = PETSc.Options("signorini_amg_")
-        wanted = {**GAMG_OPTIONS,
-                  **(MUMPS_COARSE_OPTIONS if PETSc.Sys.hasExternalPackage("mumps") else {})}
-        for name, value in wanted.items():  # see GAMG_OPTIONS; a user's wins
-            if not options.hasName(name):
-                options.setValue(name, value)
+            petsc_piece.near_null_space(PETSc, self._A, modes)
+        petsc_piece.unless_given(PETSc, "signorini_amg_", {  # see GAMG_OPTIONS
+            **GAMG_OPTIONS, **(MUMPS_COARSE_OPTIONS if PETSc.Sys.hasExternalPackage("mumps") else {})})
         self._pc = PETSc.PC().create(comm)
         self._pc.setType("gamg")
         self._pc.setOperators(self._A)
@@ -172,14 +164,12 @@ class PinnedCG:
         if rhs.ndim == 2:
             return np.column_stack([self.solve(column) for column in rhs.T])
         system, form = self.system, self.system.form
-        full = np.zeros(form.T.shape[0])
-        full[form.free_dofs] = rhs
-        f = form.T.T @ full
+        f = rotated(form, rhs)
         x = np.zeros(form.n)
         pinned = system.prescribed.copy()
         if self.fixed.size:  # each row bounds one dof: T is the identity there
             targets = form.free_dofs[self.fixed]
-            x[targets], pinned[targets] = full[targets], True
+            x[targets], pinned[targets] = rhs[self.fixed], True
         f[pinned] = 0.0
         target = CERTIFICATE_RTOL * max(float(np.linalg.norm(f)), 1e-300)
         result = pinned_cg(system.product, f, x, ~pinned, system.hierarchy.apply,

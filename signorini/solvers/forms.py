@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 from typing import Any, Iterator
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
 from signorini.errors import InputError
@@ -46,7 +45,7 @@ from signorini.certification.kkt import ACTIVE, certificate, classify
 from signorini.numerics.active_set import ActiveSetSolver
 from signorini.numerics.factor import factorize
 from signorini.numerics.work import counting
-from signorini.numerics.lcp import delassus
+from signorini.numerics.lcp import delassus, forces_on
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import acceptance
 
@@ -204,10 +203,7 @@ def _kkt_on(problem: ContactProblem, form: Formulation, active: np.ndarray):
         solver = ActiveSetSolver(problem.K, problem.N)
         u, lam = solver.solve(active, problem.f, problem.d)
         return u, lam, solver.factor or form.factor
-    lam = np.zeros(problem.m)
-    if active.any():
-        W_AA = form.W[np.ix_(active, active)]
-        lam[active] = sla.solve(0.5 * (W_AA + W_AA.T), form.b[active], assume_a="pos")
+    lam = forces_on(form.W, form.b, active)  # W is symmetric (delassus)
     return form.factor.solve(problem.f - problem.N.T @ lam), lam, form.factor
 
 

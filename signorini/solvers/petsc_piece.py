@@ -16,8 +16,8 @@ import numpy as np
 
 from signorini.solvers.bounds import BoundForm
 
-__all__ = ["PREFIX", "ROUND_OFF_FLOOR", "SAFETY", "SAFETY_RELATIVE", "load_petsc", "pieces",
-           "reason_text", "solve_piece"]
+__all__ = ["PREFIX", "ROUND_OFF_FLOOR", "SAFETY", "SAFETY_RELATIVE", "load_petsc", "near_null_space",
+           "pieces", "reason_text", "solve_piece", "unless_given"]
 
 #: how far below the requested tolerance PETSc's own stopping test is set
 SAFETY = 1e-5
@@ -77,7 +77,15 @@ def _vec(PETSc, A, values: np.ndarray):
     return vec
 
 
-def _near_null_space(PETSc, A, modes: np.ndarray):
+def unless_given(PETSc, prefix: str, values: dict[str, str]) -> None:
+    """Set the PETSc options ``values`` under ``prefix``, each unless the user already gave it."""
+    options = PETSc.Options(prefix)
+    for name, value in values.items():
+        if not options.hasName(name):
+            options.setValue(name, value)
+
+
+def near_null_space(PETSc, A, modes: np.ndarray):
     """Give ``A`` the columns of ``modes`` (this rank's rows) as near-null space for GAMG."""
     vectors = [_vec(PETSc, A, column) for column in modes.T]
     A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=A.getComm()))
@@ -120,7 +128,7 @@ class FreshMultigrid:
         A, P = pc.getOperators()
         rows = None if self.modes is None else self._free_rows(P)
         if rows is not None:
-            _near_null_space(PETSc, P, self.modes[rows])
+            near_null_space(PETSc, P, self.modes[rows])
         if self.inner is not None:
             self.inner.destroy()
         self.inner = PETSc.PC().create(pc.getComm())
@@ -216,7 +224,7 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
     A.assemble()
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     if piece["modes"] is not None:
-        _near_null_space(PETSc, A, piece["modes"])
+        near_null_space(PETSc, A, piece["modes"])
     b, lower, upper = (_vec(PETSc, A, piece[key]) for key in ("f", "lower", "upper"))
     x = _vec(PETSc, A, piece["x0"])
     _set_options(PETSc, job["petsc_options"])
@@ -235,9 +243,7 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
         solver.setConvergenceTest(_stationarity_test(PETSc, lower, upper, b, job))
         solver.setJacobian(lambda *args: None, A, A)
         solver.setVariableBounds(lower, upper)
-        options = PETSc.Options(PREFIX)
-        if not options.hasName("snes_linesearch_type"):
-            options.setValue("snes_linesearch_type", "basic")
+        unless_given(PETSc, PREFIX, {"snes_linesearch_type": "basic"})
         solver.setTolerances(max_it=job["max_iter"])  # the stopping test is the one above
     else:
         solver = PETSc.TAO().create(comm)
@@ -258,15 +264,13 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
         solver.setMaximumIterations(job["max_iter"])
     multigrid = None
     if job["ksp"] == "gamg":
-        options = PETSc.Options(PREFIX + "mg_")
-        if not options.hasName("pc_gamg_agg_nsmooths"):
-            # plain aggregation: with six rigid modes, smoothing the prolongator makes each
-            # set-up many times dearer for fewer CG iterations (docs/petsc.md)
-            options.setValue("pc_gamg_agg_nsmooths", "0")
-        if kind == "snes" and not PETSc.Options(PREFIX).hasName("snes_ksp_ew"):
+        # plain aggregation: with six rigid modes, smoothing the prolongator makes each set-up
+        # many times dearer for fewer CG iterations (docs/petsc.md)
+        unless_given(PETSc, PREFIX + "mg_", {"pc_gamg_agg_nsmooths": "0"})
+        if kind == "snes":
             # Eisenstat-Walker: loose CG solves while the active set still moves, a fraction of
             # the CG iterations for the same final residuals (docs/petsc.md)
-            PETSc.Options(PREFIX).setValue("snes_ksp_ew", "")
+            unless_given(PETSc, PREFIX, {"snes_ksp_ew": ""})
         free_set = (lambda: solver.getVIInactiveSet().getIndices()) if kind == "snes" else None
         multigrid = FreshMultigrid(PETSc, n, piece["modes"], piece["first"], free_set)
     _configure_ksp(PETSc, solver.getKSP(), job["ksp"], job["tol"], multigrid)
