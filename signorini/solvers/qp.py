@@ -8,14 +8,19 @@ multiplier ``z`` of ``Gx ≤ h`` is non-negative and satisfies
 ``shifted`` in ``u − K⁻¹f``, ``dual`` over ``λ ≥ 0`` with ``W = N K⁻¹ Nᵀ``.
 
 Every backend is one row of :data:`signorini.solvers.qp_backends.BACKENDS`; the methods are
-registered by one loop at the bottom of the module.
+registered by one loop at the bottom of the module. A backend that prints from C whatever its
+verbosity runs with the process's output sent nowhere (:func:`c_output_discarded`): the
+library never prints.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import functools
 import importlib.util
+import os
+import sys
 import time
 from typing import Any
 
@@ -25,12 +30,44 @@ from signorini.errors import BackendNotInstalled, InputError, SolverError, insta
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
-from signorini.solvers.backend_output import c_output_discarded, silence_highs_banner
 from signorini.solvers.options import checked
 from signorini.solvers.qp_backends import (BACKEND_BY_NAME, BACKENDS, COMMON_TYPES,
                                            DEFAULT_MAX_DENSE_DOFS, FAILED, MAX_ITER, Backend)
 
 __all__ = ["METHODS", "solve_qp"]
+
+
+@contextlib.contextmanager
+def c_output_discarded():
+    """The process's stdout and stderr sent nowhere, at the file descriptors and in Python: for
+    backends that print whatever their verbosity, from C or through Python's ``sys.stdout``
+    (HiGHS's banner; OSQP's "Polishing not needed")."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    sink = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(sink, 1)
+        os.dup2(sink, 2)
+        with open(os.devnull, "w") as nowhere, contextlib.redirect_stdout(nowhere), \
+                contextlib.redirect_stderr(nowhere):
+            yield
+    finally:
+        ctypes.CDLL(None).fflush(None)  # what C buffered goes where it was meant to: nowhere
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved + [sink]:
+            os.close(fd)
+
+
+@functools.cache
+def silence_highs_banner() -> None:
+    """HiGHS prints its banner from C on the first ``Highs()`` of a process, whatever the
+    options (highspy 1.16): make that first one with the process's output sent nowhere."""
+    import highspy
+
+    with c_output_discarded():
+        highspy.Highs()
 
 
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,

@@ -12,10 +12,11 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from signorini.solvers import clarabel_, forms
+from signorini.solvers import forms
 from signorini.solvers.options import Option, declare
 from signorini.solvers.qp_reports import (Reader, read_clarabel, read_cvxopt, read_ecos, read_found,
-                                          read_gurobi, read_info, read_quadprog, read_scs)
+                                          read_gurobi, read_info, read_quadprog, read_scs,
+                                          solve_clarabel)
 
 __all__ = ["BACKENDS", "BACKEND_BY_NAME", "COMMON_TYPES", "DEFAULT_MAX_DENSE_DOFS",
            "Backend"]
@@ -225,7 +226,7 @@ BACKENDS: tuple[Backend, ...] = (
                   "presolve_enable"),
             text=("direct_kkt_solver", "direct_solve_method")),
         tolerance=_clarabel_tolerance, max_iter_option="max_iter", extra="",
-        call=clarabel_.solve_problem,  # qpsolvers drops the iteration count
+        call=solve_clarabel,  # qpsolvers drops the iteration count
         polish=True),  # polished, the validation cases end converged and exact at 1e-8
     Backend(
         "proxqp", "ProxQP", "ProxQP (proximal augmented Lagrangian) through qpsolvers",
