@@ -1,23 +1,20 @@
 """Work as data: what a stage of a solve did, counted (tests count work instead of timing it).
 
-A :class:`Work` record counts factorisations, back-solves (one per right-hand
-side), multigrid hierarchies built, CG iterations and active-set steps of load
-control. A stage opens one with :func:`counting`; the numerics
-add to every record open in the current context (:func:`count`), so a stage
-inside another counts into both. The open records live in a
-:class:`contextvars.ContextVar`, which is per thread and per task: two solves
-running side by side never see each other's work, and outside any
-``counting`` block nothing is kept.
+A :class:`Work` record counts factorisations, back-solves (one per right-hand side), multigrid
+hierarchies built, CG iterations and active-set steps of load control. A stage opens one with
+:func:`counting`; the numerics add to every record open in the current context
+(:func:`count`), so a stage inside another counts into both. The open records live in a
+:class:`contextvars.ContextVar` (per thread and per task): two solves side by side never see
+each other's work, and outside any ``counting`` block nothing is kept.
 
 >>> with counting() as work:
 ...     count("back_solves", 2)
 >>> work.as_dict()
 {'back_solves': 2}
 
-Time is the other record a solve carries: :func:`timed` adds a block's wall
-time to a stage of a plain ``{stage: seconds}`` dict that travels with the
-problem or the answer (``solution.seconds``), so the stages of one solve sum
-to its wall time.
+Time is the other record a solve carries: :func:`timed` adds a block's wall time to a stage
+of a ``{stage: seconds}`` dict (``solution.seconds``), so the stages of one solve sum to its
+wall time.
 """
 
 from __future__ import annotations

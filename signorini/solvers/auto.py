@@ -1,20 +1,15 @@
 """``auto``: the method picked from the problem's dimension, size, warm start and backends.
 
-- a warm start holding a factorisation of K around the contact zone (load
-  control leaves one, :mod:`signorini.load_control`): ``nested``, which reuses
-  it and costs back-solves only;
-- 2D and axisymmetric models: ``pdas`` (exact; sparse factorisations of a 2D
-  stiffness barely fill in);
-- 3D models from :data:`AMG_FROM_DOFS` dofs (:data:`PUSHED_AMG_FROM_DOFS`
-  when no load control precedes the method): ``pdas-amg`` (CG + algebraic
-  multigrid, no factorisation: 3D factors fill in like n^(4/3)), when pyamg
-  is installed and every contact row bounds its own dofs (rows sharing a dof
-  have no bound form); otherwise ``pdas``.
+- a warm start holding a factorisation of K around the contact zone (load control leaves
+  one): ``nested``, which reuses it and costs back-solves only;
+- 2D and axisymmetric models: ``pdas`` (a 2D stiffness barely fills in);
+- 3D models from :data:`AMG_FROM_DOFS` dofs (:data:`PUSHED_AMG_FROM_DOFS` when no load control
+  precedes the method): ``pdas-amg`` (no factorisation: 3D factors fill in like n^(4/3)), when
+  pyamg is installed and no two contact rows share a dof; otherwise ``pdas``.
 
-The chosen method's name is the solution's ``method``; ``extras["auto"]``
-and the message say what was picked and why. Options and the warm start
-are passed on to the chosen method. The thresholds were chosen from
-measurements on the Hertz sphere (docs/amg.md).
+The chosen method's name is the solution's ``method``; ``extras["auto"]`` and the message say
+what was picked and why; options and the warm start go to the chosen method. The thresholds
+were chosen on the Hertz sphere (docs/amg.md).
 """
 
 from __future__ import annotations

@@ -98,22 +98,11 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
           **options: Any) -> ContactSolution:
     """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` as a cvxpy model.
 
-    Parameters
-    ----------
-    problem : the contact QP.
-    tol : relative KKT tolerance, translated into the chosen solver's options
-        (``None``: cvxpy's own defaults).
-    max_iter : iteration limit, translated likewise.
-    solver : (option) cvxpy solver name, default ``"CLARABEL"``; any installed
-        solver that accepts a QP.
-    form, polish, max_dense_dofs : (options) as for the ``qp-*`` methods
-        (:mod:`signorini.solvers.forms`); default ``form="primal"``, ``polish=True``.
-
-    Returns
-    -------
-    ContactSolution
-        ``u = x.value``, ``λ = constraint.dual_value``; ``extras["raw_status"]``
-        is cvxpy's status.
+    ``tol`` and ``max_iter`` are translated into the chosen solver's options (None: cvxpy's
+    defaults). Options: ``solver`` (an installed cvxpy solver that accepts a QP, default
+    ``"CLARABEL"``); ``form``, ``polish`` and ``max_dense_dofs`` as for the ``qp-*`` methods
+    (:mod:`signorini.solvers.forms`; default ``form="primal"``, ``polish=True``). The answer:
+    ``u = x.value``, ``λ = constraint.dual_value``; ``extras["raw_status"]`` is cvxpy's status.
     """
     options = take_options(METHOD, options, TYPED_OPTIONS)
     form, note = forms.resolve(METHOD, problem, options["form"], DEFAULT_FORM,

@@ -1,31 +1,22 @@
 """The contact QP on PETSc: SNES-VI and TAO on the bound form, serial or under MPI.
 
-The constraints become bounds (:mod:`signorini.solvers.bounds`: each contact node's
-dofs rotated into its obstacle's normal–tangent frame), and PETSc solves
+The constraints become bounds (:mod:`signorini.solvers.bounds`: each contact node's dofs
+rotated into its obstacle's normal–tangent frame), and PETSc solves
+``min ½ vᵀ K v − fᵀ v`` subject to ``lower ≤ v ≤ upper`` by one of
 
-    min ½ vᵀ K v − fᵀ v   subject to   lower ≤ v ≤ upper
+* ``petsc-vi``: SNES ``vinewtonrsls``, reduced-space semismooth Newton for the variational
+  inequality ``K v − f ⟂ bounds``, with a full-step line search (on a QP a full Newton step
+  is exact on the set it guesses);
+* ``petsc-tron``: TAO ``tron``, trust-region Newton with gradients projected onto the bounds;
+* ``petsc-gpcg``: TAO ``gpcg``, gradient projection with conjugate gradients.
 
-by one of
-
-* ``petsc-vi``: SNES ``vinewtonrsls``, the reduced-space semismooth Newton
-  method for the variational inequality ``K v − f ⟂ bounds``, with a basic
-  (full-step) line search: on a QP a full Newton step is exact on the set it
-  guesses, so a line search only slows it;
-* ``petsc-tron``: TAO ``tron``, a trust-region Newton method that projects
-  gradients onto the bounds and solves on the free variables;
-* ``petsc-gpcg``: TAO ``gpcg``, gradient projection with conjugate gradients,
-  written for bound-constrained QPs.
-
-The linear solves are MUMPS's parallel LU (``ksp=mumps``) or CG
-preconditioned by PETSc's algebraic multigrid GAMG given the rigid-body
-modes as near-null space (``ksp=gamg``); ``ksp=auto`` (the default) takes
-GAMG for 3D problems from :data:`GAMG_FROM_DOFS` dofs and MUMPS otherwise
-(chosen from measurements, docs/petsc.md). Under ``mpirun -n N`` rank 0
-assembles, rotates and splits the rows by whole nodes
-(:mod:`signorini.solvers.cluster`); each rank builds its block of a parallel AIJ
-matrix, and rank 0 gathers the answer, recovers the contact forces as the
-reactions on the active bounds and judges it like any other method's.
-Extra PETSc options go through ``petsc_options`` ("-snes_monitor -ksp_view …").
+The linear solves are MUMPS's parallel LU (``ksp=mumps``) or CG preconditioned by PETSc's
+GAMG with the rigid-body modes as near-null space (``ksp=gamg``); ``ksp=auto`` takes GAMG for
+3D problems from :data:`GAMG_FROM_DOFS` dofs and MUMPS otherwise (docs/petsc.md). Under
+``mpirun -n N`` rank 0 assembles, rotates and splits the rows by whole nodes
+(:mod:`signorini.solvers.cluster`); each rank builds its block of a parallel AIJ matrix, and
+rank 0 gathers the answer and recovers the contact forces as the reactions on the active
+bounds. Extra PETSc options go through ``petsc_options`` ("-snes_monitor -ksp_view …").
 """
 
 from __future__ import annotations

@@ -1,11 +1,9 @@
 """The contact QP through qpsolvers: one method ``qp-<backend>`` per backend.
 
-``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` is handed to :func:`qpsolvers.solve_problem`
-in the formulation of the option ``form`` (:mod:`signorini.solvers.forms`):
-``primal`` as ``P = ½(K + Kᵀ)``, ``q = −f``, ``G = N``, ``h = d`` (qpsolvers'
-multiplier ``z`` of ``Gx ≤ h`` is non-negative and satisfies
-``Px + q + Gᵀz = 0``, our ``K u − f + Nᵀλ = 0`` with ``λ = z``: no sign change),
-``shifted`` in ``u − K⁻¹f``, ``dual`` over ``λ ≥ 0`` with ``W = N K⁻¹ Nᵀ``.
+``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` is handed to :func:`qpsolvers.solve_problem` in the
+formulation of the option ``form`` (:mod:`signorini.solvers.forms`). qpsolvers' multiplier
+``z`` of ``Gx ≤ h`` is non-negative and satisfies ``Px + q + Gᵀz = 0``, our
+``K u − f + Nᵀλ = 0`` with ``λ = z``: no sign change.
 
 Every backend is one row of :data:`signorini.solvers.qp_backends.BACKENDS`; the methods are
 registered by one loop at the bottom of the module. A backend that prints from C whatever its
@@ -72,36 +70,16 @@ def silence_highs_banner() -> None:
 
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
              max_iter: int | None = None, **options: Any) -> ContactSolution:
-    """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with one qpsolvers backend.
+    """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with the qpsolvers ``backend`` (``"osqp"``…).
 
-    Parameters
-    ----------
-    problem : the contact QP.
-    backend : a qpsolvers backend name listed in :data:`BACKENDS` (``"osqp"``...).
-    tol : relative KKT tolerance, translated into the backend's own options
-        (``None`` leaves the backend's defaults untouched).
-    max_iter : iteration limit, translated likewise (quadprog has none).
-    **options : backend options, passed through after ``tol`` and ``max_iter``
-        (so they win); ``max_dense_dofs`` (default 3000) caps ``n`` for dense backends
-        and ``m`` for ``form="dual"``; ``form`` (:data:`~signorini.solvers.forms.FORMS`,
-        default the backend's ``form``) and ``polish`` (default the backend's ``polish``:
-        True for OSQP and Clarabel, else False) are explained in
-        :mod:`signorini.solvers.forms`.
-
-    Returns
-    -------
-    ContactSolution
-        ``u = x``, ``λ = z``; ``extras["raw_status"]`` is the backend's own word.
-
-    Raises
-    ------
-    InputError
-        Unknown option or form, a dense backend asked to solve more than ``max_dense_dofs``
-        dofs, or the dual form more than ``max_dense_dofs`` candidates.
-    BackendNotInstalled
-        qpsolvers cannot load the backend.
-    SolverError
-        The backend raised (re-raised ``from`` its exception).
+    ``tol`` (the relative KKT tolerance) and ``max_iter`` are translated into the backend's own
+    options (None: its defaults); the backend's ``options`` pass through after them, so they
+    win. ``max_dense_dofs`` (default 3000) caps ``n`` for dense backends and ``m`` for the dual
+    form; ``form`` and ``polish`` default to the backend's (:mod:`signorini.solvers.forms`).
+    The answer: ``u = x``, ``λ = z``; ``extras["raw_status"]`` is the backend's own word.
+    InputError for a bad option or a problem too large for a dense backend;
+    BackendNotInstalled when qpsolvers cannot load it; SolverError (``from`` the backend's
+    exception) when it raises.
     """
     spec = BACKEND_BY_NAME[backend]
     options = checked(spec.method_name, options, spec.typed_options)
