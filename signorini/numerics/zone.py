@@ -160,8 +160,7 @@ class ZoneSolver:
         #: per band node: ``N z_j`` and the core's reactions to ``z_j``, and ``z_j`` while it fits
         self._columns: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
         self._whole = 0
-        self.factorisations = 0
-        self.back_solves = 0
+        self.factorisations = 0  # numeric factorisations made (one per core)
 
     # --- linear algebra on the pinned factorisation -------------------------------------------
 
@@ -195,7 +194,6 @@ class ZoneSolver:
         for chunk in chunks or [[]]:
             units = self._units(chunk)
             block = self.factor.solve(units if U0 is not None else np.hstack([rhs, units]))
-            self.back_solves += block.shape[1]
             if U0 is None:
                 U0, block = block[:, :rhs.shape[1]], block[:, rhs.shape[1]:]
             gaps, reactions = self.N @ block, self.factor.fixed_rows(block)
@@ -216,7 +214,6 @@ class ZoneSolver:
         kept = [self._columns[j][2] for j in band]
         if all(z is not None for z in kept):
             return U0 - np.column_stack(kept) @ lam_band
-        self.back_solves += 1
         return self.factor.solve(rhs - self._units(band) @ lam_band)
 
     def _pieces(self, F: np.ndarray, D: np.ndarray, zone: Zone):

@@ -25,6 +25,7 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.numerics.active_set import selection_dofs
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
+from signorini.numerics.work import counting
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
@@ -96,14 +97,13 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     build_time = time.perf_counter() - start
     if system is None:
         system = ZoneSolver(problem.K, problem.N, opts["backend"])
-    factorisations, back_solves = system.factorisations, system.back_solves
-    u, lam, final = system.solve(problem.f, problem.d, zone)
+    with counting() as work:
+        u, lam, final = system.solve(problem.f, problem.d, zone)
     moved = int((final.band & ~zone.band).sum())
     return ContactSolution(
         method="nested", u=u, lam=lam, status="converged",
         message=(f"zone from {source}: {final.counts()} ({moved} amended); "
-                 f"{system.factorisations - factorisations} factorisation(s), "
-                 f"{system.back_solves - back_solves} back-solves"),
+                 f"{work.factorisations} factorisation(s), {work.back_solves} back-solves"),
         iterations=1, build_time=build_time, solve_time=time.perf_counter() - start - build_time,
         extras={"backend": system.backend, "core": int(final.core.sum()),
                 "band": int(final.band.sum())}, factor=system.factor)

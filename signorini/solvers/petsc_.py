@@ -31,8 +31,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import cluster
 from signorini.solvers.base import Method
 from signorini.solvers.bounds import NoBoundForm, bound_form
-from signorini.solvers.options import resolved
-from signorini.solvers.options import Option, declare, take_options
+from signorini.solvers.options import Option, declare, resolved, take_options
 from signorini.solvers.petsc_piece import pieces, reason_text
 
 KSP_CHOICES = ("auto", "mumps", "gamg")
@@ -68,10 +67,8 @@ def solve(problem: ContactProblem, method: str, *, tol: float | None = None,
         ksp = "gamg" if form.block == 3 and form.n >= GAMG_FROM_DOFS else "mumps"
     ranks = cluster.size()
     job = {"run": "signorini.solvers.petsc_piece:solve_piece", "n": form.n, "block": form.block,
-           "kind": (kind, petsc_type), "ksp": ksp, "tol": tol,
-           "f_norm": float(np.linalg.norm(form.f)),
-           "max_iter": max_iter,
-           "petsc_options": opts["petsc_options"]}
+           "kind": (kind, petsc_type), "ksp": ksp, "tol": tol, "max_iter": max_iter,
+           "f_norm": float(np.linalg.norm(form.f)), "petsc_options": opts["petsc_options"]}
     parts = pieces(form, ranks, x0, gamg=ksp == "gamg")
     build_time = time.perf_counter() - start
     results = cluster.distribute(job, parts)
