@@ -9,7 +9,7 @@ preconditioned with algebraic multigrid, the rigid-body modes as near-null space
 
 - the first active set is given (``active0``: ``signorini.solve`` passes the scene's
   prediction), or comes from a warm start's forces or from a coarse QP (``coarse``);
-- a pending target load (``problem.pending``, left to this method by load control:
+- a pending target load (``problem.model.pending``, left to this method by load control:
   ``Method.matches_load``) is matched with the answer: the push is one more unknown of every
   CG system (:mod:`signorini.solvers.load_border`); the push found is
   ``solution.extras["push"]`` (``push0`` the first guess);
@@ -80,7 +80,7 @@ def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.n
     coarse = opts["coarse"]
     if coarse is None:
         return np.zeros(problem.m, dtype=bool), "none (no prediction)"
-    if coarse.pending:
+    if coarse.model.pending:
         raise InputError("method 'pdas-amg': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
     solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse,
@@ -109,7 +109,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     c = opts["c"]
     tol, max_iter = resolved("pdas-amg", "active set", tol, max_iter)
     start = time.perf_counter()
-    if problem.pending and border_factor(problem) is None:
+    if problem.model.pending and border_factor(problem) is None:
         raise InputError("method 'pdas-amg': the push of this problem does not move one rigid "
                          "set of dofs, so its target load cannot be a CG unknown: match the load "
                          "first (signorini.solve does)")

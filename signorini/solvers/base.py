@@ -297,7 +297,7 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
         solution.status = "inaccurate"
         solution.message = f"{solution.message}; {reason}".lstrip("; ")
         return solution
-    if problem.discretisation is None:  # a QP given as arrays: no model to judge
+    if problem.model.watch is None:  # nothing beyond the candidates to judge (a QP given as arrays)
         return solution
     found = adequacy(problem, solution, accept)
     if found is not None:

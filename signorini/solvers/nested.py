@@ -54,7 +54,7 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any],
         return zone, "the given zone"
     if coarse is None:
         return None, ""
-    if coarse.pending:
+    if coarse.model.pending:
         raise InputError("method 'nested': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
     try:
