@@ -207,13 +207,12 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     if unknowns.push is not None:
         extras["push"] = unknowns.push
         message += "; the load matched with the push as one more unknown (no factorisation)"
-    solution = ContactSolution(
+    return ContactSolution(
         method="pdas-amg", u=u, lam=lam, status=status,
         message=(f"{message}; first active set from {source}; one {hierarchy.backend} hierarchy "
                  f"({hierarchy.setup_s:.2f} s), {cg_iterations} CG iterations"),
         iterations=step, build_time=build_time, solve_time=time.perf_counter() - start - build_time,
         history=history, extras=extras, factor=PinnedCG(unknowns.at_push(problem), system, active))
-    return solution
 
 
 METHODS = (

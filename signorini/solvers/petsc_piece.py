@@ -119,24 +119,20 @@ class FreshMultigrid:
 
     def setUp(self, pc) -> None:
         start = time.perf_counter()
-        self._build(pc)
-        self.setups += 1
-        self.setup_s += time.perf_counter() - start
-
-    def _build(self, pc) -> None:
-        PETSc = self.PETSc
         A, P = pc.getOperators()
         rows = None if self.modes is None else self._free_rows(P)
         if rows is not None:
-            near_null_space(PETSc, P, self.modes[rows])
+            near_null_space(self.PETSc, P, self.modes[rows])
         if self.inner is not None:
             self.inner.destroy()
-        self.inner = PETSc.PC().create(pc.getComm())
+        self.inner = self.PETSc.PC().create(pc.getComm())
         self.inner.setType("gamg")
         self.inner.setOperators(A, P)
         self.inner.setOptionsPrefix(PREFIX + "mg_")
         self.inner.setFromOptions()
         self.inner.setUp()
+        self.setups += 1
+        self.setup_s += time.perf_counter() - start
 
     def apply(self, pc, x, y) -> None:
         start = time.perf_counter()
