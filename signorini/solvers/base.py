@@ -228,26 +228,34 @@ SAME_PRODUCT_RTOL = 1e-12
 MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps"}
 
 
+def _summary(array: Any, x: np.ndarray) -> Any:
+    """``A x`` of a matrix (K or N); a hash of the bytes of a vector (f or d)."""
+    if np.ndim(array) == 2:
+        return array @ x
+    return hashlib.blake2b(np.ascontiguousarray(array, dtype=float).view(np.uint8),
+                           digest_size=16).hexdigest()
+
+
+def _arrays(problem: ContactProblem) -> dict[str, Any]:
+    return {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d}
+
+
 def fingerprint(problem: ContactProblem) -> dict[str, tuple]:
-    """Of each of K, f, N and d: its shape, and ``K x`` and ``N x`` for a fixed random x, or a
-    hash of the bytes of f and d (a few vectors, no copy of K)."""
+    """Of each of K, f, N and d: its shape and its :func:`_summary` with a fixed random x (a few
+    vectors, no copy of K)."""
     x = np.random.default_rng(1).uniform(0.5, 1.5, problem.K.shape[1])
-    arrays = {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d}
-    return {name: (np.shape(a), a @ x if name in "KN" else hashlib.blake2b(
-        np.ascontiguousarray(a, dtype=float).view(np.uint8), digest_size=16).hexdigest())
-        for name, a in arrays.items()}
+    return {name: (np.shape(a), _summary(a, x)) for name, a in _arrays(problem).items()}
 
 
 def changed(problem: ContactProblem, before: dict[str, tuple]) -> list[str]:
     """The names of the arrays of ``problem`` that differ from their ``before`` fingerprint."""
-    shapes = {"K": problem.K.shape, "f": np.shape(problem.f), "N": problem.N.shape,
-              "d": np.shape(problem.d)}
-    if any(shapes[name] != kept[0] for name, kept in before.items()):
-        return [name for name, kept in before.items() if shapes[name] != kept[0]]
+    moved = [name for name, a in _arrays(problem).items() if np.shape(a) != before[name][0]]
+    if moved:
+        return moved
     now = fingerprint(problem)
     return [name for name, (_, kept) in before.items() if not (
-        np.allclose(now[name][1], kept, rtol=SAME_PRODUCT_RTOL, atol=0.0) if name in "KN"
-        else now[name][1] == kept)]
+        np.allclose(now[name][1], kept, rtol=SAME_PRODUCT_RTOL, atol=0.0)
+        if isinstance(kept, np.ndarray) else now[name][1] == kept)]
 
 
 def held_to_problem(problem: ContactProblem, before: dict[str, tuple], solution: ContactSolution,
