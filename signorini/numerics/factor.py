@@ -120,11 +120,6 @@ class Factor:
 NESTED_DISSECTION_FROM = 100_000
 
 
-def cholmod_ordering(n: int) -> str:
-    """CHOLMOD's fill-reducing ordering for an n × n stiffness."""
-    return "nesdis" if n >= NESTED_DISSECTION_FROM else "amd"
-
-
 #: from this many dofs CHOLMOD factorises by supernodes; below, simplicially: faster there
 #: (measured on the Hertz cylinder's K, docs/performance.md)
 SUPERNODAL_FROM = 40_000
@@ -140,7 +135,8 @@ def cholmod_analysis(K: sp.csc_matrix):
     from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
 
     mode = "supernodal" if K.shape[0] >= SUPERNODAL_FROM else "simplicial"
-    return analyze(K, mode=mode, ordering_method=cholmod_ordering(K.shape[0]))
+    ordering = "nesdis" if K.shape[0] >= NESTED_DISSECTION_FROM else "amd"
+    return analyze(K, mode=mode, ordering_method=ordering)
 
 
 def cholmod_numeric(symbolic, K: sp.csc_matrix):

@@ -55,15 +55,12 @@ def qp_solvers() -> list[str]:
     from cvxpy.constraints import SOC
     from cvxpy.reductions.solvers import defines
 
-    out = []
-    for name in cp.installed_solvers():
+    def takes_second_order_cones(name: str) -> bool:
         conic = defines.SOLVER_MAP_CONIC.get(name)
-        if name in _NOT_FOR_QP:
-            continue
-        if name in defines.SOLVER_MAP_QP or (conic is not None
-                                              and SOC in conic.SUPPORTED_CONSTRAINTS):
-            out.append(name)
-    return out
+        return conic is not None and SOC in conic.SUPPORTED_CONSTRAINTS
+
+    return [name for name in cp.installed_solvers() if name not in _NOT_FOR_QP
+            and (name in defines.SOLVER_MAP_QP or takes_second_order_cones(name))]
 
 
 def solver_options(solver: str, tol: float | None, max_iter: int | None) -> dict[str, Any]:
