@@ -16,7 +16,11 @@
 import lazy_loader
 
 # loaded at first use (lazy_loader): a module of the folder imports only what it needs
-__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs={
+__getattr__, __dir__, _ = lazy_loader.attach(__name__, submod_attrs={
     "active_set": ["ActiveSetSolver", "PinnedFactor"], "factor": ["available_backends", "factorize"],
     "lcp": ["delassus", "delassus_max_eigenvalue", "solve_lcp"], "push": ["push_for_load"],
     "multigrid": ["PyamgHierarchy", "pinned_cg"], "zone": ["Zone", "ZoneSolver", "predict_zone"]})
+
+__all__ = ["ActiveSetSolver", "PinnedFactor", "PyamgHierarchy", "Zone", "ZoneSolver",
+           "available_backends", "delassus", "delassus_max_eigenvalue", "factorize", "pinned_cg",
+           "predict_zone", "push_for_load", "solve_lcp"]

@@ -10,5 +10,7 @@ import lazy_loader
 
 # loaded at first use (lazy_loader): a command reading solvers.options (the options and the
 # table of default tolerances) imports no method
-__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs={
+__getattr__, __dir__, _ = lazy_loader.attach(__name__, submod_attrs={
     "base": ["Method"], "registry": ["REGISTRY", "get_method", "methods"]})
+
+__all__ = ["Method", "REGISTRY", "get_method", "methods"]
