@@ -1,7 +1,7 @@
 """The finite sphere against Hertz's half-space: the axisymmetric sphere's difference from Hertz
-under uniform refinement, at contact radii a/R from 0.05 down, for ν = 0 and 0.3.
+under uniform refinement, at contact radii a/R from 0.05 down, for ν = 0, 0.3 and 0.45.
 
-    .venv/bin/python tools/finite_sphere.py        # ~8 min here; writes docs/accuracy/finite-sphere.json
+    .venv/bin/python tools/finite_sphere.py        # ~20 min here; writes docs/accuracy/finite-sphere.json
     .venv/bin/python tools/finite_sphere.py --doc  # docs/accuracy.md's tables from the JSON
 
 A discretisation error falls under refinement and, at a fixed number of elements across a,
@@ -32,8 +32,10 @@ from signorini.studies.runner import run_tasks  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "accuracy" / "finite-sphere.json"
 SCENE = "hertz-sphere"
-#: the series: ν, contact radii, one graded mesh refined uniformly
-SERIES_NUS = (0.0, 0.3)
+#: the series: ν, contact radii, one graded mesh refined uniformly; the rate is fitted where the
+#: difference stands clear of the discretisation's (at ν = 0.45 it is within 0.04 % at every a/R)
+SERIES_NUS = (0.0, 0.3, 0.45)
+RATE_NUS = (0.0, 0.3)
 RATIOS = (0.05, 0.025, 0.0125, 0.00625, 0.0025)
 LEVELS = (0, 1, 2)
 #: the meshes of at most 10k dofs: (a/R, n_contact, grading, units), Triangle's (None: the
@@ -132,7 +134,7 @@ def tables(rows: list[dict]) -> dict[str, str]:
     found = limits(rows)
     lines = ["| ν | quantity | k in c·(a/R)^k | c | finest level at a/R = 0.05 | a/R for 0.01 % |",
              "|---:|---|---:|---:|---:|---:|"]
-    for nu in dict.fromkeys(r["nu"] for r in found):
+    for nu in RATE_NUS:
         at_nu = [r for r in found if r["nu"] == nu]
         for key, name in (("a_err", "a"), ("p0_err", "p₀")):
             k, c = rate(at_nu, key)
