@@ -11,7 +11,7 @@ preconditioned with algebraic multigrid, the rigid-body modes as near-null space
   prediction), or comes from a warm start's forces or from a coarse QP (``coarse``);
 - a pending target load (``problem.model.pending``, left to this method by load control:
   ``Method.matches_load``) is matched with the answer: the push is one more unknown of every
-  CG system (:mod:`signorini.solvers.load_border`); the push found is
+  CG system (:class:`~signorini.solvers.amg_system.LoadBorder`); the push found is
   ``solution.extras["push"]`` (``push0`` the first guess);
 - **one hierarchy** is built, for K with the first active set pinned; later sets differ in a
   few rows and CG pays for them in iterations;
@@ -45,8 +45,8 @@ from signorini.numerics.zone import predict_zone
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import pdas
 from signorini.solvers.bounds import NoBoundForm, bound_form
-from signorini.solvers.amg_system import CG_MAX_ITER, PinnedCG, PinnedSystem
-from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
+from signorini.solvers.amg_system import (CG_MAX_ITER, PinnedCG, PinnedSystem, Unknowns,
+                                          border_factor, load_border, rotated)
 from signorini.problem.solution import WarmStart
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare, per_candidate, resolved, take_options
