@@ -10,7 +10,7 @@ from pathlib import Path
 
 from signorini.errors import InputError
 from signorini.cli.common import (PROBLEM_FILES, add_command, family_of, input_files, out_folder,
-                                  pairs, parse_sizes)
+                                  pairs)
 
 
 def _bench_peer(args: argparse.Namespace) -> int:
@@ -45,7 +45,11 @@ def _bench_peer(args: argparse.Namespace) -> int:
 
 def _sizes(text: str | None, default: str) -> list[int]:
     """``--sizes`` as distinct levels (``default`` when not given; an empty list is refused)."""
-    levels = parse_sizes(default if text is None else text)
+    try:
+        levels = [int(x) for x in (default if text is None else text).split(",")]
+    except ValueError:
+        raise InputError(f"--sizes {text!r} is not a comma-separated list of sizes, "
+                         "e.g. --sizes 0,1,2") from None
     if len(set(levels)) != len(levels):
         raise InputError(f"--sizes {text!r} names a size twice: give each once, e.g. --sizes 0,1")
     return levels
