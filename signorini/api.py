@@ -26,10 +26,7 @@ from signorini.problem.contact import ContactProblem
 from signorini.problem.scales import record_units
 from signorini.problem.solution import ContactSolution, WarmStart
 from signorini.result import SCHEMA_VERSION, Result, solve_summary
-from signorini.scenes import SCENES, SceneFamily, build_problem
-from signorini.scenes.adapt import parse_target, solve_adaptive as adapt
-from signorini.scenes.base import scene_params
-from signorini.scenes.build import coarse_problem, with_load
+from signorini import scenes  # loaded at first use: a QP given as arrays needs no scene
 from signorini.solvers import registry
 from signorini.solvers.registry import Method, Request, check_request
 from signorini.solvers.registry import methods as _all_methods
@@ -86,7 +83,8 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
                          "refinement: call signorini.solve_adaptive(scene, target_error, ...)")
     request = checked(method, tol, max_iter, options)  # once, before the scene is built
     if isinstance(problem, str):
-        problem = build_problem(problem, params=scene_params(params), solved_by=request.method)
+        problem = scenes.build_problem(problem, params=scenes.scene_params(params),
+                                       solved_by=request.method)
     elif params:
         raise InputError("params= builds a scene by name: give solve('hertz-cylinder', params=...) "
                          "or build the problem with those parameters first")
@@ -95,17 +93,17 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
                          f"{type(problem).__name__}: build one with signorini.build_problem(...) "
                          "or ContactProblem.from_qp(K, f, N, d)")
     start = None if warm_start is None else WarmStart.of(warm_start)
-    if problem.pending or request.method.runs(problem, request.options, start).prediction:
+    if problem.model.pending or request.method.runs(problem, request.options, start).prediction:
         # a target load to match, or the scene's prediction of the contact for the method
         return Result(*load_control.solve(problem, request, warm_start=start,
-                                          coarse=coarse_problem, keep_factor=keep_factor))
+                                          coarse=scenes.coarse_problem, keep_factor=keep_factor))
     return Result(*registry.run(problem, request, warm_start=start, keep_factor=keep_factor))
 
 
 def at_load(problem: ContactProblem) -> ContactProblem:
     """``problem`` at its target load, or itself when it has none: the QP any method (or your
     own code) can then solve as it is. Load control matches the push (:mod:`signorini.load_control`)."""
-    return load_control.at_load(problem, coarse_problem)
+    return load_control.at_load(problem, scenes.coarse_problem)
 
 
 def solve_adaptive(scene: str, target_error: float | str, method: MethodLike = DEFAULT_METHOD, *,
@@ -127,17 +125,18 @@ def solve_adaptive(scene: str, target_error: float | str, method: MethodLike = D
     if not isinstance(scene, str):
         raise InputError("adaptive refinement refines a scene's mesh: give the scene by name, "
                          "solve_adaptive('hertz-cylinder', 0.01)")
-    params = scene_params(params)
+    params = scenes.scene_params(params)
     request = checked(method, tol, max_iter, options)
     certificates: dict[int, Certificate] = {}
 
     def solver(problem: ContactProblem) -> tuple[ContactProblem, ContactSolution]:
-        solved = load_control.solve(problem, request, coarse=coarse_problem)
+        solved = load_control.solve(problem, request, coarse=scenes.coarse_problem)
         certificates[id(solved.solution)] = solved.certificate
         return solved.problem, solved.solution
 
-    run = adapt(scene, params, parse_target(target_error), solver, max_dofs=max_dofs,
-                quantity=target_on, solved_by=request.method)
+    run = scenes.adapt.solve_adaptive(scene, params, scenes.adapt.parse_target(target_error),
+                                      solver, max_dofs=max_dofs, quantity=target_on,
+                                      solved_by=request.method)
     result = Result(run.problem, run.solution, certificates[id(run.solution)])
     result._estimate = run.estimate
     return result
@@ -179,14 +178,14 @@ def methods(installed_only: bool = False) -> list[Method]:
     return _all_methods(installed_only)
 
 
-def scene_families() -> dict[str, SceneFamily]:
+def scene_families() -> dict[str, scenes.SceneFamily]:
     """The built-in scene families by name (each lists its parameters and reference).
 
     (Not ``scenes``: that name is the subpackage :mod:`signorini.scenes`.)
     """
-    return dict(SCENES)
+    return dict(scenes.SCENES)
 
 
-__all__ = ["DEFAULT_METHOD", "SCHEMA_VERSION", "Request", "Result", "at_load", "build_problem",
+__all__ = ["DEFAULT_METHOD", "SCHEMA_VERSION", "Request", "Result", "at_load",
            "certificate", "check_request", "checked", "methods", "record_units", "scene_families",
-           "solve", "solve_adaptive", "solve_summary", "with_load"]
+           "solve", "solve_adaptive", "solve_summary"]

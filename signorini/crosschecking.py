@@ -27,7 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from signorini.api import SCHEMA_VERSION, Result, build_problem, record_units, solve
+from signorini.api import SCHEMA_VERSION, Result, record_units, solve
+from signorini import scenes  # loaded at first use: a QP given as arrays needs no scene
 from signorini.crosscheck_tables import render, render_candidates, render_markdown
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.certification.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify, compare
@@ -167,9 +168,9 @@ class CrossCheck:
         """The record ``signorini crosscheck --json`` writes."""
         problem = self.problem
         return {"schema_version": SCHEMA_VERSION, "units": record_units(problem),
-                "scene": problem.scene, "params": problem.params, "dofs": problem.n,
+                "scene": problem.name, "params": problem.model.params, "dofs": problem.n,
                 "contact_candidates": problem.m, "tol": self.tol,
-                "reference": problem.reference, "agree_factor": AGREE_FACTOR,
+                "reference": problem.model.reference_name, "agree_factor": AGREE_FACTOR,
                 "passed": self.passed, "failures": self.failures, "allowed": list(self.allowed),
                 "reference_method": self.reference_method, "polish": self.polish,
                 "methods": [run.as_dict() for run in self.runs],
@@ -267,7 +268,7 @@ def crosscheck(problem: ContactProblem | str, methods: list[str] | tuple[str, ..
         raise InputError(f"polish={polish!r} must be True or False")
     tol = check_tol(tol)
     if isinstance(problem, str):
-        problem = build_problem(problem, params=params)
+        problem = scenes.build_problem(problem, params=params)
     elif params:
         raise InputError("params= builds a scene by name: give crosscheck('hertz-cylinder', "
                          "params=...) or build the problem with those parameters first")

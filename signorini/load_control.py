@@ -1,7 +1,7 @@
 """Load control, and the one pipeline from a checked request to a certified answer.
 
 A scene loaded by a target force P is assembled at a nominal push
-(``problem.pending``). Its load and gaps are affine in the push s,
+(``problem.model.pending``). Its load and gaps are affine in the push s,
 ``f(s) = s f₁ + f₀`` and ``d(s) = d₀ + s d₁``, so on a fixed active set the
 answer is affine in s too, and the push whose total contact force
 ``μ Σλ`` equals P solves one scalar equation per active set
@@ -101,7 +101,7 @@ def coarse_zone(problem: ContactProblem, coarse: ContactProblem | None,
     if coarse is None:
         return None, None
     try:
-        if coarse.pending:
+        if coarse.model.pending:
             settled = match(coarse)
             coarse, lam = settled.problem, settled.warm_start.lam
         else:
@@ -118,8 +118,8 @@ def coarse_zone(problem: ContactProblem, coarse: ContactProblem | None,
 def predicted_zone(problem: ContactProblem, coarse: CoarseModel | None = None) -> Zone | None:
     """The contact zone load control matches a large model on: analytic, else from a coarser
     model; None for models under :data:`ZONE_FROM_DOFS` dofs or rows that bound no single dof."""
-    disc = problem.discretisation
-    if disc is None or disc.prescribed.size < ZONE_FROM_DOFS or selection_dofs(problem.N) is None:
+    model = problem.model
+    if model.prescribed.size < ZONE_FROM_DOFS or selection_dofs(problem.N) is None:
         return None
     zone = analytic_zone(problem)
     if zone is None and coarse is not None:
@@ -138,7 +138,7 @@ def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
     fail) on the full active-set system from the candidates the scene
     predicts in contact.
     """
-    if not problem.pending:
+    if not problem.model.pending:
         raise InputError("the problem has no target load to match: it is solved as it is")
     with counting() as work:
         problem, start, how = _matched(problem, zone)
@@ -146,7 +146,8 @@ def match(problem: ContactProblem, zone: Zone | None = None) -> Matched:
 
 
 def _matched(problem: ContactProblem, zone: Zone | None) -> tuple[ContactProblem, WarmStart, str]:
-    pu, disc = problem.push, problem.discretisation
+    model = problem.model
+    pu = model.push
     f0 = pu.load * pu.f_load if pu.f_load is not None else None
     if zone is not None and pu.resultant is None:  # the zone kernel sums forces along the push
         try:
@@ -164,7 +165,7 @@ def _matched(problem: ContactProblem, zone: Zone | None) -> tuple[ContactProblem
     system = ActiveSetSolver(problem.K, problem.N)
     scale, lam, u = calibrate_push(problem.K, problem.N, pu.f1, pu.d0, pu.d1, pu.target,
                                    problem.force_multiplicity, f0=f0,
-                                   start=disc.predicted_contact, weights=pu.resultant, system=system)
+                                   start=model.predicted_contact, weights=pu.resultant, system=system)
     return (problem.pushed(scale), WarmStart(lam=lam, u=u, factor=system.factor),
             "full active set")
 
@@ -172,7 +173,7 @@ def _matched(problem: ContactProblem, zone: Zone | None) -> tuple[ContactProblem
 def at_load(problem: ContactProblem, coarse: CoarseModel | None = None) -> ContactProblem:
     """``problem`` at its target load (matched by :func:`match` on the zone the scene predicts),
     or itself when it has none: the QP every method can then be run on, cold."""
-    if not problem.pending:
+    if not problem.model.pending:
         return problem
     return match(problem, predicted_zone(problem, coarse)).problem
 
@@ -201,10 +202,10 @@ def _predictions(problem: ContactProblem, kind: str, options: dict[str, Any],
         if zone is None:
             return {}
         found = {"active0": zone.core}
-        if problem.pending and settled is not None:  # the coarse model's push, as a first guess
-            mine = float(np.max(np.abs(problem.discretisation.prescribed)))
-            theirs = float(np.max(np.abs(settled.discretisation.prescribed)))
-            found["push0"] = (problem.push.scale * theirs * settled.scales.displacement
+        if problem.model.pending and settled is not None:  # the coarse model's push, as a first guess
+            mine = float(np.max(np.abs(problem.model.prescribed)))
+            theirs = float(np.max(np.abs(settled.model.prescribed)))
+            found["push0"] = (problem.model.push.scale * theirs * settled.scales.displacement
                               / (mine * problem.scales.displacement))
         return found
     return {}
@@ -238,7 +239,7 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
     stages: dict[str, dict[str, int]] = {}
     seconds: dict[str, float] = {}
     zone, matched, options = None, None, request.options
-    if problem.pending and not runs.matches(problem):
+    if problem.model.pending and not runs.matches(problem):
         log.info("matching the target load: predicting the contact zone on a coarser model")
         with timed(seconds, "load control"):
             zone = predicted_zone(problem, coarse)  # predicted once: load control's and the method's

@@ -124,7 +124,7 @@ class Result:
     @property
     def displacement(self) -> np.ndarray:
         """Every dof of the mesh (free and prescribed), in length units."""
-        return self.problem.expand(self.solution.u) * self.problem.scales.displacement
+        return self.problem.model.expand(self.solution.u) * self.problem.scales.displacement
 
     @property
     def u(self) -> np.ndarray:
@@ -213,7 +213,7 @@ class Result:
         start = time.perf_counter()
         record: dict[str, Any] = {
             "schema_version": SCHEMA_VERSION, "units": record_units(problem),
-            "scene": problem.scene, "params": problem.params, "method": solution.method,
+            "scene": problem.name, "params": problem.model.params, "method": solution.method,
             "status": solution.status, "claimed_status": solution.own_status,
             "message": solution.message,
             "iterations": self.iterations, "dofs": problem.n,
@@ -238,7 +238,7 @@ class Result:
             record["adequacy"] = solution.extras["adequacy"]
         record["extras"] = {k: v for k, v in solution.extras.items()
                             if isinstance(v, (int, float, str, bool)) or _scalar_rows(v)}
-        disc = problem.discretisation
+        disc = problem.model
         built = {"mesh": disc.mesh_s, "assemble": disc.assemble_s} if disc is not None else {}
         record["time"] = {**stage_times({**built, **solution.seconds,
                                          "output": time.perf_counter() - start}),

@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.problem.contact import ContactProblem, Discretisation
+from signorini.problem.contact import ContactProblem, Model
 
 
 def random_problem(n: int = 8, m: int = 3, seed: int = 0, condition: float = 10.0,
@@ -120,7 +120,7 @@ def bogie(*, half_length: float = 1.0, bending_stiffness: float = 10.0,
     return ContactProblem(
         K=sp.csr_matrix(K), f=f, N=N, d=gap, weights=np.ones(2),
         contact_points=np.column_stack([nodes[[0, 2]], np.zeros(2)]), name="bogie",
-        discretisation=Discretisation(
+        model=Model(
             mesh=nodes, free_dofs=np.arange(6), prescribed=np.zeros(6), load_row=load_row,
             load_offset=k_v * float(lowering),
             params={"half_length": ell, "bending_stiffness": float(bending_stiffness),
@@ -130,7 +130,7 @@ def bogie(*, half_length: float = 1.0, bending_stiffness: float = 10.0,
 
 def bogie_compliance(problem: ContactProblem) -> np.ndarray:
     """The closed-form ``W`` of :func:`bogie` from its parameters (see its docstring)."""
-    p = problem.params
+    p = problem.model.params
     ell, EI = p["half_length"], p["bending_stiffness"]
     own = ell ** 3 / (3 * EI) + 1 / p["mount_stiffness"] + ell ** 2 / p["tilt_stiffness"]
     other = 1 / p["mount_stiffness"] - ell ** 2 / p["tilt_stiffness"]
@@ -145,8 +145,8 @@ def bogie_deflection(problem: ContactProblem, u: np.ndarray,
     ``w = H₁ w_a + h H₂ θ_a + H₃ w_b + h H₄ θ_b`` with ``H₁ = 1 − 3s² + 2s³``,
     ``H₂ = s − 2s² + s³``, ``H₃ = 3s² − 2s³``, ``H₄ = −s² + s³``.
     """
-    nodes = np.asarray(problem.mesh, dtype=float)
-    full = problem.expand(np.asarray(u, dtype=float))
+    nodes = np.asarray(problem.model.mesh, dtype=float)
+    full = problem.model.expand(np.asarray(u, dtype=float))
     x = np.linspace(nodes[0], nodes[-1], samples)
     element = np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, nodes.size - 2)
     h = nodes[element + 1] - nodes[element]

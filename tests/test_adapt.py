@@ -64,7 +64,7 @@ def test_the_cylinder_refines_until_the_energy_target():
     assert all(later < earlier for earlier, later in zip(estimates, estimates[1:]))
     assert steps[-1]["action"] == "target met" and steps[-1]["dofs"] == result.problem.n
     # the refined arc nodes lie on the cylinder (radius R = 1 about (0, 1))
-    mesh = result.problem.mesh
+    mesh = result.problem.model.mesh
     boundary = mesh.boundary_nodes()
     x, y = mesh.p[:, boundary]
     arc = (x > 1e-9) & (y < 1 - 1e-9)
@@ -239,7 +239,7 @@ def test_a_sharp_punch_grows_its_candidates_around_the_corner():
     assert result.status == "converged" and "candidates widened" in actions
     assert result.estimate.relative <= 0.02
     assert result.to_dict()["adequacy"]["penetrating_nodes"] == 0
-    beyond = result.problem.contact_points[:, 0] > float(result.problem.params["a"]) * (1 + 1e-9)
+    beyond = result.problem.contact_points[:, 0] > float(result.problem.model.params["a"]) * (1 + 1e-9)
     assert beyond.any() and np.any(result.solution.lam[beyond] > 0)
 
 

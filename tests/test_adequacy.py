@@ -42,7 +42,7 @@ def test_more_candidates_make_the_same_push_adequate():
 def test_the_default_scenes_are_adequate_and_watched(scene):
     result = signorini.solve(scene)
     assert result.converged, result.message
-    assert result.problem.discretisation.watch is not None
+    assert result.problem.model.watch is not None
     assert result.to_dict()["adequacy"]["edge_active"] == 0
 
 
@@ -58,14 +58,14 @@ def test_the_cli_exits_1_on_an_inadequate_model(tmp_path):
 def test_a_watched_node_through_the_obstacle_is_found():
     problem = signorini.build_problem("hertz-cylinder", params=SMALL)
     solution = signorini.solve(problem).solution
-    watch = problem.discretisation.watch
+    watch = problem.model.watch
     assert adequacy(problem, solution, 1e-9).penetrating_nodes == 0
     # move the first watched node's gap below zero: the check must see it
     gaps = watch.gap(problem, solution.u)
     moved = watch.gaps.copy()
     moved[0] -= gaps[0] + 1e-3
     shifted = Watch(watch.rows, moved, watch.edge, watch.candidate_gaps, watch.remedy)
-    problem.discretisation.watch = shifted
+    problem.model.watch = shifted
     found = adequacy(problem, solution, 1e-9)
     assert found.penetrating_nodes == 1 and found.inadequate(1e-9)
     assert found.penetration == pytest.approx(1e-3 * problem.scales.displacement)
@@ -79,8 +79,8 @@ def test_warnings_keep_the_status():
     result = signorini.solve("hertz-cylinder", params={"nu": 0.49, **SMALL})
     assert result.converged and "lock" not in result.message
     problem = signorini.build_problem("hertz-cylinder", params=SMALL)
-    watch = problem.discretisation.watch
-    push = np.max(np.abs(problem.discretisation.prescribed))
-    problem.discretisation.watch = Watch(watch.rows, watch.gaps, watch.edge, watch.candidate_gaps - 2 * push,
+    watch = problem.model.watch
+    push = np.max(np.abs(problem.model.prescribed))
+    problem.model.watch = Watch(watch.rows, watch.gaps, watch.edge, watch.candidate_gaps - 2 * push,
                           watch.remedy)
     assert any("inside the body" in w for w in warnings(problem))

@@ -226,7 +226,7 @@ def test_auto_leaves_a_pushed_3d_model_to_pdas_amg_sooner_than_a_load_targeted_o
     monkeypatch.setattr(auto, "PUSHED_AMG_FROM_DOFS", 1_000)
     pushed = build_problem("hertz-sphere-3d", params={"delta": 0.0025})
     loaded = build_problem("hertz-sphere-3d")
-    assert pushed.n < auto.AMG_FROM_DOFS and loaded.pending
+    assert pushed.n < auto.AMG_FROM_DOFS and loaded.model.pending
     assert auto.choose(pushed)[0] == "pdas-amg"
     assert auto.choose(loaded)[0] == "pdas"
     matched = load_control.match(loaded)

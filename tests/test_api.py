@@ -48,7 +48,7 @@ def test_forces_are_in_the_scene_units_and_equal_the_cli_json(tmp_path):
     assert result.hertz.p0_ref == pytest.approx(2 * result.total_force / (np.pi * a), rel=1e-9)
     assert result.hertz.p0 == pytest.approx(result.hertz.p0_ref, rel=0.05)  # a coarse mesh
     assert np.all(result.gap >= -1e-12 * SI["R"])
-    assert result.displacement.shape == (result.problem.discretisation.prescribed.size,)
+    assert result.displacement.shape == (result.problem.model.prescribed.size,)
 
     path = tmp_path / "r.json"
     argv = ["solve", "hertz-cylinder", "--tol", "1e-9", "--json", str(path)]

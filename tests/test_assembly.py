@@ -53,15 +53,15 @@ def exact(problem):
 
 def full_stiffness(problem):
     """The unconstrained stiffness on the problem's own basis, assembled here (E = 1)."""
-    form = linear_elasticity(*lame_parameters(1.0, problem.params["nu"]))
-    return asm(form, problem.basis).tocsr()
+    form = linear_elasticity(*lame_parameters(1.0, problem.model.params["nu"]))
+    return asm(form, problem.model.basis).tocsr()
 
 
 def rigid_modes(problem):
     """Two translations and the infinitesimal rotation (−y, x) as full dof vectors."""
-    x, y = problem.mesh.p
-    dofs = problem.basis.nodal_dofs
-    n_full = problem.discretisation.prescribed.size
+    x, y = problem.model.mesh.p
+    dofs = problem.model.basis.nodal_dofs
+    n_full = problem.model.prescribed.size
     modes = np.zeros((3, n_full))
     modes[0, dofs[0]] = 1.0
     modes[1, dofs[1]] = 1.0
@@ -98,7 +98,7 @@ def test_free_stiffness_is_positive_definite(scene):
 
 def test_free_stiffness_is_the_condensed_full_stiffness(scene):
     K_full = full_stiffness(scene)
-    free = scene.discretisation.free_dofs
+    free = scene.model.free_dofs
     assert abs(K_full[free][:, free] - scene.K).max() <= 1e-13 * abs(K_full).max()
 
 
@@ -128,11 +128,11 @@ def test_gap_rows_are_unit_normals_towards_the_obstacle(scene):
     row_norms = np.sqrt(np.asarray(scene.N.multiply(scene.N).sum(axis=1)).ravel())
     np.testing.assert_allclose(row_norms, 1.0, rtol=0, atol=1e-14)
     # each row acts on its own node's vertical dof with −1 (the flat y = 0 lies below)
-    full = np.zeros((scene.m, scene.discretisation.prescribed.size))
-    full[:, scene.discretisation.free_dofs] = scene.N.toarray()
-    nodes = [int(np.argmin(np.hypot(*(scene.mesh.p - point[:, None]))))
+    full = np.zeros((scene.m, scene.model.prescribed.size))
+    full[:, scene.model.free_dofs] = scene.N.toarray()
+    nodes = [int(np.argmin(np.hypot(*(scene.model.mesh.p - point[:, None]))))
              for point in scene.contact_points]
-    y_dofs = scene.basis.nodal_dofs[1, nodes]
+    y_dofs = scene.model.basis.nodal_dofs[1, nodes]
     np.testing.assert_array_equal(full[np.arange(scene.m), y_dofs], -1.0)
     assert np.count_nonzero(full) == scene.m
 
@@ -154,11 +154,11 @@ def test_block_weights_sum_to_the_half_width(block):
 
 
 def test_cylinder_weights_sum_to_the_candidate_arc_plus_half_a_facet(hertz):
-    R = hertz.params["R"]
+    R = hertz.model.params["R"]
     L = hertz.scales.length
-    points = hertz.mesh.p * L
+    points = hertz.model.mesh.p * L
     centre = np.array([0.0, R])
-    boundary = hertz.mesh.boundary_nodes()
+    boundary = hertz.model.mesh.boundary_nodes()
     radius = np.hypot(points[0, boundary] - centre[0], points[1, boundary] - centre[1])
     arc = boundary[(np.abs(radius - R) < 1e-9 * R) & (points[1, boundary] < R * (1 - 1e-9))]
     arc = arc[np.argsort(points[0, arc])]
@@ -173,9 +173,9 @@ def test_cylinder_weights_sum_to_the_candidate_arc_plus_half_a_facet(hertz):
     arc_length = R * np.arcsin(candidates[-1, 0] / R)
     assert 0.0 < total - arc_length <= half_next * (1 + 1e-6)
     # candidates reach `candidates · a` (a from Hertz's formula for the load)
-    a = hertz.params["a_over_R"] * R
-    assert candidates[-1, 0] <= hertz.params["candidates"] * a * (1 + 1e-9)
-    assert points[0, arc[hertz.m]] > hertz.params["candidates"] * a
+    a = hertz.model.params["a_over_R"] * R
+    assert candidates[-1, 0] <= hertz.model.params["candidates"] * a * (1 + 1e-9)
+    assert points[0, arc[hertz.m]] > hertz.model.params["candidates"] * a
 
 
 # --- the block: a patch test -----------------------------------------------------------------
@@ -191,11 +191,11 @@ def test_block_patch_test_uniform_pressure(block):
 
 def test_block_patch_test_linear_displacement(block):
     solution = exact(block)
-    full = block.expand(solution.u) * block.scales.displacement
-    x, y = block.mesh.p * block.scales.length
+    full = block.model.expand(solution.u) * block.scales.displacement
+    x, y = block.model.mesh.p * block.scales.length
     delta, H, nu = BLOCK["delta"], BLOCK["H"], BLOCK["nu"]
-    u_x = full[block.basis.nodal_dofs[0]]
-    u_y = full[block.basis.nodal_dofs[1]]
+    u_x = full[block.model.basis.nodal_dofs[0]]
+    u_y = full[block.model.basis.nodal_dofs[1]]
     # uniaxial plane strain: ε_yy = −δ/H, σ_xx = 0 ⇒ ε_xx = ν/(1 − ν) δ/H
     np.testing.assert_allclose(u_y, -delta * y / H, rtol=0, atol=1e-10 * delta)
     np.testing.assert_allclose(u_x, nu / (1 - nu) * delta / H * x, rtol=0, atol=1e-10 * delta)
@@ -206,7 +206,7 @@ def test_block_patch_test_linear_displacement(block):
 def test_block_force_balance(block):
     solution = exact(block)
     contact = block.total_contact_force(solution.lam) * block.scales.force
-    applied = block.applied_load(solution.u) * block.scales.force
+    applied = block.model.applied_load(solution.u) * block.scales.force
     E_star = contact_modulus(BLOCK["E"], BLOCK["nu"])
     assert contact == pytest.approx(applied, rel=1e-10)
     assert contact == pytest.approx(2 * BLOCK["W"] * E_star * BLOCK["delta"] / BLOCK["H"], rel=1e-10)
@@ -215,7 +215,7 @@ def test_block_force_balance(block):
 def test_hertz_force_balance(hertz):
     solution = exact(hertz)
     contact = hertz.total_contact_force(solution.lam)
-    applied = hertz.applied_load(solution.u)
+    applied = hertz.model.applied_load(solution.u)
     assert contact > 0
     assert contact == pytest.approx(applied, rel=1e-9)
 
@@ -294,13 +294,13 @@ def test_target_load_is_reached(values):
     solution = exact(problem)
     total = problem.total_contact_force(solution.lam) * problem.scales.force
     assert total == pytest.approx(values["P"], rel=1e-8)
-    assert problem.applied_load(solution.u) * problem.scales.force == pytest.approx(
+    assert problem.model.applied_load(solution.u) * problem.scales.force == pytest.approx(
         values["P"], rel=1e-8)
 
 
 def test_default_load_is_hertz_load_for_default_a_over_R(hertz):
     solution = exact(hertz)
-    R, E, nu = hertz.params["R"], hertz.params["E"], hertz.params["nu"]
+    R, E, nu = hertz.model.params["R"], hertz.model.params["E"], hertz.model.params["nu"]
     P = hertz_cylinder_load(0.05 * R, R, contact_modulus(E, nu))
     total = hertz.total_contact_force(solution.lam) * hertz.scales.force
     assert total == pytest.approx(P, rel=1e-8)
@@ -316,8 +316,8 @@ def test_consistent_a_over_R_and_P_give_the_same_problem():
     assert rel_diff(by_width.N.toarray(), by_load.N.toarray()) < 1e-12
     assert rel_diff(by_width.f, by_load.f) < 1e-10
     assert rel_diff(by_width.d, by_load.d) < 1e-10
-    assert by_width.params["P"] == pytest.approx(P, rel=1e-12)
-    assert by_load.params["a_over_R"] == pytest.approx(a_over_R, rel=1e-12)
+    assert by_width.model.params["P"] == pytest.approx(P, rel=1e-12)
+    assert by_load.model.params["a_over_R"] == pytest.approx(a_over_R, rel=1e-12)
 
 
 def test_P_and_a_over_R_together_raise():

@@ -31,9 +31,9 @@ def test_problem_cache_round_trip(tmp_path):
     problem.save(tmp_path / "p.npz")
     again = ContactProblem.load(tmp_path / "p.npz")
     assert (again.K != problem.K).nnz == 0 and np.array_equal(again.f, problem.f)
-    assert again.params == problem.params and again.scales == problem.scales
-    assert np.array_equal(again.push.f1, problem.push.f1)
-    assert np.array_equal(again.mesh.p, problem.mesh.p)  # node blocks for the petsc methods
+    assert again.model.params == problem.model.params and again.scales == problem.scales
+    assert np.array_equal(again.model.push.f1, problem.model.push.f1)
+    assert np.array_equal(again.model.mesh.p, problem.model.mesh.p)  # node blocks for the petsc methods
 
 
 @pytest.mark.slow

@@ -92,7 +92,7 @@ def test_the_multiplier_is_the_price_of_the_gap(results, name):
 
 def test_the_block_obeys_its_linear_law():
     result = signorini.solve("block")
-    P, params = result.total_force, result.problem.params
+    P, params = result.total_force, result.problem.model.params
     by_push = signorini.derivative(result, "total_force", "delta")
     by_modulus = signorini.derivative(result, "total_force", "E")
     assert by_push.value == pytest.approx(P, rel=1e-12)

@@ -116,7 +116,7 @@ def test_every_result_reports_its_estimate():
     result = signorini.solve("hertz-cylinder", params=COARSE)
     record = json.loads(to_json(result.to_dict()))["estimate"]
     assert set(record) >= {"total", "relative", "elements", "max_element"}
-    assert record["elements"] == result.problem.mesh.t.shape[1]
+    assert record["elements"] == result.problem.model.mesh.t.shape[1]
     assert record["relative"] == pytest.approx(result.estimate.relative)
     assert len(result.estimate.elements) == record["elements"]
     problem = signorini.ContactProblem.from_qp(K=np.diag([2.0, 1.0]), f=np.array([1.0, 1.0]),
@@ -145,9 +145,9 @@ def test_the_body_normals_follow_the_arc():
     from signorini.fem.contact_estimate import boundary_normals, candidate_nodes
 
     problem = signorini.build_problem("hertz-cylinder")
-    nodes = candidate_nodes(problem.mesh, problem.contact_points)
-    normals = boundary_normals(problem.mesh, nodes)
-    x, y = problem.mesh.p[:, nodes]
+    nodes = candidate_nodes(problem.model.mesh, problem.contact_points)
+    normals = boundary_normals(problem.model.mesh, nodes)
+    x, y = problem.model.mesh.p[:, nodes]
     radial = np.array([x, y - 1.0]) / np.hypot(x, y - 1.0)  # the quarter disc's centre is (0, R = 1)
     assert np.all(np.sum(normals * radial, axis=0) > 1 - 1e-5)
     first = np.argmin(x)  # the corner on the symmetry axis: its axis edge does not count, so its
@@ -307,8 +307,8 @@ def test_the_closed_form_for_constant_strains_is_the_quadrature(scene, params):
     quadrature points) gives what the order-2 quadrature gives, element by element."""
     result = signorini.solve(scene, params=params)
     problem = result.problem
-    mesh, dim = problem.mesh, problem.mesh.p.shape[0]
-    u = problem.expand(result.solution.u).reshape(-1, dim)
+    mesh, dim = problem.model.mesh, problem.model.mesh.p.shape[0]
+    u = problem.model.expand(result.solution.u).reshape(-1, dim)
     material = lame(*material_units(problem))
     closed = _constant_strains(mesh, u, *material)
     by_points = _by_quadrature(problem, mesh, u, *material)

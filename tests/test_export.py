@@ -33,8 +33,8 @@ def test_file_reads_back_with_the_named_data(block, tmp_path, suffix):
     assert POINT_DATA <= set(mesh.point_data)
     assert CELL_DATA <= set(mesh.cell_data)
     assert not set(mesh.point_data) & set(mesh.cell_data)  # each array listed once in ParaView
-    assert mesh.cells[0].type == "triangle" and len(mesh.cells[0].data) == problem.mesh.t.shape[1]
-    assert mesh.point_data["displacement"].shape == (problem.mesh.p.shape[1], 3)
+    assert mesh.cells[0].type == "triangle" and len(mesh.cells[0].data) == problem.model.mesh.t.shape[1]
+    assert mesh.point_data["displacement"].shape == (problem.model.mesh.p.shape[1], 3)
 
 
 def test_patch_test_stresses_and_contact_fields(block, tmp_path):
@@ -48,7 +48,7 @@ def test_patch_test_stresses_and_contact_fields(block, tmp_path):
     np.testing.assert_allclose(mesh.cell_data["sigma_zz"][0], -0.3 * p, rtol=1e-9)
     np.testing.assert_allclose(mesh.cell_data["von_mises"][0], p * np.sqrt(1 - 0.3 + 0.09), rtol=1e-9)
     # the undeformed points (physical units): Warp By Vector adds the displacement once
-    reference = problem.mesh.p.T * problem.scales.length
+    reference = problem.model.mesh.p.T * problem.scales.length
     np.testing.assert_allclose(mesh.points[:, :2], reference, atol=1e-12)
     assert mesh.point_data["displacement"][:, 1].min() == pytest.approx(-1e-3)
     # gap and pressure at the candidates; NaN / zero elsewhere
@@ -65,7 +65,7 @@ def test_deformed_points_when_asked(block, tmp_path):
     from signorini.output.export import export_mesh
     mesh = export_mesh(problem, solution, deformed=True)
     np.testing.assert_allclose(mesh.points[:, :2] - mesh.point_data["displacement"][:, :2],
-                               problem.mesh.p.T * problem.scales.length, atol=1e-12)
+                               problem.model.mesh.p.T * problem.scales.length, atol=1e-12)
     assert np.abs(mesh.point_data["displacement"]).max() > 0
 
 

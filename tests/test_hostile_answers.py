@@ -165,7 +165,7 @@ def test_the_forward_error_on_a_plain_factorisation_adds_no_factorisation(hertz)
 def test_the_sweep_judges_every_level_without_factorising(hertz):
     problem = signorini.at_load(build_problem("hertz-cylinder", params={"n_contact": 24, "grading": 0.3}))
     problem.factor()
-    loads = np.array([0.6, 1.0]) * problem.params["P"]
+    loads = np.array([0.6, 1.0]) * problem.model.params["P"]
     cost, levels = spent(lambda: sweep_loads(problem, loads))
     assert cost["factorisations"] == 0
     assert [lv.status for lv in levels] == ["converged", "converged"]
@@ -211,7 +211,7 @@ HOSTILE = textwrap.dedent("""
         return solution
 
     def answers_a_pushed_problem(problem, **options):
-        other = problem.pushed(0.5 * problem.push.scale)
+        other = problem.pushed(0.5 * problem.model.push.scale)
         solution = pdas(other)
         solution.problem = other
         return solution
@@ -261,8 +261,8 @@ def test_a_method_that_matches_the_load_is_judged_at_the_push_it_reports():
     problem = build_problem("hertz-sphere-3d")
     settled, solution, _ = registry.run(problem, registry.check_request("pdas-amg"))
     assert solution.status == "converged", solution.message
-    assert not settled.pending and settled.push.scale == solution.extras["push"]
-    assert settled.total_contact_force(solution.lam) == pytest.approx(problem.push.target, rel=1e-6)
+    assert not settled.model.pending and settled.model.push.scale == solution.extras["push"]
+    assert settled.total_contact_force(solution.lam) == pytest.approx(problem.model.push.target, rel=1e-6)
 
 
 # --- the atlas's ν = 0.49999999999 row ---------------------------------------------------------
@@ -313,7 +313,7 @@ def test_the_target_load_is_the_load_applied_on_a_curved_obstacle(scene, params)
     tilt), which the boundary applies: not Σλ, the total normal force, which exceeds it."""
     result = signorini.solve(scene, params=params)
     assert result.converged, result.message
-    target = result.problem.push.target * result.problem.scales.force
+    target = result.problem.model.push.target * result.problem.scales.force
     assert result.applied_load == pytest.approx(target, rel=1e-9)
     assert result.to_dict()["load_resultant"] == pytest.approx(target, rel=1e-9)
     assert result.total_force > 1.001 * target  # the normal forces' sum is more than the load

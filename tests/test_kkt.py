@@ -310,7 +310,7 @@ def test_duality_gap_by_conjugate_gradients_equals_the_factorised_one(hertz, exa
     monkeypatch.setattr(problem_module, "ITERATIVE_ENERGY_FROM", 0)
     fresh = hertz.with_data()  # no cached factorisation
     assert fresh.factorises_for_certificates  # a 2D mesh: factorised at any size
-    fresh.discretisation = dataclasses.replace(fresh.discretisation, mesh=None)  # a mesh unknown
+    fresh.model = dataclasses.replace(fresh.model, mesh=None)  # a mesh unknown
     assert not fresh.factorises_for_certificates
     by_cg = certificate(fresh, rough).duality_gap
     assert fresh._factor is None
@@ -460,7 +460,7 @@ def test_the_gap_on_a_pinned_factorisation_is_the_textbook_one_or_tighter(zoned,
 def test_pinned_nodes_that_would_pull_are_released(zoned, monkeypatch):
     """A factorisation pinned on a wider zone than the answer's (the same K pushed less)."""
     wide = registry.get_method("pdas").function(zoned).factor
-    lighter = zoned.pushed(0.9 * zoned.push.scale)
+    lighter = zoned.pushed(0.9 * zoned.model.push.scale)
     exact = registry.solve(lighter, "pdas")
     assert 0 < len(wide.fixed) - (exact.lam > 0).sum() <= MAX_RELEASED
     refuse_the_fallback(monkeypatch)

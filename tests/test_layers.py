@@ -186,7 +186,7 @@ PARAMETER_OWNERS = ("signorini.scenes",)
 
 def parameter_reads(source: str) -> list[int]:
     """Lines that read a parameter by name: ``params[…]`` or ``params.get(…)`` on a name
-    ``params``, an attribute ``….params`` or a name bound to one (``p = problem.params``).
+    ``params``, an attribute ``….params`` or a name bound to one (``p = problem.model.params``).
     Writing one (``params[k] = v``, a dict built for a scene) is not a read; ``+=`` is."""
     tree = ast.parse(source)
     aliases = {"params"} | {target.id for node in ast.walk(tree) if isinstance(node, ast.Assign)
@@ -211,12 +211,12 @@ def test_scene_parameters_are_read_by_typed_fields(module):
     lines = parameter_reads(MODULES[module].read_text())
     assert not lines, (
         f"{module} reads scene parameters by name (lines {lines}): read the typed record instead "
-        "(ContactProblem.reference_data, ContactProblem.push's delta and P, SceneModel's fields), "
+        "(Model.reference, Model.push's delta and P, SceneModel's fields), "
         "which the scene family builds from its parameters")
 
 
 def test_the_parameter_rule_can_fail():
     """The matcher sees reads by name, through an alias too, and lets writes be."""
-    assert parameter_reads("E = problem.params['E']\nR = params.get('R')\n") == [1, 2]
-    assert parameter_reads("p = problem.params\nx = p['half_length']\nparams['P'] *= 2\n") == [2, 3]
+    assert parameter_reads("E = problem.model.params['E']\nR = params.get('R')\n") == [1, 2]
+    assert parameter_reads("p = problem.model.params\nx = p['half_length']\nparams['P'] *= 2\n") == [2, 3]
     assert parameter_reads("params['delta'] = 1.0\nbuild(params={'E': 1.0})\nd = dict(params)\n") == []

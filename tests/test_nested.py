@@ -107,8 +107,8 @@ def test_a_wrong_analytic_zone_is_amended_not_trusted():
     """A zone predicted for a load 10 % lower (a 5 % too small): the answer stays exact."""
     problem = signorini.at_load(build_problem("hertz-cylinder", params={"refine": 1}))
     zone = analytic_zone(problem)
-    shifted = analytic_zone(problem.with_data(push=dataclasses.replace(problem.push,
-                                                                       P=problem.push.P * 0.9)))
+    shifted = analytic_zone(problem.with_data(push=dataclasses.replace(problem.model.push,
+                                                                       P=problem.model.push.P * 0.9)))
     assert shifted is not None and shifted.core.sum() < zone.core.sum()
     reference = solve(problem, "pdas")
     nested = solve(problem, "nested", zone=shifted)
@@ -166,11 +166,11 @@ def test_the_push_on_a_zone_equals_the_full_active_set_calibration():
     params = family.parse(values)
     model = family.build(params, set(values))
     nominal = assemble(model)
-    assert nominal.reference == "hertz-2d"  # the family's model hands on its reference record
+    assert nominal.model.reference_name == "hertz-2d"  # the family's model hands on its reference record
     full = load_control.match(nominal)  # no zone: one factorisation per active-set step
     zoned = load_control.match(nominal, analytic_zone(nominal))
     assert full.how == "full active set" and zoned.how == "zone kernel"
-    assert zoned.problem.push.scale == pytest.approx(full.problem.push.scale, rel=1e-10)
+    assert zoned.problem.model.push.scale == pytest.approx(full.problem.model.push.scale, rel=1e-10)
     assert_same_answer(full.problem, solve(full.problem, "pdas"),
                        solve(zoned.problem, "nested", warm_start=zoned.warm_start))
 
@@ -283,7 +283,7 @@ def test_named_nested_takes_load_controls_factorisation():
     """Named, nested costs what auto's route does: load control factorises K once around the
     predicted zone and nested solves on that factorisation by back-solves only."""
     problem = build_problem("hertz-cylinder", params={"refine": 1, "n_contact": 60})
-    assert problem.pending and problem.discretisation.prescribed.size >= load_control.ZONE_FROM_DOFS
+    assert problem.model.pending and problem.model.prescribed.size >= load_control.ZONE_FROM_DOFS
     named = signorini.solve(problem, method="nested")
     assert named.method == "nested" and named.status == "converged"
     assert named.solution.work["load_control"]["factorisations"] == 1

@@ -151,7 +151,7 @@ def test_reverse_hertz_rows_follow_the_cylinder(reverse):
     problem, _ = reverse
     N = problem.N.toarray()
     points = problem.contact_points * problem.scales.length
-    R = problem.params["R"]
+    R = problem.model.params["R"]
     for row, (x, y) in zip(N, points):
         entries = row[row != 0]
         expected = np.array([-x, -R]) / np.hypot(x, R)

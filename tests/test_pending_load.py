@@ -49,11 +49,11 @@ def pair(request):
 
 def test_the_target_is_pending_until_matched(pair):
     pending, eager = pair
-    assert pending.pending and not eager.pending
-    assert pending.push.target == pytest.approx(eager.push.target, rel=1e-12)
+    assert pending.model.pending and not eager.model.pending
+    assert pending.model.push.target == pytest.approx(eager.model.push.target, rel=1e-12)
     matched = load_control.match(pending)
-    assert not matched.problem.pending and matched.work["factorisations"] >= 1
-    assert matched.problem.push.scale == pytest.approx(eager.push.scale, rel=1e-9)
+    assert not matched.problem.model.pending and matched.work["factorisations"] >= 1
+    assert matched.problem.model.push.scale == pytest.approx(eager.model.push.scale, rel=1e-9)
     assert np.allclose(matched.problem.f, eager.f, rtol=0, atol=1e-9 * np.abs(eager.f).max())
     with pytest.raises(signorini.InputError, match="no target load to match"):
         load_control.match(matched.problem)
@@ -66,13 +66,13 @@ def test_pdas_amg_matches_the_load_without_a_factorisation(pair):
         settled, solution = solved(pending, "pdas-amg")
     assert solution.status == "converged", solution.message
     assert "one more unknown" in solution.message and "load_control" not in solution.work
-    assert not settled.pending
+    assert not settled.model.pending
     # no factorisation of the fine model (its coarse model, if any, is small and counted apart)
     assert work.factorisations <= 1
     assert certificate(settled, solution).worst()[1] <= 1e-9
-    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
+    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.model.push.target,
                                                                       rel=1e-8)
-    assert settled.push.scale == pytest.approx(eager.push.scale, rel=1e-7)
+    assert settled.model.push.scale == pytest.approx(eager.model.push.scale, rel=1e-7)
     agreement = compare(eager, solution, reference)
     assert agreement.lam_rel <= 1e-7 and agreement.misclassified == 0, agreement.as_dict()
 
@@ -82,9 +82,9 @@ def test_any_other_method_gets_the_problem_matched_first(pair):
     with pytest.raises(signorini.InputError, match="not matched yet"):
         solve(pending, "pdas")  # the method alone solves the QP as it is: it refuses
     settled, solution = solved(pending, "pdas")
-    assert solution.status == "converged" and not settled.pending
+    assert solution.status == "converged" and not settled.model.pending
     assert solution.work["load_control"]["factorisations"] >= 1
-    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
+    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.model.push.target,
                                                                       rel=1e-9)
 
 
@@ -92,8 +92,8 @@ def test_the_api_reports_the_matched_problem(monkeypatch):
     monkeypatch.setattr(auto, "AMG_FROM_DOFS", 1_000)
     result = signorini.solve(SCENE)
     assert result.status == "converged" and result.method == "pdas-amg"
-    assert not result.problem.pending
-    assert result.total_force == pytest.approx(result.problem.params["P"], rel=1e-8)
+    assert not result.problem.model.pending
+    assert result.total_force == pytest.approx(result.problem.model.params["P"], rel=1e-8)
     assert result.certificate.worst()[1] <= 1e-9
 
 
@@ -110,9 +110,9 @@ def test_a_pending_problem_is_saved_pending(tmp_path, pair):
     path = tmp_path / "pending.npz"
     pending.save(path)
     loaded = ContactProblem.load(path)
-    assert loaded.pending and loaded.push.target == pending.push.target
+    assert loaded.model.pending and loaded.model.push.target == pending.model.push.target
     settled, solution = solved(loaded, "pdas")
-    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.push.target,
+    assert settled.total_contact_force(solution.lam) == pytest.approx(pending.model.push.target,
                                                                       rel=1e-9)
 
 
@@ -153,14 +153,14 @@ def test_a_push_pdas_amg_cannot_carry_is_matched_before_its_bound_form(pair):
     matches the load by factorisation first and pdas-amg solves that problem, not the nominal
     one; alone, pdas-amg refuses the pending problem."""
     pending, _ = pair
-    d1 = np.full(pending.m, 1e-3 * np.abs(pending.push.d0).max())
-    moved = pending.with_data(push=dataclasses.replace(pending.push, d1=d1),
-                              d=pending.push.d0 + pending.push.scale * d1)
-    assert moved.pending
+    d1 = np.full(pending.m, 1e-3 * np.abs(pending.model.push.d0).max())
+    moved = pending.with_data(push=dataclasses.replace(pending.model.push, d1=d1),
+                              d=pending.model.push.d0 + pending.model.push.scale * d1)
+    assert moved.model.pending
     with pytest.raises(signorini.InputError, match="not matched yet"):
         solve(moved, "pdas-amg")
     (ours_problem, ours), (their_problem, reference) = (solved(moved, "pdas-amg"),
                                                         solved(moved, "pdas"))
     assert ours.status == reference.status == "converged"
-    assert ours_problem.push.scale == pytest.approx(their_problem.push.scale, rel=1e-9)
+    assert ours_problem.model.push.scale == pytest.approx(their_problem.model.push.scale, rel=1e-9)
     assert compare(their_problem, ours, reference).lam_rel <= 1e-7

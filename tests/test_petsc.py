@@ -42,8 +42,8 @@ def references():
 
 
 def full_vector(problem, u):
-    out = np.zeros(problem.discretisation.prescribed.size)
-    out[problem.discretisation.free_dofs] = u
+    out = np.zeros(problem.model.prescribed.size)
+    out[problem.model.free_dofs] = u
     return out
 
 
@@ -113,7 +113,7 @@ def test_rigid_modes_are_a_near_null_space(references):
     from skfem import Basis, ElementVector, asm
     from skfem.models.elasticity import linear_elasticity
 
-    mesh = problem.mesh
+    mesh = problem.model.mesh
     body = asm(linear_elasticity(1.0, 1.0), Basis(mesh, ElementVector(mesh.elem())))
     rotated = form.T.T @ body @ form.T
     assert np.abs(rotated @ modes).max() <= 1e-10 * abs(rotated).max()

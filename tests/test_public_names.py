@@ -29,11 +29,21 @@ PACKAGES = sorted(package_name(init) for init in PACKAGE.rglob("__init__.py"))
 
 
 def declared(init: Path) -> list[str] | None:
-    """The names an ``__init__.py`` assigns to ``__all__`` (None when it does not)."""
+    """The names an ``__init__.py`` assigns to ``__all__`` (None when it does not): a literal
+    list, or the names a ``lazy_loader.attach(...)`` call lists literally, and what ``+=`` adds."""
+    names = None
     for node in ast.parse(init.read_text()).body:
         if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "__all__" for t in node.targets):
-            return [ast.literal_eval(element) for element in node.value.elts]
-    return None
+            names = [ast.literal_eval(element) for element in node.value.elts]
+        elif (isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Tuple)
+              and getattr(node.targets[0].elts[-1], "id", "") == "__all__"):
+            call = node.value  # __getattr__, __dir__, __all__ = lazy_loader.attach(...)
+            listed = {k.arg: ast.literal_eval(k.value) for k in call.keywords}
+            names = list(listed.get("submodules", [])) + [
+                name for attrs in listed.get("submod_attrs", {}).values() for name in attrs]
+        elif isinstance(node, ast.AugAssign) and getattr(node.target, "id", "") == "__all__":
+            names += ast.literal_eval(node.value)
+    return names
 
 
 def test_every_package_is_seen():

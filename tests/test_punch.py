@@ -36,7 +36,7 @@ def test_punch_formula_integrates_to_the_load():
 def test_force_balance_and_integral_of_pressure(punch):
     problem, solution = punch
     profile = contact_profile(problem, solution)
-    P = problem.params["P"]
+    P = problem.model.params["P"]
     # ∫p = P with the lumped pressure: Σ pᵢ wᵢ over the half model, times two
     integral = 2.0 * np.sum(profile.pressure * problem.weights * problem.scales.weight)
     assert integral == pytest.approx(P, rel=1e-12)
@@ -75,7 +75,7 @@ def test_whole_block_is_symmetric_and_equals_the_half(punch):
     np.testing.assert_allclose(p[np.argsort(x)], p[np.argsort(-x)], rtol=1e-8)
     right = np.argsort(x)[x[np.argsort(x)] >= 0]
     np.testing.assert_allclose(p[right], contact_profile(half_problem, half).pressure, rtol=1e-7)
-    assert load_resultant(problem, whole.lam) == pytest.approx(problem.params["P"], rel=1e-10)
+    assert load_resultant(problem, whole.lam) == pytest.approx(problem.model.params["P"], rel=1e-10)
 
 
 @pytest.mark.parametrize("method", ["uzawa", "condensed"])
@@ -134,5 +134,5 @@ def test_two_load_parameters_raise():
 def test_prescribed_delta_without_target():
     problem = signorini.at_load(build_problem("punch", params={"delta": 1e-3, **SMALL}))
     solution = solve(problem, "pdas", tol=1e-10)
-    assert problem.params["P"] is None
+    assert problem.model.params["P"] is None
     assert compare_punch(problem, solution).force_balance < 1e-9

@@ -46,10 +46,10 @@ COARSE = {"punch": {"n_contact": 16, "grading": 0.6}, "reverse-hertz": {"n_conta
 @pytest.mark.parametrize("name", sorted(SCENES))
 def test_every_family_hands_its_reference_the_record_of_its_parameters(name):
     problem = build_problem(name, params=COARSE.get(name, SCENES[name].convergence_start))
-    record = problem.reference_data
-    assert record.name == problem.reference == SCENES[name].reference
+    record = problem.model.reference
+    assert record.name == problem.model.reference_name == SCENES[name].reference
     assert record.name in REFERENCES
-    p = problem.params
+    p = problem.model.params
     if name in TWO_BODIES:  # the pair's record: both bodies' compliances in series
         for field, value in TWO_BODIES[name](p).items():
             assert getattr(record, field) == pytest.approx(value, rel=1e-15)
@@ -58,15 +58,15 @@ def test_every_family_hands_its_reference_the_record_of_its_parameters(name):
         for field, param in RECORD_PARAMS[record.name].items():
             assert getattr(record, field) == p[param]
     # the push carries the scene's δ and target P, as the parameters report them
-    assert problem.push.delta == problem.params["delta"]
-    assert problem.push.P == problem.params.get("P")
+    assert problem.model.push.delta == problem.model.params["delta"]
+    assert problem.model.push.P == problem.model.params.get("P")
 
 
 def test_a_push_moves_delta_and_the_uniform_pressure_with_it():
     problem = build_problem("block")
-    twice = problem.pushed(2.0 * problem.push.scale)
-    assert twice.push.delta == 2.0 * problem.push.delta == twice.params["delta"]
-    assert problem.push.delta == problem.params["delta"]  # the problem pushed from is unchanged
+    twice = problem.pushed(2.0 * problem.model.push.scale)
+    assert twice.model.push.delta == 2.0 * problem.model.push.delta == twice.model.params["delta"]
+    assert problem.model.push.delta == problem.model.params["delta"]  # the problem pushed from is unchanged
     once, doubled = (compare_uniform(p, solve(p, "pdas")) for p in (problem, twice))
     assert doubled.pressure_ref == pytest.approx(2.0 * once.pressure_ref, rel=1e-14)
     assert doubled.pressure_max_rel < 1e-8
@@ -76,8 +76,8 @@ def test_save_and_load_keep_the_record_and_the_push(tmp_path):
     problem = build_problem("hertz-cylinder", params={"n_contact": 8, "grading": 0.6})
     problem.save(tmp_path / "p.npz")
     again = ContactProblem.load(tmp_path / "p.npz")
-    assert again.reference_data == problem.reference_data
-    assert (again.push.delta, again.push.P) == (problem.push.delta, problem.push.P)
+    assert again.model.reference == problem.model.reference
+    assert (again.model.push.delta, again.model.push.P) == (problem.model.push.delta, problem.model.push.P)
 
 
 def test_a_file_that_stored_the_reference_by_name_loads_without_one(tmp_path, caplog):
@@ -92,7 +92,7 @@ def test_a_file_that_stored_the_reference_by_name_loads_without_one(tmp_path, ca
     np.savez(tmp_path / "old.npz", **arrays)
     with caplog.at_level(logging.WARNING, logger="signorini.problem.contact"):
         old = ContactProblem.load(tmp_path / "old.npz")
-    assert old.reference_data is None and old.reference == "" and old.push.delta is None
+    assert old.model.reference is None and old.model.reference_name == "" and old.model.push.delta is None
     assert "'uniform'" in caplog.text and "rebuild" in caplog.text
 
 
@@ -103,4 +103,4 @@ def test_a_family_whose_model_hands_on_another_reference_is_refused():
             build_problem("mislabelled", params={"nx": 4, "ny": 4})
     finally:
         unregister("mislabelled")
-    assert build_problem("block", params={"nx": 4, "ny": 4}).reference == "uniform"
+    assert build_problem("block", params={"nx": 4, "ny": 4}).model.reference_name == "uniform"

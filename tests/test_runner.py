@@ -35,7 +35,7 @@ def test_a_policy_without_an_exact_answer_compares_nothing():
 
 def test_a_kept_exact_answer_is_stored_once_and_read_back(tmp_path):
     problem = build_problem("block", params=TINY_BLOCK)
-    keep = tmp_path / "block.reference.npz"
+    keep = tmp_path / "block.model.reference_name.npz"
     spec = {"kind": "nested", "tol": 1e-9, "keep": str(keep)}
     first = trusted(exact_attempt(problem, spec))
     assert first is not None and keep.exists()

@@ -78,10 +78,10 @@ def test_registering_makes_the_family_known_everywhere(slab):
 def test_solve_gives_the_uniform_pressure(slab):
     result = signorini.solve("slab", "pdas", params={"delta": 0.02})
     assert result.status == "converged"
-    assert result.problem.reference == "uniform"
+    assert result.problem.model.reference_name == "uniform"
     uniform = result.to_dict()["uniform"]
     assert uniform["pressure_max_rel"] < 1e-8
-    assert result.problem.params["W"] == 4.0 and result.problem.params["nx"] == 8
+    assert result.problem.model.params["W"] == 4.0 and result.problem.model.params["nx"] == 8
 
 
 def test_the_validation_suite_runs_the_family_case(slab):
@@ -90,7 +90,7 @@ def test_the_validation_suite_runs_the_family_case(slab):
     names = {(check.case, check.name) for check in result.checks}
     assert ("slab", "uniform pressure max relative error (pdas)") in names
     assert result.passed, [c for c in result.checks if not c.passed]
-    assert result.results[0].problem.params["nx"] == 6
+    assert result.results[0].problem.model.params["nx"] == 6
 
 
 def test_adaptive_refinement_uses_the_family_snap(slab):

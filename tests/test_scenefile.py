@@ -45,12 +45,12 @@ def test_family_file_builds_what_the_parameters_build(tmp_path):
     path = write(tmp_path, FAMILY)
     from_file = signorini.at_load(build_problem(str(path)))
     direct = signorini.at_load(build_problem("block", params={"E": 2.0, "nu": 0.25, "nx": 4, "ny": 3}))
-    assert from_file.scene == "block"
-    assert from_file.params == direct.params
+    assert from_file.name == "block"
+    assert from_file.model.params == direct.model.params
     assert abs(from_file.K - direct.K).max() == 0.0
     # --set overrides a value of the file
     finer = signorini.at_load(build_problem(str(path), params={"nx": "8"}))
-    assert finer.params["nx"] == 8
+    assert finer.model.params["nx"] == 8
 
 
 def line_of(text, needle):
@@ -166,11 +166,11 @@ def test_mesh_scene_passes_the_patch_test(tmp_path):
     write_block_msh(tmp_path / "block.msh")
     problem = signorini.at_load(build_problem(str(write(tmp_path, MESH_SCENE))))
     solution = solve(problem, "pdas", tol=1e-10)
-    assert problem.scene.startswith("file:")
+    assert problem.name.startswith("file:")
     # what compare_uniform reads, which a mesh scene does not name: E*, the height and the push
-    E_star = contact_modulus(problem.discretisation.E, problem.discretisation.nu)
+    E_star = contact_modulus(problem.model.E, problem.model.nu)
     problem = problem.with_data(reference=ReferenceData("uniform", E_star=E_star, H=1.0),
-                                push=dataclasses.replace(problem.push, delta=0.02))
+                                push=dataclasses.replace(problem.model.push, delta=0.02))
     assert compare_uniform(problem, solution).pressure_max_rel < 1e-10
     assert contact_profile(problem, solution).total_force == pytest.approx(
         2 * 4.0 / (1 - 0.09) * 0.02, rel=1e-10)

@@ -95,7 +95,7 @@ def test_non_integer_block_resolution_names_the_parameter(name, value):
 def test_numbers_given_as_strings_are_accepted():
     from_strings = build_problem("block", params={"nx": "2", "ny": " 2 ", "E": "70e9", "nu": "0.33"})
     from_numbers = build_problem("block", params={"nx": 2, "ny": 2, "E": 70e9, "nu": 0.33})
-    assert from_strings.params == from_numbers.params
+    assert from_strings.model.params == from_numbers.model.params
     assert abs(from_strings.K - from_numbers.K).max() == 0.0
 
 
@@ -118,7 +118,7 @@ def test_two_load_parameters_raise(values):
 def test_good_input_builds():
     problem = build("hertz-cylinder", E=2.1e11, R=0.01, nu=0.3, a_over_R=0.5)
     assert problem.m > 0
-    assert problem.params["a_over_R"] == 0.5
+    assert problem.model.params["a_over_R"] == 0.5
 
 
 @pytest.mark.parametrize("scene, name, value", [
@@ -140,5 +140,5 @@ def test_P_none_is_the_default():
     # P=None is the documented default (the load from a_over_R), not an error: pinned as such
     default = build("hertz-cylinder")
     explicit = build("hertz-cylinder", P=None)
-    assert explicit.params["P"] == pytest.approx(default.params["P"], rel=1e-12)
+    assert explicit.model.params["P"] == pytest.approx(default.params["P"], rel=1e-12)
     np.testing.assert_allclose(explicit.f, default.f, rtol=1e-10)

@@ -25,7 +25,7 @@ def test_the_memory_limit_stops_the_adaptive_loop_before_a_mesh_beyond_it_is_ass
     result = signorini.solve_adaptive("hertz-cylinder", "0.0001%", max_dofs=10 ** 9)
     steps = result.solution.extras["adaptive"]
     assert len(assembled) >= 3 and max(assembled) <= fits, assembled
-    assert steps[-1]["action"] == "memory limit" and result.problem.mesh.p.size == assembled[-1]
+    assert steps[-1]["action"] == "memory limit" and result.problem.model.mesh.p.size == assembled[-1]
     assert f"memory limit of {limit_gb:.1f} GB ({MEMORY_VARIABLE}" in result.message, result.message
     assert "> target 0.0001 %" in result.message
     next_dofs = int(result.message.split("the next mesh has ")[1].split()[0])

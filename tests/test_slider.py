@@ -28,7 +28,7 @@ def test_a_change_of_E_alone_meshes_nothing(meshings):
     first = signorini.solve("hertz-cylinder", params={**SMALL, "E": 1.0})
     second = signorini.solve("hertz-cylinder", params={**SMALL, "E": 3.0})
     assert meshings() == 1
-    assert np.array_equal(first.problem.mesh.p, second.problem.mesh.p)
+    assert np.array_equal(first.problem.model.mesh.p, second.problem.model.mesh.p)
     assert second.status == "converged" and second.total_force == pytest.approx(3 * first.total_force)
 
 
@@ -37,7 +37,7 @@ def test_the_load_that_grades_the_mesh_meshes_again(meshings):
     first = signorini.build_problem("hertz-cylinder", params={**SMALL, "a_over_R": 0.05})
     second = signorini.build_problem("hertz-cylinder", params={**SMALL, "a_over_R": 0.08})
     assert meshings() == 2
-    assert first.mesh.p.shape != second.mesh.p.shape or not np.allclose(first.mesh.p, second.mesh.p)
+    assert first.model.mesh.p.shape != second.model.mesh.p.shape or not np.allclose(first.model.mesh.p, second.model.mesh.p)
 
 
 def test_a_kept_mesh_is_the_mesh_made_afresh_and_cannot_be_changed(meshings):
@@ -61,14 +61,14 @@ def test_a_load_slider_meshes_and_assembles_nothing(monkeypatch, meshings):
     monkeypatch.setattr(build, "assemble", lambda *a, **k: assembled.append(1))
     for a_over_R in (0.04, 0.06):
         moved = with_load(problem, a_over_R=a_over_R)
-        assert np.shares_memory(moved.K.data, problem.K.data) and moved.mesh is problem.mesh
+        assert np.shares_memory(moved.K.data, problem.K.data) and moved.model.mesh is problem.model.mesh
         result = signorini.solve(moved)
         assert result.status == "converged"
-        assert result.total_force == pytest.approx(moved.params["P"], rel=1e-9)
-        assert result.problem.params["a_over_R"] == a_over_R
+        assert result.total_force == pytest.approx(moved.model.params["P"], rel=1e-9)
+        assert result.problem.model.params["a_over_R"] == a_over_R
         assert result.to_dict()["time"]["mesh_s"] == 0.0
     assert meshings() == 1 and assembled == []
-    back = signorini.solve(with_load(problem, P=problem.params["P"]))
+    back = signorini.solve(with_load(problem, P=problem.model.params["P"]))
     assert back.solution.lam == pytest.approx(first.solution.lam, rel=1e-9, abs=1e-12)
 
 

@@ -107,7 +107,7 @@ def test_verdict_flags_a_converged_status_with_a_wrong_answer():
 
 
 def test_the_touching_block_has_weakly_active_nodes_and_keeps_its_default(block):
-    assert block.params["touching"] == 0.0
+    assert block.model.params["touching"] == 0.0
     plain = signorini.at_load(build_problem("block", params={**TINY_BLOCK, "touching": 0.0}))
     assert abs(plain.K - block.K).max() == 0 and np.array_equal(plain.d, block.d)
     problem = signorini.at_load(build_problem("block", params={**TINY_BLOCK, "touching": 0.5}))
@@ -148,7 +148,7 @@ def test_force_controlled_block_is_singular_and_its_patch_solution_is_exact():
     exact = force_controlled_exact(problem)
     cert = certificate(problem, exact, duality_gap=False)
     assert cert.worst()[1] < 1e-12
-    assert problem.total_contact_force(exact.lam) == pytest.approx(problem.discretisation.load_offset, rel=1e-12)
+    assert problem.total_contact_force(exact.lam) == pytest.approx(problem.model.load_offset, rel=1e-12)
     assert any("singular" in line for line in diagnose(problem))
 
 

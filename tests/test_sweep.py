@@ -21,27 +21,27 @@ def test_a_sweep_level_equals_a_full_solve_at_that_load():
     base = signorini.at_load(build_problem("hertz-cylinder", params={"delta": 0.003, **SMALL}))
     # the same mesh and model (the cut pushed flat), its P found by assembly
     targeted = signorini.at_load(build_problem("hertz-cylinder", params={"loading": "displacement", **SMALL}))
-    loads = np.array([0.5, 2.0, 1.0]) * targeted.params["P"]
+    loads = np.array([0.5, 2.0, 1.0]) * targeted.model.params["P"]
     levels = sweep_loads(base, loads)
     assert [lv.total_force for lv in levels] == pytest.approx(list(loads), rel=1e-9)
     exact = solve(targeted, "pdas")
     profile = contact_profile(targeted, exact)
     assert levels[2].p0 == pytest.approx(profile.pressure[0], rel=1e-9)
     assert levels[2].a == pytest.approx(contact_half_width(profile), rel=1e-9)
-    assert levels[2].delta == pytest.approx(targeted.params["delta"], rel=1e-9)
+    assert levels[2].delta == pytest.approx(targeted.model.params["delta"], rel=1e-9)
 
 
 def test_a_traction_loaded_sweep_level_equals_a_full_solve_at_that_load():
     # a traction on the cut, the centre pinned
     targeted = signorini.at_load(build_problem("hertz-cylinder", params=SMALL))
-    assert targeted.push.f_load is not None
-    loads = np.array([2.0, 0.5, 1.0]) * targeted.params["P"]
+    assert targeted.model.push.f_load is not None
+    loads = np.array([2.0, 0.5, 1.0]) * targeted.model.params["P"]
     levels = sweep_loads(targeted, loads)
     assert [lv.total_force for lv in levels] == pytest.approx(list(loads), rel=1e-9)
     profile = contact_profile(targeted, solve(targeted, "pdas"))
     assert levels[2].p0 == pytest.approx(profile.pressure[0], rel=1e-9)
     assert levels[2].a == pytest.approx(contact_half_width(profile), rel=1e-9)
-    assert levels[2].delta == pytest.approx(targeted.params["delta"], rel=1e-9)
+    assert levels[2].delta == pytest.approx(targeted.model.params["delta"], rel=1e-9)
     assert profile.applied_load == pytest.approx(profile.total_force, rel=1e-9)  # the pin carries 0
 
 

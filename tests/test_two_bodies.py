@@ -51,7 +51,7 @@ def test_the_pressure_parameter_sets_the_push_by_the_springs_in_series():
     problem, p = patch(p=0.02)
     assert p == 0.02
     assert pressure_error(problem)[1] < 1e-8
-    assert problem.push.delta == pytest.approx(0.02 * (1.0 / (1 / 0.91) + 0.7 / (3.0 / 0.96)))
+    assert problem.model.push.delta == pytest.approx(0.02 * (1.0 / (1 / 0.91) + 0.7 / (3.0 / 0.96)))
     with pytest.raises(InputError, match="delta and p"):
         signorini.build_problem("two-block-patch", params={"p": 0.02, "delta": 0.01})
 
@@ -73,7 +73,7 @@ def test_the_compliance_is_the_sum_of_the_two_bodies():
     problem, _ = patch(nx=4, ny=2)
     K, N = problem.K.toarray(), problem.N.toarray()
     upper_nodes = build(FAMILY.parse({**MATERIALS, "nx": 4, "ny": 2})).slave.mesh.p.shape[1]
-    upper = problem.discretisation.free_dofs < 2 * upper_nodes  # body 1's dofs come first
+    upper = problem.model.free_dofs < 2 * upper_nodes  # body 1's dofs come first
     W = N @ np.linalg.solve(K, N.T)
     parts = [N[:, body] @ np.linalg.solve(K[np.ix_(body, body)], N[:, body].T)
              for body in (upper, ~upper)]
@@ -91,9 +91,9 @@ def test_a_floating_body_is_refused():
 
 def test_the_two_body_problem_has_one_mesh_of_both_bodies():
     problem, _ = patch(nx=4, ny=2, mesh_ratio=1.5)
-    mesh = problem.mesh
+    mesh = problem.model.mesh
     assert mesh.p.shape[1] == 5 * 3 + 7 * 3  # the lower and the upper grid
-    assert problem.n + np.count_nonzero(problem.discretisation.prescribed) <= 2 * mesh.p.shape[1]
+    assert problem.n + np.count_nonzero(problem.model.prescribed) <= 2 * mesh.p.shape[1]
     assert sp.issparse(problem.N) and problem.m == 7  # a row per node of the upper (slave) face
 
 
@@ -134,7 +134,7 @@ def test_the_error_estimate_takes_each_body_s_own_material_and_no_pressure():
     # ‖u_h‖²_E = Σ u_bᵀ K_b u_b, each body's K assembled with its own material
     model, problem = cylinders.FAMILY.build(params), result.problem
     L, stress = problem.scales.length, series_modulus(1.0, 0.3, 5.0, 0.2)
-    u = problem.expand(result.solution.u)
+    u = problem.model.expand(result.solution.u)
     first = 2 * model.slave.mesh.p.shape[1]
     energy = sum(part @ body.stiffness(MeshTri(body.mesh.p / L, body.mesh.t), stress) @ part
                  for body, part in ((model.slave, u[:first]), (model.master, u[first:])))
@@ -150,7 +150,7 @@ def test_the_vtu_holds_both_bodies_each_stressed_by_its_own_material(tmp_path):
     result = signorini.solve(problem, "pdas")
     mesh = meshio.read(export_vtk(problem, result.solution, tmp_path / "patch.vtu"))
     body = mesh.cell_data["body"][0]
-    assert body.size == problem.mesh.t.shape[1] and set(body) == {1, 2}
+    assert body.size == problem.model.mesh.t.shape[1] and set(body) == {1, 2}
     # uniaxial in each block: σ_yy = −p in both, σ_zz = ν σ_yy with the block's own ν
     np.testing.assert_allclose(mesh.cell_data["sigma_yy"][0], -p, rtol=1e-8)
     nu = np.where(body == 1, MATERIALS["nu2"], MATERIALS["nu1"])  # the upper block is the slave
@@ -166,8 +166,8 @@ def test_a_picture_shows_both_deformed_bodies_and_the_pressure():
 
     problem, p = patch()
     result = signorini.solve(problem, "pdas")
-    body = np.repeat([1, 2], [material[0] for material in problem.discretisation.materials])
-    ax = deformed_bodies(problem.mesh.p * problem.scales.length, problem.mesh.t,
+    body = np.repeat([1, 2], [material[0] for material in problem.model.materials])
+    ax = deformed_bodies(problem.model.mesh.p * problem.scales.length, problem.model.mesh.t,
                          nodal_displacement(problem, result.solution), body,
                          candidate_nodes(problem), contact_profile(problem, result.solution).pressure)
     assert {t.get_text() for t in ax.get_legend().get_texts()} == {"body 1", "body 2"}

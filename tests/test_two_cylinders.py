@@ -27,7 +27,7 @@ def test_two_cylinders_of_different_materials_and_radii_meet_two_body_hertz(disc
     assert result.converged
     c = result.comparison  # against a and p0 of the pair's E* and R* at the load carried
     assert abs(c.a / c.a_ref - 1) < 5e-3 and abs(c.p0 / c.p0_ref - 1) < 5e-3
-    assert result.applied_load == pytest.approx(result.problem.push.P, rel=1e-8)  # load control
+    assert result.applied_load == pytest.approx(result.problem.model.push.P, rel=1e-8)  # load control
 
 
 @pytest.mark.parametrize("loading", ["traction", "displacement"])
@@ -59,7 +59,7 @@ def test_the_rows_follow_the_normal_asked_for():
                                                 params={**COARSE, "normal": normal})
                         for normal in ("vertical", "master"))
     for problem, tilted in ((vertical, False), (master, True)):
-        x_dofs = problem.discretisation.free_dofs % 2 == 0  # dofs interleaved by node: x even
+        x_dofs = problem.model.free_dofs % 2 == 0  # dofs interleaved by node: x even
         assert (abs(problem.N[:, x_dofs]).max() > 1e-3) == tilted
 
 
@@ -85,7 +85,7 @@ def test_the_load_derivative_of_the_pair_follows_hertz():
     assert force.derivative == pytest.approx(1.0, rel=1e-8)  # the contact carries the load
     peak = signorini.derivative(result, "p0", "P")
     # Hertz: p0 = 2P/(πa) with a ∝ √P, so dp0/dP = p0 / (2P) (the mesh's own error aside)
-    assert peak.derivative == pytest.approx(peak.value / (2 * result.problem.push.P), rel=0.05)
+    assert peak.derivative == pytest.approx(peak.value / (2 * result.problem.model.push.P), rel=0.05)
 
 
 @pytest.mark.parametrize("scene, wrt, words", [("hertz-two-cylinders", "E", "E1 or E2"),

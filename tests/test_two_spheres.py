@@ -28,14 +28,14 @@ def test_the_dual_basis_is_biorthogonal_in_the_segment_s_weight(radial):
 def test_two_spheres_of_different_materials_and_radii_meet_two_body_hertz(discretisation):
     params = {**COARSE, "E2": 3.0, "nu2": 0.2, "R2": 2.0, "discretisation": discretisation}
     result = signorini.solve("hertz-two-spheres", "pdas", params=params)
-    assert result.converged and result.problem.axisymmetric
+    assert result.converged and result.problem.model.axisymmetric
     c = result.comparison  # against a and p0 of the pair's E* and R* at the load carried
-    reference = result.problem.reference_data  # the pair's R* and E*
+    reference = result.problem.model.reference  # the pair's R* and E*
     assert reference.R == pytest.approx(2 / 3, rel=1e-15)
     assert reference.E_star == pytest.approx(1 / ((1 - 0.3 ** 2) / 1.0 + (1 - 0.2 ** 2) / 3.0),
                                              rel=1e-15)
     assert abs(c.a / c.a_ref - 1) < 5e-3 and abs(c.p0 / c.p0_ref - 1) < 5e-3
-    assert result.applied_load == pytest.approx(result.problem.push.P, rel=1e-8)  # load control
+    assert result.applied_load == pytest.approx(result.problem.model.push.P, rel=1e-8)  # load control
 
 
 def test_a_stiff_large_lower_sphere_approaches_the_rigid_flat():

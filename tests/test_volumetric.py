@@ -64,7 +64,7 @@ def test_auto_averages_from_nu_0_4():
     small = {"n_contact": 12, "grading": 0.4}
     for nu, used in ((0.3, "element"), (0.45, "nodal")):
         problem = signorini.build_problem("hertz-cylinder", params={"nu": nu, **small})
-        assert problem.params["volumetric"] == used  # what K integrates, recorded in the result
+        assert problem.model.params["volumetric"] == used  # what K integrates, recorded in the result
     with pytest.raises(InputError, match="volumetric"):
         signorini.build_problem("hertz-cylinder", params={"volumetric": "mixed"})
 

@@ -52,12 +52,11 @@ def cost(params: dict) -> dict:
 
 def widths(count: int = 41) -> dict:
     base = signorini.solve("hertz-cylinder")
-    problem, push = base.problem, base.problem.push
+    problem, push = base.problem, base.problem.model.push
     rows = []
     for ratio in np.linspace(0.8, 1.25, count):
-        moved = problem.with_data(discretisation=dataclasses.replace(
-            problem.discretisation, push=dataclasses.replace(push, target=push.target * ratio,
-                                                             pending=True)))
+        moved = problem.with_data(push=dataclasses.replace(push, target=push.target * ratio),
+                                  pending=True)
         result = signorini.solve(moved, "pdas")
         x = result.x[result.active]
         slope = signorini.derivative(result, "a", "P")

@@ -115,7 +115,7 @@ def run() -> list[dict]:
                 rows.append({"scene": scene, "size": size, **params,
                              "triangle_size": factor if mesher == "triangle" else None,
                              "status": result.status, "dofs": result.problem.n,
-                             "mesh_seconds": seconds, **shape(made.mesh),
+                             "mesh_seconds": seconds, **shape(made.model.mesh),
                              "a_err": hertz.a / hertz.a_ref - 1, "p0_err": hertz.p0 / hertz.p0_ref - 1})
                 print(f"{scene} {params} {result.problem.n} dofs {seconds:.3f} s: "
                       f"a {rows[-1]['a_err']:+.2e} p0 {rows[-1]['p0_err']:+.2e}", file=sys.stderr)

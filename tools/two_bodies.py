@@ -153,8 +153,8 @@ def figure(path: Path = OUT.parent / "cylinders-deformed.png") -> Path:
 
     result = signorini.solve("hertz-two-cylinders", "pdas", params=PAIRS["different"])
     problem, solution = result.problem, result.solution
-    body = np.repeat([1, 2], [material[0] for material in problem.discretisation.materials])
-    ax = deformed_bodies(problem.mesh.p * problem.scales.length, problem.mesh.t,
+    body = np.repeat([1, 2], [material[0] for material in problem.model.materials])
+    ax = deformed_bodies(problem.model.mesh.p * problem.scales.length, problem.model.mesh.t,
                          nodal_displacement(problem, solution), body, candidate_nodes(problem),
                          contact_profile(problem, solution).pressure, magnify=1.0)
     a = result.comparison.a

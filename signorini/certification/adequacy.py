@@ -63,7 +63,7 @@ class Adequacy:
 
 def adequacy(problem: ContactProblem, solution: ContactSolution, accept: float) -> Adequacy | None:
     """Check the boundary beyond the candidates (None when the problem has no watch or no answer)."""
-    watch = None if problem.discretisation is None else problem.discretisation.watch
+    watch = problem.model.watch
     if watch is None or not np.all(np.isfinite(solution.u)):
         return None
     gaps = watch.gap(problem, solution.u)
@@ -85,19 +85,18 @@ def warnings(problem: ContactProblem, solution: ContactSolution | None = None) -
     """What may make an exact answer a poor model (the status stays)."""
     said = []
     touching = None if solution is None else int(np.sum(solution.lam > 0))
-    if problem.reference and touching is not None and 0 < touching < FEWEST_IN_CONTACT:
+    if problem.model.reference_name and touching is not None and 0 < touching < FEWEST_IN_CONTACT:
         said.append(f"the contact covers {touching} candidate(s), too few to resolve it (its "
                     "width and peak pressure cannot be fitted): refine the mesh at the contact "
                     "or raise the load")
-    disc = problem.discretisation
-    nu = None if disc is None else disc.nu
-    if nu is not None and nu > LOCKING_NU and disc.volumetric == "element":
-        said.append(f"ν = {nu:g} > {LOCKING_NU:g}: P1 triangles lock, the pressure can be several "
+    model = problem.model
+    if model.nu > LOCKING_NU and model.volumetric == "element":
+        said.append(f"ν = {model.nu:g} > {LOCKING_NU:g}: P1 triangles lock, the pressure can be several "
                     f"percent off ({docs_page('accuracy')}); set the scene parameter volumetric=nodal "
                     "(the volumetric strain averaged at the nodes: no locking)")
-    watch = None if disc is None else disc.watch
+    watch = model.watch
     if watch is not None and watch.candidate_gaps.size:
-        push = float(np.max(np.abs(problem.discretisation.prescribed), initial=0.0))
+        push = float(np.max(np.abs(model.prescribed), initial=0.0))
         inside = float(-watch.candidate_gaps.min())
         if inside > 0 and inside > push:
             said.append(f"the obstacle starts {inside * problem.scales.displacement:.3g} inside the "

@@ -55,8 +55,8 @@ def regularise(problem: ContactProblem, epsilon: float) -> ContactProblem:
                          "e.g. 1e-8")
     stiffness = float(np.mean(np.abs(problem.K.diagonal()))) or 1.0
     K = (problem.K + epsilon * stiffness * sp.identity(problem.n, format="csr")).tocsr()
-    new = problem.with_data(K=K, params={**problem.params, "regularisation": float(epsilon)})
-    new.basis = problem.basis
+    new = problem.with_data(K=K, params={**problem.model.params, "regularisation": float(epsilon)})
+    new.model.basis = problem.model.basis
     return new
 
 

@@ -14,7 +14,8 @@ from signorini.solvers.options import DEFAULT_TOL, guess_value
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.api import Result, at_load, build_problem, solve, solve_adaptive  # per command
+    from signorini.api import Result, at_load, solve, solve_adaptive  # per command
+    from signorini.scenes import build_problem  # per command (start-up)
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
     from signorini.certification.kkt import certificate  # per command (start-up)
     from signorini.problem.files import is_problem_file  # per command (start-up)
@@ -66,7 +67,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         else:
             problem = build_problem(args.scene, params=params, nondimensionalise=not args.raw_units,
                                     solved_by=method)
-            if vtk_path and problem.mesh is None:
+            if vtk_path and problem.model.mesh is None:
                 raise InputError(f"--vtk writes the mesh, and {args.scene!r} holds none (a QP "
                                  "given as arrays): drop --vtk, or save the problem of a scene")
             if time_limit is None:

@@ -133,7 +133,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         directory = writable_directory(out)
         atomic_write_text(directory / "sweep.csv", csv + "\n")
         atomic_write_text(directory / "sweep.json", to_json({"scene": args.scene,
-                                                             "params": problem.params, "levels": rows}))
+                                                             "params": problem.model.params, "levels": rows}))
         save_figure(ax.figure, directory / "sweep.png")
     print(f"{'load':>12} {'a':>12} {'a Hertz':>12} {'p0':>12} {'p0 Hertz':>12}  status")
     for lv in levels:

@@ -65,13 +65,13 @@ class SceneDerivative:
 
 
 def _load_controlled(problem: ContactProblem) -> bool:
-    return problem.push is not None and problem.push.target is not None
+    return problem.model.push is not None and problem.model.push.target is not None
 
 
 def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Change:
     """The change of K, f, d and the target load per unit of the scene parameter ``wrt``."""
-    disc, push, s = problem.discretisation, problem.push, problem.scales
-    if disc is None or push is None:
+    model, push, s = problem.model, problem.model.push, problem.scales
+    if push is None:
         raise InputError("derivatives with respect to scene parameters need a scene "
                          "(a problem from ContactProblem.from_qp has none): use Result.jvp")
     zero_n, zero_m = np.zeros(problem.n), np.zeros(problem.m)
@@ -84,16 +84,16 @@ def change(problem: ContactProblem, solution: ContactSolution, wrt: str) -> Chan
         return Change(np.where(on, problem.K @ u, 0.0) / E, np.where(on, lift, 0.0) / E, zero_m)
     if wrt == "P":
         if not _load_controlled(problem):
-            raise InputError(f"{problem.scene or 'this scene'} is loaded by a prescribed push, not "
+            raise InputError(f"{problem.name or 'this scene'} is loaded by a prescribed push, not "
                              "a target load: differentiate with respect to delta")
         return Change(zero_n, zero_n, zero_m, target=1.0 / s.force)
     if wrt == "delta":
         if _load_controlled(problem):
-            raise InputError(f"{problem.scene or 'this scene'} is loaded by a target load P, which "
+            raise InputError(f"{problem.name or 'this scene'} is loaded by a target load P, which "
                              "sets the push: differentiate with respect to P (or build the scene "
                              "with delta=)")
         if push.delta is None:
-            raise InputError(f"{problem.scene or 'this scene'} names no push delta to differentiate "
+            raise InputError(f"{problem.name or 'this scene'} names no push delta to differentiate "
                              "with respect to: build it from a scene with a delta parameter")
         ratio = push.scale / push.delta  # the push moves in proportion to delta
         return Change(zero_n, push.f1 * ratio, push.d1 * ratio)
@@ -107,36 +107,36 @@ def _material(problem: ContactProblem, wrt: str) -> tuple[str, np.ndarray, float
     """``("E" or "nu", the free dofs it acts on, the body's E, ν and volumetric integration)``
     of ``wrt``: ``E``/``nu`` for one body, ``E1``/``nu1`` (the first body's, the slave) and
     ``E2``/``nu2`` for two."""
-    disc = problem.discretisation
+    model = problem.model
     name, body = wrt.rstrip("12"), wrt[len(wrt.rstrip("12")):]
-    if not body and disc.materials:
-        raise InputError(f"{problem.scene or 'this scene'} has two bodies: differentiate with "
+    if not body and model.materials:
+        raise InputError(f"{problem.name or 'this scene'} has two bodies: differentiate with "
                          f"respect to {wrt}1 or {wrt}2")
-    if body and not disc.materials:
-        raise InputError(f"{problem.scene or 'this scene'} has one body: differentiate with "
+    if body and not model.materials:
+        raise InputError(f"{problem.name or 'this scene'} has one body: differentiate with "
                          f"respect to {name}")
     if not body:
-        return name, np.ones(problem.n, dtype=bool), disc.E, disc.nu, disc.volumetric
-    counts = [material[0] for material in disc.materials]
+        return name, np.ones(problem.n, dtype=bool), model.E, model.nu, model.volumetric
+    counts = [material[0] for material in model.materials]
     first = sum(counts[:int(body) - 1])
-    on = np.zeros(disc.prescribed.size, dtype=bool)
-    on[nodal_dofs(disc.mesh)[:, np.unique(disc.mesh.t[:, first:first + counts[int(body) - 1]])]] = True
-    _, E, nu, volumetric = disc.materials[int(body) - 1]
-    return name, on[disc.free_dofs], E, nu, volumetric
+    on = np.zeros(model.prescribed.size, dtype=bool)
+    on[nodal_dofs(model.mesh)[:, np.unique(model.mesh.t[:, first:first + counts[int(body) - 1]])]] = True
+    _, E, nu, volumetric = model.materials[int(body) - 1]
+    return name, on[model.free_dofs], E, nu, volumetric
 
 
 def _poisson_change(problem: ContactProblem, u: np.ndarray, E: float, nu: float,
                     volumetric: str, on: np.ndarray) -> Change:
     """∂K/∂ν from K's two Lamé parts, ``∂K/∂ν = E (∂Λ/∂ν K_Λ + ∂μ/∂ν K_μ)`` (exact), on the
     free dofs ``on`` of the body of modulus E and ratio ν (K is block diagonal by body)."""
-    disc, s = problem.discretisation, problem.scales
-    k = 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
+    model, s = problem.model, problem.scales
+    k = 1 if (model.axisymmetric or model.mesh.p.shape[0] == 3) else 0
     E = E * s.displacement * s.length ** k / s.force  # E in the problem's units
     lame = (1 + 2 * nu ** 2) / ((1 + nu) * (1 - 2 * nu)) ** 2, -0.5 / (1 + nu) ** 2
-    dK = lame_stiffness(disc.mesh, E * lame[0], E * lame[1], axisymmetric=disc.axisymmetric,
+    dK = lame_stiffness(model.mesh, E * lame[0], E * lame[1], axisymmetric=model.axisymmetric,
                         volumetric=volumetric)
-    free = disc.free_dofs
-    on_free, prescribed = np.zeros(disc.prescribed.size), disc.prescribed.copy()
+    free = model.free_dofs
+    on_free, prescribed = np.zeros(model.prescribed.size), model.prescribed.copy()
     on_free[free] = u
     prescribed[free] = 0.0
     return Change(np.where(on, (dK @ on_free)[free], 0.0),
@@ -147,7 +147,7 @@ def scene_tangent(sensitivity: Sensitivity, delta: Change) -> tuple[np.ndarray, 
     """``(du, dλ, ds)`` for a change of the data; a load-controlled problem keeps its load
     ``μ Σ cᵢ λᵢ`` at the target by moving its push s (one more right-hand side)."""
     problem = sensitivity.problem
-    push = problem.push
+    push = problem.model.push
     f, d = delta.f - delta.Ku, delta.d
     if not _load_controlled(problem):
         du, dlam, _ = sensitivity.tangent(f, d)
@@ -164,7 +164,7 @@ def outputs(problem: ContactProblem, solution: ContactSolution, output: str, at:
             tangent: tuple[np.ndarray, np.ndarray, float] | None = None,
             delta: Change | None = None) -> tuple[Any, Any]:
     """``(value, derivative)`` of one physical output (the derivative None without a tangent)."""
-    s, disc = problem.scales, problem.discretisation
+    s, model = problem.scales, problem.model
     profile = contact_profile(problem, solution)
     du, dlam, ds = tangent if tangent is not None else (None, None, 0.0)
     if output == "total_force":
@@ -185,23 +185,23 @@ def outputs(problem: ContactProblem, solution: ContactSolution, output: str, at:
         value = problem.energy(u) * s.force * s.displacement
         if du is None:
             return value, None
-        push = problem.push
+        push = problem.model.push
         f = delta.f + (ds * push.f1 if push is not None else 0.0)
         d = delta.d + (ds * push.d1 if push is not None else 0.0)
         slope = 0.5 * u @ delta.Ku - f @ u - lam @ d  # the envelope theorem
         return value, slope * s.force * s.displacement
     if output == "displacement":
-        if at is None or disc is None or disc.mesh is None:
+        if at is None or model.mesh is None:
             raise InputError("output 'displacement' needs a point: at=(x, y) in the scene's units")
-        mesh = disc.mesh
+        mesh = model.mesh
         point = _point(at, mesh.p.shape[0]) / s.length
         node = int(np.argmin(np.linalg.norm(mesh.p - point[:, None], axis=0)))
         dofs = np.arange(mesh.p.shape[0]) + mesh.p.shape[0] * node
-        value = problem.expand(solution.u)[dofs] * s.displacement
+        value = problem.model.expand(solution.u)[dofs] * s.displacement
         if du is None:
             return value, None
-        full = disc.prescribed * (ds / disc.push.scale if disc.push is not None else 0.0)
-        full[disc.free_dofs] = du
+        full = model.prescribed * (ds / model.push.scale if model.push is not None else 0.0)
+        full[model.free_dofs] = du
         return value, full[dofs] * s.displacement
     raise InputError(f"output must be one of {', '.join(OUTPUTS)}, got {output!r}")
 

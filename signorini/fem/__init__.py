@@ -10,15 +10,14 @@
   recovery and a contact term), per element; :mod:`~signorini.fem.contact_estimate` its contact
   term and the contact pressure's estimate;
 - :mod:`~signorini.fem.transfer`: P1 fields carried onto a refined mesh (midpoint parents).
+
+The names below are loaded at first use (``lazy_loader``): a QP given as arrays, which has no
+mesh, never loads scikit-fem.
 """
 
-from signorini.fem.assembly import assemble
-from signorini.fem.checks import check_model
-from signorini.fem.contact_estimate import PressureEstimate
-from signorini.fem.estimate import ErrorEstimate, estimate
-from signorini.fem.model import CutLoad, FlatObstacle, FlatObstacle3D, SceneModel
-from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, Obstacle, SignedDistance
+import lazy_loader
 
-__all__ = ["Circle", "CutLoad", "ErrorEstimate", "FlatObstacle", "FlatObstacle3D", "FlatPunch",
-           "HalfPlane", "Obstacle", "PressureEstimate", "SceneModel", "SignedDistance", "assemble",
-           "check_model", "estimate"]
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs={
+    "assembly": ["assemble"], "checks": ["check_model"], "contact_estimate": ["PressureEstimate"],
+    "estimate": ["ErrorEstimate"], "model": ["CutLoad", "FlatObstacle", "FlatObstacle3D", "SceneModel"],
+    "obstacles": ["Circle", "FlatPunch", "HalfPlane", "Obstacle", "SignedDistance"]})

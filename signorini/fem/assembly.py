@@ -46,7 +46,7 @@ from signorini.fem.model import SceneModel
 from signorini.fem.stiffness import simplex_stiffness
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import volumetric_stiffness
-from signorini.problem.contact import ContactProblem, Discretisation, Push, Scales, Watch
+from signorini.problem.contact import ContactProblem, Model, Push, Scales, Watch
 
 log = logging.getLogger(__name__)
 
@@ -180,9 +180,9 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     """The contact QP of ``model`` at its nominal push: K, f, N, d, weights, points, scales.
 
     Pure linear algebra: no contact is solved here. A scene with a target
-    load gets a problem whose target is pending (``problem.pending``): f and
+    load gets a problem whose target is pending (``problem.model.pending``): f and
     d are at the nominal push, and load control (:mod:`signorini.load_control`)
-    finds the push whose load is the target, from ``problem.push``.
+    finds the push whose load is the target, from ``problem.model.push``.
     """
     start = time.perf_counter()
     log.info("assembling K: %s nodes, %s elements", f"{model.mesh.p.shape[1]:,}",
@@ -248,7 +248,7 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
     delta = model.delta
     if model.target_load is not None:  # the nominal push that load control scales
         delta = params["delta"] = -min(v for c, _, v in model.dirichlet if c == model.load_dofs[0])
-    discretisation = Discretisation(
+    made = Model(
         mesh=mesh, free_dofs=free, prescribed=full, load_row=load_full[free],
         load_offset=load_offset, E=float(model.E), nu=float(model.nu),
         volumetric=model.volumetric, axisymmetric=axisymmetric, reference=model.reference,
@@ -256,16 +256,17 @@ def assemble(model: SceneModel, nondimensionalise: bool = True) -> ContactProble
         push=_push(lifted, 1.0, None if f_load is None else f_load[free], offset_load, target,
                    _resultant(N_full, np.sort(dof_table[component][is_free[dof_table[component]]])),
                    delta=delta, P=model.target_load),
-        predicted_contact=model.predicted_contact, watch=boundary_watch(model, dof_table, U))
+        predicted_contact=model.predicted_contact, watch=boundary_watch(model, dof_table, U),
+        pending=target is not None)
     problem = ContactProblem(
         K=K_II, f=f, N=N_free, d=d, weights=contact_weights(mesh, model.contact_facets, nodes,
                                                             axisymmetric),
         contact_points=mesh.p[:, nodes].T, force_multiplicity=model.force_multiplicity,
         scales=Scales(length=L, displacement=U, force=force_unit, weight=L ** (k + 1)),
-        discretisation=discretisation)
-    discretisation.assemble_s = time.perf_counter() - start
+        model=made)
+    made.assemble_s = time.perf_counter() - start
     log.info("assembled %d free dofs, %d contact candidates in %.2f s",
-             problem.n, problem.m, discretisation.assemble_s)
+             problem.n, problem.m, made.assemble_s)
     return problem
 
 
@@ -362,5 +363,5 @@ def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
     f1, d_one, offset_one, _ = lifted(1.0)
     return Push(f1=f1 - f0, d0=d0, d1=d_one - d0, offset1=offset_one - offset0, scale=scale,
                 f_load=f_load, offset_load=offset_load if f_load is not None else 0.0,
-                load=load if f_load is not None else 0.0, target=load, pending=load is not None,
+                load=load if f_load is not None else 0.0, target=load,
                 resultant=resultant, delta=delta, P=P)

@@ -145,7 +145,7 @@ def unit_normals(problem: ContactProblem, dim: int) -> np.ndarray:
     N = problem.N.tocsr()
     normals = np.zeros((problem.m, dim))
     rows = np.repeat(np.arange(problem.m), np.diff(N.indptr))
-    full = problem.discretisation.free_dofs[N.indices]
+    full = problem.model.free_dofs[N.indices]
     np.add.at(normals, (rows, full % dim), N.data)
     length = np.linalg.norm(normals, axis=1)
     return normals / np.where(length > 0, length, 1.0)[:, None]
@@ -178,7 +178,7 @@ def pressure_estimate(problem: ContactProblem, solution: ContactSolution, nodal:
     biases p* by about 0.2 % of p₀ for any mesh (docs/estimate.md). ``nodal_trace`` is the
     volumetric strain at the nodes when K averages it there (else the recovered strain's trace).
     """
-    mesh, dim = problem.mesh, problem.mesh.p.shape[0]
+    mesh, dim = problem.model.mesh, problem.model.mesh.p.shape[0]
     if dim != 2 or problem.weights is None or not np.all(np.isfinite(solution.lam)):
         return None
     try:

@@ -33,8 +33,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from skfem.models.elasticity import lame_parameters as lame  # Lamé's λ and μ of E and ν
-from skfem.quadrature import get_quadrature
 
 from signorini.fem.contact_estimate import PressureEstimate, candidate_nodes, contact_term, pressure_estimate
 from signorini.fem.stiffness import barycentric_gradients
@@ -107,11 +105,18 @@ class Quadrature:
     gradients: np.ndarray
 
 
+def lame(E: Any, nu: Any) -> tuple[Any, Any]:
+    """Lamé's λ and μ of Young's modulus E and Poisson's ratio ν (numbers or arrays)."""
+    return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+
+
 def quadrature(mesh: Any, axisymmetric: bool = False, order: int | None = None) -> Quadrature:
     """The quadrature of order ``order`` on every simplex of ``mesh`` (triangles or tetrahedra);
     by default :data:`QUADRATURE_ORDER`, or :data:`AXISYMMETRIC_ORDER` when axisymmetric."""
     if order is None:
         order = AXISYMMETRIC_ORDER if axisymmetric else QUADRATURE_ORDER
+    from skfem.quadrature import get_quadrature  # scikit-fem at first use (start-up)
+
     X, W = get_quadrature(mesh.refdom, order)
     bary = np.vstack([1.0 - X.sum(axis=0), X])
     gradients, jacobian = simplex_gradients(mesh)
@@ -207,13 +212,13 @@ def material_units(problem: ContactProblem) -> tuple[Any, Any] | None:
     (k = 1 in axisymmetric and 3D models), which is E itself for a scene made
     dimensionless and 1 otherwise.
     """
-    disc = problem.discretisation
-    if disc is None or getattr(disc.mesh, "p", None) is None:  # no finite-element mesh
+    model = problem.model
+    if getattr(model.mesh, "p", None) is None:  # no finite-element mesh
         return None
     s = problem.scales
-    k = 1 if (disc.axisymmetric or disc.mesh.p.shape[0] == 3) else 0
+    k = 1 if (model.axisymmetric or model.mesh.p.shape[0] == 3) else 0
     stress = s.force / (s.displacement * s.length ** k)
-    E, nu = disc.element_materials()
+    E, nu = model.element_materials()
     return E / stress, nu
 
 
@@ -221,11 +226,11 @@ def _by_quadrature(problem: ContactProblem, mesh: Any, u: np.ndarray, Lambda: fl
                    Mu: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """Per element ``a(u_h, u_h)`` and ``a(e*, e*)``, the recovered nodal strain and volumetric
     strain (or None), by quadrature: axisymmetric models and the nodal volumetric average."""
-    axisymmetric, dim = bool(problem.axisymmetric), mesh.p.shape[0]
+    axisymmetric, dim = bool(problem.model.axisymmetric), mesh.p.shape[0]
     rule = quadrature(mesh, axisymmetric)
     eps = strains(mesh, u, rule, axisymmetric)
     theta = theta_points = jump = None
-    if problem.discretisation.volumetric == "nodal":
+    if problem.model.volumetric == "nodal":
         # K's λ-part sees the volumetric strain averaged at the nodes, θ̄: a continuous P1 field
         # that is already ZZ's recovery of tr ε_h. Recovered once more (θ*), it smooths the
         # one-sided averages of the boundary nodes: on the default Hertz meshes at ν = 0.45 the
@@ -278,12 +283,12 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
     material = material_units(problem)
     if material is None or not np.all(np.isfinite(solution.u)):
         return None
-    mesh, axisymmetric = problem.mesh, bool(problem.axisymmetric)
+    mesh, axisymmetric = problem.model.mesh, bool(problem.model.axisymmetric)
     Lambda, Mu = lame(*material)
-    bodies = max(1, len(problem.discretisation.materials))
+    bodies = max(1, len(problem.model.materials))
     contact = contact and bodies == 1
-    u = problem.expand(solution.u).reshape(-1, mesh.p.shape[0])
-    if axisymmetric or problem.discretisation.volumetric == "nodal":
+    u = problem.model.expand(solution.u).reshape(-1, mesh.p.shape[0])
+    if axisymmetric or problem.model.volumetric == "nodal":
         energy, squares, nodal, theta = _by_quadrature(problem, mesh, u, Lambda, Mu)
     else:
         energy, squares, nodal = _constant_strains(mesh, u, Lambda, Mu)

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.fem.checks import check_model
 from signorini.fem.volumetric import resolve
 

@@ -27,13 +27,13 @@ from skfem import MeshTri
 from skfem.models.elasticity import lame_parameters
 
 from signorini.references.analytic import contact_modulus
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.assembly import lame_stiffness, nodal_dofs
 from signorini.fem.mortar import Face, couple
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import resolve
-from signorini.problem.contact import ContactProblem, Discretisation, Push, Scales
+from signorini.problem.contact import ContactProblem, Model, Push, Scales
 
 log = logging.getLogger(__name__)
 
@@ -171,10 +171,10 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
     resultant = -np.asarray(N_full[:, dof_table[1, slave_face.nodes]].sum(axis=1)).ravel()
     push = Push(f1=f1, d0=d0, d1=d1, offset1=offset1, scale=1.0,
                 f_load=None if f_load is None else f_load[free], offset_load=offset_load,
-                load=load, target=target, pending=target is not None,
+                load=load, target=target,
                 resultant=None if np.all(resultant == 1.0) else resultant,
                 delta=max(pushed) if pushed else None, P=target_load)
-    discretisation_record = Discretisation(
+    record = Model(
         mesh=mesh, free_dofs=free, prescribed=prescribed, load_row=load_full[free],
         load_offset=offset, E=float(slave.E), nu=float(slave.nu),
         volumetric=resolve(slave.volumetric, slave.nu), axisymmetric=axisymmetric,
@@ -182,17 +182,18 @@ def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar
                                               resolve(body.volumetric, body.nu))
                                              for body in (slave, master)),
         params=dict(params or {}, discretisation=discretisation), push=push,
-        predicted_contact=None if predicted is None else np.asarray(predicted(points * L)))
+        predicted_contact=None if predicted is None else np.asarray(predicted(points * L)),
+        pending=target is not None)
     problem = ContactProblem(
         K=K_II, f=f, N=N_full[:, free].tocsr(), d=d0 + d1,
         weights=coupling.weights / L ** (k + 1),
         contact_points=points,
         force_multiplicity=force_multiplicity,
         scales=Scales(length=L, displacement=U, force=stress * U * L ** k, weight=L ** (k + 1)),
-        discretisation=discretisation_record)
-    discretisation_record.assemble_s = time.perf_counter() - start
+        model=record)
+    record.assemble_s = time.perf_counter() - start
     log.info("assembled two bodies: %d free dofs, %d %s rows in %.2f s", problem.n, problem.m,
-             discretisation, discretisation_record.assemble_s)
+             discretisation, record.assemble_s)
     return problem
 
 

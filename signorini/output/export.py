@@ -39,6 +39,7 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.files import atomic_write, check_output_file
 from signorini.fem.contact_estimate import candidate_nodes as mesh_nodes_at
+from signorini.fem.estimate import lame
 from signorini.references.profile import contact_profile
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -50,14 +51,10 @@ CELL_TYPES = {3: "triangle", 4: "tetra"}
 
 
 def nodal_displacement(problem: ContactProblem, solution: ContactSolution) -> np.ndarray:
-    """Displacement of every mesh node, shape (nodes, dim), in physical units."""
-    full = problem.expand(solution.u) * problem.scales.displacement
-    mesh = problem.mesh
-    dim, nodes = mesh.p.shape
-    basis = getattr(problem, "basis", None)
-    dofs = basis.nodal_dofs if basis is not None else \
-        np.arange(dim * nodes).reshape(nodes, dim).T  # scikit-fem's interleaved vector dofs
-    return full[dofs].T
+    """Displacement of every mesh node, shape (nodes, dim), in physical units (scikit-fem's
+    vector P1 dofs are interleaved: a node's components are neighbours)."""
+    full = problem.model.expand(solution.u) * problem.scales.displacement
+    return full.reshape(-1, problem.model.mesh.p.shape[0])
 
 
 def element_gradients(points: np.ndarray, elements: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -82,12 +79,11 @@ def element_stress(problem: ContactProblem, solution: ContactSolution,
     any) adds the hoop strain ``u_r / r`` at each element's centroid; a 2D
     model is otherwise in plane strain.
     """
-    if problem.discretisation is None or problem.mesh is None:
+    if problem.model.mesh is None:
         raise InputError("stresses need the mesh and the material: this problem has neither")
-    E, nu = problem.discretisation.element_materials()  # one per element for several bodies
-    lam = np.reshape(E * nu / ((1 + nu) * (1 - 2 * nu)), (-1, 1, 1))
-    mu = np.reshape(E / (2 * (1 + nu)), (-1, 1, 1))
-    mesh = problem.mesh
+    E, nu = problem.model.element_materials()  # one per element for several bodies
+    lam, mu = (np.reshape(value, (-1, 1, 1)) for value in lame(E, nu))
+    mesh = problem.model.mesh
     points = mesh.p * problem.scales.length
     dim = points.shape[0]
     u = nodal_displacement(problem, solution)
@@ -128,7 +124,7 @@ def project_to_nodes(points: np.ndarray, elements: np.ndarray, cell_values: np.n
 
 def candidate_nodes(problem: ContactProblem) -> np.ndarray:
     """The mesh node of each contact candidate (matched by coordinates)."""
-    return mesh_nodes_at(problem.mesh, problem.contact_points)
+    return mesh_nodes_at(problem.model.mesh, problem.contact_points)
 
 
 def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed: bool = False,
@@ -136,7 +132,7 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
     """The solved scene as a :class:`meshio.Mesh` (physical units; see the module's docstring)."""
     import meshio  # meshio: only when a file is written
 
-    mesh = problem.mesh
+    mesh = problem.model.mesh
     if mesh is None:
         raise InputError("the problem carries no mesh to export")
     if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
@@ -176,7 +172,7 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
         components.update(sigma_yz=(1, 2), sigma_xz=(0, 2))
     cell_data = {"von_mises": [mises]}
     cell_data.update({name: [stress[:, i, j]] for name, (i, j) in components.items()})
-    materials = problem.discretisation.materials
+    materials = problem.model.materials
     if materials:
         cell_data["body"] = [np.repeat(np.arange(1, len(materials) + 1, dtype=np.int32),
                                        [material[0] for material in materials])]

@@ -6,10 +6,10 @@
 """
 
 from signorini.problem.contact import ContactProblem
-from signorini.problem.discretisation import Discretisation, Push, ReferenceData, Watch
+from signorini.problem.model import Model, Push, ReferenceData, Watch
 from signorini.problem.files import read_problem
 from signorini.problem.scales import Scales
 from signorini.problem.solution import ContactSolution, WarmStart
 
-__all__ = ["ContactProblem", "ContactSolution", "Discretisation", "Push", "ReferenceData", "Scales",
+__all__ = ["ContactProblem", "ContactSolution", "Model", "Push", "ReferenceData", "Scales",
            "WarmStart", "Watch", "read_problem"]

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.problem.discretisation import Discretisation, Push, ReferenceData, Watch
+from signorini.problem.model import Model, Push, ReferenceData, Watch
 from signorini.errors import InputError
 from signorini.numerics.arrays import (
     multiplicity_argument,
@@ -38,7 +38,7 @@ from signorini.problem.scales import Scales
 from signorini.problem.solution import STATUSES, ContactSolution
 
 
-__all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Discretisation", "Push", "ReferenceData",
+__all__ = ["STATUSES", "ContactProblem", "ContactSolution", "Model", "Push", "ReferenceData",
            "Scales", "Watch"]
 
 #: from this many dofs :meth:`ContactProblem.inverse_energy` uses CG instead of a factorisation
@@ -65,7 +65,8 @@ class ContactProblem:
         axisymmetric one).
     scales : the units of every array above.
     name : the scene (or the user's name for the problem).
-    discretisation : the mesh and model behind the QP (None for a QP given as arrays).
+    model : the model that made the QP (:class:`Model`: the mesh, material and load family;
+        for a QP given as arrays, :meth:`Model.of_arrays`, with no mesh).
     """
 
     K: sp.csr_matrix
@@ -77,7 +78,7 @@ class ContactProblem:
     force_multiplicity: float = 1.0
     scales: Scales = field(default_factory=Scales)
     name: str = ""
-    discretisation: Discretisation | None = None
+    model: Model | None = None
 
     def __post_init__(self) -> None:
         self.K, self.N = sparse_argument(self.K, "K"), sparse_argument(self.N, "N")
@@ -109,8 +110,9 @@ class ContactProblem:
                 "every candidate must lie on a boundary edge of positive length")
         if self.contact_points is None:
             self.contact_points = np.full((m, 2), np.nan)
+        if self.model is None:
+            self.model = Model.of_arrays(n)
         self._factor = None
-        self._basis = None
 
     @classmethod
     def from_qp(cls, K: Any, f: Any, N: Any, d: Any, *, weights: Any = None,
@@ -138,55 +140,6 @@ class ContactProblem:
                    contact_points=points_argument(contact_points, N),
                    force_multiplicity=multiplicity_argument(force_multiplicity), name=name)
 
-    # -- what the discretisation says (neutral values for a QP given as arrays) ---------------
-    scene = property(lambda self: self.name, doc="The scene's name (``name``).")
-
-    @property
-    def mesh(self) -> Any:
-        return None if self.discretisation is None else self.discretisation.mesh
-
-    @property
-    def axisymmetric(self) -> bool:
-        return self.discretisation is not None and self.discretisation.axisymmetric
-
-    @property
-    def params(self) -> dict[str, Any]:
-        """The scene's parameters as built (empty for a QP given as arrays)."""
-        return {} if self.discretisation is None else self.discretisation.params
-
-    @property
-    def reference(self) -> str:
-        """The name of the analytic reference the scene declares ("" for none)."""
-        return "" if self.reference_data is None else self.reference_data.name
-
-    @property
-    def reference_data(self) -> ReferenceData | None:
-        """What the scene hands its analytic reference (None for none)."""
-        return None if self.discretisation is None else self.discretisation.reference
-
-    @property
-    def push(self) -> Push | None:
-        return None if self.discretisation is None else self.discretisation.push
-
-    @property
-    def pending(self) -> bool:
-        """A target load is set and not matched yet: f and d are at a nominal push
-        (:func:`signorini.load_control.match` finds the push)."""
-        return self.push is not None and self.push.pending
-
-    @property
-    def basis(self):
-        """scikit-fem's vector P1 basis on ``mesh`` (built when first asked for)."""
-        if self._basis is None and self.mesh is not None:
-            from skfem import Basis, ElementVector
-
-            self._basis = Basis(self.mesh, ElementVector(self.mesh.elem()))
-        return self._basis
-
-    @basis.setter
-    def basis(self, value) -> None:
-        self._basis = value
-
     @property
     def n(self) -> int:
         """Number of free dofs."""
@@ -196,20 +149,6 @@ class ContactProblem:
     def m(self) -> int:
         """Number of contact candidates."""
         return self.N.shape[0]
-
-    def dofs(self) -> tuple[int, np.ndarray]:
-        """The size of the full dof vector (free and prescribed) and the free dofs' places in it."""
-        if self.discretisation is None:
-            return self.n, np.arange(self.n)
-        return self.discretisation.prescribed.size, self.discretisation.free_dofs
-
-    def expand(self, u: np.ndarray) -> np.ndarray:
-        """Full dof vector (free and prescribed) from the free-dof vector ``u``."""
-        if self.discretisation is None:
-            return np.array(u, dtype=float)
-        full = self.discretisation.prescribed.copy()
-        full[self.discretisation.free_dofs] = u
-        return full
 
     def qp(self) -> tuple[sp.csr_matrix, np.ndarray, sp.csr_matrix, np.ndarray]:
         """``(K, f, N, d)`` in the problem's physical units (its :class:`Scales` undone): for
@@ -247,7 +186,7 @@ class ContactProblem:
         :data:`ITERATIVE_ENERGY_FROM` dofs, and at any size on a 2D mesh (whose factorisation
         fills in little: 10⁶ dofs in seconds, where Jacobi-preconditioned CG converges slowly on
         such stiff, graded meshes)."""
-        mesh = None if self.discretisation is None else self.discretisation.mesh
+        mesh = self.model.mesh
         return self.n < ITERATIVE_ENERGY_FROM or (mesh is not None and mesh.p.shape[0] == 2)
 
     def inverse_energy(self, r: np.ndarray) -> float:
@@ -281,68 +220,29 @@ class ContactProblem:
         """Total contact force of the full body (dimensionless): multiplicity · Σλ."""
         return float(self.force_multiplicity * np.sum(lam))
 
-    def applied_load(self, u: np.ndarray) -> float:
-        """Total load the boundary conditions apply to the full body (dimensionless)."""
-        if self.discretisation is None or self.discretisation.load_row is None:
-            return float("nan")
-        return float(self.discretisation.load_row @ u + self.discretisation.load_offset)
-
     def pushed(self, scale: float, load: float | None = None) -> "ContactProblem":
-        """The same body pushed by ``scale`` times the prescribed displacement.
-
-        For a body loaded by a traction on a cut, ``load`` (dimensionless,
-        full body) sets the traction; by default it stays as assembled. The
-        problem returned is at that push (nothing pending); K, its cached
-        factorisation and its basis are shared.
-        """
-        if self.push is None:
-            raise ValueError("this problem does not record how its load depends on the push")
-        pu, old = self.push, self.discretisation
-        ratio = scale / pu.scale
-        load = pu.load if load is None else load
-        changed: dict[str, float] = {}  # δ and P in the scene's units, where the scene names them
-        if pu.delta is not None:
-            changed["delta"] = pu.delta * ratio
-        if pu.f_load is not None and pu.P is not None:
-            changed["P"] = load * self.scales.force
-        discretisation = dataclasses.replace(
-            old, load_offset=pu.offset(scale, load), prescribed=old.prescribed * ratio,
-            params={**old.params, **changed},  # the record of the parameters says the same
-            push=dataclasses.replace(pu, scale=scale, load=load, pending=False, **changed))
-        new = self.with_data(f=pu.f(scale, load), d=pu.d0 + scale * pu.d1,
-                             discretisation=discretisation)
-        new._factor, new._basis = self._factor, self._basis  # K is unchanged
-        return new
+        """The QP of this problem's model at push ``scale`` (:meth:`Model.at_push
+        <signorini.problem.model.Model.at_push>`; for a traction on a cut, ``load`` sets it,
+        dimensionless, full body). Nothing is pending; K and its cached factorisation are shared."""
+        model, f, d = self.model.at_push(scale, load, self.scales.force)
+        return self._same_k(f, d, model)
 
     def with_target(self, P: float, params: dict[str, Any] | None = None,
                     predicted_contact: np.ndarray | None = None) -> "ContactProblem":
-        """The same body with the target load ``P`` (the scene's units, full body), pending.
+        """The QP of this problem's model with the target load ``P`` (the scene's units, full
+        body), pending until load control matches it; mesh, K and its factorisation are shared.
+        ``params`` are the parameters the model records (default: its own with ``P``),
+        ``predicted_contact`` the candidates load control starts from (default: as before)."""
+        model, f, d = self.model.with_target(P, P / self.scales.force, params, predicted_contact)
+        return self._same_k(f, d, model)
 
-        Mesh, K and K's cached factorisation are shared (nothing is meshed or
-        assembled: ``mesh_s`` and ``assemble_s`` are 0); load control matches
-        the new target when the problem is solved. ``params`` are the
-        parameters the problem records (default: its own with ``P``),
-        ``predicted_contact`` the candidates load control starts from (default: as before).
-        """
-        pu = self.push
-        if pu is None or pu.target is None:
-            raise InputError("this problem has no target load to change: build the scene with a "
-                             "load P (or a_over_R), or build it again with the new load")
-        target = P / self.scales.force
-        load = target if pu.f_load is not None else pu.load  # a cut's traction is the load itself
-        discretisation = dataclasses.replace(
-            self.discretisation, load_offset=pu.offset(pu.scale, load), mesh_s=0.0, assemble_s=0.0,
-            params=dict(self.params, P=P) if params is None else params,
-            predicted_contact=(self.discretisation.predicted_contact if predicted_contact is None
-                               else predicted_contact),
-            push=dataclasses.replace(pu, load=load, target=target, pending=True, P=P))
-        new = self.with_data(f=pu.f(pu.scale, load), d=pu.d0 + pu.scale * pu.d1,
-                             discretisation=discretisation)
-        new._factor, new._basis = self._factor, self._basis  # K is unchanged
+    def _same_k(self, f: np.ndarray, d: np.ndarray, model: Model) -> "ContactProblem":
+        new = dataclasses.replace(self, f=f, d=d, model=model)
+        new._factor = self._factor  # K is unchanged
         return new
 
     def with_data(self, **changes: Any) -> "ContactProblem":
-        """A copy with some fields (or fields of its discretisation) replaced.
+        """A copy with some fields (or fields of its model) replaced.
 
         The cached factorisation is dropped (it belongs to the old K) unless
         only fields other than K change and the caller restores it.
@@ -350,9 +250,7 @@ class ContactProblem:
         own = {name: changes.pop(name) for name in list(changes)
                if name in ContactProblem.__dataclass_fields__}
         if changes:
-            if self.discretisation is None:
-                raise ValueError(f"a problem without a discretisation has no {sorted(changes)}")
-            own.setdefault("discretisation", dataclasses.replace(self.discretisation, **changes))
+            own.setdefault("model", self.model.with_basis(**changes))
         return dataclasses.replace(self, **own)
 
     def save(self, path: str | os.PathLike) -> None:

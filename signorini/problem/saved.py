@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.problem.discretisation import Discretisation, Push, ReferenceData
+from signorini.problem.model import Model, Push, ReferenceData
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
 from signorini.numerics.arrays import symmetric_argument
@@ -38,8 +38,8 @@ def save(problem: Any, path: str | os.PathLike) -> None:
         contact_points=problem.contact_points)
     meta: dict[str, Any] = {"scene": problem.name, "force_multiplicity": problem.force_multiplicity,
                             "scales": vars(problem.scales), "discretisation": None}
-    disc = problem.discretisation
-    if disc is not None:
+    disc = problem.model
+    if not disc.empty:
         arrays.update(free_dofs=disc.free_dofs, prescribed=disc.prescribed,
                       load_row=disc.load_row if disc.load_row is not None else np.zeros(0))
         if disc.mesh is not None:  # node blocks and rigid modes for the petsc methods
@@ -57,7 +57,7 @@ def save(problem: Any, path: str | os.PathLike) -> None:
             "materials": [list(m) for m in disc.materials],
             "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
                                              "offset_load": pu.offset_load, "load": pu.load,
-                                             "target": pu.target, "pending": pu.pending,
+                                             "target": pu.target, "pending": disc.pending,
                                              "delta": pu.delta, "P": pu.P}}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     buffer = io.BytesIO()
@@ -75,7 +75,7 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
                          f"{type(meta).__name__}, not the object ContactProblem.save writes: "
                          "save the problem again")
     n, m = (int(v) for v in z["shape"])
-    discretisation = None
+    model = None
     about = meta.get("discretisation")
     if about is not None:
         push = None
@@ -83,7 +83,7 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
             p = about["push"]
             push = Push(z["push_f1"], z["push_d0"], z["push_d1"], p["offset1"], p["scale"],
                         z["push_f_load"] if "push_f_load" in z else None, p["offset_load"],
-                        p["load"], p["target"], p["pending"],
+                        p["load"], p["target"],
                         z["push_resultant"] if "push_resultant" in z else None,
                         p.get("delta"), p.get("P"))
         mesh = None
@@ -92,12 +92,13 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
 
             kind = MeshTri if z["mesh_t"].shape[0] == 3 else MeshTet
             mesh = kind(z["mesh_p"], z["mesh_t"])
-        discretisation = Discretisation(
+        model = Model(
             mesh=mesh, free_dofs=z["free_dofs"], prescribed=z["prescribed"],
             load_row=z["load_row"] if z["load_row"].size else None,
             load_offset=about["load_offset"], E=about["E"], nu=about["nu"],
             volumetric=about["volumetric"], axisymmetric=about["axisymmetric"],
             reference=_reference_data(about["reference"]), params=about["params"], push=push,
+            pending=about["push"] is not None and about["push"]["pending"],
             assemble_s=about["assemble_s"],
             materials=tuple(tuple(m) for m in about.get("materials", ())))
     K = symmetric_argument(sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]),
@@ -106,8 +107,8 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
         K=K, f=z["f"], N=sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
         d=z["d"], weights=z["weights"] if z["weights"].size else None,
         contact_points=z["contact_points"], force_multiplicity=meta["force_multiplicity"],
-        scales=Scales(**meta["scales"]), name=meta["scene"], discretisation=discretisation)
-    return problem if discretisation is not None else in_given_units(problem)
+        scales=Scales(**meta["scales"]), name=meta["scene"], model=model)
+    return problem if model is not None else in_given_units(problem)
 
 
 def in_given_units(problem: Any) -> Any:

@@ -52,15 +52,15 @@ def record_units(problem: Any) -> dict[str, str]:
     in m and pressures in Pa. A problem from its QP data (:meth:`ContactProblem.from_qp`) is in
     the units of d (lengths) and of f (forces).
     """
-    if problem.mesh is None:
+    if problem.model.mesh is None:
         return {"system": "the QP's own", "length": "the unit of d", "force": "the unit of f",
                 "total_force": "the unit of f", "pressure": "the unit of f per unit of the weights",
                 "time": "s"}
-    if problem.mesh.p.shape[0] == 2 and not problem.axisymmetric:
+    if problem.model.mesh.p.shape[0] == 2 and not problem.model.axisymmetric:
         force = total = "stress·length (per unit thickness, plane strain)"
     else:
         total = "stress·length²"
-        force = total + (" (per radian: axisymmetric)" if problem.axisymmetric else "")
+        force = total + (" (per radian: axisymmetric)" if problem.model.axisymmetric else "")
     return {"system": "the scene's own (length: its lengths' unit, stress: E's unit)",
             "length": "length", "force": force, "total_force": total, "pressure": "stress",
             "time": "s"}

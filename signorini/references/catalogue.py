@@ -150,7 +150,7 @@ def _punch_claims(problem: ContactProblem, exact: ContactSolution,
     """The pressure away from the edges, force balance, the load (sharp corners), full contact."""
     claims = [Claim("punch pressure max relative error on |x| <= a/2 (pdas)",
                     metrics["pressure_max_rel"], "punch_pressure_rel"), _force_balance(metrics)]
-    if np.isfinite(metrics["target_rel"]) and problem.reference_data.corner_radius == 0:
+    if np.isfinite(metrics["target_rel"]) and problem.model.reference.corner_radius == 0:
         claims.append(Claim("total contact force equals the load P (pdas)", metrics["target_rel"],
                             "load_target_rel"))
     touching = metrics["active_fraction"] == 1.0
@@ -168,7 +168,7 @@ def _hertz_extent(half_width: Callable[[float, float, float], float]):
     """``extent(problem)``: Hertz's contact half-width (radius) at the scene's target load
     (None without a target: a prescribed push)."""
     def extent(problem: ContactProblem) -> float | None:
-        scene, P = problem.reference_data, problem.push.P if problem.push else None
+        scene, P = problem.model.reference, problem.model.push.P if problem.model.push else None
         if scene is None or scene.R is None or scene.E_star is None or P is None or not P > 0:
             return None
         return half_width(P, scene.R, scene.E_star)
@@ -201,12 +201,12 @@ def summary_lines(record: dict[str, Any]) -> list[str]:
 
 def reference_of(problem: ContactProblem) -> Reference | None:
     """The reference ``problem`` declares (None when it declares none)."""
-    if not problem.reference:
+    if not problem.model.reference_name:
         return None
-    if problem.reference not in REFERENCES:
-        raise InputError(f"reference {problem.reference!r} is not one of "
+    if problem.model.reference_name not in REFERENCES:
+        raise InputError(f"reference {problem.model.reference_name!r} is not one of "
                          f"{', '.join(sorted(REFERENCES))} (or '' for none)")
-    return REFERENCES[problem.reference]
+    return REFERENCES[problem.model.reference_name]
 
 
 def reference_metrics(problem: ContactProblem, solution: ContactSolution) -> dict[str, float]:

@@ -96,7 +96,7 @@ def _against_cylinder(problem: ContactProblem, profile: ContactProfile, P: float
     if not P > 0:
         nan = float("nan")
         return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
-    scene = problem.reference_data  # what the scene hands its reference
+    scene = problem.model.reference  # what the scene hands its reference
     a_ref = hertz_cylinder_half_width(P, scene.R, scene.E_star)
     p0_ref = hertz_cylinder_peak(P, a_ref)
     p0, a = hertz_fit(profile.x, profile.pressure, profile.active)
@@ -122,8 +122,8 @@ class UniformComparison:
 def compare_uniform(problem: ContactProblem, solution: ContactSolution) -> UniformComparison:
     """Compare ``solution`` of the block scene with its uniform pressure."""
     profile = contact_profile(problem, solution)
-    scene = problem.reference_data  # what the scene hands its reference
-    p_ref = scene.E_star * problem.push.delta / scene.H
+    scene = problem.model.reference  # what the scene hands its reference
+    p_ref = scene.E_star * problem.model.push.delta / scene.H
     P = profile.total_force
     return UniformComparison(
         pressure_ref=p_ref,
@@ -156,7 +156,7 @@ def _l2_relative_surface(problem: ContactProblem, pressure: np.ndarray, referenc
     """
     from scipy.spatial import cKDTree
 
-    mesh = problem.mesh
+    mesh = problem.model.mesh
     nodes = cKDTree(mesh.p.T).query(problem.contact_points)[1]
     position = np.full(mesh.p.shape[1], -1)
     position[nodes] = np.arange(nodes.size)
@@ -198,7 +198,7 @@ def compare_hertz_sphere(problem: ContactProblem, solution: ContactSolution) -> 
     (area-weighted), ``edge_margin`` the outermost candidate's radius over a.
     """
     profile = contact_profile(problem, solution)
-    scene = problem.reference_data  # what the scene hands its reference
+    scene = problem.model.reference  # what the scene hands its reference
     P = profile.total_force
     if not P > 0:
         nan = float("nan")
@@ -272,9 +272,9 @@ def compare_punch(problem: ContactProblem, solution: ContactSolution,
                   inner: float = 0.5) -> PunchComparison:
     """Compare ``solution`` of the punch scene with ``p(x) = P/(π√(a² − x²))`` on ``|x| ≤ inner·a``."""
     profile = half_line(problem, contact_profile(problem, solution))
-    a = float(problem.reference_data.a)
+    a = float(problem.model.reference.a)
     P = load_resultant(problem, solution.lam)
-    target = None if problem.push is None else problem.push.P
+    target = None if problem.model.push is None else problem.model.push.P
     nan = float("nan")
     if not P > 0:
         return PunchComparison(a, P, profile.applied_load, nan, nan, inner, nan, nan, nan, nan, nan,

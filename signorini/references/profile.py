@@ -54,7 +54,7 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
     force = solution.lam * s.force
     labels = classify(problem, solution)
     return ContactProfile(
-        x=radial_distance(problem.contact_points, signed=problem.mesh is None) * s.length,
+        x=radial_distance(problem.contact_points, signed=problem.model.mesh is None) * s.length,
         gap=problem.gap(solution.u) * s.displacement,
         force=force,
         pressure=(force / (problem.weights * s.weight) if problem.weights is not None
@@ -62,7 +62,7 @@ def contact_profile(problem: ContactProblem, solution: ContactSolution) -> Conta
         active=labels == ACTIVE,
         labels=labels,
         total_force=problem.total_contact_force(solution.lam) * s.force,
-        applied_load=problem.applied_load(solution.u) * s.force)
+        applied_load=problem.model.applied_load(solution.u) * s.force)
 
 
 def unit_of(values: np.ndarray) -> float:
@@ -198,7 +198,7 @@ def load_resultant(problem: ContactProblem, lam: np.ndarray, component: int = -1
     """
     dim = problem.contact_points.shape[1]
     component = component % dim
-    size, free = problem.dofs()
+    size, free = problem.model.dofs()
     full = np.zeros(size)
     full[free] = problem.N.T @ np.asarray(lam, dtype=float)
     basis = getattr(problem, "basis", None)

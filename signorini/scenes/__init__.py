@@ -5,11 +5,10 @@ known of it (parameters, builder, size model, coarse rule, snapping, reference,
 validation cases) and one :func:`register` call.
 """
 
-from signorini.fem.model import FlatObstacle, SceneModel
-from signorini.scenes.base import Case, Param, SceneFamily
-from signorini.scenes.build import build_problem, coarse_problem, coarse_values
-from signorini.scenes.families import SCENES, get_scene, portable_scene, register, scene_reference, unregister
+import lazy_loader
 
-__all__ = ["SCENES", "Case", "FlatObstacle", "Param", "SceneFamily", "SceneModel", "build_problem",
-           "coarse_problem", "coarse_values", "get_scene", "portable_scene", "register", "scene_reference",
-           "unregister"]
+# loaded at first use (lazy_loader): solving a QP given as arrays never loads a scene or a mesher
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submodules=["adapt", "build"], submod_attrs={
+    "base": ["Case", "Param", "SceneFamily", "scene_params"],
+    "build": ["build_problem", "coarse_problem", "coarse_values", "with_load"],
+    "families": ["SCENES", "get_scene", "portable_scene", "register", "scene_reference", "unregister"]})

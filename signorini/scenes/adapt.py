@@ -191,7 +191,7 @@ def beyond_candidates(model: SceneModel, problem: ContactProblem,
                       solution: ContactSolution) -> np.ndarray:
     """Boundary nodes beyond the candidates that went through the obstacle, and those sharing a
     boundary facet with an edge candidate in contact (mesh node numbers)."""
-    watch = problem.discretisation.watch
+    watch = problem.model.watch
     if watch is None or watch.nodes is None:
         return np.zeros(0, dtype=int)
     through = watch.nodes[-watch.gap(problem, solution.u) > 1e-9 * gap_scale(problem, solution.u)]
@@ -345,7 +345,7 @@ def _limit_reached(dofs: int, max_dofs: int, model: SceneModel,
 def _row(step: int, problem: ContactProblem, solution: ContactSolution,
          found: ErrorEstimate | None, marked: int, seconds: float, action: str) -> dict[str, Any]:
     """One flat record of a step (kept in the result's JSON under extras.adaptive)."""
-    return {"step": step, "dofs": problem.n, "elements": int(problem.mesh.t.shape[1]),
+    return {"step": step, "dofs": problem.n, "elements": int(problem.model.mesh.t.shape[1]),
             "candidates": problem.m, "status": solution.status,
             "estimate": found.relative if found is not None else float("nan"),
             "pressure_estimate": found.pressure.relative

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Protocol
 
 from signorini.references.analytic import contact_modulus
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.errors import InputError, docs_page
 from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel

@@ -27,7 +27,7 @@ import numpy as np
 from skfem import MeshTri
 
 from signorini.references.analytic import contact_modulus
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble, boundary_weights
 from signorini.fem.model import FlatObstacle, SceneModel
@@ -132,8 +132,8 @@ def _touching_model(p: dict[str, Any]) -> SceneModel:
         raise InputError(f"scene parameter touching={p['touching']!r}: the supported block did not "
                          f"solve ({exc})") from None
     u = factor.solve(problem.f - problem.N.T @ lam)
-    full = problem.expand(u) * problem.scales.displacement
-    deflection = full[problem.basis.nodal_dofs[1, bottom]]
+    full = problem.model.expand(u) * problem.scales.displacement
+    deflection = full[problem.model.basis.nodal_dofs[1, bottom]]
     height = np.where(np.isin(bottom, supported), 0.0, deflection)
     profile = HeightProfile(tuple(x[bottom]), tuple(height))
     obstacle = ScaledQuery(profile, mesh.p[:, bottom].T, p["H"])
@@ -198,21 +198,21 @@ def force_controlled_problem(pressure: float = 0.01, params: dict[str, Any] | No
                        obstacle=FlatObstacle(0.0), load_dofs=(1, top), length_scale=p["H"],
                        force_multiplicity=2.0, params=dict(p), volumetric_choice=p["volumetric"])
     problem = assemble(model, nondimensionalise=nondimensionalise)
-    basis = problem.basis
+    basis = problem.model.basis
     L, E = problem.scales.length, (p["E"] if nondimensionalise else 1.0)
     U = p["pressure"] * p["H"] * (1.0 - p["nu"] ** 2) / p["E"] if nondimensionalise else 1.0
     force = E * U  # plane strain: forces per unit thickness in units of E·U
-    facets = problem.mesh.boundary_facets()
-    on_top = np.all(np.isin(problem.mesh.facets[:, facets], top), axis=0)
-    weights = boundary_weights(problem.mesh, facets[on_top], top) * L  # physical lengths
+    facets = problem.model.mesh.boundary_facets()
+    on_top = np.all(np.isin(problem.model.mesh.facets[:, facets], top), axis=0)
+    weights = boundary_weights(problem.model.mesh, facets[on_top], top) * L  # physical lengths
     load = np.zeros(basis.N)
     load[basis.nodal_dofs[1, top]] = -p["pressure"] * weights / force
     problem = problem.with_data(
-        f=load[problem.discretisation.free_dofs], load_row=np.zeros(problem.n),
+        f=load[problem.model.free_dofs], load_row=np.zeros(problem.n),
         load_offset=2.0 * p["W"] * p["pressure"] / force, push=None,
         scales=Scales(length=L, displacement=U, force=force, weight=L), params=dict(p),
         name="block (force control)")
-    problem.basis = basis
+    problem.model.basis = basis
     return problem
 
 
@@ -222,13 +222,13 @@ def force_controlled_exact(problem: ContactProblem) -> ContactSolution:
     ``u_x = q ν(1 + ν) x / E``, ``u_y = −q (1 − ν²) y / E`` and ``λᵢ = q wᵢ``:
     a homogeneous stress ``σ_yy = −q``, reproduced exactly by P1 elements.
     """
-    p, s = problem.params, problem.scales
+    p, s = problem.model.params, problem.scales
     q, E, nu = p["pressure"], p["E"], p["nu"]
-    x, y = problem.mesh.p * s.length
-    full = np.zeros(problem.basis.N)
-    full[problem.basis.nodal_dofs[0]] = q * nu * (1.0 + nu) * x / E
-    full[problem.basis.nodal_dofs[1]] = -q * (1.0 - nu ** 2) * y / E
-    u = full[problem.discretisation.free_dofs] / s.displacement
+    x, y = problem.model.mesh.p * s.length
+    full = np.zeros(problem.model.basis.N)
+    full[problem.model.basis.nodal_dofs[0]] = q * nu * (1.0 + nu) * x / E
+    full[problem.model.basis.nodal_dofs[1]] = -q * (1.0 - nu ** 2) * y / E
+    u = full[problem.model.free_dofs] / s.displacement
     lam = q * problem.weights * s.weight / s.force
     return ContactSolution(method="exact", u=u, lam=lam, status="converged",
                            message="patch solution of the force-controlled block")

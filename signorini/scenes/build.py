@@ -55,7 +55,7 @@ def _coarse_model(name: str, params: dict[str, Any], nondimensionalise: bool):
 
 def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
     """A coarser model of the scene ``problem`` was built from (None when there is none)."""
-    return _coarse_model(problem.scene, problem.params, problem.scales != Scales())
+    return _coarse_model(problem.name, problem.model.params, problem.scales != Scales())
 
 
 def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensionalise: bool = True,
@@ -70,7 +70,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     read as stored, with no parameters to set. A target load stays pending (load
     control matches it when the problem is solved). ``solved_by`` is the
     method that will solve it, for the size guard (a method that never
-    factorises needs less memory). The problem's ``discretisation.mesh_s`` is
+    factorises needs less memory). The problem's ``model.mesh_s`` is
     the time spent up to assembly (checking, meshing, the model) and
     ``assemble_s`` assembly's.
     """
@@ -124,7 +124,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
     problem = (model.assemble(nondimensionalise) if isinstance(model, TwoBodyModel)
                else assemble(model, nondimensionalise=nondimensionalise))
     problem.name = name
-    problem.discretisation.mesh_s = mesh_s
+    problem.model.mesh_s = mesh_s
     return problem
 
 
@@ -139,21 +139,21 @@ def with_load(problem: ContactProblem, **load: float) -> ContactProblem:
     the answer is that mesh's; a contact zone that outgrows the candidates is
     judged ``model_inadequate`` as in any solve.
     """
-    family = SCENES.get(problem.scene or "")
-    if family is None or family.loads is None or problem.push is None or problem.push.target is None:
+    family = SCENES.get(problem.name or "")
+    if family is None or family.loads is None or problem.model.push is None or problem.model.push.target is None:
         raise InputError("with_load moves the target load of a scene built by name with one "
                          "(P or a_over_R): build this problem again with the new load instead")
     moved = sorted(set(load) - set(LOAD_NAMES))
     if not load or moved:
         raise InputError(f"with_load takes the scene's load ({', '.join(LOAD_NAMES)}), got "
                          f"{', '.join(moved) or 'none'}: e.g. with_load(problem, P=2.5)")
-    kept = {p.name: problem.params[p.name] for p in family.params
-            if p.name in problem.params and p.name not in LOAD_NAMES}
+    kept = {p.name: problem.model.params[p.name] for p in family.params
+            if p.name in problem.model.params and p.name not in LOAD_NAMES}
     target = family.loads(family.parse({**kept, **load}), set(load))[0]
     if target is None:
         raise InputError("with_load moves a target load: give P (or a_over_R); a prescribed push "
                          "delta is a new build")
-    recorded = {**problem.params, **{name: None for name in LOAD_NAMES if name in problem.params},
+    recorded = {**problem.model.params, **{name: None for name in LOAD_NAMES if name in problem.model.params},
                 **load, "P": target}
     moved = problem.with_target(target, recorded)
     reference = reference_of(moved)  # load control starts from the reference's contact zone

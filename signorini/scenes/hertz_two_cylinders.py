@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from signorini.references.analytic import hertz_cylinder_half_width, hertz_cylinder_load
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from signorini.references.analytic import hertz_sphere_load, hertz_sphere_radius
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.fem.two_bodies import TwoBodyModel
 from signorini.scenes import hertz_two_cylinders as cylinders
 from signorini.scenes.base import Case, SceneFamily

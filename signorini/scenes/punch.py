@@ -30,7 +30,7 @@ import numpy as np
 from skfem import MeshTri
 
 from signorini.references.analytic import contact_modulus
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery

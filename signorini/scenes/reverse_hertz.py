@@ -22,7 +22,7 @@ import math
 from typing import Any
 
 from signorini.references.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle

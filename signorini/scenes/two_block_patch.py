@@ -32,7 +32,7 @@ import numpy as np
 from skfem import MeshTri
 
 from signorini.references.analytic import contact_modulus
-from signorini.problem.discretisation import ReferenceData
+from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.mortar import DISCRETISATIONS
 from signorini.fem.topology import facets_on

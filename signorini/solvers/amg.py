@@ -14,7 +14,7 @@ algebraic multigrid given the rigid-body modes as near-null space
   target load, Hertz's, else the set a coarser model of the scene predicts), or
   comes from a warm start's forces or from a coarse QP (``coarse``), so that few
   steps remain;
-- a target load that is still pending (``problem.pending``: load control,
+- a target load that is still pending (``problem.model.pending``: load control,
   :mod:`signorini.load_control`, leaves it to this method: ``Method.matches_load``) is
   matched with the answer: the push is one more unknown of every CG system, preconditioned
   by block elimination (:mod:`signorini.solvers.load_border`), so no factorisation of K is
@@ -93,7 +93,7 @@ def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.n
     coarse = opts["coarse"]
     if coarse is None:
         return np.zeros(problem.m, dtype=bool), "none (no prediction)"
-    if coarse.pending:
+    if coarse.model.pending:
         raise InputError("method 'pdas-amg': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
     solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse,
@@ -125,7 +125,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     c = positive_number("pdas-amg", "c", opts["c"])
     tol, max_iter = resolved("pdas-amg", "active set", tol, max_iter)
     start = time.perf_counter()
-    if problem.pending and border_factor(problem) is None:
+    if problem.model.pending and border_factor(problem) is None:
         raise InputError("method 'pdas-amg': the push of this problem does not move one rigid "
                          "set of dofs, so its target load cannot be a CG unknown: match the load "
                          "first (signorini.solve does)")

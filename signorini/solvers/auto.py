@@ -38,8 +38,8 @@ CHOICES = {method.name: method for method in (*pdas.METHODS, *amg.METHODS, *nest
 
 def dimension(problem: ContactProblem) -> int:
     """2 or 3: the mesh's (or, without one, the contact points') dimension."""
-    if problem.mesh is not None:
-        return int(problem.mesh.p.shape[0])
+    if problem.model.mesh is not None:
+        return int(problem.model.mesh.p.shape[0])
     return int(np.atleast_2d(problem.contact_points).shape[1])
 
 
@@ -57,11 +57,11 @@ def choose(problem: ContactProblem, options: Any = (),
             and not set(options) - set(nested.DEFAULTS):
         return "nested", (f"K ({n:,} dofs) already factorised around the contact zone (the "
                           "warm start): nested (exact, back-solves only)")
-    if problem.axisymmetric or dim < 3:
-        kind = "axisymmetric" if problem.axisymmetric else "2D"
+    if problem.model.axisymmetric or dim < 3:
+        kind = "axisymmetric" if problem.model.axisymmetric else "2D"
         return "pdas", f"{kind} model: pdas (exact; 2D factorisations are fast)"
-    pushed = problem.mesh is not None and (warm_start is None or warm_start.lam is None) \
-        and not problem.pending
+    pushed = problem.model.mesh is not None and (warm_start is None or warm_start.lam is None) \
+        and not problem.model.pending
     least = PUSHED_AMG_FROM_DOFS if pushed else AMG_FROM_DOFS
     if n < least:
         return "pdas", f"3D model of {n:,} dofs < {least:,}: pdas (a factorisation is cheap)"

@@ -56,7 +56,7 @@ class Method:
 
     What it offers load control (:mod:`signorini.load_control`), which asks and
     never branches on a name: ``matches_load(problem)`` says it matches that
-    problem's pending target load itself (``problem.pending``; e.g. the push as
+    problem's pending target load itself (``problem.model.pending``; e.g. the push as
     a bordered unknown), any other problem is matched first; ``prediction``
     the kind of prediction of the contact it takes from the scene (``"zone"``:
     the option ``zone``; ``"active set"``: ``active0``, and ``push0`` for a
@@ -329,7 +329,7 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
         solution.status = "inaccurate"
         solution.message = f"{solution.message}; {reason}".lstrip("; ")
         return solution
-    if problem.discretisation is None:  # a QP given as arrays: no model to judge
+    if problem.model.watch is None:  # nothing beyond the candidates to judge (a QP given as arrays)
         return solution
     found = adequacy(problem, solution, accept)
     if found is not None:

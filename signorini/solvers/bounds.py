@@ -109,8 +109,8 @@ class BoundForm:
 
 def _node_blocks(problem: ContactProblem) -> tuple[int, np.ndarray | None]:
     """Dofs per node and the reference coordinates, from the mesh when there is one."""
-    mesh = problem.mesh
-    n_full = problem.dofs()[0]
+    mesh = problem.model.mesh
+    n_full = problem.model.dofs()[0]
     if mesh is not None and mesh.p.shape[0] * mesh.p.shape[1] == n_full:
         return mesh.p.shape[0], np.asarray(mesh.p, dtype=float)
     return 1, None
@@ -151,7 +151,7 @@ def bound_form(problem: ContactProblem) -> BoundForm:
     no bound form. A row over several nodes' dofs is rotated as one block.
     """
     block, coordinates = _node_blocks(problem)
-    n_full, free = problem.dofs()
+    n_full, free = problem.model.dofs()
     embed = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))),
                           shape=(n_full, problem.n))
     N = sp.csr_matrix(embed @ problem.N.T).T.tocsr()  # rows over the full dof vector

@@ -1,6 +1,6 @@
 """A pending target load as one more unknown of ``pdas-amg``'s CG systems: no factorisation.
 
-A scene pushed towards a target load P (``problem.pending``) whose pushed
+A scene pushed towards a target load P (``problem.model.pending``) whose pushed
 dofs move together has a load row parallel to the push's forces, so the
 push ``s`` joins the displacement as one more unknown of a symmetric
 system, SPD once the contact holds the body (:class:`LoadBorder`). CG
@@ -46,10 +46,10 @@ class LoadBorder:
 def border_factor(problem: ContactProblem) -> float | None:
     """β of :class:`LoadBorder` for a problem whose target load is pending, or None (nothing
     pending, the pushed dofs do not move together, or the push moves a contact candidate)."""
-    pu = problem.push
-    if not problem.pending or problem.discretisation.load_row is None or np.any(pu.d1 != 0):
+    pu = problem.model.push
+    if not problem.model.pending or problem.model.load_row is None or np.any(pu.d1 != 0):
         return None
-    f1, row = pu.f1, problem.discretisation.load_row
+    f1, row = pu.f1, problem.model.load_row
     beta = float(row @ f1) / max(float(f1 @ f1), 1e-300)
     if not beta or np.linalg.norm(row - beta * f1) > 1e-9 * np.linalg.norm(row):
         return None
@@ -61,7 +61,7 @@ def load_border(problem: ContactProblem, form: BoundForm) -> LoadBorder | None:
     beta = border_factor(problem)
     if beta is None:
         return None
-    pu = problem.push
+    pu = problem.model.push
     fixed = pu.load * pu.f_load if pu.f_load is not None else np.zeros(problem.n)
     return LoadBorder(g=rotated(form, pu.f1), k=-pu.offset1 / beta,
                       h=-(pu.target - pu.load * pu.offset_load) / beta, f0=rotated(form, fixed),

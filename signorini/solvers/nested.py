@@ -58,7 +58,7 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any],
     coarse = opts["coarse"]
     if coarse is None:
         return None, ""
-    if coarse.pending:
+    if coarse.model.pending:
         raise InputError("method 'nested': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
     return zone_from_coarse(problem.contact_points, coarse, opts["neighbours"], tol), \

@@ -139,7 +139,7 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
     spec, tol, max_iter, options = request
     method = spec.name  # a callable given as the method is known by its name
     spec.runs(problem, options, warm_start).check_rows(problem)
-    if problem.pending and not spec.runs(problem, options, warm_start).matches(problem):
+    if problem.model.pending and not spec.runs(problem, options, warm_start).matches(problem):
         raise InputError(f"method {method!r} solves the QP as it is, and this problem's target "
                          "load is not matched yet: solve it with signorini.solve (load control "
                          "finds the push), or match it first with signorini.load_control.match")
@@ -184,13 +184,13 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
         solution.method = method
     log.info("checking the answer: the KKT certificate")
     with timed(seconds, "certificate"):
-        if problem.pending and "push" not in solution.extras:
+        if problem.model.pending and "push" not in solution.extras:
             solution = ContactSolution.failure(method, problem, solution.status if
                                                solution.status != "converged" else "failed",
                                                f"{solution.message}; the target load was not matched")
             cert = certify(problem, solution)
         else:
-            if problem.pending:
+            if problem.model.pending:
                 problem = problem.pushed(float(solution.extras["push"]))
             cert = certify(problem, solution)
             solution = judge(problem, solution, tol, cert)

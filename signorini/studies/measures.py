@@ -185,13 +185,13 @@ def energy_error(coarse: ContactProblem, coarse_solution: ContactSolution, fine:
     """``‖u_fine − P u_coarse‖_E`` (``error``, physical) with P the prolongation over ``steps``
     uniform refinements, summed element by element on the finer mesh, and the fine answer's
     ``λᵀ·gap(P u_coarse)`` (``complementarity``, physical)."""
-    P = uniform_prolongation(coarse.mesh.t, coarse.mesh.p.shape[1], steps)
+    P = uniform_prolongation(coarse.model.mesh.t, coarse.model.mesh.p.shape[1], steps)
     moved = P @ nodal_displacement(coarse, coarse_solution)
     E, nu = material_units(fine)
     s = fine.scales
     difference = (nodal_displacement(fine, fine_solution) - moved) / s.displacement
-    energy = element_energies(fine.mesh, difference, E, nu, fine.axisymmetric).sum()
-    v = (moved.ravel() / s.displacement)[fine.dofs()[1]]
+    energy = element_energies(fine.model.mesh, difference, E, nu, fine.model.axisymmetric).sum()
+    v = (moved.ravel() / s.displacement)[fine.model.dofs()[1]]
     return {"error": float(np.sqrt(energy * s.force * s.displacement)),
             "complementarity": float(fine_solution.lam @ fine.gap(v)) * s.force * s.displacement,
             "dofs": fine.n}

@@ -190,7 +190,7 @@ def _solved_by(method: str) -> Callable[..., ContactSolution]:
         try:
             solution = solve(source, method, tol=spec.get("tol", REFERENCE_TOL))
         except Exception as exc:  # the reference is optional: say so and go on
-            log.warning("no reference for %s: %s raised %s", problem.scene, method, exc)
+            log.warning("no reference for %s: %s raised %s", problem.name, method, exc)
             return ContactSolution.failure(method, problem, "failed", f"{type(exc).__name__}: {exc}")
         if other is None or solution.status != "converged":
             return solution

@@ -143,13 +143,13 @@ def run_task(task: Task, cache: _Cache | None = None) -> Row:
         row.update(status="input-error", wrapper="input-error", claimed_status="",
                    message=str(exc), scene=task.problem.get("scene", "block"))
         return verdict(row, task)
-    row.update(scene=problem.scene, dofs=problem.n, candidates=problem.m)
+    row.update(scene=problem.name, dofs=problem.n, candidates=problem.m)
     if "matrix" in task.measure:
         row["nonzeros"] = int(problem.K.nnz)
     if "factor_memory" in task.measure:
         row["factor_memory"] = factor_memory(problem)
     if "mesh" in task.measure:
-        made = problem.discretisation  # None for a QP given as arrays (a problem file)
+        made = problem.model  # None for a QP given as arrays (a problem file)
         row.update(h=candidate_spacing(problem),
                    assemble_s=float("nan") if made is None else made.assemble_s)
     if "diagnosis" in task.measure:

@@ -117,7 +117,7 @@ def run_one(problem: ContactProblem, method: Method, tol: float | None,
     The runner's measurement of a suite run, for scripts that hold their own
     problems (``docs/punch/punch_study.py``).
     """
-    task = run_task_of(Case("", problem.scene), method.name, tol)
+    task = run_task_of(Case("", problem.name), method.name, tol)
     row = task_row(task)
     solved = run_on(problem, task, row)
     if solved is None:

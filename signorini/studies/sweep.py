@@ -80,19 +80,19 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
                 progress: Callable[[int, int], None] | None = None) -> list[SweepLevel]:
     """Solve ``problem`` exactly at every load of ``loads`` (physical units, full body), each
     level judged (its ``status``: ``converged`` only when certified and the model adequate)."""
-    if problem.push is None:
-        raise InputError(f"scene {problem.scene!r} is not loaded by a prescribed push: "
+    if problem.model.push is None:
+        raise InputError(f"scene {problem.name!r} is not loaded by a prescribed push: "
                          "it cannot be swept over loads")
     start = time.perf_counter()
     factor = problem.factor()
     W = delassus(problem.N, factor)
-    pu = problem.push
+    pu = problem.model.push
     b1 = problem.N @ factor.solve(pu.f1) - pu.d1
     # a body loaded by a traction on a cut: the traction follows the load, the push is found
     c = problem.N @ factor.solve(pu.f_load) if pu.f_load is not None else np.zeros(problem.m)
     log.info("sweep set-up (factorisation and %d × %d Delassus operator) in %.2f s",
              problem.m, problem.m, time.perf_counter() - start)
-    hertz = problem.reference_data is not None and problem.reference_data.R is not None
+    hertz = problem.model.reference is not None and problem.model.reference.R is not None
     levels = []
     for i, load in enumerate(loads):
         target = load / problem.scales.force
@@ -108,7 +108,7 @@ def sweep_loads(problem: ContactProblem, loads: np.ndarray,
         ref = compare_hertz(level_problem, solution) if hertz else None
         levels.append(SweepLevel(
             load=float(load), total_force=profile.total_force,
-            delta=float(level_problem.push.delta or np.nan),
+            delta=float(level_problem.model.push.delta or np.nan),
             a=contact_half_width(profile), p0=float(profile.pressure[np.argmin(profile.x)]),
             a_ref=ref.a_ref if ref else None, p0_ref=ref.p0_ref if ref else None,
             status=solution.status, message=solution.message,
