@@ -120,7 +120,7 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
         md += ["", f"## {result.case.name}", "",
                f"Scene `{result.case.scene}` with "
                + ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                           for k, v in p.params.items() if v is not None)
+                           for k, v in p.model.params.items() if v is not None)
                + f": {p.n} dofs, {p.m} contact candidates.", ""]
         md += runs_table(result.runs)
         notes = [r for r in result.runs if r["status"] in ("skipped", "failed")]
