@@ -22,11 +22,9 @@ lie across it (docs/accuracy.md).
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from signorini.references.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
-from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.scenes.base import (
     CANDIDATE_REMEDY,
@@ -37,13 +35,15 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    checked_ratio,
+    candidates,
     contact_ratio,
-    grading_check,
+    grading,
+    hertz_load,
     hertz_record,
     length,
     poisson_ratio,
     positive,
+    refinements,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
@@ -65,43 +65,25 @@ PARAMS = (
           check=positive),
     Param("n_contact", 24, "elements across the contact half-width (mesh fineness)", kind=int,
           check=at_least(4)),
-    Param("grading", 0.11, "growth of the element size with distance from the contact zone",
-          check=grading_check),
-    Param("candidates", 2.0, "contact candidates extend to this multiple of the half-width",
-          check=at_least(1.2)),
-    Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
-          kind=int, check=lambda k: None if 0 <= k <= 6 else "in 0..6"),
+    grading(0.11),
+    candidates(),
+    refinements(),
     LOADING,
     MESHER,
 )
 
 
-def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
-    """Resolve which load parameter rules: the target P, or a prescribed delta."""
-    chosen = {name for name in given & {"P", "a_over_R", "delta"} if p[name] is not None}
-    if len(chosen) > 1:
-        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
-                         "give only one of P, a_over_R, delta")
-    E_star = p["E"] / (1.0 - p["nu"] ** 2)
-    if "delta" in chosen:  # a ~ √(δ R) up to Hertz's logarithm: refused where a/R would be
-        checked_ratio(math.sqrt(p["delta"] / p["R"]), "delta", p["delta"])
-        return None, p["delta"]
-    if "P" in chosen:
-        checked_ratio(hertz_cylinder_half_width(p["P"], p["R"], E_star) / p["R"], "P", p["P"])
-        return p["P"], None
-    return hertz_cylinder_load(p["a_over_R"] * p["R"], p["R"], E_star), None
+def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
+    """``(target P or None, prescribed δ or None, a/R the mesh is graded for)``
+    (:func:`~signorini.scenes.base.hertz_load`)."""
+    return hertz_load(p, given, p["R"], contact_modulus(p["E"], p["nu"]), hertz_cylinder_half_width,
+                      hertz_cylinder_load)
 
 
 def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
     """The quarter-disc model of Hertz's cylinder in physical units."""
-    given = set() if given is None else given
-    R, E, nu = p["R"], p["E"], p["nu"]
-    E_star = E / (1.0 - nu ** 2)
-    target, delta = _load_choice(p, given)
-    if target is not None and "P" in given and p["P"] is not None:  # the mesh's a from the force
-        a_est = hertz_cylinder_half_width(target, R, E_star) / R  # in range: _load_choice
-    else:  # as given (not through P and back, which rounds differently for every E)
-        a_est = p["a_over_R"]
+    R = p["R"]
+    target, delta, a_est = load_choice(p, set() if given is None else given)
     if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
         disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
     else:
@@ -110,7 +92,7 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
     delta_nominal = delta if delta is not None else a_est ** 2 * R
     pushed, cut_load = disc_loading(disc, p["loading"], target)
     return SceneModel(
-        mesh=disc.mesh, E=E, nu=nu,
+        mesh=disc.mesh, E=p["E"], nu=p["nu"],
         dirichlet=[(0, disc.axis, 0.0), (1, pushed, -delta_nominal)],
         contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),
@@ -149,7 +131,7 @@ ADAPTIVE_START = {"mesher": "relaxed", "n_contact": 40, "grading": 0.15}
 FAMILY = SceneFamily(
     name="hertz-cylinder",
     summary="elastic cylinder on a rigid flat, plane strain, quarter model graded to the contact",
-    params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE, size_model=SIZE,
+    params=PARAMS, build=build, loads=load_choice, reference=REFERENCE, size_model=SIZE,
     coarse=two_refinements_coarser, snap=quarter_disc_snap, validation=VALIDATION,
     convergence_start={"n_contact": 15, "grading": 0.6},
     adaptive_start=ADAPTIVE_START)
