@@ -105,23 +105,6 @@ def measured(found: ErrorEstimate, quantity: str) -> float:
     return found.relative if quantity == "energy" else found.pressure.relative
 
 
-def _rebuild(family, params: dict[str, Any], given: set[str], mesh: Any,
-             contact_extent: float | None) -> SceneModel:
-    """The scene on ``mesh``; load targeting starts from the candidates within ``contact_extent``."""
-    model = family.build(params, given, mesh=mesh)
-    if contact_extent is not None:
-        x = model.mesh.p[0, model.contact_nodes]
-        model.predicted_contact = x <= contact_extent
-    return model
-
-
-def _contact_extent(model: SceneModel, problem: ContactProblem, solution: ContactSolution) -> float | None:
-    """How far the contact reached (physical x of the last candidate with a force)."""
-    if not np.all(np.isfinite(solution.lam)) or not np.any(solution.lam > 0):
-        return None
-    return float(np.max(model.mesh.p[0, model.contact_nodes][solution.lam > 0]))
-
-
 @dataclass
 class _Scene:
     """What the loop rebuilds on each new mesh: a family that builds on a given mesh (and can
@@ -135,14 +118,21 @@ class _Scene:
     given: set[str] = field(default_factory=set)
     snap: Callable | None = None
 
-    def on(self, model: SceneModel, mesh: Any, problem: ContactProblem,
-           solution: ContactSolution) -> SceneModel:
-        """The scene on ``mesh``, refined from ``model``'s (not yet snapped); ``problem`` and
-        ``solution`` are ``model``'s, and load targeting starts from its contact."""
+    def rebuilt(self, mesh: Any, model: SceneModel, solution: ContactSolution) -> SceneModel:
+        """The family's scene on ``mesh``; load targeting starts from the candidates within the
+        reach of ``model``'s contact in ``solution`` (the x of its last candidate with a force)."""
+        rebuilt = self.family.build(self.params, self.given, mesh=mesh)
+        lam = solution.lam
+        if np.all(np.isfinite(lam)) and np.any(lam > 0):
+            extent = float(np.max(model.mesh.p[0, model.contact_nodes][lam > 0]))
+            rebuilt.predicted_contact = rebuilt.mesh.p[0, rebuilt.contact_nodes] <= extent
+        return rebuilt
+
+    def on(self, model: SceneModel, mesh: Any, solution: ContactSolution) -> SceneModel:
+        """The scene on ``mesh``, refined from ``model``'s (not yet snapped); ``solution`` is
+        ``model``'s, and load targeting starts from its contact."""
         if self.family is not None:
-            return _rebuild(self.family, self.params, self.given,
-                            self.snap(mesh) if self.snap else mesh,
-                            _contact_extent(model, problem, solution))
+            return self.rebuilt(self.snap(mesh) if self.snap else mesh, model, solution)
         return refined_model(model, mesh, solution.lam > 0, self.snap)
 
 
@@ -178,8 +168,7 @@ def _grown(scene: _Scene, model: SceneModel, problem: ContactProblem,
         scene.params = {**scene.params, "candidates": scene.params["candidates"] * GROWTH}
         log.info("the contact outgrew the candidates; widened to %g half-widths",
                  scene.params["candidates"])
-        return _rebuild(scene.family, scene.params, scene.given, model.mesh,
-                        _contact_extent(model, problem, solution))
+        return scene.rebuilt(model.mesh, model, solution)
     extra = beyond_candidates(model, problem, solution)
     if extra.size == 0:
         return None
@@ -225,10 +214,8 @@ def _checked(scene: _Scene) -> _Scene:
     return scene
 
 
-Solver = Callable[[ContactProblem], "tuple[ContactProblem, ContactSolution]"]
-
-
-def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Solver, *,
+def solve_adaptive(name: str, values: dict[str, Any], target: float,
+                   solver: Callable[[ContactProblem], tuple[ContactProblem, ContactSolution]], *,
                    max_dofs: int | None = None, theta: float = THETA, quantity: str | None = None,
                    solved_by: Solver | None = None,
                    on_step: Callable[[ContactProblem, ContactSolution, ErrorEstimate | None], None]
@@ -304,7 +291,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Sol
             steps.append(_row(step, problem, solution, found, 0, seconds, action))
             break
         steps.append(_row(step, problem, solution, found, len(marked), seconds, "refined"))
-        model = scene.on(model, mesh, problem, solution)
+        model = scene.on(model, mesh, solution)
     else:
         run.reason = f"adaptive refinement stopped after {MAX_STEPS} steps"
     run.reason += _steeper_than_measured(scene)

@@ -193,9 +193,9 @@ def refinements(most: int = 6, growth: str = "quadruples the dofs") -> Param:
                  check=lambda k: None if 0 <= k <= most else f"in 0..{most}")
 
 
-def candidates(contact: str = "half-width") -> Param:
+def candidates(contact: str = "half-width", default: float = 2.0) -> Param:
     """A Hertz scene's ``candidates`` parameter, in multiples of the ``contact`` half-width or radius."""
-    return Param("candidates", 2.0, f"contact candidates extend to this multiple of the {contact}",
+    return Param("candidates", default, f"contact candidates extend to this multiple of the {contact}",
                  check=at_least(1.2))
 
 

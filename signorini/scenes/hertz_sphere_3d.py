@@ -33,8 +33,10 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    grading_check,
+    candidates,
+    grading,
     hertz_record,
+    refinements,
     two_refinements_coarser,
 )
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice
@@ -50,12 +52,9 @@ from signorini.scenes.meshing import (
 PARAMS = COMMON_PARAMS + (
     Param("n_contact", 10, "elements across the contact radius (mesh fineness)", kind=int,
           check=at_least(3)),
-    Param("grading", 0.5, "growth of the element size with distance from the contact zone",
-          check=grading_check),
-    Param("candidates", 1.3, "contact candidates extend to this multiple of the contact radius",
-          check=at_least(1.2)),
-    Param("refine", 0, "uniform refinements of the graded mesh (each multiplies the dofs by "
-          "about 8)", kind=int, check=lambda k: None if 0 <= k <= 3 else "in 0..3"),
+    grading(0.5),
+    candidates("contact radius", 1.3),
+    refinements(3, "multiplies the dofs by about 8"),
     LOADING,
 )
 
