@@ -42,20 +42,16 @@ def coarse_values(name: str, params: dict[str, Any]) -> dict[str, Any] | None:
     return family.coarse({k: v for k, v in params.items() if k in names})
 
 
-def _coarse_model(name: str, params: dict[str, Any], nondimensionalise: bool):
-    """The coarser model of :func:`coarse_values`, or None (none, or parameters out of range)."""
-    values = coarse_values(name, params)
+def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
+    """The model of :func:`coarse_values` of the scene ``problem`` was built from (None when there
+    is none, or when its parameters are out of range)."""
+    values = coarse_values(problem.name, problem.model.params)
     if values is None:
         return None
     try:
-        return build_problem(name, params=values, nondimensionalise=nondimensionalise)
+        return build_problem(problem.name, params=values, nondimensionalise=problem.scales != Scales())
     except InputError:  # the coarser parameters are out of range: no coarse model
         return None
-
-
-def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
-    """A coarser model of the scene ``problem`` was built from (None when there is none)."""
-    return _coarse_model(problem.name, problem.model.params, problem.scales != Scales())
 
 
 def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensionalise: bool = True,
