@@ -21,7 +21,7 @@ from signorini.problem.contact import ContactProblem, Scales
 from signorini.problem.files import is_problem_file, read_problem
 from signorini.references.catalogue import reference_of
 from signorini.scenes.base import GRADING_RANGE, LOAD_NAMES, scene_params
-from signorini.scenes.families import SCENES, get_scene
+from signorini.scenes.families import SCENES, get_scene, scene_reference
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import Solver, check_size
 
@@ -110,7 +110,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
                     "mesher=bisection" if relaxed else
                     f" ({type(exc).__name__}: {exc}): make the mesh coarser (a larger grading or "
                     "a smaller n_contact)")) from None
-    declared = SCENES[name].reference if name in SCENES else ""
+    declared = scene_reference(name)
     if model.reference is None and declared or model.reference and model.reference.name != declared:
         raise InputError(f"scene family {name!r} declares the reference {declared!r}, but its build "
                          f"hands on {model.reference!r}: give its SceneModel "

@@ -67,9 +67,8 @@ REFERENCE = "hertz-3d"
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The quarter model of Hertz's sphere in physical units (z vertical, contact at the origin)."""
-    given = set() if given is None else given
     R = p["R"]
-    target, a_est = load_choice(p, given)
+    target, a_est = load_choice(p, set() if given is None else given)
     h_contact = a_est / p["n_contact"]
 
     def target_size(points: np.ndarray) -> np.ndarray:
