@@ -25,6 +25,14 @@ from signorini.fem.model import SceneModel
 from signorini.fem.volumetric import CHOICES
 from signorini.scenes.meshing import MESHERS
 
+__all__ = ["A_OVER_R_RANGE", "CANDIDATE_REMEDY", "Case", "GRADING_RANGE", "HALF", "LOADING",
+           "LOAD_NAMES", "MAX_BLOCK", "MAX_DIGITS", "MAX_INT", "MESHER", "Param", "SceneFamily",
+           "SizeEstimate", "VOLUMETRIC", "at_least", "between", "block_size", "candidates",
+           "checked_ratio", "chosen_load", "contact_ratio", "grading", "grading_check",
+           "hertz_load", "hertz_record", "length", "one_of", "poisson_ratio", "positive",
+           "refinements", "representable", "scene_params", "shown", "two_refinements_coarser",
+           "within"]
+
 
 @dataclass(frozen=True)
 class Param:

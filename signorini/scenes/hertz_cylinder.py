@@ -7,17 +7,10 @@ unit thickness of the full cylinder, twice the quarter's), as Hertz's theory
 loads the body; the centre node is pushed down by δ, and assembly adjusts δ
 until that node carries no force (it only removes the rigid translation, so
 K is non-singular). ``loading=displacement`` pushes the whole cut down by a
-uniform δ instead (the cut stays flat; the model before the traction, about
-0.2 % further from Hertz on the default mesh: docs/accuracy.md), which is
-also the model when ``delta`` is given. The mesh is graded towards the
+uniform δ instead (the cut stays flat: docs/accuracy.md compares the two), which
+is also the model when ``delta`` is given. The mesh is graded towards the
 first point of contact and only the arc nodes with ``x ≤ candidates · a`` are
-contact candidates.
-
-Default mesh (``n_contact=24``, ``grading=0.11``, Triangle: 5,207 dofs): the
-fastest solve in process whose a and p₀ are within 0.05 % of Hertz at a/R =
-0.05 (the accuracy-time front of docs/mesher.md). Near-equilateral triangles
-and a smooth growth away from the contact matter more than how many elements
-lie across it (docs/accuracy.md).
+contact candidates. The default mesh is on the accuracy-time front of docs/mesher.md.
 """
 
 from __future__ import annotations
@@ -73,7 +66,7 @@ PARAMS = (
 )
 
 
-def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
+def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
     """``(target P or None, prescribed δ or None, a/R the mesh is graded for)``
     (:func:`~signorini.scenes.base.hertz_load`)."""
     return hertz_load(p, given, p["R"], contact_modulus(p["E"], p["nu"]), hertz_cylinder_half_width,
@@ -83,7 +76,7 @@ def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float
 def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
     """The quarter-disc model of Hertz's cylinder in physical units."""
     R = p["R"]
-    target, delta, a_est = load_choice(p, set() if given is None else given)
+    target, delta, a_est = _load_choice(p, set() if given is None else given)
     if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
         disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
     else:
@@ -131,7 +124,7 @@ ADAPTIVE_START = {"mesher": "relaxed", "n_contact": 40, "grading": 0.15}
 FAMILY = SceneFamily(
     name="hertz-cylinder",
     summary="elastic cylinder on a rigid flat, plane strain, quarter model graded to the contact",
-    params=PARAMS, build=build, loads=load_choice, reference=REFERENCE, size_model=SIZE,
+    params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE, size_model=SIZE,
     coarse=two_refinements_coarser, snap=quarter_disc_snap, validation=VALIDATION,
     convergence_start={"n_contact": 15, "grading": 0.6},
     adaptive_start=ADAPTIVE_START)

@@ -114,8 +114,8 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
 #: n_contact 3..20 and a/R 0.01..0.2, 1.0 to 1.25 times their dofs
 OCTANT_FAR, OCTANT_SCALE, OCTANT_POWER = 100.0, 64.4, 0.915
 #: a uniform refinement of a tetrahedral mesh of N nodes multiplies them by 1 + edges / nodes,
-#: below OCTANT_REFINE[0] − OCTANT_REFINE[1] · N^(-1/3) (6.35 at 647 nodes, 6.63 at 2,428, 7.10
-#: at 19,168: the surface's nodes have fewer edges), and never more than 8
+#: below OCTANT_REFINE[0] − OCTANT_REFINE[1] · N^(-1/3) (the surface's nodes have fewer edges),
+#: and never more than 8
 OCTANT_REFINE = (7.7, 10.0)
 
 

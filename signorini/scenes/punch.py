@@ -55,6 +55,8 @@ from signorini.scenes.base import (
 from signorini.scenes.meshing import distance_to_segment, refine_to_size
 from signorini.scenes.size import SizeModel
 
+__all__ = ["FAMILY", "block_on_obstacle", "graded_half_block", "load_choice", "mirrored_about_x0"]
+
 PARAMS = (
     Param("a", 1.0, "half-width of the punch's flat face", check=length),
     Param("corner_radius", 0.0, "radius of the punch's rounded corners (0: sharp)",

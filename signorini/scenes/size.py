@@ -92,7 +92,7 @@ def _plain_bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
 #: grading 0.05..2 its meshes had up to 1.18 times the nodes of the relaxed mesh of the same
 #: parameters (more where the grading is fine or coarse, fewer between; docs/calibration.md)
 TRIANGLE_DOFS = 1.2
-#: a half-block's far field per unit of ln(size / 20): punch size=200 built 11,732 dofs, 7,948 at 20
+#: a half-block's far field per unit of ln(size / 20) (docs/calibration.md)
 BLOCK_FAR_GROWTH = 1.4
 
 
