@@ -26,7 +26,7 @@ from signorini.references.analytic import hertz_sphere_load, hertz_sphere_radius
 from signorini.scenes import hertz_two_cylinders as cylinders
 from signorini.scenes.hertz_sphere import SIZE as ONE_SPHERE
 
-__all__ = ["FAMILY"]
+__all__ = ["FAMILY", "SPHERES_PAIR"]
 
 #: what differs from the cylinders' parameters: the load's words and a sphere's mesh defaults
 SPHERES = {"R1": {"doc": "radius of the upper sphere"}, "R2": {"doc": "radius of the lower sphere"},
