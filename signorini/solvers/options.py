@@ -149,10 +149,16 @@ def _convert(option: Option, value: Any) -> Any:
         except (TypeError, ValueError):
             array = None
         return array if array is not None and array.ndim == 1 and np.all(np.isfinite(array)) else _BAD
-    ok = {"any": True, "choice": any(value == c and type(value) is type(c) for c in option.choices),
-          "text": isinstance(value, str), "callable": callable(value),
-          "object": isinstance(value, option.types)}[kind]
-    return value if ok else _BAD
+    return value if _KEPT[kind](option, value) else _BAD
+
+
+#: the test of each kind whose value is kept as given
+_KEPT = {"any": lambda option, value: True,
+         "choice": lambda option, value: any(value == c and type(value) is type(c)
+                                             for c in option.choices),
+         "text": lambda option, value: isinstance(value, str),
+         "callable": lambda option, value: callable(value),
+         "object": lambda option, value: isinstance(value, option.types)}
 
 
 def declare(*options: Option) -> dict[str, Option]:
