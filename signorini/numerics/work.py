@@ -116,4 +116,5 @@ def timed(seconds: dict[str, float], stage: str) -> Iterator[None]:
         seconds[stage] = seconds.get(stage, 0.0) + time.perf_counter() - start
 
 
-__all__ = ["STAGES", "Work", "count", "count_solves", "counting", "stage_key", "stage_times", "time_line", "timed"]
+__all__ = ["STAGES", "Work", "count", "count_solves", "counting", "stage_key", "stage_times", "time_line",
+           "timed"]

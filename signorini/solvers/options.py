@@ -269,5 +269,6 @@ def resolved(name: str, family: str, tol: float | None,
             row.max_iter if max_iter is None else int(max_iter))
 
 
-__all__ = ["DEFAULT_TOL", "EXACT_TOL", "KINDS", "MIN_TOL", "Defaults", "Option", "TABLE", "check_names", "checked",
-           "declare", "defaults_of", "finite_number", "guess_value", "per_candidate", "resolved", "take_options"]
+__all__ = ["DEFAULT_TOL", "EXACT_TOL", "KINDS", "MIN_TOL", "Defaults", "Option", "TABLE", "check_names",
+           "checked", "declare", "defaults_of", "finite_number", "guess_value", "per_candidate",
+           "resolved", "take_options"]

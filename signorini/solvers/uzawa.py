@@ -230,8 +230,8 @@ METHODS = (
     Method(name="uzawa", function=solve, family="dual", exact=False,
            summary="the paper's Uzawa iteration: projected gradient ascent on the dual",
            typed_options=DEFAULTS),
-    Method(name="uzawa-nesterov",
-           function=functools.partial(solve, _name="uzawa-nesterov", _defaults=NESTEROV_DEFAULTS), family="dual", exact=False,
+    Method(name="uzawa-nesterov", family="dual", exact=False,
+           function=functools.partial(solve, _name="uzawa-nesterov", _defaults=NESTEROV_DEFAULTS),
            summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
            typed_options=NESTEROV_DEFAULTS),
 )
