@@ -83,8 +83,8 @@ def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.n
     if coarse.model.pending:
         raise InputError("method 'pdas-amg': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
-    solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse,
-                                                                        amg=opts["amg"])
+    solution = pdas.pdas(coarse) if coarse.n < DIRECT_BELOW else pdas_amg(coarse,
+                                                                           amg=opts["amg"])
     if solution.status != "converged":
         return np.zeros(problem.m, dtype=bool), "none (the coarse model did not solve)"
     zone = predict_zone(problem.contact_points, coarse.contact_points, solution.lam > 0,
@@ -102,7 +102,7 @@ def _forcing(eta: float, r0: float, r0_last: float | None) -> float:
     return min(max(new, ETA_MIN), ETA_MAX)
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def pdas_amg(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """PDAS with each pinned system solved by CG + algebraic multigrid (see module doc)."""
     opts = take_options("pdas-amg", options, DEFAULTS)
@@ -216,7 +216,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="pdas-amg", function=solve, family="active set", exact=True,
+    Method(name="pdas-amg", function=pdas_amg, family="active set", exact=True,
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
            requires=("pyamg",), extra="", typed_options=DEFAULTS,
            matches_load=lambda problem: border_factor(problem) is not None,

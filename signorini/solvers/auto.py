@@ -63,7 +63,7 @@ def choose(problem: ContactProblem, options: Any = (),
                         "(CG + multigrid, no factorisation to fill in)")
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def auto(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Solve with the method :func:`choose` picks; say which and why."""
     name, why = choose(problem, options, options.get("warm_start"))
@@ -77,7 +77,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="auto", function=solve, family="auto", exact=True,
+    Method(name="auto", function=auto, family="auto", exact=True,
            summary="picks nested (K factorised by load control), pdas (2D, small 3D) or pdas-amg "
                    "(large 3D) and says why",
            warm_from_load=True, factor_free_from=AMG_FROM_DOFS,

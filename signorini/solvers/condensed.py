@@ -28,7 +28,7 @@ DEFAULTS = declare(
     Option("block", "positive_count", None), Option("max_candidates", "positive_count", 20_000))
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def condensed(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Exact contact through the Delassus operator of the candidates."""
     opts = take_options("condensed", options, DEFAULTS)
@@ -53,7 +53,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="condensed", function=solve, family="active set", exact=True,
+    Method(name="condensed", function=condensed, family="active set", exact=True,
            summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
            typed_options=DEFAULTS),
 )

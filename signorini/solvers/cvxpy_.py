@@ -91,7 +91,7 @@ def _check_solver(solver: Any) -> str:
     return name
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def solve_cvxpy(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` as a cvxpy model.
 
@@ -150,7 +150,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name=METHOD, function=solve,
+    Method(name=METHOD, function=solve_cvxpy,
            summary="the QP as a cvxpy model (Clarabel by default; option solver)",
            requires=("cvxpy",), extra="", family="cvxpy", exact=False,
            typed_options=TYPED_OPTIONS),

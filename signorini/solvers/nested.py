@@ -58,7 +58,7 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any],
         raise InputError("method 'nested': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
     try:
-        solution = judge(coarse, pdas.solve(coarse, tol=tol), tol)
+        solution = judge(coarse, pdas.pdas(coarse, tol=tol), tol)
     except Exception as exc:  # noqa: BLE001 - any failure of the coarse solve: no prediction
         log.info("the coarse model did not solve (%s): no prediction", exc)
         return None, ""
@@ -68,7 +68,7 @@ def _prediction(problem: ContactProblem, opts: dict[str, Any],
                          opts["neighbours"]), f"coarse model of {coarse.n} dofs")
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def nested(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Exact contact from a coarse model's contact zone on one factorisation."""
     opts = take_options("nested", options, DEFAULTS)
@@ -89,7 +89,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     else:
         zone, source = _prediction(problem, opts, tol)
     if zone is None:
-        solution = pdas.solve(problem, tol=tol, max_iter=max_iter)
+        solution = pdas.pdas(problem, tol=tol, max_iter=max_iter)
         solution.method = "nested"
         solution.message = f"no coarse model or no pinnable rows: pdas: {solution.message}"
         solution.extras["fallback"] = "pdas"
@@ -110,7 +110,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="nested", function=solve, family="active set", exact=True,
+    Method(name="nested", function=nested, family="active set", exact=True,
            summary="predicted contact zone (the scene's); one factorisation + exact band LCP",
            typed_options=DEFAULTS, prediction="zone",
            warm_from_load=True),

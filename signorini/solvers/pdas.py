@@ -55,7 +55,7 @@ def _finish_condensed(problem: ContactProblem, lam: np.ndarray) -> tuple[np.ndar
     return factor.solve(problem.f - problem.N.T @ lam), lam, steps
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def pdas(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Semismooth Newton / PDAS on the full saddle-point system (one sparse LU per step)."""
     opts = take_options("pdas", options, DEFAULTS)
@@ -113,7 +113,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="pdas", function=solve, family="active set", exact=True,
+    Method(name="pdas", function=pdas, family="active set", exact=True,
            summary="primal-dual active set / semismooth Newton, exact when it converges",
            typed_options=DEFAULTS),
 )

@@ -119,7 +119,7 @@ def _uncertified(problem: ContactProblem, lam: np.ndarray, u: np.ndarray, factor
     return shortfall(certificate(problem, candidate), acceptance(tol))
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def uzawa(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           _name: str = "uzawa", _defaults: dict[str, Any] = DEFAULTS,
           **options: Any) -> ContactSolution:
     """The paper's Uzawa iteration with one factorisation of K (optionally accelerated)."""
@@ -227,11 +227,11 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="uzawa", function=solve, family="dual", exact=False,
+    Method(name="uzawa", function=uzawa, family="dual", exact=False,
            summary="the paper's Uzawa iteration: projected gradient ascent on the dual",
            typed_options=DEFAULTS),
     Method(name="uzawa-nesterov", family="dual", exact=False,
-           function=functools.partial(solve, _name="uzawa-nesterov", _defaults=NESTEROV_DEFAULTS),
+           function=functools.partial(uzawa, _name="uzawa-nesterov", _defaults=NESTEROV_DEFAULTS),
            summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
            typed_options=NESTEROV_DEFAULTS),
 )
