@@ -41,7 +41,7 @@ __version__ = "0.1.0"
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 # each public name is imported from its module at first use
-__getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
+__getattr__, _, _ = lazy_loader.attach(__name__, submod_attrs={
     "api": ["DEFAULT_METHOD", "Result", "at_load", "certificate", "methods", "scene_families",
             "solve", "solve_adaptive"],
     "certification.kkt": ["Certificate"],
@@ -52,7 +52,12 @@ __getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs={
     "problem.solution": ["WarmStart"],
     "scenes.build": ["build_problem", "with_load"],
     "solvers.base": ["DEFAULT_TOL"]})
-__all__ += ["__version__"]
+
+__all__ = ["DEFAULT_METHOD", "DEFAULT_TOL", "BackendNotInstalled", "Certificate", "ContactProblem",
+           "ContactSolution", "CrossCheck", "InputError", "Model", "Result", "Scales",
+           "SignoriniError", "SolverError", "WarmStart", "__version__", "at_load", "build_problem",
+           "certificate", "crosscheck", "derivative", "methods", "scene_families", "solve",
+           "solve_adaptive", "with_load"]
 
 
 def __dir__() -> list[str]:

@@ -1,40 +1,22 @@
 """Cross-checking methods against each other: the paper's Uzawa, QP backends, the exact answer.
 
-``crosscheck(problem, methods)`` solves one problem with every method at one
-relative KKT tolerance and compares every pair of answers (:func:`signorini.certification.kkt.compare`):
+``crosscheck(problem, methods)`` solves one problem with every method at one relative KKT
+tolerance and compares every pair of answers (:func:`signorini.certification.kkt.compare`):
+λ and u by their relative ∞-norm distance (``lam_rel``, ``u_rel``), and the candidates
+classified ``apart`` (active in one answer, inactive in the other). A node is **weakly active**
+in an answer when its scaled force and gap are both at most ``max(kkt.WEAK_TOL, tol_a, tol_b)``:
+it touches with (next to) no force, no residual within the tolerance can say on which side it
+belongs, and it is counted apart (``weak``).
 
-- ``lam_rel`` = ‖λ_a − λ_b‖∞ / max(‖λ_a‖∞, ‖λ_b‖∞), ``u_rel`` likewise for u;
-- ``apart``: candidates active (λ̃ > g̃) in one answer and inactive in the other,
-  with λ̃ = λᵢ/‖λ‖∞ and g̃ the gap over the length scale of :class:`signorini.certification.kkt.Certificate`;
-  **weakly active** nodes are left out and counted apart (``weak``): a node is
-  weakly active in an answer when both λ̃ and g̃ are at most
-  ``max(kkt.WEAK_TOL, tol_a, tol_b)`` — it touches with (next to) no force, and a natural
-  residual within the tolerance cannot say on which side it belongs.
-
-A pair is **judged** when both methods *say* ``converged`` — their own claim
-(``claimed_status``), whether or not the certificate backed it, because a
-claim of success is what a cross-check is there to test. A judged pair
-**disagrees** when a node is classified apart, or λ or u differ by more than
-``AGREE_FACTOR × max(tol_a, tol_b)``; that is a bug in one of the two (or a
-tolerance that means less than it says). The factor: the certificate bounds
-residuals, not errors, and W = N K⁻¹ Nᵀ's conditioning turns residuals within
-tol into λ errors of up to 1.6e3 × tol in the formulation runs (docs/crosscheck.md);
-10⁴ leaves room for finer meshes and still catches, at tol 1e-8, a λ off by 1e-4.
-
-The check **passes** when every method converged (certified at the tolerance)
-and no judged pair disagrees; ``allow`` names known-weak methods whose failure
-or disagreement is shown and let through. The QP methods' own answers are
-judged: a method with the option ``polish`` runs with ``polish=False`` unless
-its options say otherwise; ``polish=True`` adds the polished answer as an
-extra column (a second run), never as the one judged. Each method's answer is
-also set against the reference answer (pdas when it is compared, else the
-first exact method that converged): ``lam_ref`` (λ's relative distance),
-``active`` (candidates in contact) and ``apart_ref`` (nodes classified apart).
-
-The methods run one after another in this process (a problem from
-:meth:`ContactProblem.from_qp` cannot be rebuilt in a worker); a method that
-refuses the problem (a dense backend on a large one) or is not installed is a
-row that says so, and takes part in no pair.
+A pair is **judged** when both methods *say* ``converged`` (their own claim, backed by the
+certificate or not: a claim of success is what a cross-check tests), and it **disagrees** when
+a node is classified apart or λ or u differ by more than ``AGREE_FACTOR × max(tol_a, tol_b)``.
+The factor: the certificate bounds residuals, not errors, and W = N K⁻¹ Nᵀ turns residuals
+within tol into λ errors of up to 1.6e3 × tol in the formulation runs (docs/crosscheck.md);
+10⁴ leaves room for finer meshes and still catches, at tol 1e-8, a λ off by 1e-4. The check
+**passes** when every method converged and no judged pair disagrees (``allow`` lets known-weak
+methods through). The methods run one after another in this process (a problem from
+:meth:`ContactProblem.from_qp` cannot be rebuilt in a worker).
 """
 
 from __future__ import annotations
@@ -72,9 +54,10 @@ class MethodRun:
     the polished answer is returned, False when polish left the backend's own,
     None when there was no polish. ``reference`` holds the errors against the
     problem's analytic reference (``p0_rel``, ``a_rel``, ``pressure_l2_rel`` for
-    Hertz), empty when it has none. ``lam_ref``, ``active`` and ``apart_ref``
-    set the answer against the reference method's (see the module's
-    docstring; NaN and -1 when there is none); ``polished_lam_ref`` and
+    Hertz), empty when it has none. ``lam_ref`` (λ's relative distance), ``active``
+    (candidates in contact) and ``apart_ref`` (nodes classified apart) set the answer
+    against the reference method's: pdas when it is compared, else the first exact
+    method that converged (NaN and -1 when there is none); ``polished_lam_ref`` and
     ``polished_status`` are those of the polished answer when polish was asked
     for (None otherwise); ``allowed`` says the method was let through.
     """

@@ -19,7 +19,7 @@ from signorini.certification.kkt import INACTIVE, WEAK, classify, compare
 IGNORES = textwrap.dedent("""
     import numpy as np
     import signorini
-    from signorini.solvers.pdas import solve as pdas
+    from signorini.solvers.pdas import pdas
 
 
     def ignores_eight(problem, **options):

@@ -190,7 +190,7 @@ def test_an_outgrown_sweep_is_not_converged(tmp_path, capsys, saved_figures, loa
 # --- a method judged on the problem it was given --------------------------------------------
 
 HOSTILE = textwrap.dedent("""
-    from signorini.solvers.pdas import solve as pdas
+    from signorini.solvers.pdas import pdas
 
     def halves_the_load(problem, **options):
         problem.f *= 0.5

@@ -32,7 +32,7 @@ METHODS = textwrap.dedent("""
     import sys
     import time
 
-    from signorini.solvers.pdas import solve as pdas
+    from signorini.solvers.pdas import pdas
 
 
     class Boom(BaseException):

@@ -106,12 +106,12 @@ def test_a_vector_option_is_checked_for_kind_then_length():
 ])
 def test_the_cli_refuses_a_bad_option_in_one_line_before_building_the_scene(capsys, monkeypatch,
                                                                             argv, words):
-    import signorini.api
+    import signorini.scenes
 
     def no_build(*args, **kwargs):  # the option is checked before the scene would be built
         raise AssertionError("the scene was built before the options were checked")
 
-    monkeypatch.setattr(signorini.api, "build_problem", no_build)
+    monkeypatch.setattr(signorini.scenes, "build_problem", no_build)
     code = main(["solve", "block", *argv])
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1 and "Traceback" not in err, err

@@ -4,7 +4,7 @@ A scene with a target load P is assembled at a nominal push with the target
 ``pending``; building it factorises nothing. Load control matches it: by
 factorisation (the full active-set system, or the zone kernel), or, for
 pdas-amg, with the push as one more unknown of its CG systems
-(:class:`signorini.solvers.load_border.LoadBorder`), never factorised. Every route
+(:class:`signorini.solvers.amg_system.LoadBorder`), never factorised. Every route
 must give the same answer for the same load; a method that solves the QP as
 it is refuses a pending problem. Work is counted, not timed.
 """

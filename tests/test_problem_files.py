@@ -133,7 +133,7 @@ def test_a_user_method_returning_u_and_lam_solves_a_problem_file(block, tmp_path
                                                                   monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "mine.py").write_text(
-        "from signorini.solvers.pdas import solve as pdas\n\n"
+        "from signorini.solvers.pdas import pdas\n\n"
         "def solve(problem, **options):\n    answer = pdas(problem)\n"
         "    return answer.u, answer.lam\n")
     path = write_coo(block, tmp_path)

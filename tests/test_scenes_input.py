@@ -140,5 +140,5 @@ def test_P_none_is_the_default():
     # P=None is the documented default (the load from a_over_R), not an error: pinned as such
     default = build("hertz-cylinder")
     explicit = build("hertz-cylinder", P=None)
-    assert explicit.model.params["P"] == pytest.approx(default.params["P"], rel=1e-12)
+    assert explicit.model.params["P"] == pytest.approx(default.model.params["P"], rel=1e-12)
     np.testing.assert_allclose(explicit.f, default.f, rtol=1e-10)

@@ -37,7 +37,7 @@ def exact(scene):
 
 def wrapped_pdas(problem, *, tol=None, max_iter=None, **options):
     """A user-defined solver: PDAS under another name."""
-    solution = pdas.solve(problem, tol=tol, max_iter=max_iter, **options)
+    solution = pdas.pdas(problem, tol=tol, max_iter=max_iter, **options)
     solution.extras["wrapped"] = True
     return solution
 

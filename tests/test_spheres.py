@@ -62,7 +62,7 @@ def test_axisymmetric_energy_of_a_uniform_dilation_is_exact():
 
 
 def test_axisymmetric_stiffness_is_symmetric(spheres):
-    K = spheres.model.axisymmetric.K
+    K = spheres.axisymmetric.K
     assert abs(K - K.T).max() <= 1e-14 * abs(K).max()
 
 
@@ -137,7 +137,7 @@ def test_three_d_patch_test_uniaxial_stress():
 
 def test_axisymmetric_sphere_within_one_percent_of_hertz(spheres):
     h = spheres.hertz_axisymmetric
-    assert spheres.model.axisymmetric.n <= 20_000
+    assert spheres.axisymmetric.n <= 20_000
     assert h.p0_rel < 0.01
     assert h.a_rel < 0.01
     assert h.pressure_l2_rel < 0.01
@@ -194,8 +194,8 @@ def test_models_agree_with_each_other(spheres):
     assert abs(td.p0 / ax.p0 - 1) < 0.03
     # node by node inside 0.9 a, the 3D pressures scatter about the axisymmetric p(r)
     problem, solution = spheres.three_d, spheres.exact_three_d
-    r_ax = radial_distance(spheres.model.axisymmetric.contact_points) * spheres.model.axisymmetric.scales.length
-    p_ax = contact_profile(spheres.model.axisymmetric, spheres.exact_axisymmetric).pressure
+    r_ax = radial_distance(spheres.axisymmetric.contact_points) * spheres.axisymmetric.scales.length
+    p_ax = contact_profile(spheres.axisymmetric, spheres.exact_axisymmetric).pressure
     rho = radial_distance(problem.contact_points) * problem.scales.length
     inside = rho < 0.9 * ax.a_ref
     deviation = (contact_profile(problem, solution).pressure - np.interp(rho, r_ax, p_ax)) / ax.p0_ref

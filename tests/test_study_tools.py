@@ -60,7 +60,7 @@ def test_a_crosscheck_case_is_the_public_crosscheck():
     task = type(task)(**{**task.as_dict(), "options": {"methods": ["qp-osqp", "pdas"],
                                                        "options": {"qp-osqp": {"polish": False}}}})
     record = run_tasks([task], isolate=False)[0]["crosscheck"]
-    direct = signorini.crosscheck(signorini.build_problem(block.name, params=block.model.params),
+    direct = signorini.crosscheck(signorini.build_problem(block.scene, params=block.params),
                                   ["qp-osqp", "pdas"], tol=crosscheck.TOL,
                                   options={"qp-osqp": {"polish": False}}).to_dict()
     assert record["passed"] == direct["passed"] and record["dofs"] == direct["dofs"]

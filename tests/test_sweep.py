@@ -47,7 +47,7 @@ def test_a_traction_loaded_sweep_level_equals_a_full_solve_at_that_load():
 
 def test_half_width_grows_like_the_square_root_of_the_load():
     base = signorini.at_load(build_problem("hertz-cylinder", params=SMALL))
-    loads = np.array([0.6, 1.0, 1.4]) * base.params["P"]
+    loads = np.array([0.6, 1.0, 1.4]) * base.model.params["P"]
     levels = sweep_loads(base, loads)
     slope = np.polyfit(np.log(loads), np.log([lv.a for lv in levels]), 1)[0]
     assert slope == pytest.approx(0.5, abs=0.03)

@@ -26,7 +26,7 @@ METHODS = textwrap.dedent("""
     import numpy as np
 
     from signorini.problem.contact import ContactSolution
-    from signorini.solvers.pdas import solve as pdas
+    from signorini.solvers.pdas import pdas
 
 
     def answer(problem, u=None, lam=None, status="converged"):
@@ -225,7 +225,7 @@ DEBUGGED = textwrap.dedent("""
     import sys
 
     from helper import compare
-    from signorini.solvers.pdas import solve as pdas
+    from signorini.solvers.pdas import pdas
 
 
     def crashes(problem, **options):

@@ -59,14 +59,14 @@ def test_the_problem_holds_the_arrays_given(kind):
 GRAB = textwrap.dedent("""
     import numpy as np
 
-    from signorini.solvers.pdas import solve
+    from signorini.solvers.pdas import pdas
 
 
     def grab(problem, *, tol, max_iter, **options):
         np.savez({out!r}, K=problem.K.toarray(), f=problem.f, N=problem.N.toarray(), d=problem.d,
                  tol=np.array(repr(tol)), max_iter=np.array(repr(max_iter)),
                  kinds=np.array(repr((type(tol).__name__, type(max_iter).__name__))))
-        answer = solve(problem, tol=tol)
+        answer = pdas(problem, tol=tol)
         return answer.u, answer.lam
 """)
 
@@ -175,7 +175,7 @@ def test_every_registered_method_has_a_row():
     assert get_method("pdas").default_tol < get_method("uzawa").default_tol  # exact is held tighter
 
 
-@pytest.mark.parametrize("solve", [pdas.solve, condensed.solve], ids=["pdas", "condensed"])
+@pytest.mark.parametrize("solve", [pdas.pdas, condensed.condensed], ids=["pdas", "condensed"])
 def test_an_exact_method_uses_tol(solve):
     """Stopped as soon as its answer on the active set meets the bounds to tol: at a loose tol
     one step sooner, at a tight one only when the active set repeats."""

@@ -23,7 +23,7 @@ SCHEMA = Path(__file__).parent / "data" / "junit-10.xsd"
 
 METHODS = textwrap.dedent("""
     import numpy as np
-    from signorini.solvers.pdas import solve as pdas
+    from signorini.solvers.pdas import pdas
 
 
     def right(problem, **options):

@@ -65,15 +65,16 @@ def cases() -> list[dict]:
     return out
 
 
-#: the case's keys that are the scene's parameters
+#: the case's keys that are the scene's parameters, and those a case may add to them
 PARAMS = ("loading", "mesher", "n_contact", "grading", "nu", "a_over_R", "volumetric")
+OPTIONAL_PARAMS = ("refine", "E", "R")
 
 
 def task(case: dict) -> Task:
     """The runner's task of a case: pdas at 1e-10 on the scene as signorini.solve builds it."""
     return Task(axis=case["table"], case=case["scene"], value=case["nu"],
                 problem={"kind": "scene", "scene": case["scene"], "matched": False,
-                         "params": {k: case[k] for k in PARAMS}},
+                         "params": {k: case[k] for k in PARAMS + OPTIONAL_PARAMS if k in case}},
                 method="pdas", tol=1e-10, reference={"kind": "none"},
                 measure=("reference", "matrix"))
 
@@ -86,6 +87,8 @@ def row_of(case: dict, row: dict) -> dict:
             "a_err": h.get("a", nan) / h.get("a_ref", nan) - 1,
             "p0_err": h.get("p0", nan) / h.get("p0_ref", nan) - 1,
             "p0_nodal_err": h.get("p0_nodal", nan) / h.get("p0_ref", nan) - 1,
+            "a_edge_err": h.get("a_edge", nan) / h.get("a_ref", nan) - 1,
+            "force_balance": h.get("force_balance", nan), "a_ref": h.get("a_ref", nan),
             "l2": h.get("pressure_l2_rel", nan), "seconds": row["time_s"]}
 
 

@@ -21,6 +21,7 @@ import amg_bench  # noqa: E402  (tools/amg_bench.py: 3D at scale, docs/amg)
 import budget  # noqa: E402  (tools/budget.py: the 10⁶-dof command against one factorisation)
 import derivatives as derivative_cost  # noqa: E402  (tools/derivatives.py: a derivative against the solve)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
+import finite_sphere  # noqa: E402  (tools/finite_sphere.py: the finite sphere against Hertz)
 import mesher_compare  # noqa: E402  (tools/mesher_compare.py: the Hertz discs' three meshers)
 import mesher_front  # noqa: E402  (tools/mesher_front.py: accuracy against time per mesher)
 import slider_timing  # noqa: E402  (tools/slider_timing.py: a small solve by stage, the sliders)
@@ -143,7 +144,7 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
             peer = peer_table(json.loads((ROOT / "docs" / name / "peer.json").read_text())["rows"])
             runs[name] = "\n".join(peer[:peer.index("")])
         runs["peer-nu045-summary"] = "\n".join(peer[peer.index("") + 1:])
-        return {**accuracy.tables(accuracy.load()), **runs}
+        return {**accuracy.tables(accuracy.load()), **finite_sphere.tables(finite_sphere.load()), **runs}
     if document == PEER:
         peer = peer_table(json.loads((ROOT / "docs" / "peer" / "peer.json").read_text())["rows"])
         two = peer_table(json.loads((ROOT / "docs" / "peer-two" / "peer.json").read_text())["rows"])

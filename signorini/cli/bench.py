@@ -10,7 +10,7 @@ from pathlib import Path
 
 from signorini.errors import InputError
 from signorini.cli.common import (PROBLEM_FILES, add_command, family_of, input_files, out_folder,
-                                  pairs, parse_sizes)
+                                  pairs, parse_time_limit)
 
 
 def _bench_peer(args: argparse.Namespace) -> int:
@@ -28,7 +28,8 @@ def _bench_peer(args: argparse.Namespace) -> int:
         return 0
     load = {"before": os.getloadavg()}
     rows = peer.run_peer(points, repeat=args.repeat, in_process=args.in_process,
-                         timeout=args.time_limit, progress=lambda line: print(line, file=sys.stderr))
+                         timeout=parse_time_limit(args.time_limit),
+                         progress=lambda line: print(line, file=sys.stderr))
     load["after"] = os.getloadavg()
     given = " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == ["bench"] else ""
     meta = {"machine": provenance(), "repeat": args.repeat, "in_process": args.in_process,
@@ -45,7 +46,11 @@ def _bench_peer(args: argparse.Namespace) -> int:
 
 def _sizes(text: str | None, default: str) -> list[int]:
     """``--sizes`` as distinct levels (``default`` when not given; an empty list is refused)."""
-    levels = parse_sizes(default if text is None else text)
+    try:
+        levels = [int(x) for x in (default if text is None else text).split(",")]
+    except ValueError:
+        raise InputError(f"--sizes {text!r} is not a comma-separated list of sizes, "
+                         "e.g. --sizes 0,1,2") from None
     if len(set(levels)) != len(levels):
         raise InputError(f"--sizes {text!r} names a size twice: give each once, e.g. --sizes 0,1")
     return levels
@@ -64,8 +69,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise InputError("--peer runs GetFEM on its own Hertz scenes: drop --problem (or --peer)")
     if args.peer:
         return _bench_peer(args)
-    import math
-
     # each command loads what it needs (the benchmark's report starts matplotlib)
     from signorini.files import all_or_none, writable_directory
     from signorini.problem.files import read_problem  # as above
@@ -98,9 +101,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         if wrong:
             raise InputError(f"--sizes {args.sizes!r}: level {wrong[0][0]} must be {wrong[0][1]} "
                              f"(the refinements of {family.name}), e.g. --sizes 0,1")
-    if not (math.isfinite(args.time_limit) and args.time_limit > 0):
-        raise InputError(f"--time-limit {args.time_limit!r} must be a positive number of seconds, "
-                         "e.g. --time-limit 120")
+    time_limit = parse_time_limit(args.time_limit)
     tolerances = args.tol.split(",")
     unknown = [t for t in tolerances if t not in TOLERANCES]
     if unknown:
@@ -145,7 +146,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
               f"{row.get('time_s', float('nan')):.3g} s", file=sys.stderr)
 
     if not args.report_only:  # the CSV grows run by run (resumable): the folder is made now
-        run_benchmark(runs, writable_directory(out), time_limit=args.time_limit, progress=progress)
+        run_benchmark(runs, writable_directory(out), time_limit=time_limit, progress=progress)
     given = [a for a in sys.argv[2:] if a != "--report-only"]  # the command that made the CSV
     command = "signorini bench " + " ".join(given) if given else "signorini bench"
     with all_or_none():  # the report and its figures, or none of them
@@ -188,7 +189,7 @@ def add_parsers(sub) -> None:
     bench.add_argument("--default-only-from", type=int, default=None, metavar="LEVEL",
                        help="from this refinement level on, iterative methods run at their "
                             "default tolerance only (large sizes)")
-    bench.add_argument("--time-limit", type=float, default=600.0, help="seconds per run")
+    bench.add_argument("--time-limit", default="600", help="seconds per run")
     bench.add_argument("--ranks", default="1", help="MPI ranks for the petsc methods, e.g. 1,2 "
                        "(each count is one more run; never more than the cores)")
     bench.add_argument("--out", help="default bench-report (with --peer: peer-report)")

@@ -184,14 +184,6 @@ def process_seconds() -> float | None:
         return None
 
 
-def parse_sizes(text: str) -> list[int]:
-    try:
-        return [int(x) for x in text.split(",")]
-    except ValueError:
-        raise InputError(f"--sizes {text!r} is not a comma-separated list of sizes, "
-                         "e.g. --sizes 0,1,2") from None
-
-
 def family_of(scene: str, params: dict[str, Any], command: str) -> tuple[str, dict[str, Any]]:
     """``(scene family, parameters)`` of a scene name, or of a scene file that names its family
     (``scene = "hertz-cylinder"``, its values under ``params``): what a command that refines a

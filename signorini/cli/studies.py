@@ -19,8 +19,6 @@ def cmd_converge(args: argparse.Namespace) -> int:
     from signorini.studies.convergence import check_study, grading_comparison, run_study  # as above
     from signorini.studies.convergence_report import study_table, write_study  # as above
 
-    if args.levels < 0 or args.levels > 6:
-        raise InputError(f"--levels {args.levels} must be in 0..6 (each level quadruples the dofs)")
     if args.uniform_levels is not None and not 0 <= args.uniform_levels <= 4:
         raise InputError(f"--uniform-levels {args.uniform_levels} must be in 0..4")
     out = out_folder(args.out, input_files(args.scene, args.method))

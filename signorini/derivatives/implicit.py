@@ -21,7 +21,7 @@ to its parameters on this system.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -36,49 +36,40 @@ from signorini.problem.solution import ContactSolution
 SIDES = ("auto", "in", "out")
 
 
-@dataclass(frozen=True)
-class Tangent:
-    """``(du, dforce)`` from :meth:`Result.jvp <signorini.api.Result.jvp>`; unpacks as a pair.
+class _Pair:
+    """A derivative that unpacks as the pair of its first two fields; one-sided where some
+    candidates are ``weakly_active`` (touching with zero force)."""
 
-    ``weakly_active`` lists the candidates touching with zero force: where it
-    is not empty the derivative is one-sided, and ``pressed`` says which of
-    them were kept in contact.
-    """
+    __repr__ = short_repr
+
+    def __iter__(self):
+        return iter([getattr(self, field.name) for field in fields(self)[:2]])
+
+    @property
+    def one_sided(self) -> bool:
+        return bool(self.weakly_active.size)
+
+
+@dataclass(frozen=True, repr=False)
+class Tangent(_Pair):
+    """``(du, dforce)`` from :meth:`Result.jvp <signorini.api.Result.jvp>`; ``pressed`` says
+    which of the ``weakly_active`` candidates were kept in contact."""
 
     du: np.ndarray
     dforce: np.ndarray
     weakly_active: np.ndarray
     pressed: np.ndarray
-    __repr__ = short_repr
-
-    def __iter__(self):
-        return iter((self.du, self.dforce))
-
-    @property
-    def one_sided(self) -> bool:
-        return bool(self.weakly_active.size)
 
 
-@dataclass(frozen=True)
-class Cotangent:
-    """``(gf, gd)`` from :meth:`Result.vjp <signorini.api.Result.vjp>`; unpacks as a pair.
-
-    ``side`` is the branch at the ``weakly_active`` candidates (``in``: kept in
-    contact, ``out``: let go).
-    """
+@dataclass(frozen=True, repr=False)
+class Cotangent(_Pair):
+    """``(gf, gd)`` from :meth:`Result.vjp <signorini.api.Result.vjp>`; ``side`` is the branch at
+    the ``weakly_active`` candidates (``in``: kept in contact, ``out``: let go)."""
 
     gf: np.ndarray
     gd: np.ndarray
     weakly_active: np.ndarray
     side: str
-    __repr__ = short_repr
-
-    def __iter__(self):
-        return iter((self.gf, self.gd))
-
-    @property
-    def one_sided(self) -> bool:
-        return bool(self.weakly_active.size)
 
 
 class Sensitivity:

@@ -170,15 +170,14 @@ def outputs(problem: ContactProblem, solution: ContactSolution, output: str, at:
     if output == "total_force":
         slope = None if du is None else problem.total_contact_force(dlam) * s.force
         return profile.total_force, slope
+    dpressure = None if du is None else dlam * s.force / (problem.weights * s.weight)
     if output == "pressure":
-        unit = s.force / (problem.weights * s.weight)
-        return profile.pressure, None if du is None else dlam * unit
+        return profile.pressure, dpressure
     if output in ("p0", "a"):
         which = 0 if output == "p0" else 1
         value = hertz_fit(profile.x, profile.pressure, profile.active)[which]
         if du is None:
             return value, None
-        dpressure = dlam * s.force / (problem.weights * s.weight)
         return value, hertz_fit_tangent(profile.x, profile.pressure, profile.active, dpressure)[which]
     if output == "energy":
         u, lam = solution.u, solution.lam

@@ -13,12 +13,13 @@
   the linear algebra of ``pdas-amg``.
 """
 
-from signorini.numerics.active_set import ActiveSetSolver, PinnedFactor
-from signorini.numerics.factor import available_backends, factorize
-from signorini.numerics.lcp import delassus, delassus_max_eigenvalue, solve_lcp
-from signorini.numerics.push import push_for_load
-from signorini.numerics.multigrid import PyamgHierarchy, pinned_cg
-from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
+import lazy_loader
+
+# loaded at first use (lazy_loader): a module of the folder imports only what it needs
+__getattr__, __dir__, _ = lazy_loader.attach(__name__, submod_attrs={
+    "active_set": ["ActiveSetSolver", "PinnedFactor"], "factor": ["available_backends", "factorize"],
+    "lcp": ["delassus", "delassus_max_eigenvalue", "solve_lcp"], "push": ["push_for_load"],
+    "multigrid": ["PyamgHierarchy", "pinned_cg"], "zone": ["Zone", "ZoneSolver", "predict_zone"]})
 
 __all__ = ["ActiveSetSolver", "PinnedFactor", "PyamgHierarchy", "Zone", "ZoneSolver",
            "available_backends", "delassus", "delassus_max_eigenvalue", "factorize", "pinned_cg",

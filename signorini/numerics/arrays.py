@@ -69,13 +69,18 @@ def symmetric_argument(K: sp.csr_matrix, name: str = "K") -> sp.csr_matrix:
     return K
 
 
-def vector_argument(value: Any, name: str) -> np.ndarray:
-    """``value`` as a 1D float array, or InputError naming ``name``."""
+def _floats(value: Any, name: str, what: str) -> np.ndarray:
+    """``value`` as an array of floats, or InputError saying that ``name`` must be ``what``."""
     _refuse_complex_or_none(value, name)
     try:
-        vector = np.asarray(value, dtype=float)
+        return np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be a 1D array of numbers, got {type(value).__name__}") from None
+        raise InputError(f"{name} must be {what}, got {type(value).__name__}") from None
+
+
+def vector_argument(value: Any, name: str) -> np.ndarray:
+    """``value`` as a 1D float array, or InputError naming ``name``."""
+    vector = _floats(value, name, "a 1D array of numbers")
     if vector.ndim != 1:
         raise InputError(f"{name} must be a 1D array of numbers, got shape {vector.shape}")
     return vector
@@ -114,12 +119,7 @@ def points_argument(value: Any, N: sp.csr_matrix) -> np.ndarray:
     m = N.shape[0]
     if value is None:
         return np.full((m, dimension_of(N) or 2), np.nan)
-    _refuse_complex_or_none(value, "contact_points")
-    try:
-        points = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"contact_points must be an (m, 2) or (m, 3) array of numbers, got "
-                         f"{type(value).__name__}") from None
+    points = _floats(value, "contact_points", "an (m, 2) or (m, 3) array of numbers")
     if points.ndim != 2 or points.shape[0] != m or points.shape[1] not in (2, 3):
         raise InputError(f"contact_points must have shape ({m}, 2) or ({m}, 3), one row per "
                          f"candidate, got {points.shape}")

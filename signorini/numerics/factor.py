@@ -30,7 +30,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.errors import BackendNotInstalled, InputError, install_hint
-from signorini.numerics.work import count
+from signorini.numerics.work import count, count_solves
 
 log = logging.getLogger(__name__)
 
@@ -40,12 +40,6 @@ _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
 EXTRAS = {"cholmod": "fast", "pardiso": "pardiso"}
 
 NO_DOFS = np.zeros(0, dtype=int)
-
-
-def _count_solve(b: np.ndarray) -> np.ndarray:
-    b = np.asarray(b, dtype=float)  # counted, one per right-hand side
-    count("back_solves", 1 if b.ndim == 1 else b.shape[1])
-    return b
 
 
 def available_backends() -> list[str]:
@@ -117,18 +111,13 @@ class Factor:
                              options={"SymmetricMode": True})
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._lu.solve(_count_solve(b))
+        return self._lu.solve(count_solves(b))
 
 
 #: from this many dofs CHOLMOD orders by nested dissection (METIS) instead of AMD: below it AMD
 #: is faster, above it nested dissection's smaller factor wins (chosen from measurements,
 #: docs/speed.md §1)
 NESTED_DISSECTION_FROM = 100_000
-
-
-def cholmod_ordering(n: int) -> str:
-    """CHOLMOD's fill-reducing ordering for an n × n stiffness."""
-    return "nesdis" if n >= NESTED_DISSECTION_FROM else "amd"
 
 
 #: from this many dofs CHOLMOD factorises by supernodes; below, simplicially: faster there
@@ -146,7 +135,8 @@ def cholmod_analysis(K: sp.csc_matrix):
     from sksparse.cholmod import analyze  # optional backend: imported when CHOLMOD is used
 
     mode = "supernodal" if K.shape[0] >= SUPERNODAL_FROM else "simplicial"
-    return analyze(K, mode=mode, ordering_method=cholmod_ordering(K.shape[0]))
+    ordering = "nesdis" if K.shape[0] >= NESTED_DISSECTION_FROM else "amd"
+    return analyze(K, mode=mode, ordering_method=ordering)
 
 
 def cholmod_numeric(symbolic, K: sp.csc_matrix):
@@ -177,7 +167,7 @@ class CholmodFactor(Factor):
         self._factor = cholmod_numeric(cholmod_analysis(K) if symbolic is None else symbolic, K)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._factor(_count_solve(b))
+        return self._factor(count_solves(b))
 
 
 #: PARDISO's settings (iparm, counted from 1 as its manual does): 1 — these, not its defaults;
@@ -303,7 +293,7 @@ class PardisoFactor(Factor):
     def solve(self, b: np.ndarray) -> np.ndarray:
         # PARDISO's solve phase on the factorisation made above (pypardiso's solve() hashes K)
         self._solver.set_phase(33)
-        return self._solver._call_pardiso(self._upper, np.asfortranarray(_count_solve(b)))
+        return self._solver._call_pardiso(self._upper, np.asfortranarray(count_solves(b)))
 
     def __del__(self) -> None:
         # MKL keeps a factorisation until told to drop it: without this every PARDISO factor

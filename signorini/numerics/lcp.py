@@ -41,6 +41,14 @@ def delassus(N: sp.csr_matrix, factor, block: int | None = None) -> np.ndarray:
     return 0.5 * (W + W.T)
 
 
+def forces_on(W: np.ndarray, b: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """λ with ``W_AA λ_A = b_A`` on the active set A and zero off it (b: m, or m × k)."""
+    lam = np.zeros(np.shape(b))
+    if active.any():
+        lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
+    return lam
+
+
 def _slack(lam: np.ndarray, gap: np.ndarray, b: np.ndarray) -> float:
     """How far ``(λ, g)`` is from ``λ ≥ 0, g ≥ 0``, relative to ``‖λ‖∞`` and ``‖b‖∞``."""
     def worst(x: np.ndarray, scale: float) -> float:
@@ -77,9 +85,7 @@ def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
             return lam, iteration + steps
         seen.add(new_active.tobytes())
         active = new_active
-        lam = np.zeros(m)
-        if active.any():
-            lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
+        lam = forces_on(W, b, active)
     raise ArithmeticError(f"active set still changing after {max_iter} PDAS steps")
 
 
@@ -95,9 +101,7 @@ def least_index_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 100_000) -> tu
     m = len(b)
     active = np.zeros(m, dtype=bool)
     for step in range(1, max_iter + 1):
-        lam = np.zeros(m)
-        if active.any():
-            lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
+        lam = forces_on(W, b, active)
         gap = W @ lam - b
         force_tol = 1e-13 * max(float(np.max(np.abs(lam))), 1e-300)
         gap_tol = 1e-13 * max(float(np.max(np.abs(b))), 1e-300)

@@ -1,23 +1,18 @@
 """Algebraic multigrid for elasticity, and conjugate gradients with some dofs pinned.
 
-A hierarchy is built once for an SPD matrix ``A`` (K with some dofs pinned:
-their rows and columns replaced by ``s·I``, ``s`` the mean free diagonal, so
-that they neither couple nor stand out) and then preconditions CG on systems
-whose pinned set differs from ``A``'s in a few rows: each such row is a
-low-rank change, which costs CG a few iterations, not a new hierarchy.
+A hierarchy is built once for an SPD matrix ``A`` (K with some dofs pinned: their rows and
+columns replaced by ``s·I``, ``s`` the mean free diagonal) and then preconditions CG on systems
+whose pinned set differs from ``A``'s in a few rows: each such row is a low-rank change, which
+costs CG a few iterations, not a new hierarchy. Two hierarchies, one interface
+(``apply(r) -> z``, ``backend``, ``setup_s``, ``levels``): pyamg's smoothed aggregation (Vaněk,
+Mandel & Brezina 1996) on K's node blocks with the rigid-body modes as near-null space, here;
+PETSc's GAMG in :mod:`signorini.solvers.amg_system`.
 
-Two hierarchies, one interface (``apply(r) -> z``, ``backend``, ``setup_s``):
-
-- ``pyamg``: smoothed aggregation (Vaněk, Mandel & Brezina 1996) from pyamg,
-  on K's node blocks with the rigid-body modes as near-null space;
-- ``petsc``: PETSc's GAMG (plain aggregation, the same near-null space) through
-  petsc4py, serial (built in :mod:`signorini.solvers.amg`, which knows PETSc's set-up).
-
-:func:`pinned_cg` is preconditioned CG on the free dofs only: the pinned dofs
-keep their values, the preconditioner's output is zeroed on them (so the
-operator CG sees, ``P M P`` on the free subspace, stays SPD whatever pinned
-set the hierarchy was built for). Hierarchies built, CG solves and CG iterations are counted
-into the stage's work record (:mod:`signorini.numerics.work`).
+:func:`pinned_cg` is preconditioned CG on the free dofs only: the pinned dofs keep their
+values and the preconditioner's output is zeroed on them (so the operator CG sees, ``P M P``
+on the free subspace, stays SPD whatever pinned set the hierarchy was built for). Hierarchies
+built and CG iterations are counted into the stage's work record
+(:mod:`signorini.numerics.work`).
 """
 
 from __future__ import annotations
@@ -189,7 +184,6 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
     r = mask * (f - K @ x)
     initial = norms(r)[0]
     iterations = 0
-    count("cg_solves")
     for _ in range(MAX_RESTARTS + 1):
         if done(*norms(r), initial):
             break

@@ -23,6 +23,7 @@ import scipy.sparse as sp
 
 from signorini.errors import InputError
 from signorini.numerics.active_set import ActiveSetSolver
+from signorini.numerics.lcp import forces_on
 from signorini.numerics.work import count
 
 log = logging.getLogger(__name__)
@@ -87,12 +88,10 @@ def condensed_pair(W: np.ndarray, b_pair: np.ndarray) -> PairSolve:
     """Pairs of the condensed problem ``Wλ − b ≥ 0`` (dense work only, no back-solve)."""
 
     def solve_pair(active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        lam = np.zeros((len(b_pair), 2))
-        if active.any():
-            try:
-                lam[active] = sla.solve(W[np.ix_(active, active)], b_pair[active], assume_a="pos")
-            except sla.LinAlgError as exc:
-                raise ArithmeticError("the contact operator is singular on the active set") from exc
+        try:
+            lam = forces_on(W, b_pair, active)
+        except sla.LinAlgError as exc:
+            raise ArithmeticError("the contact operator is singular on the active set") from exc
         return lam, b_pair - W @ lam
 
     return solve_pair

@@ -1,23 +1,20 @@
 """Work as data: what a stage of a solve did, counted (tests count work instead of timing it).
 
-A :class:`Work` record counts factorisations, back-solves (one per right-hand
-side), multigrid hierarchies built, CG solves and iterations, and active-set
-steps of load control. A stage opens one with :func:`counting`; the numerics
-add to every record open in the current context (:func:`count`), so a stage
-inside another counts into both. The open records live in a
-:class:`contextvars.ContextVar`, which is per thread and per task: two solves
-running side by side never see each other's work, and outside any
-``counting`` block nothing is kept.
+A :class:`Work` record counts factorisations, back-solves (one per right-hand side), multigrid
+hierarchies built, CG iterations and active-set steps of load control. A stage opens one with
+:func:`counting`; the numerics add to every record open in the current context
+(:func:`count`), so a stage inside another counts into both. The open records live in a
+:class:`contextvars.ContextVar` (per thread and per task): two solves side by side never see
+each other's work, and outside any ``counting`` block nothing is kept.
 
 >>> with counting() as work:
 ...     count("back_solves", 2)
 >>> work.as_dict()
 {'back_solves': 2}
 
-Time is the other record a solve carries: :func:`timed` adds a block's wall
-time to a stage of a plain ``{stage: seconds}`` dict that travels with the
-problem or the answer (``solution.seconds``), so the stages of one solve sum
-to its wall time.
+Time is the other record a solve carries: :func:`timed` adds a block's wall time to a stage
+of a ``{stage: seconds}`` dict (``solution.seconds``), so the stages of one solve sum to its
+wall time.
 """
 
 from __future__ import annotations
@@ -28,6 +25,8 @@ from contextvars import ContextVar
 from dataclasses import asdict, dataclass
 from typing import Iterator
 
+import numpy as np
+
 
 @dataclass
 class Work:
@@ -36,7 +35,6 @@ class Work:
     factorisations: int = 0
     back_solves: int = 0
     hierarchies: int = 0
-    cg_solves: int = 0
     cg_iterations: int = 0
     load_steps: int = 0
 
@@ -76,6 +74,13 @@ def count(kind: str, amount: int = 1) -> None:
         setattr(work, kind, getattr(work, kind) + amount)
 
 
+def count_solves(b: np.ndarray) -> np.ndarray:
+    """``b`` as floats, its right-hand sides (one, or its columns) counted as back-solves."""
+    b = np.asarray(b, dtype=float)
+    count("back_solves", 1 if b.ndim == 1 else b.shape[1])
+    return b
+
+
 #: the stages of a solve, in the order they run (the solve record's ``time``); ``startup`` is the
 #: command's process before it builds the scene (interpreter, imports, parsing): 0 in a library call
 STAGES = ("startup", "mesh", "assemble", "load control", "prediction", "method", "certificate",
@@ -112,4 +117,5 @@ def timed(seconds: dict[str, float], stage: str) -> Iterator[None]:
         seconds[stage] = seconds.get(stage, 0.0) + time.perf_counter() - start
 
 
-__all__ = ["STAGES", "Work", "count", "counting", "stage_key", "stage_times", "time_line", "timed"]
+__all__ = ["STAGES", "Work", "count", "count_solves", "counting", "stage_key", "stage_times", "time_line",
+           "timed"]

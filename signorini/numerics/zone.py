@@ -1,27 +1,21 @@
 """Exact contact from a predicted contact zone: one factorisation and a small LCP on its edge.
 
-A prediction (from a coarser model of the same scene) splits the candidates
-into a *core* that surely touches, a *band* where the edge of the contact
-zone may lie, and the *rest* that surely stays apart. Then:
+A prediction (from a coarser model of the same scene) splits the candidates into a *core* that
+surely touches, a *band* where the edge of the contact zone may lie, and the *rest* that surely
+stays apart. Then:
 
-1. K is factorised once with the core's dofs pinned at gap-closing values
-   (a Dirichlet condition; this needs every row of N to bound one dof, as
-   for a flat obstacle);
-2. the band is condensed onto ``W_B = N_B K̃⁻¹ N_Bᵀ`` (one back-solve per
-   band node, never one per candidate) and its complementarity problem
-   solved exactly (:func:`signorini.numerics.lcp.solve_lcp`);
-3. the result is checked on every candidate: a core node whose reaction
-   pulls, or a node of the rest that penetrates, joins the band and the
-   band problem is solved again (a pulling core node also costs a new
-   numeric factorisation with it released).
+1. K is factorised once with the core's dofs pinned at gap-closing values (a Dirichlet
+   condition; this needs every row of N to bound one dof, as for a flat obstacle);
+2. the band is condensed onto ``W_B = N_B K̃⁻¹ N_Bᵀ`` (one back-solve per band node) and its
+   complementarity problem solved exactly (:func:`signorini.numerics.lcp.solve_lcp`);
+3. a core node whose reaction pulls, or a node of the rest that penetrates, joins the band and
+   the band problem is solved again (a pulling core node also costs a new numeric
+   factorisation with it released).
 
-The loop ends only when every KKT condition holds to round-off, so the
-answer is exact whatever the prediction; a good prediction only makes it
-cheap: one factorisation plus a few dozen back-solves.
-
-With a target load the push ``s`` (see :mod:`signorini.numerics.push`) joins the
-band problem as one more unknown, with the total contact force (band forces
-plus core reactions) as one more equation.
+The loop ends only when every KKT condition holds to round-off, so the answer is exact whatever
+the prediction; a good prediction only makes it cheap. With a target load the push ``s``
+(:mod:`signorini.numerics.push`) joins the band problem as one more unknown, with the total
+contact force (band forces plus core reactions) as one more equation.
 """
 
 from __future__ import annotations
@@ -72,14 +66,11 @@ def predict_zone(points: np.ndarray, coarse_points: np.ndarray, coarse_active: n
                  neighbours: int | None = None) -> Zone:
     """The zone of candidates at ``points`` from a coarse model's active set.
 
-    A candidate is core when its ``neighbours`` nearest coarse candidates all
-    touch (default: 4 on a contact curve, 2D and axisymmetric; 10 on a
-    contact surface, 3D), rest when none of the nearest half of them does,
-    band otherwise: about two coarse elements inside the coarse edge and one
-    outside. The sides differ in what a wrong guess costs: a core node that
-    should separate costs a new factorisation, a rest node that penetrates
-    one back-solve. (On the cylinder from 66k to 1M dofs this band of 7–9
-    nodes held the edge every time; the symmetric one had 11–13.)
+    A candidate is core when its ``neighbours`` nearest coarse candidates all touch (default: 4
+    on a contact curve, 2D and axisymmetric; 10 on a contact surface, 3D), rest when none of
+    the nearest half of them does, band otherwise: about two coarse elements inside the coarse
+    edge and one outside, leaning on what a wrong guess costs (a core node that should separate
+    costs a new factorisation, a rest node that penetrates one back-solve).
     """
     from scipy.spatial import cKDTree  # on use: scipy.spatial is slow to import
 
@@ -145,9 +136,9 @@ def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | No
 class ZoneSolver:
     """``min ½uᵀKu − fᵀu, Nu ≤ d`` solved exactly around a predicted zone (see module doc).
 
-    Keeps its pinned factorisation and its band columns ``K̃⁻¹N_jᵀ`` between
-    calls, so the same K solved for other loads (a sweep, the solve after
-    load targeting) costs back-solves only while the core stays the same.
+    Keeps its pinned factorisation (``factor``, which the certificate reuses) and its band
+    columns ``K̃⁻¹N_jᵀ`` between calls, so the same K solved for other loads costs back-solves
+    only while the core stays the same.
     """
 
     def __init__(self, K: sp.spmatrix, N: sp.spmatrix, backend: str | None = None):
@@ -165,24 +156,18 @@ class ZoneSolver:
         self.backend = resolve_backend(backend, self.n, self.K.nnz)
         self._pinning = Pinning(self.K, self.backend)
         self._core: np.ndarray | None = None
-        self._factor: PinnedFactor | None = None
+        self.factor: PinnedFactor | None = None
         #: per band node: ``N z_j`` and the core's reactions to ``z_j``, and ``z_j`` while it fits
         self._columns: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
         self._whole = 0
-        self.factorisations = 0
-        self.back_solves = 0
-
-    @property
-    def factor(self) -> PinnedFactor | None:
-        """The factorisation of K with the core pinned now in use (the certificate reuses it)."""
-        return self._factor
+        self.factorisations = 0  # numeric factorisations made (one per core)
 
     # --- linear algebra on the pinned factorisation -------------------------------------------
 
     def _use_core(self, core: np.ndarray) -> None:
         if self._core is not None and np.array_equal(core, self._core):
             return
-        self._factor = PinnedFactor(self.K, self.dofs[core], self.backend, self._pinning)
+        self.factor = PinnedFactor(self.K, self.dofs[core], self.backend, self._pinning)
         self._core = core.copy()
         self._columns.clear()
         self._whole = 0
@@ -198,8 +183,7 @@ class ZoneSolver:
                    band: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``U0``: u (n × k) with the core's gaps closed, loads F and no band forces, and the
         right-hand sides it solves; the band columns ``z_j = K̃⁻¹ N_jᵀ`` not kept from an earlier
-        call are solved in the same call as U0 (one pass over the factor for both; at 1M dofs a
-        pass costs a tenth of the factorisation) and kept (see :data:`COLUMN_BYTES`).
+        call are solved with U0 (one pass over the factor for both) and kept (:data:`COLUMN_BYTES`).
         """
         core = zone.core
         rhs = np.array(F, dtype=float).reshape(self.n, -1)
@@ -209,18 +193,17 @@ class ZoneSolver:
         U0 = None
         for chunk in chunks or [[]]:
             units = self._units(chunk)
-            block = self._factor.solve(units if U0 is not None else np.hstack([rhs, units]))
-            self.back_solves += block.shape[1]
+            block = self.factor.solve(units if U0 is not None else np.hstack([rhs, units]))
             if U0 is None:
                 U0, block = block[:, :rhs.shape[1]], block[:, rhs.shape[1]:]
-            gaps, reactions = self.N @ block, self._factor.fixed_rows(block)
+            gaps, reactions = self.N @ block, self.factor.fixed_rows(block)
             for k, j in enumerate(chunk):
                 whole = (self._whole + 1) * self.n * 8 <= COLUMN_BYTES
                 self._whole += whole
                 column = block[:, k].copy() if whole else None
                 self._columns[j] = (gaps[:, k], reactions[:, k], column)
                 if whole:  # the certificate's bordering reads it back (forward_error)
-                    self._factor.kept[int(self.dofs[j])] = (column, self.coef[j])
+                    self.factor.kept[int(self.dofs[j])] = (column, self.coef[j])
         return U0, rhs
 
     def _displacement(self, U0: np.ndarray, rhs: np.ndarray, band: np.ndarray,
@@ -231,32 +214,25 @@ class ZoneSolver:
         kept = [self._columns[j][2] for j in band]
         if all(z is not None for z in kept):
             return U0 - np.column_stack(kept) @ lam_band
-        self.back_solves += 1
-        return self._factor.solve(rhs - self._units(band) @ lam_band)
-
-    def _core_reactions(self, F: np.ndarray, U: np.ndarray, core: np.ndarray) -> np.ndarray:
-        """Contact forces of the core nodes, ``(F − K U)`` on their dofs (``F`` None: ``−K U``)."""
-        coef = self.coef[core][:, None] if U.ndim == 2 else self.coef[core]
-        residual = -self._factor.fixed_rows(U)
-        if F is not None:
-            residual += F[self.dofs[core]]
-        return residual / coef
+        return self.factor.solve(rhs - self._units(band) @ lam_band)
 
     def _pieces(self, F: np.ndarray, D: np.ndarray, zone: Zone):
-        """Everything affine: ``u = U0 − Zλ_B`` (U0 and its right-hand sides), band gaps
-        ``Wλ_B − b``, core ``R + Gλ_B``."""
+        """Everything affine in the band forces, for loads F (n × k) and gaps D (m × k):
+        ``u = U0 − Zλ_B`` (U0 and its right-hand sides), band gaps ``Wλ_B − b``, core reactions
+        ``R + Gλ_B`` (``R``: ``F − K U0`` on the core's dofs)."""
         self._use_core(zone.core)
         band = np.nonzero(zone.band)[0]
         U0, rhs = self._solutions(F, D, zone, band)
+        coef = self.coef[zone.core][:, None]
         if len(band):
             W = np.column_stack([self._columns[j][0][band] for j in band])
             W = 0.5 * (W + W.T)
-            G = np.column_stack([self._columns[j][1] for j in band]) / self.coef[zone.core][:, None]
+            G = np.column_stack([self._columns[j][1] for j in band]) / coef
         else:
             W, G = np.zeros((0, 0)), np.zeros((0, 0))
-        b = self.N[band] @ U0 - np.asarray(D, dtype=float)[band].reshape(len(band), U0.shape[1])
-        R = self._core_reactions(F, U0 if np.ndim(F) > 1 else U0[:, 0], zone.core)
-        return band, U0, rhs, W, (b if np.ndim(F) > 1 else b[:, 0]), R, G
+        b = self.N[band] @ U0 - np.asarray(D, dtype=float)[band]
+        R = (F[self.dofs[zone.core]] - self.factor.fixed_rows(U0)) / coef
+        return band, U0, rhs, W, b, R, G
 
     # --- the check that makes it exact ---------------------------------------------------------
 
@@ -278,20 +254,33 @@ class ZoneSolver:
 
     # --- the two problems ----------------------------------------------------------------------
 
+    def _rounds(self, F: np.ndarray, D: np.ndarray, zone: Zone, band_solve,
+                max_rounds: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Zone]:
+        """The band solved by ``band_solve(W, b, R, G) → (weights, λ_B)`` (the load is
+        ``F @ weights``, the gaps ``D @ weights``) and the zone amended until no node was wrong:
+        ``(weights, u, λ, final zone)``."""
+        zone = zone.copy()
+        for _ in range(max_rounds):
+            band, U0, rhs, W, b, R, G = self._pieces(F, D, zone)
+            weights, lam_band = band_solve(W, b, R, G)
+            u = self._displacement(U0 @ weights, rhs @ weights, band, lam_band)
+            lam = np.zeros(self.m)
+            lam[band] = lam_band
+            lam[zone.core] = R @ weights + (G @ lam_band if len(band) else 0.0)
+            d = D @ weights
+            if self._amend(zone, lam, self.N @ u - d, d, u):
+                return weights, u, lam, zone
+        raise ArithmeticError(f"the contact zone kept changing for {max_rounds} rounds")
+
     def solve(self, f: np.ndarray, d: np.ndarray, zone: Zone,
               max_rounds: int = 100) -> tuple[np.ndarray, np.ndarray, Zone]:
         """``(u, λ, final zone)`` for load f and gaps d, starting from ``zone``."""
-        zone = zone.copy()
-        for _ in range(max_rounds):
-            band, U0, rhs, W, b, R, G = self._pieces(f, d, zone)
-            lam_band = solve_lcp(W, b)[0] if len(band) else np.zeros(0)
-            u = self._displacement(U0[:, 0], rhs[:, 0], band, lam_band)
-            lam = np.zeros(self.m)
-            lam[band] = lam_band
-            lam[zone.core] = R + (G @ lam_band if len(band) else 0.0)
-            if self._amend(zone, lam, self.N @ u - d, d, u):
-                return u, lam, zone
-        raise ArithmeticError(f"the contact zone kept changing for {max_rounds} rounds")
+        def band(W, b, R, G):
+            return np.ones(1), solve_lcp(W, b[:, 0])[0] if len(b) else np.zeros(0)
+
+        _, u, lam, zone = self._rounds(np.reshape(f, (-1, 1)), np.reshape(d, (-1, 1)), zone,
+                                       band, max_rounds)
+        return u, lam, zone
 
     def push_for_load(self, f1: np.ndarray, d0: np.ndarray, d1: np.ndarray, target: float,
                       multiplicity: float, zone: Zone, max_rounds: int = 100,
@@ -300,20 +289,13 @@ class ZoneSolver:
 
         Returns ``(s, u, λ, final zone)``.
         """
-        F = np.column_stack([f1, np.zeros_like(f1) if f0 is None else f0])
-        D = np.column_stack([d1, d0])
-        zone = zone.copy()
-        for _ in range(max_rounds):
-            band, U0, rhs, W, b, R, G = self._pieces(F, D, zone)
+        def band(W, b, R, G):
             s, lam_band = _band_push(W, b, R, G, target, multiplicity)
-            u = self._displacement(U0 @ [s, 1.0], rhs @ [s, 1.0], band, lam_band)
-            lam = np.zeros(self.m)
-            lam[band] = lam_band
-            lam[zone.core] = R @ [s, 1.0] + (G @ lam_band if len(band) else 0.0)
-            d = d0 + s * d1
-            if self._amend(zone, lam, self.N @ u - d, d, u):
-                return s, u, lam, zone
-        raise ArithmeticError(f"the contact zone kept changing for {max_rounds} rounds")
+            return np.array([s, 1.0]), lam_band
+
+        F = np.column_stack([f1, np.zeros_like(f1) if f0 is None else f0])
+        weights, u, lam, zone = self._rounds(F, np.column_stack([d1, d0]), zone, band, max_rounds)
+        return float(weights[0]), u, lam, zone
 
 
 def _band_push(W: np.ndarray, b: np.ndarray, R: np.ndarray, G: np.ndarray, target: float,

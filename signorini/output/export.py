@@ -51,14 +51,10 @@ CELL_TYPES = {3: "triangle", 4: "tetra"}
 
 
 def nodal_displacement(problem: ContactProblem, solution: ContactSolution) -> np.ndarray:
-    """Displacement of every mesh node, shape (nodes, dim), in physical units."""
+    """Displacement of every mesh node, shape (nodes, dim), in physical units (scikit-fem's
+    vector P1 dofs are interleaved: a node's components are neighbours)."""
     full = problem.model.expand(solution.u) * problem.scales.displacement
-    mesh = problem.model.mesh
-    dim, nodes = mesh.p.shape
-    basis = getattr(problem, "basis", None)
-    dofs = basis.nodal_dofs if basis is not None else \
-        np.arange(dim * nodes).reshape(nodes, dim).T  # scikit-fem's interleaved vector dofs
-    return full[dofs].T
+    return full.reshape(-1, problem.model.mesh.p.shape[0])
 
 
 def element_gradients(points: np.ndarray, elements: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -150,26 +146,23 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
     u = nodal_displacement(problem, solution)
     stress = element_stress(problem, solution, axisymmetric)
     mises = von_mises(stress)
-    xyz = np.zeros((count, 3))
-    xyz[:, :dim] = points + (u if deformed else 0.0)
-    disp = np.zeros((count, 3))
-    disp[:, :dim] = u
+    three = ((0, 0), (0, 3 - dim))  # every vector padded to three components
     profile = contact_profile(problem, solution)
     nodes = candidate_nodes(problem)
-    gap = np.full(count, np.nan)
-    gap[nodes] = profile.gap
-    pressure = np.zeros(count)
-    pressure[nodes] = profile.pressure
-    force = np.zeros(count)
-    force[nodes] = profile.force
-    marker = np.zeros(count, dtype=np.int32)
-    marker[nodes] = 1
+
+    def at_candidates(values, elsewhere=0.0, dtype=float) -> np.ndarray:
+        out = np.full(count, elsewhere, dtype=dtype)
+        out[nodes] = values
+        return out
+
     reference_points = points.T
     point_data = {
-        "displacement": disp,
+        "displacement": np.pad(u, three),
         "von_mises_nodal": project_to_nodes(reference_points, mesh.t, mises),
         "sigma_yy_nodal": project_to_nodes(reference_points, mesh.t, stress[:, 1, 1]),
-        "gap": gap, "pressure": pressure, "contact_force": force, "contact_candidate": marker,
+        "gap": at_candidates(profile.gap, np.nan), "pressure": at_candidates(profile.pressure),
+        "contact_force": at_candidates(profile.force),
+        "contact_candidate": at_candidates(1, 0, np.int32),
     }
     components = {"sigma_xx": (0, 0), "sigma_yy": (1, 1), "sigma_zz": (2, 2), "sigma_xy": (0, 1)}
     if dim == 3:
@@ -180,7 +173,8 @@ def export_mesh(problem: ContactProblem, solution: ContactSolution, *, deformed:
     if materials:
         cell_data["body"] = [np.repeat(np.arange(1, len(materials) + 1, dtype=np.int32),
                                        [material[0] for material in materials])]
-    return meshio.Mesh(xyz, [(cell_type, mesh.t.T.astype(np.int64))],
+    return meshio.Mesh(np.pad(points + (u if deformed else 0.0), three),
+                       [(cell_type, mesh.t.T.astype(np.int64))],
                        point_data=point_data, cell_data=cell_data)
 
 

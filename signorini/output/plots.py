@@ -28,11 +28,11 @@ def series_style(i: int) -> tuple[str, str]:
     return f"C{i % 10}", MARKERS[i % len(MARKERS)]
 
 
-def axes(ax):
-    """``ax``, or the Axes of a new figure (pyplot's global state untouched)."""
+def axes(ax, size: tuple[float, float] = (6.4, 4.2)):
+    """``ax``, or the Axes of a new figure of ``size`` inches (pyplot's global state untouched)."""
     if ax is None:
         from matplotlib.figure import Figure  # matplotlib (0.4 s to import): only when a figure is drawn
-        ax = Figure(figsize=(6.4, 4.2), layout="constrained").add_subplot()
+        ax = Figure(figsize=size, layout="constrained").add_subplot()
     return ax
 
 
@@ -100,9 +100,7 @@ def bench_speed_accuracy(rows: list[dict], *, metric: str = "kkt_worst", ax=None
     """
     import matplotlib  # as in axes(): only when a figure is drawn
 
-    if ax is None:
-        from matplotlib.figure import Figure  # as above
-        ax = Figure(figsize=(10, 5), layout="constrained").add_subplot()
+    ax = axes(ax, (10, 5))
     markers = {"low": "v", "mid": "s", "high": "o", "default": "D"}
     methods = sorted({r["method"] for r in rows})
     for i, method in enumerate(methods):

@@ -6,41 +6,21 @@ reaches Python when the slider is released (``change``), so that one drag is one
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import anywidget
 import traitlets
 
 __all__ = ["RangeSlider"]
 
-_ESM = """
-function render({ model, el }) {
-  const label = document.createElement("label");
-  const input = document.createElement("input");
-  const shown = document.createElement("output");
-  input.type = "range";
-  input.name = model.get("name");
-  input.min = model.get("start");
-  input.max = model.get("stop");
-  input.step = model.get("step");
-  input.value = model.get("value");
-  input.style.width = "14em";
-  shown.textContent = model.get("value");
-  label.textContent = model.get("label") + " ";
-  input.addEventListener("input", () => { shown.textContent = input.value; });
-  input.addEventListener("change", () => {
-    model.set("value", Number(input.value));
-    model.save_changes();
-  });
-  label.append(input, " ", shown);
-  el.appendChild(label);
-}
-export default { render };
-"""
+#: the widget's JavaScript module, beside this file
+ESM = Path(__file__).with_name("range_slider.js")
 
 
 class RangeSlider(anywidget.AnyWidget):
     """``start ≤ value ≤ stop`` in steps of ``step``; ``name`` is the input's name in the page."""
 
-    _esm = _ESM
+    _esm = ESM
     value = traitlets.Float(0.0).tag(sync=True)
     start = traitlets.Float(0.0).tag(sync=True)
     stop = traitlets.Float(1.0).tag(sync=True)

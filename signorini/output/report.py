@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import os
 import platform
@@ -26,18 +27,14 @@ def provenance() -> dict[str, Any]:
     """Versions, machine and date of a run."""
     versions = {}
     for name in PACKAGES:
-        try:
+        with contextlib.suppress(metadata.PackageNotFoundError):
             versions[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            pass
     cpu = platform.processor() or platform.machine()
-    try:
+    with contextlib.suppress(OSError):
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
                 cpu = line.split(":", 1)[1].strip()
                 break
-    except OSError:
-        pass
     return {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
             "python": platform.python_version(), "platform": platform.platform(),
             "cpu": cpu, "cores": os.cpu_count(), "versions": versions}
@@ -120,7 +117,7 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
         md += ["", f"## {result.case.name}", "",
                f"Scene `{result.case.scene}` with "
                + ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                           for k, v in p.params.items() if v is not None)
+                           for k, v in p.model.params.items() if v is not None)
                + f": {p.n} dofs, {p.m} contact candidates.", ""]
         md += runs_table(result.runs)
         notes = [r for r in result.runs if r["status"] in ("skipped", "failed")]

@@ -4,35 +4,24 @@ Each step (:func:`solve_adaptive`):
 
 1. assemble the scene on the current mesh and solve it (any method; load
    targeting starts from the last step's contact zone);
-2. when the contact outgrew the candidates (a node beyond them through the
-   obstacle, or the outermost candidate in contact: the solution is
-   ``model_inadequate``, :mod:`signorini.certification.adequacy`), widen the candidates by
-   :data:`GROWTH` on the same mesh and solve again;
-3. estimate the error (:func:`signorini.fem.estimate.estimate`) and stop when
-   the estimate of the chosen quantity meets the target: ``"pressure"`` (the
-   default where the model has contact pressures: the relative L² error of
-   the contact pressure, :class:`signorini.fem.contact_estimate.PressureEstimate`) or
-   ``"energy"`` (``η / ‖u_h‖_E``);
-4. mark by Dörfler's bulk criterion (:func:`signorini.scenes.marking.mark`:
-   for the pressure, the candidates that carry most of its estimate and the
-   body near the contact, weighted so that it keeps up with its surface;
-   without that weight the bulk share went to the far field and the true
-   pressure error stalled at 0.2 % on Hertz's cylinder: docs/estimate.md),
-   refine them conformingly (scikit-fem's red-green-blue
-   ``MeshTri.refined(marked)``), move new boundary nodes onto the curved
-   boundary, and stop instead when the refined mesh would exceed ``max_dofs``
-   or, before its model is assembled, the memory the size guard allows
-   (:func:`signorini.scenes.size.over_limit`: its dofs times the bytes per
-   dof of the method that solves it, under ``SIGNORINI_MAX_MEMORY_GB``); the
-   last step's answer is returned, its message saying the target was not met.
+2. when the contact outgrew the candidates (the solution is ``model_inadequate``,
+   :mod:`signorini.certification.adequacy`), widen them on the same mesh and solve again;
+3. estimate the error (:func:`signorini.fem.estimate.estimate`) and stop when the estimate of
+   the chosen quantity meets the target: ``"pressure"`` (the default where the model has
+   contact pressures: :class:`signorini.fem.contact_estimate.PressureEstimate`) or ``"energy"``
+   (``η / ‖u_h‖_E``);
+4. mark (:func:`signorini.scenes.marking.mark`), refine conformingly (scikit-fem's
+   red-green-blue ``MeshTri.refined(marked)``) and move new boundary nodes onto the curved
+   boundary; stop instead when the refined mesh would exceed ``max_dofs`` or, before its model
+   is assembled, the memory the size guard allows (:func:`signorini.scenes.size.over_limit`),
+   the last step's answer returned with a message saying the target was not met.
 
 The first mesh is sized before it is made (:func:`signorini.scenes.size.check_size`). Given no
 mesh parameter, a family starts from its ``adaptive_start`` (the Hertz scenes: the relaxed mesh
 the budgets and the estimate's effectivity were measured on, :class:`~signorini.scenes.base.SceneFamily`).
 
 Every 2D and axisymmetric scene and scene file takes part. A family whose
-``build`` accepts ``mesh=`` and that has a ``snap`` (:data:`CURVED`: the Hertz scenes)
-is rebuilt on each new mesh, new nodes first moved onto its curved boundary,
+``build`` accepts ``mesh=`` and that has a ``snap`` (the Hertz scenes) is rebuilt on each new mesh, new nodes first moved onto its curved boundary,
 and widens its candidate zone by :data:`GROWTH` when the contact outgrows
 it. Any other model is carried onto the refinement
 (:func:`signorini.fem.transfer.refined_model`) and takes as new candidates
@@ -58,7 +47,7 @@ from signorini.fem.model import SceneModel
 from signorini.certification.kkt import gap_scale
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.scenes.marking import THETA, mark
-from signorini.scenes.registry import FamilyField, get_scene
+from signorini.scenes.registry import get_scene
 from signorini.scenes.scenefile import build_scene_model, family_scene_values
 from signorini.scenes.size import MEMORY_VARIABLE, Solver, check_size, over_limit
 
@@ -70,11 +59,6 @@ GROWTH = 1.5
 MAX_GROWTH = 8
 DEFAULT_MAX_DOFS = 100_000
 MAX_STEPS = 30
-
-
-#: how each adaptive family puts refined boundary nodes back on its curved boundary, by name
-#: (a live view of :attr:`SceneFamily.snap <signorini.scenes.base.SceneFamily>`)
-CURVED = FamilyField("snap")
 
 
 @dataclass
@@ -105,23 +89,6 @@ def measured(found: ErrorEstimate, quantity: str) -> float:
     return found.relative if quantity == "energy" else found.pressure.relative
 
 
-def _rebuild(family, params: dict[str, Any], given: set[str], mesh: Any,
-             contact_extent: float | None) -> SceneModel:
-    """The scene on ``mesh``; load targeting starts from the candidates within ``contact_extent``."""
-    model = family.build(params, given, mesh=mesh)
-    if contact_extent is not None:
-        x = model.mesh.p[0, model.contact_nodes]
-        model.predicted_contact = x <= contact_extent
-    return model
-
-
-def _contact_extent(model: SceneModel, problem: ContactProblem, solution: ContactSolution) -> float | None:
-    """How far the contact reached (physical x of the last candidate with a force)."""
-    if not np.all(np.isfinite(solution.lam)) or not np.any(solution.lam > 0):
-        return None
-    return float(np.max(model.mesh.p[0, model.contact_nodes][solution.lam > 0]))
-
-
 @dataclass
 class _Scene:
     """What the loop rebuilds on each new mesh: a family that builds on a given mesh (and can
@@ -135,14 +102,21 @@ class _Scene:
     given: set[str] = field(default_factory=set)
     snap: Callable | None = None
 
-    def on(self, model: SceneModel, mesh: Any, problem: ContactProblem,
-           solution: ContactSolution) -> SceneModel:
-        """The scene on ``mesh``, refined from ``model``'s (not yet snapped); ``problem`` and
-        ``solution`` are ``model``'s, and load targeting starts from its contact."""
+    def rebuilt(self, mesh: Any, model: SceneModel, solution: ContactSolution) -> SceneModel:
+        """The family's scene on ``mesh``; load targeting starts from the candidates within the
+        reach of ``model``'s contact in ``solution`` (the x of its last candidate with a force)."""
+        rebuilt = self.family.build(self.params, self.given, mesh=mesh)
+        lam = solution.lam
+        if np.all(np.isfinite(lam)) and np.any(lam > 0):
+            extent = float(np.max(model.mesh.p[0, model.contact_nodes][lam > 0]))
+            rebuilt.predicted_contact = rebuilt.mesh.p[0, rebuilt.contact_nodes] <= extent
+        return rebuilt
+
+    def on(self, model: SceneModel, mesh: Any, solution: ContactSolution) -> SceneModel:
+        """The scene on ``mesh``, refined from ``model``'s (not yet snapped); ``solution`` is
+        ``model``'s, and load targeting starts from its contact."""
         if self.family is not None:
-            return _rebuild(self.family, self.params, self.given,
-                            self.snap(mesh) if self.snap else mesh,
-                            _contact_extent(model, problem, solution))
+            return self.rebuilt(self.snap(mesh) if self.snap else mesh, model, solution)
         return refined_model(model, mesh, solution.lam > 0, self.snap)
 
 
@@ -178,8 +152,7 @@ def _grown(scene: _Scene, model: SceneModel, problem: ContactProblem,
         scene.params = {**scene.params, "candidates": scene.params["candidates"] * GROWTH}
         log.info("the contact outgrew the candidates; widened to %g half-widths",
                  scene.params["candidates"])
-        return _rebuild(scene.family, scene.params, scene.given, model.mesh,
-                        _contact_extent(model, problem, solution))
+        return scene.rebuilt(model.mesh, model, solution)
     extra = beyond_candidates(model, problem, solution)
     if extra.size == 0:
         return None
@@ -225,10 +198,8 @@ def _checked(scene: _Scene) -> _Scene:
     return scene
 
 
-Solver = Callable[[ContactProblem], "tuple[ContactProblem, ContactSolution]"]
-
-
-def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Solver, *,
+def solve_adaptive(name: str, values: dict[str, Any], target: float,
+                   solver: Callable[[ContactProblem], tuple[ContactProblem, ContactSolution]], *,
                    max_dofs: int | None = None, theta: float = THETA, quantity: str | None = None,
                    solved_by: Solver | None = None,
                    on_step: Callable[[ContactProblem, ContactSolution, ErrorEstimate | None], None]
@@ -304,7 +275,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float, solver: Sol
             steps.append(_row(step, problem, solution, found, 0, seconds, action))
             break
         steps.append(_row(step, problem, solution, found, len(marked), seconds, "refined"))
-        model = scene.on(model, mesh, problem, solution)
+        model = scene.on(model, mesh, solution)
     else:
         run.reason = f"adaptive refinement stopped after {MAX_STEPS} steps"
     run.reason += _steeper_than_measured(scene)

@@ -25,6 +25,14 @@ from signorini.fem.model import SceneModel
 from signorini.fem.volumetric import CHOICES
 from signorini.scenes.meshing import MESHERS
 
+__all__ = ["A_OVER_R_RANGE", "CANDIDATE_REMEDY", "Case", "GRADING_RANGE", "HALF", "LOADING",
+           "LOAD_NAMES", "MAX_BLOCK", "MAX_DIGITS", "MAX_INT", "MESHER", "Param", "SceneFamily",
+           "SizeEstimate", "VOLUMETRIC", "at_least", "between", "block_size", "candidates",
+           "checked_ratio", "chosen_load", "contact_ratio", "grading", "grading_check",
+           "hertz_load", "hertz_record", "length", "one_of", "poisson_ratio", "positive",
+           "refinements", "representable", "scene_params", "shown", "two_refinements_coarser",
+           "within"]
+
 
 @dataclass(frozen=True)
 class Param:
@@ -152,6 +160,11 @@ def at_least(bound: float) -> Callable[[float], str | None]:
     return lambda x: None if x >= bound else f">= {bound:g}"
 
 
+def within(lo: float, hi: float, why: str = "") -> Callable[[float], str | None]:
+    """The check of a value in ``[lo, hi]``; ``why`` follows the range in the message."""
+    return lambda x: None if lo <= x <= hi else f"in [{lo:g}, {hi:g}]{why}"
+
+
 #: the largest block around a contact, in contact half-widths: the graded mesh's largest
 #: element over its smallest (about size · n_contact) squares into K's condition number
 MAX_BLOCK = 1e4
@@ -159,9 +172,8 @@ MAX_BLOCK = 1e4
 
 def block_size(smallest: float) -> Callable[[float], str | None]:
     """The check of a block's ``size`` (in contact half-widths): in [smallest, :data:`MAX_BLOCK`]."""
-    return lambda x: None if smallest <= x <= MAX_BLOCK else (
-        f"in [{smallest:g}, {MAX_BLOCK:g}] (a larger block squares the spread of its element "
-        "sizes into K's condition number; the contact sees a half-plane long before)")
+    return within(smallest, MAX_BLOCK, " (a larger block squares the spread of its element sizes "
+                  "into K's condition number; the contact sees a half-plane long before)")
 
 
 def between(lo: float, hi: float) -> Callable[[float], str | None]:
@@ -172,25 +184,40 @@ def between(lo: float, hi: float) -> Callable[[float], str | None]:
 #: element size (the convergence study's uniform comparison); below it the mesher's series of
 #: layers degenerates
 GRADING_RANGE = (1e-6, 2.0)
+#: the range of every graded scene's ``grading``
+grading_check = within(*GRADING_RANGE, " (smaller grows the elements more slowly away from the "
+                       "contact: a larger mesh)")
 
 
-def grading_check(x: float) -> str | None:
-    """The range of every graded scene's ``grading`` (:data:`GRADING_RANGE`)."""
-    lo, hi = GRADING_RANGE
-    return None if lo <= x <= hi else (f"in [{lo:g}, {hi:g}] (smaller grows the elements more "
-                                       "slowly away from the contact: a larger mesh)")
+def grading(default: float) -> Param:
+    """A graded scene's ``grading`` parameter with its ``default``."""
+    return Param("grading", default, "growth of the element size with distance from the contact zone",
+                 check=grading_check)
+
+
+def refinements(most: int = 6, growth: str = "quadruples the dofs") -> Param:
+    """A graded scene's ``refine`` parameter: 0 to ``most`` uniform refinements."""
+    return Param("refine", 0, f"uniform refinements of the graded mesh (each {growth})", kind=int,
+                 check=lambda k: None if 0 <= k <= most else f"in 0..{most}")
+
+
+def candidates(contact: str = "half-width", default: float = 2.0) -> Param:
+    """A Hertz scene's ``candidates`` parameter, in multiples of the ``contact`` half-width or radius."""
+    return Param("candidates", default, f"contact candidates extend to this multiple of the {contact}",
+                 check=at_least(1.2))
+
+
+#: whether a block scene models the right half (a symmetry plane at x = 0) or the whole width
+HALF = Param("half", 1, "1: right half with a symmetry plane; 0: the whole width", kind=int,
+             check=lambda k: None if k in (0, 1) else "0 or 1")
 
 
 #: contact half-width (radius) over the radius a Hertz scene meshes: below it the gaps over the
 #: contact, about (a/R)² R, keep fewer than 8 digits next to R; above it Hertz's half-space
 #: theory does not hold
 A_OVER_R_RANGE = (1e-4, 0.5)
-
-
-def contact_ratio(x: float) -> str | None:
-    """The check of the ``a_over_R`` parameters (:data:`A_OVER_R_RANGE`)."""
-    lo, hi = A_OVER_R_RANGE
-    return None if lo <= x <= hi else f"in [{lo:g}, {hi:g}]"
+#: the check of the ``a_over_R`` parameters
+contact_ratio = within(*A_OVER_R_RANGE)
 
 
 def checked_ratio(a_over_R: float, name: str, value: float) -> float:
@@ -206,23 +233,40 @@ def checked_ratio(a_over_R: float, name: str, value: float) -> float:
     return a_over_R
 
 
-def recorded_params(p: dict[str, Any], target: float | None, a_over_R: float,
-                    delta_nominal: float) -> dict[str, Any]:
-    """A Hertz scene's parameters as its problem records them: the load that ruled, the
-    others None."""
-    params = dict(p)
-    params.update(P=target, delta=delta_nominal if target is None else None,
-                  a_over_R=a_over_R if target is not None else None)
-    return params
+def chosen_load(p: dict[str, Any], given: set[str],
+                names: tuple[str, ...] = ("P", "a_over_R", "delta")) -> set[str]:
+    """The load parameters among ``names`` given a value; InputError when more than one is."""
+    chosen = {name for name in given & set(names) if p[name] is not None}
+    if len(chosen) > 1:
+        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
+                         f"give only one of {', '.join(names)}")
+    return chosen
+
+
+def hertz_load(p: dict[str, Any], given: set[str], R: float, E_star: float, half_width: Callable,
+               load: Callable, check_delta: bool = True) -> tuple[float | None, float | None, float]:
+    """``(target P or None, prescribed δ or None, a/R the mesh is graded for)`` of a Hertz scene,
+    with Hertz's ``half_width(P, R, E*)`` and its inverse ``load(a, R, E*)``: one of ``P``,
+    ``a_over_R`` (the default) or ``delta`` sets the load, refused where a/R leaves
+    :data:`A_OVER_R_RANGE` (δ as ``a ~ √(δ R)``, up to Hertz's logarithm in 2D)."""
+    chosen = chosen_load(p, given)
+    if "delta" in chosen:
+        if check_delta:
+            checked_ratio(math.sqrt(p["delta"] / R), "delta", p["delta"])
+        return None, p["delta"], p["a_over_R"]
+    if "P" in chosen:
+        return p["P"], None, checked_ratio(half_width(p["P"], R, E_star) / R, "P", p["P"])
+    return load(p["a_over_R"] * R, R, E_star), None, p["a_over_R"]
 
 
 def hertz_record(p: dict[str, Any], reference: str, target: float | None, a_over_R: float,
                  delta_nominal: float) -> dict[str, Any]:
-    """What a Hertz scene's model records: its parameters as the problem reports them
-    (:func:`recorded_params`) and the typed fields code reads: the volumetric choice, the push
+    """What a Hertz scene's model records: its parameters as the problem reports them (the load
+    that ruled, the others None) and the typed fields code reads: the volumetric choice, the push
     δ, and what the reference ``reference`` reads (E* and R)."""
-    return {"params": recorded_params(p, target, a_over_R, delta_nominal),
-            "volumetric_choice": p["volumetric"], "delta": delta_nominal,
+    params = dict(p, P=target, delta=delta_nominal if target is None else None,
+                  a_over_R=a_over_R if target is not None else None)
+    return {"params": params, "volumetric_choice": p["volumetric"], "delta": delta_nominal,
             "reference": ReferenceData(reference, E_star=contact_modulus(p["E"], p["nu"]), R=p["R"])}
 
 

@@ -107,9 +107,7 @@ def _plain_model(p: dict[str, Any], contact_nodes: np.ndarray | None = None,
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The half block in physical units (with a touching outer part when ``touching > 0``)."""
-    if not p.get("touching"):
-        return _plain_model(p)
-    return _touching_model(p)
+    return _touching_model(p) if p.get("touching") else _plain_model(p)
 
 
 def _touching_model(p: dict[str, Any]) -> SceneModel:

@@ -21,7 +21,7 @@ from signorini.problem.contact import ContactProblem, Scales
 from signorini.problem.files import is_problem_file, read_problem
 from signorini.references.catalogue import reference_of
 from signorini.scenes.base import GRADING_RANGE, LOAD_NAMES, scene_params
-from signorini.scenes.families import SCENES, get_scene
+from signorini.scenes.families import SCENES, get_scene, scene_reference
 from signorini.scenes.scenefile import build_scene_model
 from signorini.scenes.size import Solver, check_size
 
@@ -42,20 +42,16 @@ def coarse_values(name: str, params: dict[str, Any]) -> dict[str, Any] | None:
     return family.coarse({k: v for k, v in params.items() if k in names})
 
 
-def _coarse_model(name: str, params: dict[str, Any], nondimensionalise: bool):
-    """The coarser model of :func:`coarse_values`, or None (none, or parameters out of range)."""
-    values = coarse_values(name, params)
+def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
+    """The model of :func:`coarse_values` of the scene ``problem`` was built from (None when there
+    is none, or when its parameters are out of range)."""
+    values = coarse_values(problem.name, problem.model.params)
     if values is None:
         return None
     try:
-        return build_problem(name, params=values, nondimensionalise=nondimensionalise)
+        return build_problem(problem.name, params=values, nondimensionalise=problem.scales != Scales())
     except InputError:  # the coarser parameters are out of range: no coarse model
         return None
-
-
-def coarse_problem(problem: ContactProblem) -> ContactProblem | None:
-    """A coarser model of the scene ``problem`` was built from (None when there is none)."""
-    return _coarse_model(problem.name, problem.model.params, problem.scales != Scales())
 
 
 def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensionalise: bool = True,
@@ -114,7 +110,7 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
                     "mesher=bisection" if relaxed else
                     f" ({type(exc).__name__}: {exc}): make the mesh coarser (a larger grading or "
                     "a smaller n_contact)")) from None
-    declared = SCENES[name].reference if name in SCENES else ""
+    declared = scene_reference(name)
     if model.reference is None and declared or model.reference and model.reference.name != declared:
         raise InputError(f"scene family {name!r} declares the reference {declared!r}, but its build "
                          f"hands on {model.reference!r}: give its SceneModel "

@@ -7,26 +7,17 @@ unit thickness of the full cylinder, twice the quarter's), as Hertz's theory
 loads the body; the centre node is pushed down by δ, and assembly adjusts δ
 until that node carries no force (it only removes the rigid translation, so
 K is non-singular). ``loading=displacement`` pushes the whole cut down by a
-uniform δ instead (the cut stays flat; the model before the traction, about
-0.2 % further from Hertz on the default mesh: docs/accuracy.md), which is
-also the model when ``delta`` is given. The mesh is graded towards the
+uniform δ instead (the cut stays flat: docs/accuracy.md compares the two), which
+is also the model when ``delta`` is given. The mesh is graded towards the
 first point of contact and only the arc nodes with ``x ≤ candidates · a`` are
-contact candidates.
-
-Default mesh (``n_contact=24``, ``grading=0.11``, Triangle: 5,207 dofs): the
-fastest solve in process whose a and p₀ are within 0.05 % of Hertz at a/R =
-0.05 (the accuracy-time front of docs/mesher.md). Near-equilateral triangles
-and a smooth growth away from the contact matter more than how many elements
-lie across it (docs/accuracy.md).
+contact candidates. The default mesh is on the accuracy-time front of docs/mesher.md.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from signorini.references.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
-from signorini.errors import InputError
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.scenes.base import (
     CANDIDATE_REMEDY,
@@ -37,13 +28,15 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    checked_ratio,
+    candidates,
     contact_ratio,
-    grading_check,
+    grading,
+    hertz_load,
     hertz_record,
     length,
     poisson_ratio,
     positive,
+    refinements,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
@@ -65,43 +58,25 @@ PARAMS = (
           check=positive),
     Param("n_contact", 24, "elements across the contact half-width (mesh fineness)", kind=int,
           check=at_least(4)),
-    Param("grading", 0.11, "growth of the element size with distance from the contact zone",
-          check=grading_check),
-    Param("candidates", 2.0, "contact candidates extend to this multiple of the half-width",
-          check=at_least(1.2)),
-    Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
-          kind=int, check=lambda k: None if 0 <= k <= 6 else "in 0..6"),
+    grading(0.11),
+    candidates(),
+    refinements(),
     LOADING,
     MESHER,
 )
 
 
-def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
-    """Resolve which load parameter rules: the target P, or a prescribed delta."""
-    chosen = {name for name in given & {"P", "a_over_R", "delta"} if p[name] is not None}
-    if len(chosen) > 1:
-        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
-                         "give only one of P, a_over_R, delta")
-    E_star = p["E"] / (1.0 - p["nu"] ** 2)
-    if "delta" in chosen:  # a ~ √(δ R) up to Hertz's logarithm: refused where a/R would be
-        checked_ratio(math.sqrt(p["delta"] / p["R"]), "delta", p["delta"])
-        return None, p["delta"]
-    if "P" in chosen:
-        checked_ratio(hertz_cylinder_half_width(p["P"], p["R"], E_star) / p["R"], "P", p["P"])
-        return p["P"], None
-    return hertz_cylinder_load(p["a_over_R"] * p["R"], p["R"], E_star), None
+def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
+    """``(target P or None, prescribed δ or None, a/R the mesh is graded for)``
+    (:func:`~signorini.scenes.base.hertz_load`)."""
+    return hertz_load(p, given, p["R"], contact_modulus(p["E"], p["nu"]), hertz_cylinder_half_width,
+                      hertz_cylinder_load)
 
 
 def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
     """The quarter-disc model of Hertz's cylinder in physical units."""
-    given = set() if given is None else given
-    R, E, nu = p["R"], p["E"], p["nu"]
-    E_star = E / (1.0 - nu ** 2)
-    target, delta = _load_choice(p, given)
-    if target is not None and "P" in given and p["P"] is not None:  # the mesh's a from the force
-        a_est = hertz_cylinder_half_width(target, R, E_star) / R  # in range: _load_choice
-    else:  # as given (not through P and back, which rounds differently for every E)
-        a_est = p["a_over_R"]
+    R = p["R"]
+    target, delta, a_est = _load_choice(p, set() if given is None else given)
     if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
         disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
     else:
@@ -110,7 +85,7 @@ def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) ->
     delta_nominal = delta if delta is not None else a_est ** 2 * R
     pushed, cut_load = disc_loading(disc, p["loading"], target)
     return SceneModel(
-        mesh=disc.mesh, E=E, nu=nu,
+        mesh=disc.mesh, E=p["E"], nu=p["nu"],
         dirichlet=[(0, disc.axis, 0.0), (1, pushed, -delta_nominal)],
         contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
         obstacle=FlatObstacle(0.0),

@@ -33,8 +33,10 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    grading_check,
+    candidates,
+    grading,
     hertz_record,
+    refinements,
     two_refinements_coarser,
 )
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice
@@ -50,12 +52,9 @@ from signorini.scenes.meshing import (
 PARAMS = COMMON_PARAMS + (
     Param("n_contact", 10, "elements across the contact radius (mesh fineness)", kind=int,
           check=at_least(3)),
-    Param("grading", 0.5, "growth of the element size with distance from the contact zone",
-          check=grading_check),
-    Param("candidates", 1.3, "contact candidates extend to this multiple of the contact radius",
-          check=at_least(1.2)),
-    Param("refine", 0, "uniform refinements of the graded mesh (each multiplies the dofs by "
-          "about 8)", kind=int, check=lambda k: None if 0 <= k <= 3 else "in 0..3"),
+    grading(0.5),
+    candidates("contact radius", 1.3),
+    refinements(3, "multiplies the dofs by about 8"),
     LOADING,
 )
 
@@ -68,9 +67,8 @@ REFERENCE = "hertz-3d"
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The quarter model of Hertz's sphere in physical units (z vertical, contact at the origin)."""
-    given = set() if given is None else given
     R = p["R"]
-    target, a_est = load_choice(p, given)
+    target, a_est = load_choice(p, set() if given is None else given)
     h_contact = a_est / p["n_contact"]
 
     def target_size(points: np.ndarray) -> np.ndarray:
@@ -116,8 +114,8 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
 #: n_contact 3..20 and a/R 0.01..0.2, 1.0 to 1.25 times their dofs
 OCTANT_FAR, OCTANT_SCALE, OCTANT_POWER = 100.0, 64.4, 0.915
 #: a uniform refinement of a tetrahedral mesh of N nodes multiplies them by 1 + edges / nodes,
-#: below OCTANT_REFINE[0] − OCTANT_REFINE[1] · N^(-1/3) (6.35 at 647 nodes, 6.63 at 2,428, 7.10
-#: at 19,168: the surface's nodes have fewer edges), and never more than 8
+#: below OCTANT_REFINE[0] − OCTANT_REFINE[1] · N^(-1/3) (the surface's nodes have fewer edges),
+#: and never more than 8
 OCTANT_REFINE = (7.7, 10.0)
 
 

@@ -25,27 +25,23 @@ rigid flat is the limit E2 → ∞, R2 → ∞.
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from signorini.references.analytic import hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.problem.model import ReferenceData
-from signorini.errors import InputError
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus
-from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Case, Param, SceneFamily, checked_ratio,
-                                   contact_ratio, length, one_of, positive)
+from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Case, Param, SceneFamily, SizeEstimate,
+                                   contact_ratio, hertz_load, length, one_of, positive)
 from signorini.scenes.hertz_cylinder import PARAMS as CYLINDER_PARAMS
 from signorini.scenes.hertz_cylinder import SIZE as ONE_DISC
 from signorini.scenes.meshing import GradedDisc, graded_quarter_disc
 from signorini.scenes.size import CountedSize
 from signorini.scenes.two_block_patch import DISCRETISATION, materials
 
-__all__ = ["FAMILY", "body", "disc", "pair_load_choice", "pair_modulus", "pair_radius"]
-
-#: the analytic reference (signorini.references.catalogue) this family's problems compare with
-REFERENCE = "hertz-2d"
+__all__ = ["CYLINDERS", "FAMILY", "HertzPair", "body", "disc", "pair_modulus", "pair_radius"]
 
 #: hertz-cylinder's parameters by name: its mesh parameters are this family's, for each disc,
 #: with a finer default (the two discs' errors add: docs/two-bodies.md)
@@ -87,29 +83,8 @@ def pair_modulus(p: dict[str, Any]) -> float:
     return series_modulus(p["E1"], p["nu1"], p["E2"], p["nu2"])
 
 
-def pair_load_choice(p: dict[str, Any], given: set[str], half_width: Any,
-                     load: Any) -> tuple[float | None, float | None]:
-    """The target load P (None: a prescribed push) and the push δ (None: matched to P), with
-    Hertz's ``half_width(P, R*, E*)`` and its inverse ``load(a, R*, E*)``."""
-    chosen = {name for name in given & {"P", "a_over_R", "delta"} if p[name] is not None}
-    if len(chosen) > 1:
-        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
-                         "give only one of P, a_over_R, delta")
-    R = pair_radius(p)
-    if "delta" in chosen:
-        return None, p["delta"]
-    if "P" in chosen:
-        checked_ratio(half_width(p["P"], R, pair_modulus(p)) / R, "P", p["P"])
-        return p["P"], None
-    return load(p["a_over_R"] * R, R, pair_modulus(p)), None
-
-
-def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
-    return pair_load_choice(p, given, hertz_cylinder_half_width, hertz_cylinder_load)
-
-
 def disc(p: dict[str, Any], radius: float, a: float, extent: float) -> GradedDisc:
-    """One cylinder's quarter disc of ``radius``, graded to the half-width ``a``, its contact
+    """One body's quarter disc of ``radius``, graded to the half-width ``a``, its contact
     candidates reaching ``extent`` times a."""
     return graded_quarter_disc(radius, a / radius, p["n_contact"], p["grading"], 0, extent,
                                mesher=p["mesher"])
@@ -117,9 +92,9 @@ def disc(p: dict[str, Any], radius: float, a: float, extent: float) -> GradedDis
 
 def body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str, upper: bool,
           traction: bool) -> Body:
-    """One cylinder: its quarter disc (mirrored below y = 0 for the lower one) held on its axis,
+    """One body: its quarter disc (mirrored below y = 0 for the lower one) held on its axis,
     its cut pushed by ``push`` (the lower one's: held), whole or at its centre node under a
-    traction towards the other cylinder."""
+    traction towards the other body."""
     mesh = disc.mesh
     if not upper:
         mesh = type(mesh)(mesh.p * np.array([[1.0], [-1.0]]), mesh.t[[0, 2, 1]])
@@ -130,38 +105,76 @@ def body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str, up
                 traction=(facets_on(mesh, disc.top), -1.0 if upper else 1.0) if traction else None)
 
 
-def build(p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
-    """The two quarter discs in physical units: upper (slave) on lower (master)."""
-    target, delta = _load_choice(p, set() if given is None else given)
-    R, E_star = pair_radius(p), pair_modulus(p)
-    a = hertz_cylinder_half_width(target, R, E_star) if target is not None else p["a_over_R"] * R
-    delta_nominal = delta if delta is not None else a * a / R
-    upper = disc(p, p["R1"], a, p["candidates"])
-    lower = disc(p, p["R2"], a, MASTER_REACH * p["candidates"])
-    traction = target is not None and p["loading"] == "traction"
-    params = dict(p, P=target, delta=delta_nominal, a_over_R=a / R if target is not None else None)
-    return TwoBodyModel(
-        slave=body(upper, p["E1"], p["nu1"], delta_nominal, p["volumetric"], True, traction),
-        master=body(lower, p["E2"], p["nu2"], 0.0, p["volumetric"], False, traction),
-        discretisation=p["discretisation"], length_scale=R, force_multiplicity=2.0,
-        reference=ReferenceData(REFERENCE, E_star=E_star, R=R), params=params,
-        target_load=target, predicted=lambda points: points[:, 0] < a,
-        direction=np.array([0.0, -1.0]) if p["normal"] == "vertical" else None)
+@dataclasses.dataclass(frozen=True)
+class HertzPair:
+    """Two elastic bodies of revolution or cylinders, each a quarter disc meshed on its own: what
+    differs between them is Hertz's ``half_width(P, R*, E*)`` and its inverse ``load(a, R*, E*)``,
+    the contact size ``pushed(δ, R*)`` a prescribed push grades the mesh for, one body's size
+    model ``one_body``, the reference, the copies ``multiplicity`` of the model in the pair and
+    whether it is axisymmetric."""
+
+    reference: str
+    half_width: Callable[[float, float, float], float]
+    load: Callable[[float, float, float], float]
+    pushed: Callable[[dict[str, Any], float, float], float]
+    one_body: SizeEstimate
+    multiplicity: float
+    axisymmetric: bool = False
+
+    def loads(self, p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
+        """The target load P (None: a prescribed push), the push δ (None: matched to P) and a/R*."""
+        return hertz_load(p, given, pair_radius(p), pair_modulus(p), self.half_width, self.load,
+                          check_delta=False)
+
+    def contact_size(self, p: dict[str, Any], target: float | None, delta: float | None) -> float:
+        """The contact half-width (radius) the discs are graded for."""
+        R = pair_radius(p)
+        return self.half_width(target, R, pair_modulus(p)) if target is not None else self.pushed(p, delta, R)
+
+    def build(self, p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
+        """The two quarter discs in physical units: upper (slave) on lower (master)."""
+        target, delta, _ = self.loads(p, set() if given is None else given)
+        R, E_star = pair_radius(p), pair_modulus(p)
+        a = self.contact_size(p, target, delta)
+        delta_nominal = delta if delta is not None else a * a / R
+        upper = disc(p, p["R1"], a, p["candidates"])
+        lower = disc(p, p["R2"], a, MASTER_REACH * p["candidates"])
+        traction = target is not None and p["loading"] == "traction"
+        params = dict(p, P=target, delta=delta_nominal, a_over_R=a / R if target is not None else None)
+        return TwoBodyModel(
+            slave=body(upper, p["E1"], p["nu1"], delta_nominal, p["volumetric"], True, traction),
+            master=body(lower, p["E2"], p["nu2"], 0.0, p["volumetric"], False, traction),
+            discretisation=p["discretisation"], length_scale=R, force_multiplicity=self.multiplicity,
+            reference=ReferenceData(self.reference, E_star=E_star, R=R), params=params,
+            target_load=target, predicted=lambda points: points[:, 0] < a,
+            direction=np.array([0.0, -1.0]) if p["normal"] == "vertical" else None,
+            axisymmetric=self.axisymmetric)
+
+    def mesh_dofs(self, p: dict[str, Any]) -> float:
+        """The dofs of the two graded discs: one body's size model for each."""
+        target, delta, _ = self.loads(p, set())
+        a = self.contact_size(p, target, delta)
+        return sum(self.one_body.graded({**p, "R": radius, "E": p["E1"], "nu": p["nu1"], "refine": 0,
+                                         "P": None, "delta": None, "a_over_R": a / radius})
+                   for radius in (p["R1"], p["R2"]))
+
+    def family(self, name: str, summary: str, params: tuple[Param, ...],
+               convergence_start: dict[str, Any]) -> SceneFamily:
+        """The scene family of this pair, validated on two unlike bodies on a coarse mesh: every
+        method of the suite, the dense ones too."""
+        return SceneFamily(
+            name=name, summary=summary, params=params, build=self.build, loads=self.loads,
+            reference=self.reference, size_model=CountedSize(self.mesh_dofs),
+            convergence_start=convergence_start,
+            validation=(Case(name, name, {"E2": 3.0, "nu2": 0.2, "R2": 2.0, "n_contact": 16,
+                                          "grading": 0.4}),))
 
 
-def mesh_dofs(p: dict[str, Any]) -> float:
-    """The dofs of the two graded discs: ``hertz-cylinder``'s size model for each."""
-    target, _ = _load_choice(p, set())
-    R = pair_radius(p)
-    a = hertz_cylinder_half_width(target, R, pair_modulus(p)) if target is not None else p["a_over_R"] * R
-    return sum(ONE_DISC.graded({**p, "P": None, "a_over_R": a / radius}) for radius in (p["R1"], p["R2"]))
+#: two cylinders: Hertz's plane-strain formulas (``hertz-2d``); a push grades for ``a_over_R``
+CYLINDERS = HertzPair("hertz-2d", hertz_cylinder_half_width, hertz_cylinder_load,
+                      lambda p, delta, R: p["a_over_R"] * R, ONE_DISC, 2.0)
 
-
-FAMILY = SceneFamily(
-    name="hertz-two-cylinders",
-    summary="two elastic cylinders in contact, plane strain, each quarter meshed on its own",
-    params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE,
-    size_model=CountedSize(mesh_dofs), convergence_start={"n_contact": 15, "grading": 0.6},
-    # unlike cylinders on a coarse mesh: every method of the suite, the dense ones too
-    validation=(Case("hertz-two-cylinders", "hertz-two-cylinders",
-                     {"E2": 3.0, "nu2": 0.2, "R2": 2.0, "n_contact": 16, "grading": 0.4}),))
+FAMILY = CYLINDERS.family(
+    "hertz-two-cylinders",
+    "two elastic cylinders in contact, plane strain, each quarter meshed on its own", PARAMS,
+    {"n_contact": 15, "grading": 0.6})

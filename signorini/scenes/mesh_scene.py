@@ -45,16 +45,20 @@ from signorini.paths import check_input_file
 from signorini.scenes.base import length, poisson_ratio
 from signorini.scenes.scene_toml import SceneFileContext
 
-__all__ = ["MESH_SCENE_KEYS", "MESH_SCENE_OVERRIDES", "MeshWithBoundaries", "mesh_scene", "read_mesh"]
+__all__ = ["MESH_SCENE_KEYS", "MESH_SCENE_OVERRIDES", "MeshWithBoundaries", "OBSTACLE_KEYS", "mesh_scene",
+           "read_mesh"]
 
+#: the keys each type of obstacle takes
+OBSTACLE_KEYS = {"flat": {"type", "height"}, "half-plane": {"type", "point", "normal"},
+                 "circle": {"type", "centre", "radius"},
+                 "punch": {"type", "half_width", "corner_radius", "height", "centre_x"}}
 #: the tables of a mesh scene and the keys each takes
 MESH_SCENE_KEYS = {
     "mesh": {"file", "length_scale"},
     "material": {"E", "nu", "volumetric"},
     "dirichlet": {"boundary", "component", "value"},
     "contact": {"boundary"},
-    "obstacle": {"type", "height", "point", "normal", "centre", "radius", "half_width",
-                 "corner_radius", "centre_x"},
+    "obstacle": set().union(*OBSTACLE_KEYS.values()),
     "load": {"boundary", "component", "multiplicity", "target"},
 }
 #: parameters of a mesh scene that ``--set`` may override, and where they live
@@ -222,14 +226,11 @@ def _boundary_nodes(ctx: SceneFileContext, mesh_info: MeshWithBoundaries, table:
 
 def _obstacle(ctx: SceneFileContext, content: dict[str, Any]) -> HalfPlane | Circle | FlatPunch:
     kind = content.get("type")
-    allowed = {"flat": {"type", "height"}, "half-plane": {"type", "point", "normal"},
-               "circle": {"type", "centre", "radius"},
-               "punch": {"type", "half_width", "corner_radius", "height", "centre_x"}}
-    if kind not in allowed:
-        raise ctx.error(f"must be one of {', '.join(allowed)}, got {kind!r}", "obstacle", "type")
-    extra = sorted(set(content) - allowed[kind])
+    if kind not in OBSTACLE_KEYS:
+        raise ctx.error(f"must be one of {', '.join(OBSTACLE_KEYS)}, got {kind!r}", "obstacle", "type")
+    extra = sorted(set(content) - OBSTACLE_KEYS[kind])
     if extra:
-        raise ctx.error(f"an obstacle of type {kind!r} takes {', '.join(sorted(allowed[kind]))}",
+        raise ctx.error(f"an obstacle of type {kind!r} takes {', '.join(sorted(OBSTACLE_KEYS[kind]))}",
                         "obstacle", extra[0])
     try:
         if kind == "flat":

@@ -36,6 +36,7 @@ from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import FlatPunch, Obstacle, ScaledQuery
 from signorini.fem.topology import facets_on
 from signorini.scenes.base import (
+    HALF,
     VOLUMETRIC,
     Case,
     Param,
@@ -43,32 +44,23 @@ from signorini.scenes.base import (
     at_least,
     between,
     block_size,
-    grading_check,
+    chosen_load,
+    grading,
     length,
     poisson_ratio,
     positive,
+    refinements,
     two_refinements_coarser,
 )
 from signorini.scenes.meshing import distance_to_segment, refine_to_size
 from signorini.scenes.size import SizeModel
 
-
-def _non_negative(x: float) -> str | None:
-    return None if x >= 0 else ">= 0"
-
-
-def _refinements(k: int) -> str | None:
-    return None if 0 <= k <= 6 else "in 0..6"
-
-
-def _flag(k: int) -> str | None:
-    return None if k in (0, 1) else "0 or 1"
-
+__all__ = ["FAMILY", "block_on_obstacle", "graded_half_block", "load_choice", "mirrored_about_x0"]
 
 PARAMS = (
     Param("a", 1.0, "half-width of the punch's flat face", check=length),
     Param("corner_radius", 0.0, "radius of the punch's rounded corners (0: sharp)",
-          check=_non_negative),
+          check=at_least(0.0)),
     Param("size", 20.0, "block half-width and height in units of a", check=block_size(2.0)),
     Param("E", 1.0, "Young's modulus of the block", check=positive),
     Param("nu", 0.3, "Poisson's ratio of the block", check=poisson_ratio),
@@ -81,30 +73,27 @@ PARAMS = (
           check=positive),
     Param("n_contact", 128, "elements across the punch half-width a (rounded up to a power of two)",
           kind=int, check=at_least(2)),
-    Param("grading", 0.2, "growth of the element size with distance from the contact zone",
-          check=grading_check),
-    Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
-          kind=int, check=_refinements),
-    Param("half", 1, "1: right half with a symmetry plane; 0: the whole width", kind=int,
-          check=_flag),
+    grading(0.2),
+    refinements(),
+    HALF,
 )
 
 
-def load_choice(p: dict[str, Any], given: set[str], length: float) -> tuple[float | None, float | None]:
+def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
     """The target load (None when δ is prescribed) and the prescribed δ (None when targeted).
 
-    One of ``P``, ``load_ratio`` (the default, ``P = load_ratio · E* · length``)
-    or ``delta`` sets the load.
+    One of ``P``, ``load_ratio`` (the default, ``P = load_ratio · E* · a``)
+    or ``delta`` sets the load, once the corners fit in the block.
     """
-    chosen = {name for name in given & {"P", "load_ratio", "delta"} if p[name] is not None}
-    if len(chosen) > 1:
-        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
-                         "give only one of P, load_ratio, delta")
+    if p["corner_radius"] > 0.5 * p["size"] * p["a"]:
+        raise InputError(f"scene parameter corner_radius={p['corner_radius']:g} must be less than "
+                         f"half the block (size · a / 2 = {0.5 * p['size'] * p['a']:g})")
+    chosen = chosen_load(p, given, ("P", "load_ratio", "delta"))
     if "delta" in chosen:
         return None, p["delta"]
     if "P" in chosen:
         return p["P"], None
-    return p["load_ratio"] * contact_modulus(p["E"], p["nu"]) * length, None
+    return p["load_ratio"] * contact_modulus(p["E"], p["nu"]) * p["a"], None
 
 
 def _coarse_coordinates(zone: float, extent: float) -> np.ndarray:
@@ -158,18 +147,28 @@ def mirrored_about_x0(mesh: MeshTri) -> MeshTri:
     return MeshTri(points, np.hstack([t, mirror_t]))
 
 
-def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidate_end: float,
-                         half: bool, obstacle: Obstacle, E: float, nu: float, delta_nominal: float,
-                         target: float | None, params: dict[str, Any],
-                         reference: ReferenceData) -> SceneModel:
-    """A block (half or whole) whose bottom y = 0 is the contact candidate, pushed down at the top.
+def block_on_obstacle(p: dict[str, Any], *, scale: float, fine_end: float, candidate_end: float,
+                      obstacle: Obstacle, target: float | None, delta: float | None,
+                      indentation: float, params: dict[str, Any],
+                      reference: ReferenceData) -> SceneModel:
+    """A block (half or whole, ``p["half"]``) whose bottom y = 0 is the contact candidate, pushed
+    down at the top: :func:`graded_half_block` of the scene's ``size``, ``n_contact``,
+    ``grading`` and ``refine``, towards ``[0, fine_end]``.
 
-    ``mesh``, ``height`` and ``candidate_end`` are in units of ``scale``; the
-    model (and ``obstacle``) are in physical units. The candidates are the
-    bottom nodes with ``|x| ≤ candidate_end``, sorted by x. ``params`` are the
-    scene's parameters as its problem reports them, ``reference`` what its
-    analytic reference reads.
+    ``fine_end`` and ``candidate_end`` are in units of ``scale``; the model (and ``obstacle``)
+    are in physical units. The candidates are the bottom nodes with ``|x| ≤ candidate_end``,
+    sorted by x. Without a prescribed ``delta``, the first guess of the push is the block's
+    compression plus an indentation, ``P/E* · (1/(2 size) + indentation)``. ``params`` are the
+    scene's parameters as its problem reports them, ``reference`` what its analytic reference
+    reads.
     """
+    height = p["size"]
+    mesh = graded_half_block(height, height, fine_end, p["n_contact"], p["grading"], p["refine"],
+                             kinks=(candidate_end,))
+    if not p["half"]:
+        mesh = mirrored_about_x0(mesh)
+    delta_nominal = delta if delta is not None else \
+        (target / contact_modulus(p["E"], p["nu"])) * (1.0 / (2.0 * height) + indentation)
     x, y = mesh.p
     tol = 1e-12 * height
     bottom = np.nonzero(np.abs(y) <= tol)[0]
@@ -177,49 +176,32 @@ def bottom_contact_model(mesh: MeshTri, *, scale: float, height: float, candidat
     bottom_facets = facets_on(mesh, bottom)
     candidates = bottom[np.abs(x[bottom]) <= candidate_end * (1 + 1e-9)]
     candidates = candidates[np.argsort(x[candidates], kind="stable")]
-    if half:
+    if p["half"]:
         dirichlet = [(0, np.nonzero(np.abs(x) <= tol)[0], 0.0), (1, top, -delta_nominal)]
     else:
         centre = top[np.argmin(np.abs(x[top]))]
         dirichlet = [(0, np.array([centre]), 0.0), (1, top, -delta_nominal)]
     mesh = MeshTri(mesh.p * scale, mesh.t)
     return SceneModel(
-        mesh=mesh, E=E, nu=nu, dirichlet=dirichlet, contact_nodes=candidates,
+        mesh=mesh, E=p["E"], nu=p["nu"], dirichlet=dirichlet, contact_nodes=candidates,
         contact_facets=bottom_facets,
         obstacle=ScaledQuery(obstacle, mesh.p[:, candidates].T, scale),
-        load_dofs=(1, top), length_scale=scale, force_multiplicity=2.0 if half else 1.0,
+        load_dofs=(1, top), length_scale=scale, force_multiplicity=2.0 if p["half"] else 1.0,
         target_load=target, params=params, volumetric_choice=params["volumetric"],
         delta=delta_nominal, reference=reference)
 
 
-def checked_load(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None]:
-    """:func:`load_choice` for the punch's half-width, once the corners fit in the block."""
-    if p["corner_radius"] > 0.5 * p["size"] * p["a"]:
-        raise InputError(f"scene parameter corner_radius={p['corner_radius']:g} must be less than "
-                         f"half the block (size · a / 2 = {0.5 * p['size'] * p['a']:g})")
-    return load_choice(p, given, p["a"])
-
-
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The punch scene in physical units."""
-    given = set() if given is None else given
     a, r = p["a"], p["corner_radius"]
-    target, delta = checked_load(p, given)
+    target, delta = load_choice(p, set() if given is None else given)
     E_star = contact_modulus(p["E"], p["nu"])
     zone = 1.0 + r / a
-    mesh = graded_half_block(p["size"], p["size"], zone, p["n_contact"], p["grading"], p["refine"])
-    if not p["half"]:
-        mesh = mirrored_about_x0(mesh)
-    # a first guess of δ for the calibration: the block's compression plus an indentation
-    delta_nominal = delta if delta is not None else \
-        (target / E_star) * (1.0 / (2 * p["size"]) + 1.0 / np.pi)
-    params = dict(p)
-    params.update(P=target, delta=delta, load_ratio=None if target is None
-                  else target / (E_star * a))
-    return bottom_contact_model(
-        mesh, scale=a, height=p["size"], candidate_end=zone, half=bool(p["half"]),
-        obstacle=FlatPunch(half_width=a, corner_radius=r), E=p["E"], nu=p["nu"],
-        delta_nominal=delta_nominal, target=target, params=params,
+    params = dict(p, P=target, delta=delta, load_ratio=None if target is None else target / (E_star * a))
+    return block_on_obstacle(
+        p, scale=a, fine_end=zone, candidate_end=zone,
+        obstacle=FlatPunch(half_width=a, corner_radius=r), target=target, delta=delta,
+        indentation=1.0 / np.pi, params=params,
         reference=ReferenceData(REFERENCE, E_star=E_star, a=a, corner_radius=r))
 
 
@@ -230,7 +212,7 @@ REFERENCE = "punch"
 FAMILY = SceneFamily(
     name="punch",
     summary="rigid flat punch (sharp or rounded corners) pressed into an elastic block, plane strain",
-    params=PARAMS, build=build, loads=checked_load, reference=REFERENCE,
+    params=PARAMS, build=build, loads=load_choice, reference=REFERENCE,
     # the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
     size_model=SizeModel(7948, 128, 0.2, uniform=6082.0, alpha=0.55, beta=1.5, far_field=1200.0,
                          margin=1.13, block=True),

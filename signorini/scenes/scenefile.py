@@ -48,7 +48,10 @@ def build_scene_model(path: str | Path,
     data, ctx = read_scene_file(path)
     overrides = dict(overrides or {})
     if "scene" in data:
-        return _family_scene(data, ctx, overrides)
+        name, values = _family_values(data, ctx, overrides)
+        params = SCENES[name].parse(values)
+        check_size(name, params)  # too big for this machine: refused before meshing, as by name
+        return name, SCENES[name].build(params, set(values))
     if "mesh" in data and isinstance(data["mesh"], dict) and "file" in data["mesh"]:
         return f"file:{ctx.path}", mesh_scene(data, ctx, overrides)
     raise ctx.error("the file needs either scene = \"<family>\" (see 'signorini scenes') "
@@ -64,15 +67,6 @@ def family_scene_values(path: str | Path,
     a mesh scene): what :func:`build_scene_model` builds, for callers that build it themselves."""
     data, ctx = read_scene_file(path)
     return _family_values(data, ctx, dict(overrides or {})) if "scene" in data else None
-
-
-def _family_scene(data: dict[str, Any], ctx: SceneFileContext,
-                  overrides: dict[str, Any]) -> tuple[str, SceneModel]:
-    name, values = _family_values(data, ctx, overrides)
-    family = SCENES[name]
-    params = family.parse(values)
-    check_size(name, params)  # too big for this machine: refused before meshing, as by name
-    return name, family.build(params, set(values))
 
 
 def _family_values(data: dict[str, Any], ctx: SceneFileContext,

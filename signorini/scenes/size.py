@@ -1,23 +1,12 @@
 """A scene's size before it is meshed: estimated dofs and memory, refused above what the machine holds.
 
-Each family's dofs are estimated from its parameters, bounding the mesh it
-builds from above (tests/test_size_guard.py holds each estimate between 1 and
-1.3 times the dofs built over grading 0.05..2, n_contact and refine;
-tests/test_scene_size.py within a factor 1.5 over the parameters' ranges). A 2D family's model,
-calibrated on its own default mesh (:class:`SizeModel`):
-
-    dofs ≈ m · [b + (dofs₀ − b) · (n_contact / n₀)^α · (grading₀ / grading)^β
-            · (1 + ¼ ln(a₀ / a))] · 4^refine
-
-(α, β, the far field b that every mesh has and the margin m fitted per
-family: each family's ``size_model``, :data:`SIZE_MODELS` by name; a the
-contact ratio the mesh is graded for, from
-the load; n_contact rounded up to a power of two and doubled with ``half=0``
-for the half-block meshes), but never more than the uniform mesh at the
-contact's element size, ``c · (n_contact / (a/R))^d · 2^(d · refine)`` (c
-per family); the 3D octant from the number of tetrahedra its target element size asks
-for (:class:`signorini.scenes.hertz_sphere_3d.GradedOctant`). The block's dofs are counted
-exactly (:class:`CountedSize`).
+Each family's ``size_model`` (:data:`SIZE_MODELS` by name) estimates its dofs from its
+parameters, bounding the mesh it builds from above (tests/test_size_guard.py holds each estimate
+between 1 and 1.3 times the dofs built over grading 0.05..2, n_contact and refine;
+tests/test_scene_size.py within a factor 1.5 over the parameters' ranges): a 2D graded mesh by
+:class:`SizeModel`, the 3D octant from the number of tetrahedra its target element size asks for
+(:class:`signorini.scenes.hertz_sphere_3d.GradedOctant`), a structured mesh counted exactly
+(:class:`CountedSize`).
 
 Memory is the peak resident size of building the scene and solving it, in
 bytes per dof: :data:`BYTES_PER_DOF` with a factorising method;
@@ -103,15 +92,22 @@ def _plain_bytes_per_dof(dim: int, dofs: float, params: dict[str, Any],
 #: grading 0.05..2 its meshes had up to 1.18 times the nodes of the relaxed mesh of the same
 #: parameters (more where the grading is fine or coarse, fewer between; docs/calibration.md)
 TRIANGLE_DOFS = 1.2
-#: a half-block's far field per unit of ln(size / 20): punch size=200 built 11,732 dofs, 7,948 at 20
+#: a half-block's far field per unit of ln(size / 20) (docs/calibration.md)
 BLOCK_FAR_GROWTH = 1.4
 
 
 @dataclass(frozen=True)
 class SizeModel:
-    """A 2D family's default mesh and how its dofs grow with the mesh parameters: the far field
-    ``far_field``, the exponents ``alpha`` (n_contact) and ``beta`` (grading), and ``margin``
-    that lifts the estimate over every mesh measured (see :data:`SIZE_MODELS`)."""
+    """A 2D family's default mesh (``dofs`` at ``n_contact``, ``grading`` and ``a_over_R``) and how
+    its dofs grow, calibrated per family (docs/calibration.md)::
+
+        dofs ≈ m · [b + (dofs₀ − b) · (n_contact / n₀)^α · (grading₀ / grading)^β
+                · (1 + ¼ ln(a₀ / a))] · 4^refine
+
+    with α ``alpha``, β ``beta``, the far field b ``far_field`` that every mesh has and m the
+    ``margin`` that lifts the estimate over every mesh measured; a the contact ratio the mesh is
+    graded for, from the load. Never more than the uniform mesh at the contact's element size,
+    ``uniform · (n_contact / a)^d · 2^(d · refine)``."""
 
     dofs: float
     n_contact: float

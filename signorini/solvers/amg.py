@@ -1,44 +1,32 @@
 """Exact contact without a factorisation: PDAS with CG + algebraic multigrid (``pdas-amg``).
 
-The primal-dual active set / semismooth Newton iteration of :mod:`~signorini.solvers.pdas`
-(Hintermüller, Ito & Kunisch 2002) on the bound form of the problem
-(:mod:`~signorini.solvers.bounds`: each contact row one bound ``aᵢ v_j ≤ dᵢ``
-on the node's rotated dofs, prescribed dofs kept as fixed rows so that node
-blocks stay whole). An active set pins its bounded dofs at ``dᵢ/aᵢ``; the
-pinned SPD system is solved by conjugate gradients preconditioned with
-algebraic multigrid given the rigid-body modes as near-null space
+The primal-dual active set iteration of :mod:`~signorini.solvers.pdas` on the bound form of the
+problem (:mod:`~signorini.solvers.bounds`: each contact row one bound ``aᵢ v_j ≤ dᵢ`` on the
+node's rotated dofs, prescribed dofs kept as fixed rows so that node blocks stay whole). An
+active set pins its bounded dofs at ``dᵢ/aᵢ``; the pinned SPD system is solved by CG
+preconditioned with algebraic multigrid, the rigid-body modes as near-null space
 (:mod:`signorini.numerics.multigrid`), never factorised. Then:
 
-- the first active set is given (``active0``: ``signorini.solve`` passes the
-  candidates inside the reference's contact radius when the scene has one at its
-  target load, Hertz's, else the set a coarser model of the scene predicts), or
-  comes from a warm start's forces or from a coarse QP (``coarse``), so that few
-  steps remain;
-- a target load that is still pending (``problem.model.pending``: load control,
-  :mod:`signorini.load_control`, leaves it to this method: ``Method.matches_load``) is
-  matched with the answer: the push is one more unknown of every CG system, preconditioned
-  by block elimination (:mod:`signorini.solvers.load_border`), so no factorisation of K is
-  ever made; the push found is ``solution.extras["push"]`` (``push0`` the first guess);
-- **one hierarchy** is built, for K with the first active set pinned; later
-  sets differ in a few rows and CG pays for them in iterations;
-- CG starts from the last step's displacement, and its tolerance follows
-  Eisenstat & Walker (1996, choice 2) while the active set still moves:
-  ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²``, ``γ = 0.9``, in [:data:`ETA_MIN`, :data:`ETA_MAX`]:
-  the first solve, from far, at ETA_MIN; the ratio against it would hold every
-  later step there, so the second step starts the sequence again at ETA_MAX;
-- when the set repeats, CG is driven to a stationarity residual of
-  :data:`SAFETY` · tol against the contact forces, and the method stops only
-  when the package's certificate (:func:`signorini.certification.kkt.certificate`) is within
-  ``tol``; the duality gap is then computed with this method's own
-  AMG-preconditioned solver for K with the final set pinned
-  (:class:`~signorini.solvers.amg_system.PinnedCG`),
-  not a serial factorisation.
+- the first active set is given (``active0``: ``signorini.solve`` passes the scene's
+  prediction), or comes from a warm start's forces or from a coarse QP (``coarse``);
+- a pending target load (``problem.model.pending``, left to this method by load control:
+  ``Method.matches_load``) is matched with the answer: the push is one more unknown of every
+  CG system (:class:`~signorini.solvers.amg_system.LoadBorder`); the push found is
+  ``solution.extras["push"]`` (``push0`` the first guess);
+- **one hierarchy** is built, for K with the first active set pinned; later sets differ in a
+  few rows and CG pays for them in iterations;
+- CG starts from the last step's displacement, and its tolerance follows Eisenstat & Walker
+  (1996, choice 2) while the active set still moves: ``η_k = γ (‖r₀,k‖/‖r₀,k−1‖)²`` in
+  [:data:`ETA_MIN`, :data:`ETA_MAX`], the first solve at ETA_MIN and the second starting the
+  sequence again at ETA_MAX;
+- when the set repeats, CG is driven to a stationarity residual of :data:`SAFETY` · tol against
+  the contact forces, and the method stops only when the package's certificate is within
+  ``tol``; the duality gap is computed with this method's own multigrid solver for K with the
+  final set pinned (:class:`~signorini.solvers.amg_system.PinnedCG`).
 
-Multigrid: ``amg=petsc`` (PETSc's GAMG, plain aggregation, through petsc4py,
-set up by :data:`~signorini.solvers.amg_system.GAMG_OPTIONS`), ``amg=pyamg`` (smoothed aggregation) or
-``auto``: GAMG when petsc4py is installed. One set-up and a CG solve to 1e-10
-of the 350k-dof pushed ``hertz-sphere-3d``'s K, each way, are in docs/amg/bench.md
-(``tools/amg_bench.py run --part backends``).
+Multigrid: ``amg=petsc`` (PETSc's GAMG through petsc4py,
+:data:`~signorini.solvers.amg_system.GAMG_OPTIONS`), ``amg=pyamg`` (smoothed aggregation) or
+``auto``: GAMG when petsc4py is installed (docs/amg/bench.md compares them).
 """
 
 from __future__ import annotations
@@ -57,17 +45,19 @@ from signorini.numerics.zone import predict_zone
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import pdas
 from signorini.solvers.bounds import NoBoundForm, bound_form
-from signorini.solvers.amg_system import CG_MAX_ITER, PinnedCG, PinnedSystem
-from signorini.solvers.load_border import Unknowns, border_factor, load_border, rotated
+from signorini.solvers.amg_system import (CG_MAX_ITER, PinnedCG, PinnedSystem, Unknowns,
+                                          border_factor, load_border, rotated)
+from signorini.problem.solution import WarmStart
 from signorini.solvers.base import Method
-from signorini.solvers.options import resolved
-from signorini.solvers.options import positive_number, take_options
+from signorini.solvers.options import Option, declare, per_candidate, resolved, take_options
 
 log = logging.getLogger(__name__)
 
-AMG_CHOICES = ("auto", "petsc", "pyamg")
-DEFAULTS = {"amg": "auto", "c": 1.0, "active0": None, "coarse": None, "callback": None,
-            "warm_start": None, "push0": None}
+DEFAULTS = declare(
+    Option("amg", "choice", "auto", choices=("auto", "petsc", "pyamg")), Option("c", "positive", 1.0),
+    Option("active0", "vector"), Option("coarse", "object", types=(ContactProblem,)),
+    Option("callback", "callable"), Option("warm_start", "object", types=(WarmStart,)),
+    Option("push0", "number"))
 #: stationarity is driven to SAFETY · tol so that the certificate's other residuals have room
 SAFETY = 0.1
 #: Eisenstat–Walker: γ, the exponent, the largest and smallest forcing terms (the first step's
@@ -83,10 +73,7 @@ MAX_CYCLES = 2
 def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.ndarray, str]:
     """The first active set and where it came from."""
     if opts["active0"] is not None:
-        active = np.asarray(opts["active0"], dtype=bool)
-        if active.shape != (problem.m,):
-            raise InputError(f"method 'pdas-amg': option active0 must be {problem.m} booleans")
-        return active, "given"
+        return per_candidate("pdas-amg", "active0", opts["active0"], problem.m) != 0, "given"
     warm = opts["warm_start"]
     if warm is not None and warm.lam is not None:
         return warm.lam > 0, "the warm start"
@@ -96,8 +83,8 @@ def _initial_active(problem: ContactProblem, opts: dict[str, Any]) -> tuple[np.n
     if coarse.model.pending:
         raise InputError("method 'pdas-amg': option coarse must be a problem at its load (its "
                          "target is not matched yet: signorini.load_control.match(coarse).problem)")
-    solution = pdas.solve(coarse) if coarse.n < DIRECT_BELOW else solve(coarse,
-                                                                        amg=opts["amg"])
+    solution = pdas.pdas(coarse) if coarse.n < DIRECT_BELOW else pdas_amg(coarse,
+                                                                           amg=opts["amg"])
     if solution.status != "converged":
         return np.zeros(problem.m, dtype=bool), "none (the coarse model did not solve)"
     zone = predict_zone(problem.contact_points, coarse.contact_points, solution.lam > 0,
@@ -115,14 +102,11 @@ def _forcing(eta: float, r0: float, r0_last: float | None) -> float:
     return min(max(new, ETA_MIN), ETA_MAX)
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def pdas_amg(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """PDAS with each pinned system solved by CG + algebraic multigrid (see module doc)."""
     opts = take_options("pdas-amg", options, DEFAULTS)
-    if opts["amg"] not in AMG_CHOICES:
-        raise InputError(f"method 'pdas-amg': option amg={opts['amg']!r} is not one of "
-                         f"{', '.join(AMG_CHOICES)}")
-    c = positive_number("pdas-amg", "c", opts["c"])
+    c = opts["c"]
     tol, max_iter = resolved("pdas-amg", "active set", tol, max_iter)
     start = time.perf_counter()
     if problem.model.pending and border_factor(problem) is None:
@@ -223,19 +207,18 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     if unknowns.push is not None:
         extras["push"] = unknowns.push
         message += "; the load matched with the push as one more unknown (no factorisation)"
-    solution = ContactSolution(
+    return ContactSolution(
         method="pdas-amg", u=u, lam=lam, status=status,
         message=(f"{message}; first active set from {source}; one {hierarchy.backend} hierarchy "
                  f"({hierarchy.setup_s:.2f} s), {cg_iterations} CG iterations"),
         iterations=step, build_time=build_time, solve_time=time.perf_counter() - start - build_time,
         history=history, extras=extras, factor=PinnedCG(unknowns.at_push(problem), system, active))
-    return solution
 
 
 METHODS = (
-    Method(name="pdas-amg", function=solve, family="active set", exact=True,
+    Method(name="pdas-amg", function=pdas_amg, family="active set", exact=True,
            summary="PDAS with CG + algebraic multigrid (one hierarchy), no factorisation: large 3D",
-           requires=("pyamg",), extra="", options=tuple(DEFAULTS),
+           requires=("pyamg",), extra="", typed_options=DEFAULTS,
            matches_load=lambda problem: border_factor(problem) is not None,
            prediction="active set", bound_rows=True, factor_free_from=0),
 )

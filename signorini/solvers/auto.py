@@ -1,20 +1,15 @@
 """``auto``: the method picked from the problem's dimension, size, warm start and backends.
 
-- a warm start holding a factorisation of K around the contact zone (load
-  control leaves one, :mod:`signorini.load_control`): ``nested``, which reuses
-  it and costs back-solves only;
-- 2D and axisymmetric models: ``pdas`` (exact; sparse factorisations of a 2D
-  stiffness barely fill in);
-- 3D models from :data:`AMG_FROM_DOFS` dofs (:data:`PUSHED_AMG_FROM_DOFS`
-  when no load control precedes the method): ``pdas-amg`` (CG + algebraic
-  multigrid, no factorisation: 3D factors fill in like n^(4/3)), when pyamg
-  is installed and every contact row bounds its own dofs (rows sharing a dof
-  have no bound form); otherwise ``pdas``.
+- a warm start holding a factorisation of K around the contact zone (load control leaves
+  one): ``nested``, which reuses it and costs back-solves only;
+- 2D and axisymmetric models: ``pdas`` (a 2D stiffness barely fills in);
+- 3D models from :data:`AMG_FROM_DOFS` dofs (:data:`PUSHED_AMG_FROM_DOFS` when no load control
+  precedes the method): ``pdas-amg`` (no factorisation: 3D factors fill in like n^(4/3)), when
+  pyamg is installed and no two contact rows share a dof; otherwise ``pdas``.
 
-The chosen method's name is the solution's ``method``; ``extras["auto"]``
-and the message say what was picked and why. Options and the warm start
-are passed on to the chosen method. The thresholds were chosen from
-measurements on the Hertz sphere (docs/amg.md).
+The chosen method's name is the solution's ``method``; ``extras["auto"]`` and the message say
+what was picked and why; options and the warm start go to the chosen method. The thresholds
+were chosen on the Hertz sphere (docs/amg.md).
 """
 
 from __future__ import annotations
@@ -28,7 +23,7 @@ from signorini.numerics.multigrid import AMG_FROM_DOFS
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
 from signorini.solvers import amg, nested, pdas
-from signorini.solvers.base import Method
+from signorini.solvers.base import Method, rows_share_dofs
 
 #: a 3D model with a mesh and nothing to match (a push) goes to pdas-amg from this many dofs
 PUSHED_AMG_FROM_DOFS = 10_000
@@ -41,11 +36,6 @@ def dimension(problem: ContactProblem) -> int:
     if problem.model.mesh is not None:
         return int(problem.model.mesh.p.shape[0])
     return int(np.atleast_2d(problem.contact_points).shape[1])
-
-
-def _rows_share_a_dof(problem: ContactProblem) -> bool:
-    N = problem.N.tocsr()
-    return bool(N.nnz and np.bincount(N.indices[N.data != 0], minlength=problem.n).max() > 1)
 
 
 def choose(problem: ContactProblem, options: Any = (),
@@ -67,13 +57,13 @@ def choose(problem: ContactProblem, options: Any = (),
         return "pdas", f"3D model of {n:,} dofs < {least:,}: pdas (a factorisation is cheap)"
     if importlib.util.find_spec("pyamg") is None:
         return "pdas", f"3D model of {n:,} dofs, but pyamg is not installed (pip install pyamg): pdas"
-    if _rows_share_a_dof(problem):
+    if rows_share_dofs(problem.N):
         return "pdas", f"3D model of {n:,} dofs whose contact rows share dofs (no bound form): pdas"
     return "pdas-amg", (f"3D model of {n:,} dofs ≥ {least:,}: pdas-amg "
                         "(CG + multigrid, no factorisation to fill in)")
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def auto(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Solve with the method :func:`choose` picks; say which and why."""
     name, why = choose(problem, options, options.get("warm_start"))
@@ -87,11 +77,11 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="auto", function=solve, family="auto", exact=True,
+    Method(name="auto", function=auto, family="auto", exact=True,
            summary="picks nested (K factorised by load control), pdas (2D, small 3D) or pdas-amg "
                    "(large 3D) and says why",
            warm_from_load=True, factor_free_from=AMG_FROM_DOFS,
            chooses=lambda problem, options, warm_start: CHOICES[choose(problem, options,
                                                                        warm_start)[0]],
-           options=tuple(sorted(set(pdas.DEFAULTS) | set(amg.DEFAULTS) | set(nested.DEFAULTS)))),
+           typed_options={**nested.DEFAULTS, **amg.DEFAULTS, **pdas.DEFAULTS}),
 )

@@ -24,7 +24,7 @@ from signorini.errors import InputError, install_hint
 from signorini.certification.kkt import Certificate, certificate, shortfall
 from signorini.problem.contact import STATUSES, ContactProblem, ContactSolution
 from signorini.solvers.options import (DEFAULT_TOL, MIN_TOL, Defaults, Option, check_names,
-                                       defaults_of, guess_value, resolved)
+                                       checked, defaults_of, finite_number, guess_value, resolved)
 
 SolverFunction = Callable[..., ContactSolution]
 
@@ -44,34 +44,26 @@ def acceptance(tol: float | None) -> float:
 class Method:
     """A registered method.
 
-    ``requires`` lists the Python modules it imports; ``extra`` is the
-    pip extra that installs them. ``dense`` methods build dense matrices and
-    refuse problems above ``max_dense_dofs``. ``exact`` methods reach the
-    answer up to round-off when they converge. ``options`` names the options
-    it takes; its :attr:`defaults` (the row of :mod:`signorini.solvers.options`) are the
-    tolerance it runs at and is held to when none is asked for and its iteration limit;
-    ``typed_options`` declares their kinds and ranges
-    (:class:`signorini.solvers.options.Option`), so that :meth:`check_options`
-    refuses a bad value before any work.
+    ``requires`` lists the Python modules it imports and ``extra`` the pip extra that installs
+    them. ``dense`` methods build dense matrices; ``exact`` ones reach the answer up to
+    round-off when they converge. ``typed_options`` declares the options it takes, their kinds
+    and ranges (:class:`~signorini.solvers.options.Option`: :meth:`check_options` refuses a
+    bad value before any work); :attr:`defaults` is its row of
+    :data:`~signorini.solvers.options.TABLE`, the ``tol`` and ``max_iter`` it runs at when none
+    is asked for.
 
-    What it offers load control (:mod:`signorini.load_control`), which asks and
-    never branches on a name: ``matches_load(problem)`` says it matches that
-    problem's pending target load itself (``problem.model.pending``; e.g. the push as
-    a bordered unknown), any other problem is matched first; ``prediction``
-    the kind of prediction of the contact it takes from the scene (``"zone"``:
-    the option ``zone``; ``"active set"``: ``active0``, and ``push0`` for a
-    pending load); ``warm_from_load`` that it takes load control's answer as
-    its warm start (else it starts cold). ``chooses(problem, options,
-    warm_start)`` returns the method it runs instead (a method that picks one),
-    whose capabilities are then the ones asked (:meth:`runs`). A ``scaled`` method is
-    handed a view of the problem in units that make its numbers of order one (its answer
-    mapped back to the problem's units before it is judged); a method that is not scaled (a
-    user's) is handed the problem as it was given. A ``bound_rows`` method takes each contact
-    row as a bound on dofs of its own (:mod:`signorini.solvers.bounds`): it refuses, by
-    :meth:`check_rows`, a problem whose rows share a dof (two bodies' rows on the master's
-    dofs, obstacles that meet at a node). ``factor_free_from`` is the size (dofs) from which it
-    solves a 3D model with a target load without any factorisation (None: it factorises at
-    every size), which a scene's memory estimate reads (:mod:`signorini.scenes.size`).
+    What it offers load control, which asks and never branches on a name:
+    ``matches_load(problem)``, that it matches that problem's pending target load itself (the
+    push as a bordered unknown); ``prediction``, the kind of prediction of the contact it takes
+    from the scene (``"zone"``: the option ``zone``; ``"active set"``: ``active0``, and
+    ``push0`` for a pending load); ``warm_from_load``, that it takes load control's answer as
+    its warm start. ``chooses(problem, options, warm_start)`` returns the method it runs
+    instead (:meth:`runs`). A ``scaled`` method is handed a view of the problem in units of
+    order one, its answer mapped back before it is judged; a user's is not. A ``bound_rows``
+    method takes each contact row as a bound on dofs of its own and refuses rows that share a
+    dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
+    model with a target load without a factorisation (None: never), for a scene's memory
+    estimate (:mod:`signorini.scenes.size`).
     """
 
     name: str
@@ -82,7 +74,6 @@ class Method:
     dense: bool = False
     exact: bool = False
     family: str = ""
-    options: tuple[str, ...] = field(default=())
     typed_options: Mapping[str, Option] = field(default_factory=dict)
     matches_load: Callable[[ContactProblem], bool] | None = None
     prediction: str = ""
@@ -91,6 +82,11 @@ class Method:
     scaled: bool = True
     bound_rows: bool = False
     factor_free_from: float | None = None
+
+    @property
+    def options(self) -> tuple[str, ...]:
+        """The names of the options it takes."""
+        return tuple(self.typed_options)
 
     @property
     def defaults(self) -> Defaults:
@@ -132,24 +128,16 @@ class Method:
         return self.matches_load is not None and bool(self.matches_load(problem))
 
     def check_options(self, given: Mapping[str, Any]) -> dict[str, Any]:
-        """``given`` with every declared option checked and converted; InputError otherwise.
-
-        Unknown names are refused for every method that lists its options (a
-        user's method lists none and takes what its function takes).
-        """
-        if self.family == "user":
-            return dict(given)
-        check_names(self.name, given, self.options)
-        return {name: self.typed_options[name].check(self.name, value)
-                if name in self.typed_options else value for name, value in given.items()}
+        """``given`` with every declared option checked and converted; InputError otherwise (a
+        user's method declares none and takes what its function takes)."""
+        return dict(given) if self.family == "user" else checked(self.name, given, self.typed_options)
 
     def parse_options(self, texts: Mapping[str, str]) -> dict[str, Any]:
         """``--opt name=text`` pairs read as each option's declared kind, and checked."""
-        if self.family != "user":
-            check_names(self.name, texts, self.options)
-        return {name: self.typed_options[name].parse(self.name, text)
-                if name in self.typed_options else guess_value(text)
-                for name, text in texts.items()}
+        if self.family == "user":
+            return {name: guess_value(text) for name, text in texts.items()}
+        check_names(self.name, texts, self.typed_options)
+        return {name: self.typed_options[name].parse(self.name, text) for name, text in texts.items()}
 
 
 def rows_share_dofs(N: Any) -> bool:
@@ -163,13 +151,13 @@ def check_tol(tol: Any, name: str = "tol") -> float | None:
     """``tol`` as a float, or InputError naming ``name`` (the API's argument or the CLI's option)."""
     if tol is None:
         return None
-    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
-            or not (np.isfinite(tol) and 0 < tol < 1):
+    number = finite_number(tol)
+    if number is None or not 0 < number < 1:
         raise InputError(f"{name} must be a number in (0, 1), got {tol!r}: e.g. {name} 1e-9")
-    if tol < MIN_TOL:
+    if number < MIN_TOL:
         raise InputError(f"{name} {tol:g} is below what double precision can certify (relative "
                          f"residuals of order 1e-16 times the conditioning): give {name} ≥ {MIN_TOL:g}")
-    return float(tol)
+    return number
 
 
 #: the largest iteration limit: every backend's counter holds it (a C int)
@@ -177,15 +165,14 @@ MAX_ITER = 2 ** 31 - 1
 
 
 def check_max_iter(max_iter: Any) -> int | None:
+    """``max_iter`` as an int in [1, :data:`MAX_ITER`], or InputError."""
     if max_iter is None:
         return None
-    ok = isinstance(max_iter, (int, np.integer)) and not isinstance(max_iter, bool)
-    ok = ok or (isinstance(max_iter, (float, np.floating)) and np.isfinite(max_iter)
-                and float(max_iter).is_integer())
-    if not ok or not 1 <= max_iter <= MAX_ITER:
+    number = finite_number(max_iter)
+    if number is None or not number.is_integer() or not 1 <= number <= MAX_ITER:
         raise InputError(f"max_iter must be a positive integer up to {MAX_ITER} (2³¹ − 1, what "
                          f"every backend's counter holds), got {max_iter!r}")
-    return int(max_iter)
+    return int(number)
 
 
 def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> ContactSolution:
@@ -241,48 +228,37 @@ SAME_PRODUCT_RTOL = 1e-12
 MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps"}
 
 
-def _digest(array: np.ndarray) -> str:
-    return hashlib.blake2b(np.ascontiguousarray(array).view(np.uint8), digest_size=16).hexdigest()
+def _summary(array: Any, x: np.ndarray) -> Any:
+    """``A x`` of a matrix (K or N); a hash of the bytes of a vector (f or d)."""
+    if np.ndim(array) == 2:
+        return array @ x
+    return hashlib.blake2b(np.ascontiguousarray(array, dtype=float).view(np.uint8),
+                           digest_size=16).hexdigest()
 
 
-def _probe(n: int) -> np.ndarray:
-    return np.random.default_rng(1).uniform(0.5, 1.5, n)
+def _arrays(problem: ContactProblem) -> dict[str, Any]:
+    return {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d}
 
 
-@dataclass(frozen=True)
-class Fingerprint:
-    """What :func:`fingerprint` keeps of a problem's data (a few vectors, no copy of K)."""
-
-    shapes: tuple
-    f: str
-    d: str
-    K: np.ndarray
-    N: np.ndarray
+def fingerprint(problem: ContactProblem) -> dict[str, tuple]:
+    """Of each of K, f, N and d: its shape and its :func:`_summary` with a fixed random x (a few
+    vectors, no copy of K)."""
+    x = np.random.default_rng(1).uniform(0.5, 1.5, problem.K.shape[1])
+    return {name: (np.shape(a), _summary(a, x)) for name, a in _arrays(problem).items()}
 
 
-def fingerprint(problem: ContactProblem) -> Fingerprint:
-    """Hashes of f and d, ``K x`` and ``N x`` for a fixed random x, and the shapes."""
-    x = _probe(problem.K.shape[1])
-    return Fingerprint((problem.K.shape, problem.N.shape, problem.f.shape, problem.d.shape),
-                       _digest(problem.f), _digest(problem.d), problem.K @ x, problem.N @ x)
+def changed(problem: ContactProblem, before: dict[str, tuple]) -> list[str]:
+    """The names of the arrays of ``problem`` that differ from their ``before`` fingerprint."""
+    moved = [name for name, a in _arrays(problem).items() if np.shape(a) != before[name][0]]
+    if moved:
+        return moved
+    now = fingerprint(problem)
+    return [name for name, (_, kept) in before.items() if not (
+        np.allclose(now[name][1], kept, rtol=SAME_PRODUCT_RTOL, atol=0.0)
+        if isinstance(kept, np.ndarray) else now[name][1] == kept)]
 
 
-def changed(problem: ContactProblem, before: Fingerprint) -> list[str]:
-    """The names of the arrays of ``problem`` that differ from ``before`` (none: unchanged)."""
-    now = (problem.K.shape, problem.N.shape, np.shape(problem.f), np.shape(problem.d))
-    if now != before.shapes:
-        return [name for name, a, b in zip("KNfd", now, before.shapes) if a != b]
-    x = _probe(problem.K.shape[1])
-    out = []
-    for name, product, kept in (("K", problem.K @ x, before.K), ("N", problem.N @ x, before.N)):
-        if not np.allclose(product, kept, rtol=SAME_PRODUCT_RTOL, atol=0.0):
-            out.append(name)
-    out += [name for name, value, kept in (("f", problem.f, before.f), ("d", problem.d, before.d))
-            if _digest(np.asarray(value, dtype=float)) != kept]
-    return sorted(out, key="KfNd".index)
-
-
-def held_to_problem(problem: ContactProblem, before: Fingerprint, solution: ContactSolution,
+def held_to_problem(problem: ContactProblem, before: dict[str, tuple], solution: ContactSolution,
                     method: str) -> ContactSolution:
     """``solution``, or a ``failed`` one when the method changed ``problem``.
 

@@ -89,21 +89,14 @@ class BoundForm:
         """
         if self.coordinates is None or self.block not in (2, 3):
             return None
-        x = self.coordinates
-        dim, count = x.shape
-        modes = []
-        for axis in range(dim):
+        dim, count = self.coordinates.shape
+        x = self.coordinates - self.coordinates.mean(axis=1, keepdims=True)
+        modes = [np.tile(np.eye(dim)[axis], count) for axis in range(dim)]  # the translations
+        for i, j in [(0, 1)] if dim == 2 else [(0, 1), (1, 2), (2, 0)]:  # the rotations
             mode = np.zeros((count, dim))
-            mode[:, axis] = 1.0
+            mode[:, i], mode[:, j] = -x[j], x[i]
             modes.append(mode.ravel())
-        planes = [(0, 1)] if dim == 2 else [(0, 1), (1, 2), (2, 0)]
-        centre = x.mean(axis=1, keepdims=True)
-        for i, j in planes:
-            mode = np.zeros((count, dim))
-            mode[:, i], mode[:, j] = -(x[j] - centre[j]), x[i] - centre[i]
-            modes.append(mode.ravel())
-        rotated = self.T.T @ np.column_stack(modes)
-        q, _ = np.linalg.qr(rotated)
+        q, _ = np.linalg.qr(self.T.T @ np.column_stack(modes))
         return q
 
 

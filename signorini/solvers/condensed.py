@@ -17,29 +17,27 @@ from typing import Any
 
 from signorini.errors import InputError
 from signorini.certification.forward_error import WithDelassus
-from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
-from signorini.numerics.factor import factorize
+from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS, factorize
 from signorini.numerics.lcp import delassus, solve_lcp
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
-from signorini.solvers.options import resolved
-from signorini.solvers.options import Option, declare, take_options
+from signorini.solvers.options import Option, declare, resolved, take_options
 
 DEFAULTS = declare(
     Option("backend", "choice", None, choices=(None, "auto", *FACTOR_BACKENDS)),
     Option("block", "positive_count", None), Option("max_candidates", "positive_count", 20_000))
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def condensed(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Exact contact through the Delassus operator of the candidates."""
     opts = take_options("condensed", options, DEFAULTS)
-    if problem.m > int(opts["max_candidates"]):
+    if problem.m > opts["max_candidates"]:
         raise InputError(f"method 'condensed' forms a dense m × m matrix and m = {problem.m} "
                          f"exceeds max_candidates = {opts['max_candidates']}: use pdas")
     start = time.perf_counter()
     factor = factorize(problem.K, opts["backend"])
-    W = delassus(problem.N, factor, block=None if opts["block"] is None else int(opts["block"]))
+    W = delassus(problem.N, factor, block=opts["block"])
     b = problem.N @ factor.solve(problem.f) - problem.d
     build_time = time.perf_counter() - start
     tol, max_iter = resolved("condensed", "active set", tol, max_iter)
@@ -55,7 +53,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="condensed", function=solve, family="active set", exact=True,
+    Method(name="condensed", function=condensed, family="active set", exact=True,
            summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
-           options=tuple(DEFAULTS), typed_options=DEFAULTS),
+           typed_options=DEFAULTS),
 )

@@ -14,9 +14,7 @@ unpacking the result.
 
 from __future__ import annotations
 
-import logging
 import time
-import warnings
 from typing import Any
 
 import numpy as np
@@ -28,8 +26,6 @@ from signorini.solvers.base import Method
 from signorini.solvers.options import Option, take_options
 from signorini.solvers.qp_backends import BACKEND_BY_NAME, COMMON_TYPES
 
-log = logging.getLogger(__name__)
-
 METHOD = "cvxpy"
 DEFAULT_SOLVER = "CLARABEL"
 #: measured by tools/formulations.py (docs/formulations.md): no form wins clearly with Clarabel
@@ -39,7 +35,6 @@ DEFAULT_FORM = "primal"
 DEFAULT_POLISH = True
 #: the options, by kind (the solver is checked against cvxpy's installed ones when it runs)
 TYPED_OPTIONS = {"solver": Option("solver", "text", DEFAULT_SOLVER), **COMMON_TYPES}
-OPTIONS = tuple(TYPED_OPTIONS)
 
 #: cvxpy status → ours (anything else is ``failed``)
 STATUS_MAP = {"optimal": "converged", "optimal_inaccurate": "inaccurate",
@@ -60,15 +55,12 @@ def qp_solvers() -> list[str]:
     from cvxpy.constraints import SOC
     from cvxpy.reductions.solvers import defines
 
-    out = []
-    for name in cp.installed_solvers():
+    def takes_second_order_cones(name: str) -> bool:
         conic = defines.SOLVER_MAP_CONIC.get(name)
-        if name in _NOT_FOR_QP:
-            continue
-        if name in defines.SOLVER_MAP_QP or (conic is not None
-                                              and SOC in conic.SUPPORTED_CONSTRAINTS):
-            out.append(name)
-    return out
+        return conic is not None and SOC in conic.SUPPORTED_CONSTRAINTS
+
+    return [name for name in cp.installed_solvers() if name not in _NOT_FOR_QP
+            and (name in defines.SOLVER_MAP_QP or takes_second_order_cones(name))]
 
 
 def solver_options(solver: str, tol: float | None, max_iter: int | None) -> dict[str, Any]:
@@ -99,32 +91,20 @@ def _check_solver(solver: Any) -> str:
     return name
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def solve_cvxpy(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` as a cvxpy model.
 
-    Parameters
-    ----------
-    problem : the contact QP.
-    tol : relative KKT tolerance, translated into the chosen solver's options
-        (``None``: cvxpy's own defaults).
-    max_iter : iteration limit, translated likewise.
-    solver : (option) cvxpy solver name, default ``"CLARABEL"``; any installed
-        solver that accepts a QP.
-    form, polish, max_dense_dofs : (options) as for the ``qp-*`` methods
-        (:mod:`signorini.solvers.forms`); default ``form="primal"``, ``polish=True``.
-
-    Returns
-    -------
-    ContactSolution
-        ``u = x.value``, ``λ = constraint.dual_value``; ``extras["raw_status"]``
-        is cvxpy's status.
+    ``tol`` and ``max_iter`` are translated into the chosen solver's options (None: cvxpy's
+    defaults). Options: ``solver`` (an installed cvxpy solver that accepts a QP, default
+    ``"CLARABEL"``); ``form``, ``polish`` and ``max_dense_dofs`` as for the ``qp-*`` methods
+    (:mod:`signorini.solvers.forms`; default ``form="primal"``, ``polish=True``). The answer:
+    ``u = x.value``, ``λ = constraint.dual_value``; ``extras["raw_status"]`` is cvxpy's status.
     """
     options = take_options(METHOD, options, TYPED_OPTIONS)
-    limit = forms.dense_limit(options["max_dense_dofs"])
-    form, note = forms.resolve(METHOD, problem, options["form"], DEFAULT_FORM, limit)
-    polishing = forms.check_polish(METHOD, DEFAULT_POLISH if options["polish"] is None
-                                   else options["polish"])
+    form, note = forms.resolve(METHOD, problem, options["form"], DEFAULT_FORM,
+                               options["max_dense_dofs"])
+    polishing = DEFAULT_POLISH if options["polish"] is None else options["polish"]
     import cvxpy as cp  # as above
 
     solver = _check_solver(options["solver"])
@@ -136,8 +116,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
     contact = x >= 0 if qp.bounds else qp.G @ x <= qp.h
     model = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, qp.P, assume_PSD=True) + qp.q @ x),
                        [contact])
-    with warnings.catch_warnings(record=True) as record:
-        warnings.simplefilter("always")
+    with forms.warned(f"cvxpy/{solver}") as caught:
         try:
             data, chain, inverse_data = model.get_problem_data(solver, solver_opts=opts)
         except Exception as exc:
@@ -153,9 +132,6 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         except Exception as exc:
             raise SolverError(f"cvxpy/{solver} raised {type(exc).__name__}: {exc}") from exc
         solve_time = time.perf_counter() - start - build_time
-    caught = [str(w.message) for w in record]
-    for message in caught:
-        log.debug("cvxpy/%s warned: %s", solver, message)
     if solver_error:
         return ContactSolution.failure(
             METHOD, problem, "failed", f"cvxpy/{solver}: solver_error",
@@ -174,8 +150,8 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name=METHOD, function=solve,
+    Method(name=METHOD, function=solve_cvxpy,
            summary="the QP as a cvxpy model (Clarabel by default; option solver)",
-           requires=("cvxpy",), extra="", family="cvxpy", exact=False, options=OPTIONS,
+           requires=("cvxpy",), extra="", family="cvxpy", exact=False,
            typed_options=TYPED_OPTIONS),
 )

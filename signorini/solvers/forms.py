@@ -30,12 +30,14 @@ is better than the backend's; ``extras["polish"]`` records both.
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import time
+import warnings
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
 from signorini.errors import InputError
@@ -43,9 +45,11 @@ from signorini.certification.kkt import ACTIVE, certificate, classify
 from signorini.numerics.active_set import ActiveSetSolver
 from signorini.numerics.factor import factorize
 from signorini.numerics.work import counting
-from signorini.numerics.lcp import delassus
+from signorini.numerics.lcp import delassus, forces_on
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import acceptance
+
+log = logging.getLogger(__name__)
 
 FORMS = ("primal", "shifted", "dual")
 #: ``‖K K⁻¹f − f‖∞ / ‖f‖∞`` above this means K is singular (SuperLU does not say so itself)
@@ -93,60 +97,39 @@ class Formulation:
         return (x + self.u0 if self.name == "shifted" else x), z
 
 
-def check_form(method: str, form: Any) -> str:
-    """``form`` as one of :data:`FORMS`, or InputError naming them."""
-    if form not in FORMS:
-        raise InputError(f"method {method!r}: option form={form!r} is not one of "
-                         f"{', '.join(FORMS)}: e.g. --opt form=shifted")
-    return form
+@contextlib.contextmanager
+def warned(label: str) -> Iterator[list[str]]:
+    """The messages of the warnings the block raised (every one, each logged at debug level),
+    in the list it is given once the block ends: a backend's warnings travel with its answer."""
+    caught: list[str] = []
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        try:
+            yield caught
+        finally:
+            caught += [str(w.message) for w in record]
+    for message in caught:
+        log.debug("%s warned: %s", label, message)
 
 
-def check_polish(method: str, polish: Any) -> bool:
-    if not isinstance(polish, (bool, np.bool_)):
-        raise InputError(f"method {method!r}: option polish={polish!r} must be true or false")
-    return bool(polish)
-
-
-def said(form: str, extras: dict[str, Any]) -> str:
-    """What a method's message adds about its form: nothing for primal asked for."""
-    note = extras.get("form_note")
-    if note:
-        return f" ({note})"
-    return "" if form == "primal" else f" ({form} form)"
-
-
-def dense_limit(value: Any) -> int:
-    """The option ``max_dense_dofs`` as a positive integer, or InputError."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise InputError(f"max_dense_dofs must be a positive integer, got {value!r}")
-    return int(value)
-
-
-def resolve(method: str, problem: ContactProblem, given: Any, default: str,
+def resolve(method: str, problem: ContactProblem, given: str | None, default: str,
             limit: int) -> tuple[str, str]:
     """The form to build and why, before any work: ``(form, note)``.
 
-    A ``form`` the caller gave is checked (InputError for an unknown one, or for
-    the dual with more than ``limit`` candidates); the method's default dual
-    falls back to ``primal`` above ``limit`` instead, and ``note`` says so.
+    The dual's dense W is refused above ``limit`` candidates when the caller asked for it (an
+    InputError); the method's default dual falls back to ``primal`` there, and ``note`` says so.
     """
-    form = check_form(method, default if given is None else given)
+    form = default if given is None else given
     if form == "dual" and problem.m > limit and given is None:
         return "primal", (f"the default dual form needs a dense {problem.m} × {problem.m} W, "
                           f"over max_dense_dofs = {limit}: primal form instead")
-    if form == "dual":
-        check_dual_size(method, problem, limit)
-    return form, ""
-
-
-def check_dual_size(method: str, problem: ContactProblem, limit: int) -> None:
-    """The dual's dense W: refuse m above ``limit`` before any work is done."""
-    if problem.m > limit:
+    if form == "dual" and problem.m > limit:
         raise InputError(
             f"method {method!r} with form='dual' builds the dense m × m Delassus operator "
             f"W = N K⁻¹ Nᵀ ({problem.m} back-solves, {8 * problem.m ** 2 / 1e6:.0f} MB) and "
             f"m = {problem.m} exceeds max_dense_dofs = {limit}: use form=shifted, or raise "
             "the option max_dense_dofs")
+    return form, ""
 
 
 def _unconstrained(problem: ContactProblem):
@@ -220,10 +203,7 @@ def _kkt_on(problem: ContactProblem, form: Formulation, active: np.ndarray):
         solver = ActiveSetSolver(problem.K, problem.N)
         u, lam = solver.solve(active, problem.f, problem.d)
         return u, lam, solver.factor or form.factor
-    lam = np.zeros(problem.m)
-    if active.any():
-        W_AA = form.W[np.ix_(active, active)]
-        lam[active] = sla.solve(0.5 * (W_AA + W_AA.T), form.b[active], assume_a="pos")
+    lam = forces_on(form.W, form.b, active)  # W is symmetric (delassus)
     return form.factor.solve(problem.f - problem.N.T @ lam), lam, form.factor
 
 
@@ -276,9 +256,11 @@ def solution_from(problem: ContactProblem, form: Formulation, method: str, statu
     """A backend's ``x`` and ``z`` in ``form`` as the problem's solution: a failure when it gave
     none, polished on its active set when ``polishing``; the message opens with ``said_by`` and
     ``extras`` gain the form's record."""
+    note = note or form.note
     extras = {**extras, "form": form.name, "form_work": form.work, "form_s": form.seconds,
-              "form_note": note or form.note}
-    common = dict(message=said_by + said(form.name, extras), iterations=int(iterations or 0),
+              "form_note": note}
+    said = f" ({note})" if note else "" if form.name == "primal" else f" ({form.name} form)"
+    common = dict(message=said_by + said, iterations=int(iterations or 0),
                   build_time=build_time, solve_time=solve_time, extras=extras)
     if x is None or (z is None and not form.bounds):
         return ContactSolution.failure(method, problem, "failed" if status == "converged" else status,

@@ -1,27 +1,14 @@
 """Method options, declared with their types and ranges and checked before any work.
 
-A method declares each option it takes as an :class:`Option` (a kind, a
-default, the allowed choices); :func:`take_options` fills the defaults and
-checks every value given, so that a string where a number belongs, a
-negative time limit or an unknown name is an :class:`InputError` naming the
-option and what to give instead — never a ``failed`` run of the solver.
+A method declares each option it takes as an :class:`Option` (a kind, a default, the allowed
+choices); :func:`take_options` fills the defaults and checks every value given, so that a bad
+value or an unknown name is an :class:`InputError` naming the option and the fix, never a
+``failed`` run. Options whose default is None accept None ("the method decides").
 
-Kinds: ``positive`` (finite float > 0), ``nonnegative`` (finite float ≥ 0),
-``fraction`` (float in (0, 1]), ``number`` (any finite float), ``integer``
-(any sign), ``count``
-(integer ≥ 0), ``positive_count`` (integer ≥ 1), ``bool``, ``choice`` (one
-of ``choices``), ``text`` (a string), ``callable``, ``vector`` (an array of
-finite floats; its length is checked by the method, which knows m),
-``object`` (an instance of ``types``) and ``any`` (passed on unchecked).
-Options whose default is None accept None ("the method decides").
-
-The two options every method takes, ``tol`` and ``max_iter``, have their defaults in one
-table, :data:`TABLE`, one row per method (or per family) with its reason. A method asked for
-no ``tol`` runs at its row's ``tol`` and its answer is held to it; asked for no ``max_iter``,
-it stops after its row's ``max_iter`` steps. A row is found by the method's name, else by its
-family (:func:`defaults_of`). ``tol`` is the relative KKT residual the certificate accepts
-(:mod:`signorini.certification.kkt`); None leaves a QP backend at its own settings, its answer
-then held to :data:`DEFAULT_TOL`.
+The defaults of ``tol`` and ``max_iter`` are one table, :data:`TABLE`, one row per method (or
+family) with its reason (:func:`defaults_of`). ``tol`` is the relative KKT residual the
+certificate accepts (:mod:`signorini.certification.kkt`); None leaves a QP backend at its own
+settings, its answer then held to :data:`DEFAULT_TOL`.
 """
 
 from __future__ import annotations
@@ -85,9 +72,10 @@ class Option:
             self.refuse(method, value)
         return checked
 
-    def refuse(self, method: str, value: Any) -> None:
-        """Raise the InputError that says what ``value`` should have been."""
-        shown = value.shown() if isinstance(value, _Typed) else repr(value)
+    def refuse(self, method: str, value: Any, typed: bool = False) -> None:
+        """Raise the InputError that says what ``value`` (the text of ``--opt`` when ``typed``)
+        should have been."""
+        shown = value if typed and type(guess_value(value)) in (int, float) else repr(value)
         if self.kind == "choice":
             raise InputError(f"method {method!r}: option {self.name}={shown} is not one of "
                              f"{', '.join(str(c) for c in self.choices if c is not None)}")
@@ -102,54 +90,35 @@ class Option:
 
     def parse(self, method: str, text: str) -> Any:
         """The value of ``--opt name=text``, read as the option's kind and checked."""
-        kind, typed = self.kind, _Typed(text)
-        if text.lower() in ("none", "null") and (self.default is None or kind == "any") \
-                and not (kind == "choice" and text in self.choices):
+        kind, word = self.kind, text.lower()
+        if word in ("none", "null") and (self.default is None or kind == "any") \
+                and text not in self.choices:
             return None
-        if kind in ("callable", "vector", "object"):
-            self.refuse(method, typed)
-        if kind == "choice":
-            for choice in self.choices:
-                if choice is not None and str(choice) == text:
-                    return choice
-            self.refuse(method, typed)
-        if kind == "bool":
-            word = text.lower()
-            if word not in ("true", "false", "1", "0", "yes", "no"):
-                self.refuse(method, typed)
-            return word in ("true", "1", "yes")
-        if kind in ("text",):
-            return text
         if kind == "any":
             return guess_value(text)
-        try:
-            checked = _convert(self, float(text))
-        except ValueError:
-            checked = _BAD
-        if checked is _BAD:
-            self.refuse(method, typed)
-        return checked
+        if kind == "text":
+            return text
+        value = _BAD  # a function, an array or an object: the Python API only
+        if kind == "choice":
+            value = next((c for c in self.choices if c is not None and str(c) == text), _BAD)
+        elif kind == "bool":
+            value = {"true": True, "1": True, "yes": True, "false": False, "0": False,
+                     "no": False}.get(word, _BAD)
+        elif kind in _NUMBERS or kind in _INTEGERS:
+            try:
+                value = _convert(self, float(text))
+            except ValueError:
+                pass
+        if value is _BAD:
+            self.refuse(method, text, typed=True)
+        return value
 
 
 _BAD = object()
 
 
-@dataclass(frozen=True)
-class _Typed:
-    """The text a user typed after ``--opt name=``, shown as typed in messages."""
-
-    text: str
-
-    def shown(self) -> str:
-        """A number as typed (``-1``), anything else quoted (``'abc'``)."""
-        try:
-            float(self.text)
-        except ValueError:
-            return repr(self.text)
-        return self.text
-
-
-def _number(value: Any) -> float | None:
+def finite_number(value: Any) -> float | None:
+    """``value`` as a float when it is a finite real number (not a bool), else None."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer,
                                                                       np.floating)):
         return None
@@ -157,44 +126,39 @@ def _number(value: Any) -> float | None:
     return number if math.isfinite(number) else None
 
 
+#: the test of each numeric kind, and the least value of each integer kind
+_NUMBERS = {"positive": lambda x: x > 0, "nonnegative": lambda x: x >= 0,
+            "fraction": lambda x: 0 < x <= 1, "number": lambda x: True}
+_INTEGERS = {"integer": -math.inf, "count": 0, "positive_count": 1}
+
+
 def _convert(option: Option, value: Any) -> Any:
     kind = option.kind
-    if kind == "any":
-        return value
-    if kind in ("positive", "nonnegative", "fraction", "number"):
-        number = _number(value)
-        ok = number is not None and {"positive": lambda x: x > 0,
-                                     "nonnegative": lambda x: x >= 0,
-                                     "fraction": lambda x: 0 < x <= 1,
-                                     "number": lambda x: True}[kind](number)
-        return number if ok else _BAD
-    if kind in ("integer", "count", "positive_count"):
-        number = _number(value)
-        least = {"integer": -math.inf, "count": 0, "positive_count": 1}[kind]
-        if number is None or not number.is_integer() or number < least:
-            return _BAD
-        return int(number)
+    number = finite_number(value)
+    if kind in _NUMBERS:
+        return number if number is not None and _NUMBERS[kind](number) else _BAD
+    if kind in _INTEGERS:
+        ok = number is not None and number.is_integer() and number >= _INTEGERS[kind]
+        return int(number) if ok else _BAD
     if kind == "bool":
-        if isinstance(value, (bool, np.bool_)):
-            return bool(value)
-        return bool(value) if isinstance(value, (int, np.integer)) and value in (0, 1) else _BAD
-    if kind == "choice":
-        return value if any(value == c and type(value) is type(c) for c in option.choices) else _BAD
-    if kind == "text":
-        return value if isinstance(value, str) else _BAD
-    if kind == "callable":
-        return value if callable(value) else _BAD
+        ok = isinstance(value, (bool, np.bool_)) or isinstance(value, (int, np.integer)) and value in (0, 1)
+        return bool(value) if ok else _BAD
     if kind == "vector":
-        if isinstance(value, (str, bytes)):
-            return _BAD
         try:
-            array = np.asarray(value, dtype=float)
+            array = None if isinstance(value, (str, bytes)) else np.asarray(value, dtype=float)
         except (TypeError, ValueError):
-            return _BAD
-        return array if array.ndim == 1 and np.all(np.isfinite(array)) else _BAD
-    if kind == "object":
-        return value if isinstance(value, option.types) else _BAD
-    return _BAD  # pragma: no cover - kinds are checked when an Option is made
+            array = None
+        return array if array is not None and array.ndim == 1 and np.all(np.isfinite(array)) else _BAD
+    return value if _KEPT[kind](option, value) else _BAD
+
+
+#: the test of each kind whose value is kept as given
+_KEPT = {"any": lambda option, value: True,
+         "choice": lambda option, value: any(value == c and type(value) is type(c)
+                                             for c in option.choices),
+         "text": lambda option, value: isinstance(value, str),
+         "callable": lambda option, value: callable(value),
+         "object": lambda option, value: isinstance(value, option.types)}
 
 
 def declare(*options: Option) -> dict[str, Option]:
@@ -210,20 +174,25 @@ def check_names(method: str, given: Mapping[str, Any], known: Any) -> None:
         raise InputError(f"method {method!r} has no option {unknown[0]!r}; accepted options: {listed}")
 
 
-def take_options(method: str, given: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict[str, Any]:
-    """``defaults`` overridden by ``given``, every given value checked.
+def checked(method: str, given: Mapping[str, Any], declared: Mapping[str, Option]) -> dict[str, Any]:
+    """``given``, every value checked and converted by its ``declared`` option; InputError for
+    an unknown name or a bad value."""
+    check_names(method, given, declared)
+    return {name: declared[name].check(method, value) for name, value in given.items()}
 
-    ``defaults`` maps each name to an :class:`Option` (its value checked and
-    converted) or to a plain default value (passed on as given).
-    """
-    check_names(method, given, defaults)
-    out: dict[str, Any] = {}
-    for name, declared in defaults.items():
-        if isinstance(declared, Option):
-            out[name] = declared.check(method, given[name]) if name in given else declared.default
-        else:
-            out[name] = given.get(name, declared)
-    return out
+
+def take_options(method: str, given: Mapping[str, Any], declared: Mapping[str, Option]) -> dict[str, Any]:
+    """Every ``declared`` option: its value in ``given``, checked and converted, else its default."""
+    return {**{name: option.default for name, option in declared.items()},
+            **checked(method, given, declared)}
+
+
+def per_candidate(method: str, name: str, vector: Any, m: int) -> Any:
+    """The option ``name`` (a vector, or None) when it has one entry per contact candidate."""
+    if vector is not None and np.shape(vector) != (m,):
+        raise InputError(f"method {method!r}: option {name} has {np.size(vector)} entries, the "
+                         f"problem {m} contact candidates")
+    return vector
 
 
 def guess_value(text: str) -> Any:
@@ -239,11 +208,6 @@ def guess_value(text: str) -> Any:
         except ValueError:
             pass
     return text
-
-
-def positive_number(method: str, name: str, value: Any) -> float:
-    """``value`` as a finite positive float, or InputError naming the option."""
-    return Option(name, "positive", 1.0).check(method, value)
 
 
 # -- the defaults of tol and max_iter ------------------------------------------------------
@@ -306,4 +270,5 @@ def resolved(name: str, family: str, tol: float | None,
 
 
 __all__ = ["DEFAULT_TOL", "EXACT_TOL", "KINDS", "MIN_TOL", "Defaults", "Option", "TABLE", "check_names",
-           "declare", "defaults_of", "guess_value", "positive_number", "resolved", "take_options"]
+           "checked", "declare", "defaults_of", "finite_number", "guess_value", "per_candidate",
+           "resolved", "take_options"]

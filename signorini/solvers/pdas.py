@@ -1,29 +1,21 @@
 """Primal-dual active set = semismooth Newton (Hintermüller, Ito & Kunisch 2002).
 
-With the complementarity function ``λ = max(0, λ + c(Nu − d))``, each step
-guesses the active set ``A = {i : λᵢ + c (Nu − d)ᵢ > 0}`` and solves the
-equality-constrained system on it (when every row of N bounds one dof, as
-for a flat obstacle, by fixing the active dofs and factorising the SPD
-``K_FF``; otherwise the saddle-point matrix by LU; see
-:class:`signorini.numerics.active_set.ActiveSetSolver`, which
-for CHOLMOD reuses one symbolic analysis for every step)::
+With the complementarity function ``λ = max(0, λ + c(Nu − d))``, each step guesses the active
+set ``A = {i : λᵢ + c (Nu − d)ᵢ > 0}`` and solves the equality-constrained system on it
+(:class:`signorini.numerics.active_set.ActiveSetSolver`: the active dofs pinned in K when each
+row of N bounds one dof, else the saddle-point matrix by LU)::
 
     [ K    N_Aᵀ ] [ u   ]   [ f   ]
     [ N_A  0    ] [ λ_A ] = [ d_A ],   λ_I = 0.
 
-It stops when A repeats; the answer is then exact up to round-off. ``tol`` is the
-accuracy the answer is held to: it stops one solve sooner when the answer on A already
-meets the remaining conditions to ``tol`` (no force on A below ``−tol`` times the force
-scale, no penetration off A beyond ``tol`` times the gap scale, as :mod:`signorini.certification.kkt`
-measures them; stationarity and the closed gaps on A hold exactly). A repeating is this
-test at ``tol = 0``. PDAS can
-cycle through active sets when W is not an M-matrix; a set seen before (but
-not the last one) is a cycle, and the method then finishes on the condensed
-LCP with Murty's least-index pivoting, which terminates for SPD W. After the
-first step ``c`` no longer matters (closed gaps are zero on A, forces zero
-off A), so ``c`` only weighs a warm start against the gaps. Without one it
-starts cold, from no contact; ``warm_start`` (an earlier answer's λ and u,
-see :class:`signorini.problem.solution.WarmStart`) or ``lam0`` start it elsewhere.
+It stops when A repeats (the answer is then exact up to round-off), or one solve sooner when
+the answer on A already meets the remaining conditions to ``tol`` (no force on A below
+``−tol`` times the force scale, no penetration off A beyond ``tol`` times the gap scale, as
+:mod:`signorini.certification.kkt` measures them). PDAS can cycle when W is not an M-matrix:
+a set seen before is a cycle, and the method finishes on the condensed LCP with Murty's
+least-index pivoting, which terminates for SPD W. After the first step ``c`` no longer
+matters, so it only weighs a warm start against the gaps. It starts cold, from no contact,
+or from ``warm_start`` (:class:`signorini.problem.solution.WarmStart`) or ``lam0``.
 
 Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 """
@@ -31,22 +23,19 @@ Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 from __future__ import annotations
 
 import logging
-
 import time
 from typing import Any
 
 import numpy as np
 
-from signorini.errors import InputError
 from signorini.certification.kkt import force_scale, gap_scale
-from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
 from signorini.numerics.active_set import ActiveSetSolver
-from signorini.numerics.factor import factorize
+from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS, factorize
 from signorini.numerics.lcp import delassus, least_index_lcp
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.solution import WarmStart
 from signorini.solvers.base import Method
-from signorini.solvers.options import Option, declare, resolved, take_options
+from signorini.solvers.options import Option, declare, per_candidate, resolved, take_options
 
 log = logging.getLogger(__name__)
 
@@ -66,28 +55,22 @@ def _finish_condensed(problem: ContactProblem, lam: np.ndarray) -> tuple[np.ndar
     return factor.solve(problem.f - problem.N.T @ lam), lam, steps
 
 
-def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
+def pdas(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           **options: Any) -> ContactSolution:
     """Semismooth Newton / PDAS on the full saddle-point system (one sparse LU per step)."""
     opts = take_options("pdas", options, DEFAULTS)
-    c = opts["c"]
+    c, warm = opts["c"], opts["warm_start"]
+    lam0 = per_candidate("pdas", "lam0", opts["lam0"], problem.m)
     tol, max_iter = resolved("pdas", "active set", tol, max_iter)
     start = time.perf_counter()
     system = ActiveSetSolver(problem.K, problem.N, opts["backend"])
-    warm = opts["warm_start"]
-    if opts["lam0"] is None and warm is not None and warm.lam is not None and warm.u is not None:
+    if lam0 is None and warm is not None and warm.lam is not None and warm.u is not None:
         u, lam = warm.u, warm.lam  # an earlier answer at this load: one step confirms it
-    elif opts["lam0"] is None and warm is not None and warm.lam is not None:
-        lam = np.maximum(warm.lam, 0.0)
+    elif lam0 is not None or warm is not None and warm.lam is not None:
+        lam = np.maximum(warm.lam if lam0 is None else lam0, 0.0)
         u = problem.displacement_for(lam)
-    elif opts["lam0"] is None:
-        u, lam = system.solve(np.zeros(problem.m, dtype=bool), problem.f, problem.d)
     else:
-        if opts["lam0"].shape != (problem.m,):
-            raise InputError(f"method 'pdas': option lam0 has {opts['lam0'].size} entries, the "
-                             f"problem {problem.m} contact candidates")
-        lam = np.maximum(opts["lam0"], 0.0)
-        u = problem.displacement_for(lam)
+        u, lam = system.solve(np.zeros(problem.m, dtype=bool), problem.f, problem.d)
     history: dict[str, list[float]] = {"changes": [], "primal": [], "active": []}
     active = None
     seen: set[bytes] = set()
@@ -101,19 +84,16 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
         history["active"].append(int(new_active.sum()))
         if opts["callback"] is not None:
             opts["callback"](iteration, u, lam)
-        if active is not None and changes == 0:
-            status = "converged"
-            message = f"active set of {int(active.sum())} nodes repeated after {iteration - 1} steps"
-            iteration -= 1
-            break
-        slack = max(history["primal"][-1],
-                    float(np.max(-lam, initial=0.0)) / force_scale(problem, lam, u))
-        if active is not None and slack <= tol:
-            status = "converged"
-            message = (f"active set of {int(active.sum())} nodes after {iteration - 1} steps: "
-                       f"its answer meets the bounds to {slack:.1e} ≤ tol {tol:.0e}")
-            iteration -= 1
-            break
+        if active is not None:
+            slack = 0.0 if changes == 0 else max(
+                history["primal"][-1], float(np.max(-lam, initial=0.0)) / force_scale(problem, lam, u))
+            if slack <= tol:
+                status, iteration = "converged", iteration - 1
+                message = (f"active set of {int(active.sum())} nodes repeated after {iteration} steps"
+                           if changes == 0 else
+                           f"active set of {int(active.sum())} nodes after {iteration} steps: its "
+                           f"answer meets the bounds to {slack:.1e} ≤ tol {tol:.0e}")
+                break
         if new_active.tobytes() in seen:
             u, lam, steps = _finish_condensed(problem, lam)
             status = "converged"
@@ -133,7 +113,7 @@ def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | 
 
 
 METHODS = (
-    Method(name="pdas", function=solve, family="active set", exact=True,
+    Method(name="pdas", function=pdas, family="active set", exact=True,
            summary="primal-dual active set / semismooth Newton, exact when it converges",
-           options=tuple(DEFAULTS), typed_options=DEFAULTS),
+           typed_options=DEFAULTS),
 )

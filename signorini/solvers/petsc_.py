@@ -1,35 +1,27 @@
 """The contact QP on PETSc: SNES-VI and TAO on the bound form, serial or under MPI.
 
-The constraints become bounds (:mod:`signorini.solvers.bounds`: each contact node's
-dofs rotated into its obstacle's normal–tangent frame), and PETSc solves
+The constraints become bounds (:mod:`signorini.solvers.bounds`: each contact node's dofs
+rotated into its obstacle's normal–tangent frame), and PETSc solves
+``min ½ vᵀ K v − fᵀ v`` subject to ``lower ≤ v ≤ upper`` by one of
 
-    min ½ vᵀ K v − fᵀ v   subject to   lower ≤ v ≤ upper
+* ``petsc-vi``: SNES ``vinewtonrsls``, reduced-space semismooth Newton for the variational
+  inequality ``K v − f ⟂ bounds``, with a full-step line search (on a QP a full Newton step
+  is exact on the set it guesses);
+* ``petsc-tron``: TAO ``tron``, trust-region Newton with gradients projected onto the bounds;
+* ``petsc-gpcg``: TAO ``gpcg``, gradient projection with conjugate gradients.
 
-by one of
-
-* ``petsc-vi``: SNES ``vinewtonrsls``, the reduced-space semismooth Newton
-  method for the variational inequality ``K v − f ⟂ bounds``, with a basic
-  (full-step) line search: on a QP a full Newton step is exact on the set it
-  guesses, so a line search only slows it;
-* ``petsc-tron``: TAO ``tron``, a trust-region Newton method that projects
-  gradients onto the bounds and solves on the free variables;
-* ``petsc-gpcg``: TAO ``gpcg``, gradient projection with conjugate gradients,
-  written for bound-constrained QPs.
-
-The linear solves are MUMPS's parallel LU (``ksp=mumps``) or CG
-preconditioned by PETSc's algebraic multigrid GAMG given the rigid-body
-modes as near-null space (``ksp=gamg``); ``ksp=auto`` (the default) takes
-GAMG for 3D problems from :data:`GAMG_FROM_DOFS` dofs and MUMPS otherwise
-(chosen from measurements, docs/petsc.md). Under ``mpirun -n N`` rank 0
-assembles, rotates and splits the rows by whole nodes
-(:mod:`signorini.solvers.cluster`); each rank builds its block of a parallel AIJ
-matrix, and rank 0 gathers the answer, recovers the contact forces as the
-reactions on the active bounds and judges it like any other method's.
-Extra PETSc options go through ``petsc_options`` ("-snes_monitor -ksp_view …").
+The linear solves are MUMPS's parallel LU (``ksp=mumps``) or CG preconditioned by PETSc's
+GAMG with the rigid-body modes as near-null space (``ksp=gamg``); ``ksp=auto`` takes GAMG for
+3D problems from :data:`GAMG_FROM_DOFS` dofs and MUMPS otherwise (docs/petsc.md). Under
+``mpirun -n N`` rank 0 assembles, rotates and splits the rows by whole nodes
+(:mod:`signorini.solvers.cluster`); each rank builds its block of a parallel AIJ matrix, and
+rank 0 gathers the answer and recovers the contact forces as the reactions on the active
+bounds. Extra PETSc options go through ``petsc_options`` ("-snes_monitor -ksp_view …").
 """
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Any
 
@@ -39,8 +31,7 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import cluster
 from signorini.solvers.base import Method
 from signorini.solvers.bounds import NoBoundForm, bound_form
-from signorini.solvers.options import resolved
-from signorini.solvers.options import Option, declare, take_options
+from signorini.solvers.options import Option, declare, resolved, take_options
 from signorini.solvers.petsc_piece import pieces, reason_text
 
 KSP_CHOICES = ("auto", "mumps", "gamg")
@@ -48,14 +39,21 @@ DEFAULTS = declare(Option("ksp", "choice", "auto", choices=KSP_CHOICES),
                    Option("petsc_options", "text", ""))
 #: ``ksp=auto`` uses GAMG for 3D problems of at least this many dofs (MUMPS below, and in 2D)
 GAMG_FROM_DOFS = 20_000
-#: PETSc type of each method
-KINDS = {"petsc-vi": ("snes", "vinewtonrsls"), "petsc-tron": ("tao", "tron"),
-         "petsc-gpcg": ("tao", "gpcg")}
+#: each method's PETSc solver kind and type, and its summary
+KINDS = {
+    "petsc-vi": ("snes", "vinewtonrsls", "PETSc SNES vinewtonrsls (semismooth Newton on the "
+                                         "bounds), MUMPS or CG+GAMG; MPI"),
+    "petsc-tron": ("tao", "tron", "PETSc TAO tron (trust-region Newton on the bounds), MUMPS or "
+                                  "CG+GAMG; MPI"),
+    "petsc-gpcg": ("tao", "gpcg", "PETSc TAO gpcg (gradient projection + CG on the bounds); MPI"),
+}
 
-def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: int | None,
-           options: dict[str, Any]) -> ContactSolution:
+
+def solve(problem: ContactProblem, method: str, *, tol: float | None = None,
+          max_iter: int | None = None, **options: Any) -> ContactSolution:
+    """PETSc's solver of ``method`` (a key of :data:`KINDS`) on the bound form."""
     opts = take_options(method, options, DEFAULTS)
-    kind, petsc_type = KINDS[method]
+    kind, petsc_type, _ = KINDS[method]
     tol, max_iter = resolved(method, "petsc", tol, max_iter)
     ksp = opts["ksp"]
     start = time.perf_counter()
@@ -69,10 +67,8 @@ def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: in
         ksp = "gamg" if form.block == 3 and form.n >= GAMG_FROM_DOFS else "mumps"
     ranks = cluster.size()
     job = {"run": "signorini.solvers.petsc_piece:solve_piece", "n": form.n, "block": form.block,
-           "kind": (kind, petsc_type), "ksp": ksp, "tol": tol,
-           "f_norm": float(np.linalg.norm(form.f)),
-           "max_iter": max_iter,
-           "petsc_options": opts["petsc_options"]}
+           "kind": (kind, petsc_type), "ksp": ksp, "tol": tol, "max_iter": max_iter,
+           "f_norm": float(np.linalg.norm(form.f)), "petsc_options": opts["petsc_options"]}
     parts = pieces(form, ranks, x0, gamg=ksp == "gamg")
     build_time = time.perf_counter() - start
     results = cluster.distribute(job, parts)
@@ -103,25 +99,8 @@ def _solve(method: str, problem: ContactProblem, tol: float | None, max_iter: in
                            extras=extras)
 
 
-def _make(method: str):
-    def solve(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
-              **options: Any) -> ContactSolution:
-        return _solve(method, problem, tol, max_iter, options)
-
-    solve.__name__ = method.replace("-", "_")
-    solve.__doc__ = f"PETSc {KINDS[method][1]} on the bound form (MUMPS or CG + GAMG)."
-    return solve
-
-
-SUMMARIES = {
-    "petsc-vi": "PETSc SNES vinewtonrsls (semismooth Newton on the bounds), MUMPS or CG+GAMG; MPI",
-    "petsc-tron": "PETSc TAO tron (trust-region Newton on the bounds), MUMPS or CG+GAMG; MPI",
-    "petsc-gpcg": "PETSc TAO gpcg (gradient projection + CG on the bounds); MPI",
-}
-
 METHODS = tuple(
-    Method(name=name, function=_make(name), summary=SUMMARIES[name],
+    Method(name=name, function=functools.partial(solve, method=name), summary=KINDS[name][2],
            requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
-           exact=name == "petsc-vi", options=tuple(DEFAULTS),
-           typed_options=DEFAULTS, bound_rows=True)
+           exact=name == "petsc-vi", typed_options=DEFAULTS, bound_rows=True)
     for name in KINDS)

@@ -16,19 +16,16 @@ import numpy as np
 
 from signorini.solvers.bounds import BoundForm
 
-__all__ = ["PREFIX", "ROUND_OFF_FLOOR", "SAFETY", "SAFETY_RELATIVE", "load_petsc", "pieces",
-           "reason_text", "solve_piece"]
+__all__ = ["PREFIX", "ROUND_OFF_FLOOR", "SAFETY", "SAFETY_RELATIVE", "load_petsc", "near_null_space",
+           "pieces", "reason_text", "solve_piece", "unless_given"]
 
 #: how far below the requested tolerance PETSc's own stopping test is set
 SAFETY = 1e-5
 #: SNES-VI's stationarity target relative to the requested tolerance
 SAFETY_RELATIVE = 0.1
 PREFIX = "signorini_"
-#: the stopping test never asks for less than this relative residual: round-off sits there
-#: (reverse-hertz with MUMPS: the residual stalls at 3e-14 ‖f‖ after the last active-set change;
-#: at 1e-13 GPCG on the axisymmetric hertz-sphere ran its 2000 iterations with the projected
-#: gradient just above the floor once its start moved by 1e-17 — 1e-12 ends it in 7, stationarity
-#: 6.6e-12, well inside any tolerance the certificate is asked for)
+#: the stopping test never asks for less than this relative residual: round-off sits there, and
+#: a test just below it can run a solver to its iteration limit (docs/petsc.md)
 ROUND_OFF_FLOOR = 1e-12
 
 
@@ -80,7 +77,15 @@ def _vec(PETSc, A, values: np.ndarray):
     return vec
 
 
-def _near_null_space(PETSc, A, modes: np.ndarray):
+def unless_given(PETSc, prefix: str, values: dict[str, str]) -> None:
+    """Set the PETSc options ``values`` under ``prefix``, each unless the user already gave it."""
+    options = PETSc.Options(prefix)
+    for name, value in values.items():
+        if not options.hasName(name):
+            options.setValue(name, value)
+
+
+def near_null_space(PETSc, A, modes: np.ndarray):
     """Give ``A`` the columns of ``modes`` (this rank's rows) as near-null space for GAMG."""
     vectors = [_vec(PETSc, A, column) for column in modes.T]
     A.setNearNullSpace(PETSc.NullSpace().create(vectors=vectors, comm=A.getComm()))
@@ -114,24 +119,20 @@ class FreshMultigrid:
 
     def setUp(self, pc) -> None:
         start = time.perf_counter()
-        self._build(pc)
-        self.setups += 1
-        self.setup_s += time.perf_counter() - start
-
-    def _build(self, pc) -> None:
-        PETSc = self.PETSc
         A, P = pc.getOperators()
         rows = None if self.modes is None else self._free_rows(P)
         if rows is not None:
-            _near_null_space(PETSc, P, self.modes[rows])
+            near_null_space(self.PETSc, P, self.modes[rows])
         if self.inner is not None:
             self.inner.destroy()
-        self.inner = PETSc.PC().create(pc.getComm())
+        self.inner = self.PETSc.PC().create(pc.getComm())
         self.inner.setType("gamg")
         self.inner.setOperators(A, P)
         self.inner.setOptionsPrefix(PREFIX + "mg_")
         self.inner.setFromOptions()
         self.inner.setUp()
+        self.setups += 1
+        self.setup_s += time.perf_counter() - start
 
     def apply(self, pc, x, y) -> None:
         start = time.perf_counter()
@@ -219,7 +220,7 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
     A.assemble()
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     if piece["modes"] is not None:
-        _near_null_space(PETSc, A, piece["modes"])
+        near_null_space(PETSc, A, piece["modes"])
     b, lower, upper = (_vec(PETSc, A, piece[key]) for key in ("f", "lower", "upper"))
     x = _vec(PETSc, A, piece["x0"])
     _set_options(PETSc, job["petsc_options"])
@@ -238,9 +239,7 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
         solver.setConvergenceTest(_stationarity_test(PETSc, lower, upper, b, job))
         solver.setJacobian(lambda *args: None, A, A)
         solver.setVariableBounds(lower, upper)
-        options = PETSc.Options(PREFIX)
-        if not options.hasName("snes_linesearch_type"):
-            options.setValue("snes_linesearch_type", "basic")
+        unless_given(PETSc, PREFIX, {"snes_linesearch_type": "basic"})
         solver.setTolerances(max_it=job["max_iter"])  # the stopping test is the one above
     else:
         solver = PETSc.TAO().create(comm)
@@ -261,15 +260,13 @@ def solve_piece(job: dict[str, Any], piece: dict[str, Any]) -> dict[str, Any]:
         solver.setMaximumIterations(job["max_iter"])
     multigrid = None
     if job["ksp"] == "gamg":
-        options = PETSc.Options(PREFIX + "mg_")
-        if not options.hasName("pc_gamg_agg_nsmooths"):
-            # plain aggregation: with six rigid modes, smoothing the prolongator makes each
-            # set-up many times dearer for fewer CG iterations (docs/petsc.md)
-            options.setValue("pc_gamg_agg_nsmooths", "0")
-        if kind == "snes" and not PETSc.Options(PREFIX).hasName("snes_ksp_ew"):
+        # plain aggregation: with six rigid modes, smoothing the prolongator makes each set-up
+        # many times dearer for fewer CG iterations (docs/petsc.md)
+        unless_given(PETSc, PREFIX + "mg_", {"pc_gamg_agg_nsmooths": "0"})
+        if kind == "snes":
             # Eisenstat-Walker: loose CG solves while the active set still moves, a fraction of
             # the CG iterations for the same final residuals (docs/petsc.md)
-            PETSc.Options(PREFIX).setValue("snes_ksp_ew", "")
+            unless_given(PETSc, PREFIX, {"snes_ksp_ew": ""})
         free_set = (lambda: solver.getVIInactiveSet().getIndices()) if kind == "snes" else None
         multigrid = FreshMultigrid(PETSc, n, piece["modes"], piece["first"], free_set)
     _configure_ksp(PETSc, solver.getKSP(), job["ksp"], job["tol"], multigrid)

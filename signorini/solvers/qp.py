@@ -1,24 +1,26 @@
 """The contact QP through qpsolvers: one method ``qp-<backend>`` per backend.
 
-``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` is handed to :func:`qpsolvers.solve_problem`
-in the formulation of the option ``form`` (:mod:`signorini.solvers.forms`):
-``primal`` as ``P = ½(K + Kᵀ)``, ``q = −f``, ``G = N``, ``h = d`` (qpsolvers'
-multiplier ``z`` of ``Gx ≤ h`` is non-negative and satisfies
-``Px + q + Gᵀz = 0``, our ``K u − f + Nᵀλ = 0`` with ``λ = z``: no sign change),
-``shifted`` in ``u − K⁻¹f``, ``dual`` over ``λ ≥ 0`` with ``W = N K⁻¹ Nᵀ``.
+``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` is handed to :func:`qpsolvers.solve_problem` in the
+formulation of the option ``form`` (:mod:`signorini.solvers.forms`). qpsolvers' multiplier
+``z`` of ``Gx ≤ h`` is non-negative and satisfies ``Px + q + Gᵀz = 0``, our
+``K u − f + Nᵀλ = 0`` with ``λ = z``: no sign change.
 
 Every backend is one row of :data:`signorini.solvers.qp_backends.BACKENDS`; the methods are
-registered by one loop at the bottom of the module.
+registered by one loop at the bottom of the module. A backend that prints from C whatever its
+verbosity runs with the process's output sent nowhere (:func:`c_output_discarded`): the
+library never prints.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import functools
 import importlib.util
-import logging
+import os
+import sys
 import time
-import warnings
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -26,67 +28,65 @@ from signorini.errors import BackendNotInstalled, InputError, SolverError, insta
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers import forms
 from signorini.solvers.base import Method
-from signorini.solvers.backend_output import c_output_discarded, silence_highs_banner
-from signorini.solvers.qp_backends import (BACKEND_BY_NAME, BACKENDS, COMMON_OPTIONS, COMMON_TYPES,
+from signorini.solvers.options import checked
+from signorini.solvers.qp_backends import (BACKEND_BY_NAME, BACKENDS, COMMON_TYPES,
                                            DEFAULT_MAX_DENSE_DOFS, FAILED, MAX_ITER, Backend)
-from signorini.solvers.qp_options import typed
 
 __all__ = ["METHODS", "solve_qp"]
 
-log = logging.getLogger(__name__)
+
+@contextlib.contextmanager
+def c_output_discarded():
+    """The process's stdout and stderr sent nowhere, at the file descriptors and in Python: for
+    backends that print whatever their verbosity, from C or through Python's ``sys.stdout``
+    (HiGHS's banner; OSQP's "Polishing not needed")."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    sink = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(sink, 1)
+        os.dup2(sink, 2)
+        with open(os.devnull, "w") as nowhere, contextlib.redirect_stdout(nowhere), \
+                contextlib.redirect_stderr(nowhere):
+            yield
+    finally:
+        ctypes.CDLL(None).fflush(None)  # what C buffered goes where it was meant to: nowhere
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved + [sink]:
+            os.close(fd)
 
 
-def _check_options(backend: Backend, options: Mapping[str, Any]) -> dict[str, Any]:
-    """Refuse options the backend does not accept or values of the wrong kind; the checked ones."""
-    unknown = sorted(set(options) - set(backend.accepted_options))
-    if unknown:
-        raise InputError(
-            f"method {backend.method_name!r} does not accept option(s) "
-            f"{', '.join(repr(name) for name in unknown)}; accepted options: "
-            f"{', '.join(backend.accepted_options)}")
-    kinds = typed(backend.options, COMMON_TYPES)
-    return {name: kinds[name].check(backend.method_name, value) for name, value in options.items()}
+@functools.cache
+def silence_highs_banner() -> None:
+    """HiGHS prints its banner from C on the first ``Highs()`` of a process, whatever the
+    options (highspy 1.16): make that first one with the process's output sent nowhere."""
+    import highspy
+
+    with c_output_discarded():
+        highspy.Highs()
 
 
 def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
              max_iter: int | None = None, **options: Any) -> ContactSolution:
-    """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with one qpsolvers backend.
+    """Solve ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with the qpsolvers ``backend`` (``"osqp"``…).
 
-    Parameters
-    ----------
-    problem : the contact QP.
-    backend : a qpsolvers backend name listed in :data:`BACKENDS` (``"osqp"``...).
-    tol : relative KKT tolerance, translated into the backend's own options
-        (``None`` leaves the backend's defaults untouched).
-    max_iter : iteration limit, translated likewise (quadprog has none).
-    **options : backend options, passed through after ``tol`` and ``max_iter``
-        (so they win); ``max_dense_dofs`` (default 3000) caps ``n`` for dense backends
-        and ``m`` for ``form="dual"``; ``form`` (:data:`~signorini.solvers.forms.FORMS`,
-        default the backend's ``form``) and ``polish`` (default the backend's ``polish``:
-        True for OSQP and Clarabel, else False) are explained in
-        :mod:`signorini.solvers.forms`.
-
-    Returns
-    -------
-    ContactSolution
-        ``u = x``, ``λ = z``; ``extras["raw_status"]`` is the backend's own word.
-
-    Raises
-    ------
-    InputError
-        Unknown option or form, a dense backend asked to solve more than ``max_dense_dofs``
-        dofs, or the dual form more than ``max_dense_dofs`` candidates.
-    BackendNotInstalled
-        qpsolvers cannot load the backend.
-    SolverError
-        The backend raised (re-raised ``from`` its exception).
+    ``tol`` (the relative KKT tolerance) and ``max_iter`` are translated into the backend's own
+    options (None: its defaults); the backend's ``options`` pass through after them, so they
+    win. ``max_dense_dofs`` (default 3000) caps ``n`` for dense backends and ``m`` for the dual
+    form; ``form`` and ``polish`` default to the backend's (:mod:`signorini.solvers.forms`).
+    The answer: ``u = x``, ``λ = z``; ``extras["raw_status"]`` is the backend's own word.
+    InputError for a bad option or a problem too large for a dense backend;
+    BackendNotInstalled when qpsolvers cannot load it; SolverError (``from`` the backend's
+    exception) when it raises.
     """
     spec = BACKEND_BY_NAME[backend]
-    options = _check_options(spec, options)
-    max_dense_dofs = forms.dense_limit(options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS))
+    options = checked(spec.method_name, options, spec.typed_options)
+    max_dense_dofs = options.get("max_dense_dofs", DEFAULT_MAX_DENSE_DOFS)
     form, note = forms.resolve(spec.method_name, problem, options.get("form"), spec.form,
                                max_dense_dofs)
-    polishing = forms.check_polish(spec.method_name, options.get("polish", spec.polish))
+    polishing = spec.polish if options.get("polish") is None else options["polish"]
     dense_n = spec.dense and problem.n > max_dense_dofs
     if form != "dual" and dense_n:
         raise InputError(
@@ -102,7 +102,7 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
             f"available: {', '.join(qpsolvers.available_solvers)}): "
             f"{install_hint(spec.extra, missing)}")
     settings = {**spec.settings(tol, max_iter), **spec.fixed,
-                **{k: v for k, v in options.items() if k not in COMMON_OPTIONS}}
+                **{k: v for k, v in options.items() if k not in COMMON_TYPES}}
     if spec.nest is not None:
         settings = spec.nest(settings)
 
@@ -116,20 +116,16 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
         silence_highs_banner()
     quiet = c_output_discarded() if spec.prints else contextlib.nullcontext()
     try:
-        with warnings.catch_warnings(record=True) as record, quiet:
-            warnings.simplefilter("always")
+        with forms.warned(spec.label) as caught, quiet:
             result = (qpsolvers.solve_problem(qp, spec.name, verbose=False, **settings)
                       if spec.call is None else spec.call(qp, **settings))
     except qpsolvers.ParamError as exc:
         raise InputError(f"{spec.label}: bad option: {exc}") from exc
     except Exception as exc:
-        passed = {k: v for k, v in options.items() if k not in COMMON_OPTIONS}
+        passed = {k: v for k, v in options.items() if k not in COMMON_TYPES}
         hint = f" (with the options {passed})" if passed else ""
         raise SolverError(f"{spec.label} raised {type(exc).__name__}: {exc}{hint}") from exc
     elapsed = time.perf_counter() - start - build_time
-    caught = [str(w.message) for w in record]
-    for message in caught:
-        log.debug("%s warned: %s", spec.label, message)
 
     report = spec.read(result, caught)
     status = spec.status(report.raw_status)
@@ -147,21 +143,9 @@ def solve_qp(problem: ContactProblem, backend: str, *, tol: float | None = None,
                                solve_time=elapsed, tol=tol, polishing=polishing)
 
 
-def _method_function(backend: Backend) -> Callable[..., ContactSolution]:
-    def solve(problem: ContactProblem, *, tol: float | None = None,
-              max_iter: int | None = None, **options: Any) -> ContactSolution:
-        return solve_qp(problem, backend.name, tol=tol, max_iter=max_iter, **options)
-
-    solve.__name__ = f"solve_{backend.name}"
-    solve.__qualname__ = solve.__name__
-    solve.__doc__ = f"{backend.summary}: see :func:`solve_qp`."
-    return solve
-
-
 METHODS = tuple(
-    Method(name=backend.method_name, function=_method_function(backend),
+    Method(name=backend.method_name, function=functools.partial(solve_qp, backend=backend.name),
            summary=backend.summary, requires=("qpsolvers", *backend.modules),
            extra=backend.extra, dense=backend.dense, exact=False, family="qp",
-           options=backend.accepted_options,
-           typed_options=typed(backend.options, COMMON_TYPES))
+           typed_options=backend.typed_options)
     for backend in BACKENDS)

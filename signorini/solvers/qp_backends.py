@@ -12,12 +12,13 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from signorini.solvers import clarabel_, forms
+from signorini.solvers import forms
 from signorini.solvers.options import Option, declare
 from signorini.solvers.qp_reports import (Reader, read_clarabel, read_cvxopt, read_ecos, read_found,
-                                          read_gurobi, read_info, read_quadprog, read_scs)
+                                          read_gurobi, read_info, read_quadprog, read_scs,
+                                          solve_clarabel)
 
-__all__ = ["BACKENDS", "BACKEND_BY_NAME", "COMMON_OPTIONS", "COMMON_TYPES", "DEFAULT_MAX_DENSE_DOFS",
+__all__ = ["BACKENDS", "BACKEND_BY_NAME", "COMMON_TYPES", "DEFAULT_MAX_DENSE_DOFS",
            "Backend"]
 
 log = logging.getLogger(__name__)
@@ -25,12 +26,19 @@ log = logging.getLogger(__name__)
 #: dense backends refuse problems with more free dofs than this (option ``max_dense_dofs``)
 DEFAULT_MAX_DENSE_DOFS = 3000
 
-#: options every ``qp-*`` method accepts besides its backend's own
-COMMON_OPTIONS = ("max_dense_dofs", "form", "polish")
-#: their kinds (None: the backend's default form and polish)
+#: the options every ``qp-*`` method takes besides its backend's own (None: the backend's
+#: default form and polish)
 COMMON_TYPES = declare(Option("max_dense_dofs", "positive_count", DEFAULT_MAX_DENSE_DOFS),
                        Option("form", "choice", None, choices=(None, *forms.FORMS)),
                        Option("polish", "bool", None))
+
+
+
+def kinds(**names: tuple[str, ...]) -> tuple[Option, ...]:
+    """A backend's own options by kind (:data:`signorini.solvers.options.KINDS`), as its
+    documentation gives them: ``kinds(positive=("eps_abs",), count=("max_iter",))``."""
+    return tuple(Option(name, kind) for kind, group in names.items() for name in group)
+
 
 CONVERGED, INACCURATE, MAX_ITER, INFEASIBLE, FAILED = (
     "converged", "inaccurate", "max_iter", "infeasible", "failed")
@@ -62,7 +70,7 @@ class Backend:
     modules: tuple[str, ...]
     read: Reader
     statuses: Mapping[str, str] | Callable[[str], str]
-    options: tuple[str, ...] = ()
+    options: tuple[Option, ...] = ()
     tolerance: Callable[[float], dict[str, Any]] | None = None
     max_iter_option: str | None = None
     dense: bool = False
@@ -79,8 +87,9 @@ class Backend:
         return f"qp-{self.name}"
 
     @property
-    def accepted_options(self) -> tuple[str, ...]:
-        return tuple(sorted(set(self.options) | set(COMMON_OPTIONS)))
+    def typed_options(self) -> dict[str, Option]:
+        """Every option its method takes, by name, with its kind."""
+        return {**declare(*self.options), **COMMON_TYPES}
 
     def settings(self, tol: float | None, max_iter: int | None) -> dict[str, Any]:
         """Backend options meaning "relative KKT tolerance ``tol``, at most ``max_iter``"."""
@@ -179,11 +188,15 @@ BACKENDS: tuple[Backend, ...] = (
         read_info,
         {"solved": CONVERGED, "solved inaccurate": INACCURATE,
          "maximum iterations reached": MAX_ITER, "primal infeasible": INFEASIBLE},
-        options=("rho", "sigma", "alpha", "delta", "scaling", "adaptive_rho",
-                 "adaptive_rho_interval", "adaptive_rho_tolerance", "adaptive_rho_fraction",
-                 "max_iter", "eps_abs", "eps_rel", "eps_prim_inf", "eps_dual_inf",
-                 "scaled_termination", "check_termination", "check_dualgap", "time_limit",
-                 "polishing", "polish_refine_iter", "warm_starting", "linsys_solver"),
+        options=kinds(
+            positive=("rho", "sigma", "delta", "adaptive_rho_tolerance", "eps_abs", "eps_rel",
+                      "eps_prim_inf", "eps_dual_inf", "time_limit"),
+            fraction=("adaptive_rho_fraction",), number=("alpha",),
+            count=("scaling", "adaptive_rho_interval", "max_iter", "check_termination",
+                   "polish_refine_iter"),
+            bool=("adaptive_rho", "scaled_termination", "check_dualgap", "polishing",
+                  "warm_starting"),
+            text=("linsys_solver",)),
         # OSQP's own polishing finishes its answer on its active set: at a tolerance of 1e-8
         # its raw λ is otherwise first-order accurate only (docs/crosscheck.md)
         tolerance=_each("eps_abs", "eps_rel", "eps_prim_inf", polishing=True),
@@ -195,32 +208,37 @@ BACKENDS: tuple[Backend, ...] = (
         read_clarabel,
         {"Solved": CONVERGED, "AlmostSolved": INACCURATE, "MaxIterations": MAX_ITER,
          "PrimalInfeasible": INFEASIBLE},
-        options=("max_iter", "time_limit", "max_step_fraction", "tol_gap_abs", "tol_gap_rel",
-                 "tol_feas", "tol_infeas_abs", "tol_infeas_rel", "tol_ktratio",
-                 "reduced_tol_gap_abs", "reduced_tol_gap_rel", "reduced_tol_feas",
-                 "reduced_tol_infeas_abs", "reduced_tol_infeas_rel", "reduced_tol_ktratio",
-                 "equilibrate_enable", "equilibrate_max_iter", "equilibrate_min_scaling",
-                 "equilibrate_max_scaling", "linesearch_backtrack_step",
-                 "min_switch_step_length", "min_terminate_step_length", "max_threads",
-                 "direct_kkt_solver", "direct_solve_method", "static_regularization_enable",
-                 "static_regularization_constant", "static_regularization_proportional",
-                 "dynamic_regularization_enable", "dynamic_regularization_eps",
-                 "dynamic_regularization_delta", "iterative_refinement_enable",
-                 "iterative_refinement_reltol", "iterative_refinement_abstol",
-                 "iterative_refinement_max_iter", "iterative_refinement_stop_ratio",
-                 "presolve_enable"),
+        options=kinds(
+            positive=("time_limit", "tol_gap_abs", "tol_gap_rel", "tol_feas", "tol_infeas_abs",
+                      "tol_infeas_rel", "tol_ktratio", "reduced_tol_gap_abs",
+                      "reduced_tol_gap_rel", "reduced_tol_feas", "reduced_tol_infeas_abs",
+                      "reduced_tol_infeas_rel", "reduced_tol_ktratio", "equilibrate_min_scaling",
+                      "equilibrate_max_scaling", "min_switch_step_length",
+                      "min_terminate_step_length", "static_regularization_constant",
+                      "static_regularization_proportional", "dynamic_regularization_eps",
+                      "dynamic_regularization_delta", "iterative_refinement_reltol",
+                      "iterative_refinement_abstol", "iterative_refinement_stop_ratio"),
+            fraction=("max_step_fraction", "linesearch_backtrack_step"),
+            count=("max_iter", "equilibrate_max_iter", "max_threads",
+                   "iterative_refinement_max_iter"),
+            bool=("equilibrate_enable", "static_regularization_enable",
+                  "dynamic_regularization_enable", "iterative_refinement_enable",
+                  "presolve_enable"),
+            text=("direct_kkt_solver", "direct_solve_method")),
         tolerance=_clarabel_tolerance, max_iter_option="max_iter", extra="",
-        call=clarabel_.solve_problem,  # qpsolvers drops the iteration count
+        call=solve_clarabel,  # qpsolvers drops the iteration count
         polish=True),  # polished, the validation cases end converged and exact at 1e-8
     Backend(
         "proxqp", "ProxQP", "ProxQP (proximal augmented Lagrangian) through qpsolvers",
         ("proxsuite",), read_info,
         {"PROXQP_SOLVED": CONVERGED, "PROXQP_MAX_ITER_REACHED": MAX_ITER,
          "PROXQP_PRIMAL_INFEASIBLE": INFEASIBLE},
-        options=("eps_abs", "eps_rel", "rho", "mu_eq", "mu_in", "max_iter",
-                 "compute_preconditioner", "initial_guess", "check_duality_gap",
-                 "eps_duality_gap_abs", "eps_duality_gap_rel", "primal_infeasibility_solving",
-                 "default_H_eigenvalue_estimate", "sparse_backend"),
+        options=kinds(
+            positive=("eps_abs", "eps_rel", "rho", "mu_eq", "mu_in", "eps_duality_gap_abs",
+                      "eps_duality_gap_rel"),
+            number=("default_H_eigenvalue_estimate",), count=("max_iter",),
+            bool=("compute_preconditioner", "check_duality_gap", "primal_infeasibility_solving"),
+            text=("initial_guess", "sparse_backend")),
         tolerance=_each("eps_abs", "eps_rel", "eps_duality_gap_abs", "eps_duality_gap_rel",
                         check_duality_gap=True),  # without the gap test it stops early
         max_iter_option="max_iter"),
@@ -229,34 +247,40 @@ BACKENDS: tuple[Backend, ...] = (
         read_info,
         {"PIQP_SOLVED": CONVERGED, "PIQP_MAX_ITER_REACHED": MAX_ITER,
          "PIQP_PRIMAL_INFEASIBLE": INFEASIBLE},
-        options=("rho_init", "delta_init", "eps_abs", "eps_rel", "check_duality_gap",
-                 "eps_duality_gap_abs", "eps_duality_gap_rel", "infeasibility_threshold",
-                 "reg_lower_limit", "reg_finetune_lower_limit",
-                 "reg_finetune_primal_update_threshold", "reg_finetune_dual_update_threshold",
-                 "max_iter", "max_factor_retires", "preconditioner_scale_cost",
-                 "preconditioner_iter", "tau", "kkt_solver",
-                 "iterative_refinement_always_enabled", "iterative_refinement_eps_abs",
-                 "iterative_refinement_eps_rel", "iterative_refinement_max_iter",
-                 "iterative_refinement_min_improvement_rate",
-                 "iterative_refinement_static_regularization_eps",
-                 "iterative_refinement_static_regularization_rel"),
+        options=kinds(
+            positive=("rho_init", "delta_init", "eps_abs", "eps_rel", "eps_duality_gap_abs",
+                      "eps_duality_gap_rel", "infeasibility_threshold", "reg_lower_limit",
+                      "reg_finetune_lower_limit", "iterative_refinement_eps_abs",
+                      "iterative_refinement_eps_rel", "iterative_refinement_min_improvement_rate",
+                      "iterative_refinement_static_regularization_eps",
+                      "iterative_refinement_static_regularization_rel"),
+            fraction=("tau",),
+            count=("reg_finetune_primal_update_threshold", "reg_finetune_dual_update_threshold",
+                   "max_iter", "max_factor_retires", "preconditioner_iter",
+                   "iterative_refinement_max_iter"),
+            bool=("check_duality_gap", "preconditioner_scale_cost",
+                  "iterative_refinement_always_enabled"),
+            text=("kkt_solver",)),
         tolerance=_each("eps_abs", "eps_rel", "eps_duality_gap_abs", "eps_duality_gap_rel"),
         max_iter_option="max_iter"),
     Backend(
         "scs", "SCS", "SCS (ADMM on the conic form, first-order) through qpsolvers", ("scs",),
         read_scs, _scs_status,
-        options=("max_iters", "time_limit_secs", "eps_abs", "eps_rel", "eps_infeas", "normalize",
-                 "scale", "adaptive_scale", "rho_x", "alpha", "acceleration_lookback",
-                 "acceleration_interval", "linear_solver", "write_data_filename",
-                 "log_csv_filename"),
+        options=kinds(
+            positive=("time_limit_secs", "eps_abs", "eps_rel", "eps_infeas", "scale", "rho_x"),
+            number=("alpha",), count=("max_iters", "acceleration_interval"),
+            integer=("acceleration_lookback",), bool=("normalize", "adaptive_scale"),
+            text=("linear_solver", "write_data_filename", "log_csv_filename")),
         tolerance=_each("eps_abs", "eps_rel"), max_iter_option="max_iters"),
     Backend(
         "ecos", "ECOS", "ECOS (interior point on an SOCP reformulation) through qpsolvers",
         ("ecos",), read_ecos,
         {"OPTIMAL": CONVERGED, "OPTIMAL_INACC": INACCURATE, "MAXIT": MAX_ITER,
          "PINF": INFEASIBLE},
-        options=("feastol", "abstol", "reltol", "feastol_inacc", "abstol_inacc",
-                 "reltol_inacc", "max_iters", "nitref"),
+        options=kinds(
+            positive=("feastol", "abstol", "reltol", "feastol_inacc", "abstol_inacc",
+                      "reltol_inacc"),
+            count=("max_iters", "nitref")),
         tolerance=_each("abstol", "reltol", "feastol"), max_iter_option="max_iters",
         dense=True,  # qpsolvers densifies P and G and takes a Cholesky factor of P
         form="dual"),  # so the m × m dual, as DAQP (docs/formulations.md)
@@ -264,19 +288,24 @@ BACKENDS: tuple[Backend, ...] = (
         "highs", "HiGHS", "HiGHS (active set QP) through qpsolvers", ("highspy",),
         read_found("kOptimal", "not optimal (qpsolvers does not pass HiGHS's model status on)"),
         {"kOptimal": CONVERGED},
-        options=("primal_feasibility_tolerance", "dual_feasibility_tolerance",
-                 "optimality_tolerance", "kkt_tolerance", "qp_iteration_limit",
-                 "qp_nullspace_limit", "qp_regularization_value", "time_limit", "presolve",
-                 "solver", "threads", "random_seed", "objective_bound"),
+        options=kinds(
+            positive=("primal_feasibility_tolerance", "dual_feasibility_tolerance",
+                      "optimality_tolerance", "kkt_tolerance", "qp_regularization_value",
+                      "time_limit"),
+            number=("objective_bound",),
+            count=("qp_iteration_limit", "qp_nullspace_limit", "threads", "random_seed"),
+            text=("presolve", "solver")),
         tolerance=_highs_tolerance, max_iter_option="qp_iteration_limit",
         form="dual"),  # primal and shifted give a wrong answer or none (docs/formulations.md)
     Backend(
         "daqp", "DAQP", "DAQP (dual active set, dense) through qpsolvers", ("daqp",),
         read_found("exitflag > 0", "exitflag <= 0 (qpsolvers does not pass the flag on)"),
         {"exitflag > 0": CONVERGED},
-        options=("primal_tol", "dual_tol", "zero_tol", "pivot_tol", "progress_tol", "cycle_tol",
-                 "iter_limit", "fval_bound", "eps_prox", "eta_prox", "sing_tol", "refactor_tol",
-                 "time_limit", "eq_reduction"),
+        options=kinds(
+            positive=("primal_tol", "dual_tol", "zero_tol", "pivot_tol", "progress_tol",
+                      "cycle_tol", "eps_prox", "eta_prox", "sing_tol", "refactor_tol",
+                      "time_limit"),
+            number=("fval_bound",), count=("iter_limit", "eq_reduction")),
         tolerance=_each("primal_tol", "dual_tol"), max_iter_option="iter_limit", dense=True,
         form="dual"),  # dense: the m × m dual, not n × n
     Backend(
@@ -289,33 +318,38 @@ BACKENDS: tuple[Backend, ...] = (
         read_info,
         {"solved": CONVERGED, "maximum iterations reached": MAX_ITER,
          "primal infeasible": INFEASIBLE},
-        options=("max_iter", "inner_max_iter", "eps_abs", "eps_rel", "eps_abs_in", "eps_rel_in",
-                 "rho", "eps_prim_inf", "eps_dual_inf", "theta", "delta", "sigma_max",
-                 "sigma_init", "proximal", "gamma_init", "gamma_upd", "gamma_max", "scaling",
-                 "nonconvex", "warm_start", "reset_newton_iter", "enable_dual_termination",
-                 "dual_objective_limit", "time_limit", "ordering", "factorization_method",
-                 "max_rank_update", "max_rank_update_fraction"),
+        options=kinds(
+            positive=("eps_abs", "eps_rel", "eps_abs_in", "eps_rel_in", "rho", "eps_prim_inf",
+                      "eps_dual_inf", "theta", "delta", "sigma_max", "sigma_init", "gamma_init",
+                      "gamma_upd", "gamma_max", "time_limit"),
+            fraction=("max_rank_update_fraction",), number=("dual_objective_limit",),
+            count=("max_iter", "inner_max_iter", "scaling", "reset_newton_iter", "ordering",
+                   "factorization_method", "max_rank_update"),
+            bool=("proximal", "nonconvex", "warm_start", "enable_dual_termination")),
         tolerance=_each("eps_abs", "eps_rel"), max_iter_option="max_iter"),
     Backend(
         "cvxopt", "CVXOPT", "CVXOPT (interior point) through qpsolvers", ("cvxopt",),
         read_cvxopt, {"optimal": CONVERGED},
-        options=("abstol", "reltol", "feastol", "maxiters", "refinement"),
+        options=kinds(
+            positive=("abstol", "reltol", "feastol"), count=("maxiters", "refinement")),
         tolerance=_each("abstol", "reltol", "feastol"), max_iter_option="maxiters"),
     Backend(
         "gurobi", "Gurobi", "Gurobi (barrier) through qpsolvers", ("gurobipy",),
         read_gurobi,
         {"OPTIMAL": CONVERGED, "SUBOPTIMAL": INACCURATE, "ITERATION_LIMIT": MAX_ITER,
          "INFEASIBLE": INFEASIBLE},
-        options=("FeasibilityTol", "OptimalityTol", "BarConvTol", "PSDTol", "TimeLimit",
-                 "IterationLimit", "BarIterLimit", "Method", "Threads", "Presolve",
-                 "NumericFocus", "Crossover", "BarHomogeneous", "ScaleFlag"),
+        options=kinds(
+            positive=("FeasibilityTol", "OptimalityTol", "BarConvTol", "PSDTol", "TimeLimit"),
+            count=("IterationLimit", "BarIterLimit", "Method", "Threads", "Presolve",
+                   "NumericFocus", "Crossover", "BarHomogeneous", "ScaleFlag")),
         tolerance=_each("FeasibilityTol", "OptimalityTol", "BarConvTol", bounds=(1e-9, 1e-2)),
         max_iter_option="BarIterLimit", extra="gurobi"),
     Backend(
         "mosek", "MOSEK", "MOSEK (interior point) through qpsolvers and CVXOPT",
         ("mosek", "cvxopt"), read_cvxopt,
         {"optimal": CONVERGED, "primal infeasible": INFEASIBLE},
-        options=("mosek",),
+        options=kinds(
+            any=("mosek",)),
         tolerance=_each("intpnt_qo_tol_rel_gap", "intpnt_qo_tol_pfeas", "intpnt_qo_tol_dfeas"),
         max_iter_option="intpnt_max_iterations", nest=_mosek_nest, extra="mosek"),
 )

@@ -1,13 +1,18 @@
 """What a qpsolvers backend reported: its raw status, iterations and other facts.
 
-One reader per backend (or family of backends) takes the :class:`qpsolvers.Solution`
-and the warnings the run raised, and returns a :class:`Report`; the backend table
-in :mod:`signorini.solvers.qp` names which reader each backend uses.
+One reader per backend (or family of backends) takes the :class:`qpsolvers.Solution` and the
+warnings the run raised, and returns a :class:`Report`; the backend table
+(:mod:`signorini.solvers.qp_backends`) names which reader each backend uses. Clarabel is
+called directly (:func:`solve_clarabel`) so that its iteration count is kept.
 """
 
 from __future__ import annotations
 
+import time
 from typing import Any, Callable, NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
 
 
 class Report(NamedTuple):
@@ -86,3 +91,36 @@ GUROBI_CODES = {1: "LOADED", 2: "OPTIMAL", 3: "INFEASIBLE", 4: "INF_OR_UNBD", 5:
 def read_gurobi(solution: Any, caught: list[str]) -> Report:
     code = int(solution.extras["status"])
     return Report(GUROBI_CODES.get(code, f"status {code}"), None, {"status_code": code})
+
+
+def solve_clarabel(qp: Any, **settings: Any) -> Any:
+    """Clarabel's answer to ``min ½xᵀPx + qᵀx  s.t.  Gx ≤ h`` (or ``x ≥ lb``, as the rows
+    ``−x + s = −lb``), called on the :class:`qpsolvers.Problem` directly and returned as
+    qpsolvers gives it (``x``, ``z`` or ``z_box``, ``found``), with its status and iterations
+    (which qpsolvers drops) in ``extras``."""
+    import clarabel  # optional backend: only when qp-clarabel runs
+    import qpsolvers
+
+    start = time.perf_counter()
+    P, q, G, h, _, _, lb, _ = qp.unpack()
+    bounds = G is None
+    if bounds:  # x ≥ lb as −x ≤ −lb
+        G, h = -sp.identity(q.size, format="csc"), -np.asarray(lb, dtype=float)
+    options = clarabel.DefaultSettings()
+    options.verbose = False
+    for name, value in settings.items():
+        setattr(options, name, value)
+    solver = clarabel.DefaultSolver(sp.triu(sp.csc_matrix(P), format="csc"), np.asarray(q, float),
+                                    sp.csc_matrix(G), np.asarray(h, float),
+                                    [clarabel.NonnegativeConeT(h.size)], options)
+    built = time.perf_counter()
+    result = solver.solve()
+    solution = qpsolvers.Solution(qp)
+    solution.x = np.array(result.x)
+    z = np.array(result.z)
+    solution.z, solution.z_box = (np.empty(0), -z) if bounds else (z, np.empty(0))
+    solution.found = result.status == clarabel.SolverStatus.Solved
+    solution.extras = {"status": result.status, "iterations": int(result.iterations),
+                       "solve_time": result.solve_time}
+    solution.build_time, solution.solve_time = built - start, time.perf_counter() - built
+    return solution

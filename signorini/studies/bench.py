@@ -242,10 +242,9 @@ def write_report(csv_path: Path, command: str) -> Path:
         raise InputError(f"{csv_path} has no rows to report")
     directory = csv_path.parent
     info = provenance()
-    ax = plots.bench_speed_accuracy(rows, metric="kkt_worst")
-    save_figure(ax.figure, directory / "speed-vs-kkt.png")
-    ax = plots.bench_speed_accuracy(rows, metric="p0_rel")
-    save_figure(ax.figure, directory / "speed-vs-p0.png")
+    for metric, name in (("kkt_worst", "kkt"), ("p0_rel", "p0")):
+        save_figure(plots.bench_speed_accuracy(rows, metric=metric).figure,
+                    directory / f"speed-vs-{name}.png")
     ax, slopes = plots.bench_time_vs_dofs(rows)
     save_figure(ax.figure, directory / "time-vs-dofs.png")
     md = ["# signorini benchmark", "", f"Command: `{command}`  ",

@@ -85,10 +85,9 @@ def write_study(study: ConvergenceStudy, out, command: str,
     """Write ``convergence-<scene>.md``, ``.json`` and ``.png`` (and the grading figure) to ``out``."""
     directory = writable_directory(out)
     stem = f"convergence-{study.scene}"
-    paths = {}
-    ax = plot_convergence(study)
-    save_figure(ax.figure, directory / f"{stem}.png")
-    paths["figure"] = directory / f"{stem}.png"
+    paths = {"figure": directory / f"{stem}.png", "markdown": directory / f"{stem}.md",
+             "json": directory / f"{stem}.json"}
+    save_figure(plot_convergence(study).figure, paths["figure"])
     md = [f"# Convergence: {study.scene}", "", f"Command: `{command}`  ",
           "Parameters: " + ", ".join(f"{k}={v}" for k, v in study.params.items()), "",
           f"Largest λ difference between exact methods: {study.max_disagreement():.1e}", ""]
@@ -96,9 +95,8 @@ def write_study(study: ConvergenceStudy, out, command: str,
     md += ["", f"![convergence]({stem}.png)"]
     payload: dict[str, Any] = {"command": command, "study": study.as_dict()}
     if comparison is not None:
-        ax = plot_grading(comparison)
-        save_figure(ax.figure, directory / f"grading-{study.scene}.png")
         paths["grading"] = directory / f"grading-{study.scene}.png"
+        save_figure(plot_grading(comparison).figure, paths["grading"])
         md += ["", "## Graded against uniform meshes", "",
                f"{LABELS.get(comparison.metric, comparison.metric)} of {100 * comparison.target:g} %: "
                f"graded {comparison.graded_dofs:,.0f} dofs ({comparison.graded_how}), uniform "
@@ -110,8 +108,6 @@ def write_study(study: ConvergenceStudy, out, command: str,
         payload["grading"] = {k: v for k, v in comparison.as_dict().items()
                               if k not in ("graded", "uniform")}
         payload["uniform"] = comparison.uniform.as_dict()
-    atomic_write_text(directory / f"{stem}.md", "\n".join(md) + "\n")
-    atomic_write_text(directory / f"{stem}.json", to_json(payload))
-    paths["markdown"] = directory / f"{stem}.md"
-    paths["json"] = directory / f"{stem}.json"
+    atomic_write_text(paths["markdown"], "\n".join(md) + "\n")
+    atomic_write_text(paths["json"], to_json(payload))
     return paths

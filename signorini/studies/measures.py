@@ -23,6 +23,7 @@ from signorini.fem.transfer import uniform_prolongation
 from signorini.certification.kkt import WEAK, WEAK_TOL, active_set, certificate, classify, force_scale, gap_scale
 from signorini.numerics.factor import PardisoFactor, factorize, resolve_backend
 from signorini.numerics.lcp import delassus
+from signorini.output.export import nodal_displacement
 from signorini.references.profile import contact_profile
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import reference_of
@@ -179,21 +180,16 @@ def estimate_record(problem: ContactProblem, solution: ContactSolution) -> dict[
             "estimate_s": seconds}
 
 
-def _nodal(problem: ContactProblem, solution: ContactSolution) -> np.ndarray:
-    """The displacement of every node (nodes, dim) in physical units."""
-    return (problem.model.expand(solution.u) * problem.scales.displacement).reshape(-1, problem.model.mesh.p.shape[0])
-
-
 def energy_error(coarse: ContactProblem, coarse_solution: ContactSolution, fine: ContactProblem,
                  fine_solution: ContactSolution, steps: int) -> dict[str, float]:
     """``‖u_fine − P u_coarse‖_E`` (``error``, physical) with P the prolongation over ``steps``
     uniform refinements, summed element by element on the finer mesh, and the fine answer's
     ``λᵀ·gap(P u_coarse)`` (``complementarity``, physical)."""
     P = uniform_prolongation(coarse.model.mesh.t, coarse.model.mesh.p.shape[1], steps)
-    moved = P @ _nodal(coarse, coarse_solution)
+    moved = P @ nodal_displacement(coarse, coarse_solution)
     E, nu = material_units(fine)
     s = fine.scales
-    difference = (_nodal(fine, fine_solution) - moved) / s.displacement
+    difference = (nodal_displacement(fine, fine_solution) - moved) / s.displacement
     energy = element_energies(fine.model.mesh, difference, E, nu, fine.model.axisymmetric).sum()
     v = (moved.ravel() / s.displacement)[fine.model.dofs()[1]]
     return {"error": float(np.sqrt(energy * s.force * s.displacement)),

@@ -25,6 +25,7 @@ The ladders (:mod:`signorini.studies.peer_cases`) differ by code; the report
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import subprocess
@@ -150,8 +151,6 @@ def _timed(argv: list[str], timeout: float) -> tuple[subprocess.CompletedProcess
 
 
 def _decode(done: subprocess.CompletedProcess | None, why: str) -> tuple[dict | None, str]:
-    import json
-
     if done is None:
         return None, why
     try:  # the package writes indented JSON, the script one line after GetFEM's own output
@@ -164,8 +163,6 @@ def _decode(done: subprocess.CompletedProcess | None, why: str) -> tuple[dict | 
 
 def run_point(point: Point, *, python: str, command: list[str], timeout: float) -> None:
     """Run ``point`` once: its whole-process wall time appended, its row kept if the fastest."""
-    import json
-
     if point.code == "getfem":
         argv = [python, str(CASES[point.scene].path), json.dumps(point.given)]
     else:
@@ -213,8 +210,6 @@ def solve_repeatedly(given: str) -> None:
     assembly, solve, certificate, estimate and profile; not the writing), and prints one
     JSON line: every solve's wall time (``runs_s``), the last one's dofs and status.
     """
-    import json
-
     point = json.loads(given)
     runs, record = [], {}
     for _ in range(point["repeat"]):
@@ -228,8 +223,6 @@ def time_in_process(point: Point, solves: int, *, python: str, timeout: float) -
     """Solve ``point`` ``solves`` times in one fresh process of its code; each solve's wall
     time, the first a warm-up (kept in ``point.solves``; empty, with ``point.solves_message``
     saying why, when the process gave none)."""
-    import json
-
     if point.code == "getfem":
         argv = [python, str(CASES[point.scene].path), json.dumps({**point.given, "repeat": solves})]
     else:

@@ -47,14 +47,12 @@ class Case:
         return SCRIPTS / self.script
 
 
-def _one_body(scene: str) -> Callable[..., tuple[float, float, float]]:
+def _one_body(load: Callable, peak: Callable) -> Callable[..., tuple[float, float, float]]:
+    """Hertz's (load P, p0, a) of one body on a rigid flat, by its ``load`` and ``peak`` formulas."""
     def reference(*, R: float, E: float, nu: float, a_over_R: float) -> tuple[float, float, float]:
-        a, E_star = a_over_R * R, contact_modulus(E, nu)
-        if scene == "cylinder":
-            P = hertz_cylinder_load(a, R, E_star)
-            return P, hertz_cylinder_peak(P, a), a
-        P = hertz_sphere_load(a, R, E_star)
-        return P, hertz_sphere_peak(P, a), a
+        a = a_over_R * R
+        P = load(a, R, contact_modulus(E, nu))
+        return P, peak(P, a), a
     return reference
 
 
@@ -76,12 +74,12 @@ CASES = {
         "getfem_hertz.py", ONE_BODY_DEFAULTS, ONE_BODY_LADDER,
         # the scene's default mesh (n_contact 24) is the middle rung
         ({"n_contact": 8}, {"n_contact": 14}, {"n_contact": 24}, {"n_contact": 48},
-         {"n_contact": 48, "refine": 1}), _one_body("cylinder"), "cylinder"),
+         {"n_contact": 48, "refine": 1}), _one_body(hertz_cylinder_load, hertz_cylinder_peak), "cylinder"),
     "hertz-sphere": Case(
         "getfem_hertz.py", ONE_BODY_DEFAULTS, ONE_BODY_LADDER,
         # the scene's default mesh (n_contact 48) is the middle rung
         ({"n_contact": 12}, {"n_contact": 24}, {"n_contact": 48}, {"n_contact": 96},
-         {"n_contact": 96, "refine": 1}), _one_body("sphere"), "sphere"),
+         {"n_contact": 96, "refine": 1}), _one_body(hertz_sphere_load, hertz_sphere_peak), "sphere"),
     # the scene's defaults (its mesh: n_contact 48); the slave's size at the contact, the
     # master's 1.25 times coarser on GetFEM's side (the script's master_ratio)
     "hertz-two-cylinders": Case(

@@ -7,6 +7,8 @@ accuracies :data:`TARGETS`, by each measure of time (:data:`MEASURES`).
 
 from __future__ import annotations
 
+import csv
+import io
 import math
 import os
 from pathlib import Path
@@ -114,9 +116,6 @@ CSV_COLUMNS = ("scene", "code", "rung", "mesh", "dofs", "contact_nodes", "active
 def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
                meta: dict[str, Any]) -> dict[str, Path]:
     """peer.csv, peer.json, peer.md and peer.png in ``out``, each written whole or not at all."""
-    import csv
-    import io
-
     directory = writable_directory(out)
     paths = {k: directory / f"peer.{k}" for k in ("csv", "json", "md", "png")}
     buffer = io.StringIO()

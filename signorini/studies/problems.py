@@ -71,18 +71,11 @@ def _force_controlled(spec: dict[str, Any]) -> ContactProblem:
     return regularise(problem, epsilon) if epsilon else problem
 
 
-def _ill_posed(spec: dict[str, Any]) -> ContactProblem:
-    return ill_posed_problem(spec["case"], params=spec.get("params", {}))
-
-
-def _stored(spec: dict[str, Any]) -> ContactProblem:
-    return at_load(read_problem(spec["path"]), coarse_problem)
-
-
 #: the kinds of problem spec and how each is built
 PROBLEM_KINDS: dict[str, Callable[[dict[str, Any]], ContactProblem]] = {
-    "scene": _scene, "force-controlled": _force_controlled, "ill-posed": _ill_posed,
-    "stored": _stored,
+    "scene": _scene, "force-controlled": _force_controlled,
+    "ill-posed": lambda spec: ill_posed_problem(spec["case"], params=spec.get("params", {})),
+    "stored": lambda spec: at_load(read_problem(spec["path"]), coarse_problem),
 }
 
 
@@ -271,14 +264,3 @@ def exact_attempt(problem: ContactProblem, spec: dict[str, Any], other: ContactP
 def trusted(answer: ContactSolution | None) -> ContactSolution | None:
     """``answer`` when it converged, else None (nothing to hold a run to)."""
     return answer if answer is not None and answer.status == "converged" else None
-
-
-def reference_solution(problem: ContactProblem, spec: dict[str, Any],
-                       other: ContactProblem | None = None) -> ContactSolution | None:
-    """The trusted exact answer for ``problem`` in its own units, or None when there is none.
-
-    ``spec["kind"]`` names the policy (:data:`REFERENCE_POLICIES`); for a
-    method's policy, ``other`` is the same mesh in other units, solved and
-    converted (with ``spec["displacement_only"]``: its displacement alone).
-    """
-    return trusted(exact_attempt(problem, spec, other))

@@ -335,18 +335,15 @@ def serve_worker() -> None:
     cache = _Cache()
     try:
         for line in sys.stdin:
-            task = Task(**json.loads(line))
-            try:
-                row = run_task(task, cache)
-            except Exception as exc:  # a bug of the runner itself: one row says so
-                row = failed_row(task, exc)
+            row = _run_here(Task(**json.loads(line)), cache)
             channel.write(json.dumps(plain(row)) + "\n")
     finally:
         cluster.release()
 
 
 def _run_here(task: Task, cache: _Cache) -> Row:
-    """:func:`run_task` in this process; an error of the runner itself becomes one row."""
+    """:func:`run_task` (a fresh task with a cache of its own); an error of the runner itself
+    becomes one row."""
     try:
         return run_task(task, _Cache() if task.fresh else cache)
     except Exception as exc:  # a bug of the runner itself: one row says so

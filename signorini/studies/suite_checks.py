@@ -99,13 +99,17 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
     """
     case, problem, ref = result.case, result.problem, result.reference
     own_case = not is_problem_file(case.scene)
-    checks = [Check(case.name, "pdas converged", ref.status == "converged", None,
-                    ref.status == "converged", ref.message)]
+    checks: list[Check] = []
+
+    def holds(name: str, ok: bool, detail: str = "") -> None:
+        checks.append(Check(case.name, name, ok, None, ok, detail))
 
     def limit(name: str, value: float | None, key: str, detail: str = "") -> None:
         value = float("nan") if value is None else float(value)  # None: not finite in a row
         checks.append(Check(case.name, name, value, limits[key],
                             bool(np.isfinite(value) and value <= limits[key]), detail))
+
+    holds("pdas converged", ref.status == "converged", ref.message)
 
     metrics = reference_metrics(problem, ref) if case.check_reference else {}
     reference = reference_of(problem)
@@ -114,8 +118,7 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
             if claim.limit is not None:
                 limit(claim.name, claim.value, claim.limit, claim.detail)
             else:
-                checks.append(Check(case.name, claim.name, bool(claim.value), None,
-                                    bool(claim.value), claim.detail))
+                holds(claim.name, bool(claim.value), claim.detail)
     if case.agrees_with and case.agrees_with in by_name and metrics:
         other = by_name[case.agrees_with]
         theirs = reference_metrics(other.problem, other.reference)
@@ -130,9 +133,8 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
         if row["tol"] == tol and row["status"] == "converged" and "vs_reference" in row:
             vs = row["vs_reference"]
             limit(f"{row['label']} converged: λ agrees with pdas", vs["lam_rel"], "lam_rel_vs_pdas")
-            checks.append(Check(case.name, f"{row['label']} converged: same active set as pdas",
-                                vs["misclassified"] == 0, None, vs["misclassified"] == 0,
-                                f"{vs['misclassified']} nodes misclassified"))
+            holds(f"{row['label']} converged: same active set as pdas", vs["misclassified"] == 0,
+                  f"{vs['misclassified']} nodes misclassified")
     must_converge = {}
     if own_case:
         checks += cross_checks(result, tol)
@@ -140,9 +142,7 @@ def case_checks(result: CaseResult, by_name: dict[str, CaseResult],
     must_converge.update({name: f"{name} (asked for by name) converged" for name in required})
     for row in result.runs:
         if row["method"] in must_converge and row["tol"] == tol:
-            ok = row["status"] == "converged"
-            checks.append(Check(case.name, must_converge[row["method"]], ok, None, ok,
-                                row["message"]))
+            holds(must_converge[row["method"]], row["status"] == "converged", row["message"])
     if case.same_as and case.same_as in by_name:
         other = by_name[case.same_as].reference
         diff = float(np.max(np.abs(other.lam - ref.lam)) / np.max(np.abs(other.lam)))

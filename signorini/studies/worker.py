@@ -93,21 +93,17 @@ class Worker:
         """Stop the worker (it is restarted by the next task): end of input, then a kill."""
         _LIVE.discard(self)
         if self._proc is not None:
-            try:
+            with contextlib.suppress(OSError, subprocess.TimeoutExpired):
                 self._proc.stdin.close()
                 if grace > 0:
                     self._proc.wait(timeout=grace)
-            except (OSError, subprocess.TimeoutExpired):
-                pass
             # the whole process group, also when the worker ended by itself: what a method
             # started (a forked child, a shell) ends with it
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(self._proc.pid, signal.SIGKILL)
             self._proc.wait()
-            try:
+            with contextlib.suppress(OSError):
                 self._proc.stdout.close()
-            except OSError:
-                pass
             self._proc = None
         if self._stderr is not None:
             self._stderr.close()
