@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+import types
 
 import numpy as np
 import pytest
@@ -176,9 +177,11 @@ def test_run_skips_the_teardown_only_as_the_one_process(monkeypatch):
     monkeypatch.setattr(app, "keep_freed_memory", lambda: None)  # this process's allocator stays
     monkeypatch.setattr(app.os, "_exit", ended.append)
     monkeypatch.setattr(app.atexit, "_run_exitfuncs", lambda: handlers.append(True))
+    monkeypatch.delitem(sys.modules, "mpi4py", raising=False)  # no MPI loaded in this process
     app.run(["methods"])
     assert ended == [0] and handlers == [True]  # the exit handlers ran, then the process ended
-    monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")  # under mpirun: MPI ends the ranks as usual
+    # with MPI loaded (under mpirun, one rank or more) MPI is finalised by the usual exit
+    monkeypatch.setitem(sys.modules, "mpi4py", types.ModuleType("mpi4py"))
     monkeypatch.setattr(app, "main", lambda argv, process: 0)
     with pytest.raises(SystemExit) as stopped:
         app.run(["methods"])

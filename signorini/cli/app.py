@@ -95,13 +95,12 @@ def run(argv: Sequence[str] | None = None) -> NoReturn:
     Once the command is done (outputs written, workers stopped), what is buffered is flushed
     and the exit handlers run; then the process ends without the interpreter's teardown,
     which frees every object one by one (at 10⁶ dofs, gigabytes of arrays and a
-    factorisation). Under ``mpirun``, or when the output cannot be flushed, it exits as usual.
+    factorisation). When MPI was loaded (under ``mpirun`` or not), or when the output cannot be
+    flushed, it exits as usual.
     """
     keep_freed_memory()
     code = main(argv, process=True)
-    from signorini.solvers import cluster  # per command (start-up)
-
-    if cluster.launched_size() > 1:
+    if "mpi4py" in sys.modules:  # MPI is finalised by the usual exit (mpirun waits for it)
         sys.exit(code)
     try:
         for stream in (sys.stdout, sys.stderr):
