@@ -39,21 +39,23 @@ DEFAULTS = declare(Option("ksp", "choice", "auto", choices=KSP_CHOICES),
                    Option("petsc_options", "text", ""))
 #: ``ksp=auto`` uses GAMG for 3D problems of at least this many dofs (MUMPS below, and in 2D)
 GAMG_FROM_DOFS = 20_000
-#: each method's PETSc solver kind and type, and its summary
+#: each method's PETSc solver kind and type, whether it is exact (a Newton method that ends on
+#: the active set's KKT system), and its summary
 KINDS = {
-    "petsc-vi": ("snes", "vinewtonrsls", "PETSc SNES vinewtonrsls (semismooth Newton on the "
-                                         "bounds), MUMPS or CG+GAMG; MPI"),
-    "petsc-tron": ("tao", "tron", "PETSc TAO tron (trust-region Newton on the bounds), MUMPS or "
-                                  "CG+GAMG; MPI"),
-    "petsc-gpcg": ("tao", "gpcg", "PETSc TAO gpcg (gradient projection + CG on the bounds); MPI"),
+    "petsc-vi": ("snes", "vinewtonrsls", True, "PETSc SNES vinewtonrsls (semismooth Newton on "
+                                               "the bounds), MUMPS or CG+GAMG; MPI"),
+    "petsc-tron": ("tao", "tron", False, "PETSc TAO tron (trust-region Newton on the bounds), "
+                                         "MUMPS or CG+GAMG; MPI"),
+    "petsc-gpcg": ("tao", "gpcg", False, "PETSc TAO gpcg (gradient projection + CG on the "
+                                         "bounds); MPI"),
 }
 
 
-def solve(problem: ContactProblem, method: str, *, tol: float | None = None,
+def solve_petsc(problem: ContactProblem, method: str, *, tol: float | None = None,
           max_iter: int | None = None, **options: Any) -> ContactSolution:
     """PETSc's solver of ``method`` (a key of :data:`KINDS`) on the bound form."""
     opts = take_options(method, options, DEFAULTS)
-    kind, petsc_type, _ = KINDS[method]
+    kind, petsc_type, _, _ = KINDS[method]
     tol, max_iter = resolved(method, "petsc", tol, max_iter)
     ksp = opts["ksp"]
     start = time.perf_counter()
@@ -100,7 +102,7 @@ def solve(problem: ContactProblem, method: str, *, tol: float | None = None,
 
 
 METHODS = tuple(
-    Method(name=name, function=functools.partial(solve, method=name), summary=KINDS[name][2],
+    Method(name=name, function=functools.partial(solve_petsc, method=name), summary=summary,
            requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
-           exact=name == "petsc-vi", typed_options=DEFAULTS, bound_rows=True)
-    for name in KINDS)
+           exact=exact, typed_options=DEFAULTS, bound_rows=True)
+    for name, (_, _, exact, summary) in KINDS.items())
