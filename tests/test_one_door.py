@@ -200,3 +200,22 @@ def test_the_registry_is_read_only():
     for table in (REGISTRY, TABLE):
         with pytest.raises(TypeError):
             table["mine"] = table[next(iter(table))]
+
+
+def test_the_qp_is_the_qp_alone_and_its_model_makes_it():
+    """ContactProblem holds the QP and reaches into no other record; the model (mesh, parameters,
+    load family) is ``problem.model``, and a QP given as arrays has the empty one."""
+    scene = signorini.build_problem("hertz-cylinder", params={"n_contact": 16, "grading": 0.4})
+    for name in ("mesh", "params", "push", "pending", "basis", "expand", "applied_load", "dofs",
+                 "reference", "reference_data", "axisymmetric", "discretisation"):
+        assert not hasattr(scene, name), name
+    assert scene.model.pending and scene.model.mesh is not None
+    model, f, d = scene.model.at_push(2.0 * scene.model.push.scale)  # the affine load family
+    assert not model.pending and model.mesh is scene.model.mesh
+    assert np.allclose(d - scene.model.push.d0, 2.0 * (scene.d - scene.model.push.d0))
+    moved = scene.pushed(2.0 * scene.model.push.scale)
+    assert np.shares_memory(moved.K.data, scene.K.data)  # K and its factorisation are shared
+    assert np.array_equal(moved.f, f) and np.array_equal(moved.d, d)
+    own = own_qp()
+    assert own.model.empty and own.model.mesh is None and not own.model.pending
+    assert np.array_equal(own.model.expand(np.arange(2.0)), np.arange(2.0))

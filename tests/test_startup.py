@@ -77,3 +77,20 @@ def test_methods_lists_what_is_installed_without_importing_it():
     for method in methods():
         installed = all(importlib.util.find_spec(module) is not None for module in method.requires)
         assert listed[method.name] == ("installed" if installed else "not"), method.name
+
+
+def test_a_qp_given_as_arrays_loads_no_scene_mesher_or_finite_elements():
+    """A QP of one's own has no mesh: solving it imports no scene family, mesher or scikit-fem
+    (the package's folders load their contents at first use); a scene does import them."""
+    meshing = ("skfem", "triangle", "signorini.scenes.build", "signorini.fem.assembly")
+    answer = fresh(loaded_after(
+        "import numpy as np, signorini\n"
+        "qp = signorini.ContactProblem.from_qp(K=np.diag([2.0, 1.0]), f=np.ones(2),\n"
+        "                                      N=np.array([[1.0, 0.0]]), d=np.array([0.25]))\n"
+        "assert signorini.solve(qp, 'pdas').status == 'converged'", meshing))
+    assert answer["loaded"] == []
+    scene = fresh(loaded_after(
+        "import signorini\n"
+        "signorini.solve('hertz-cylinder', 'pdas', params={'n_contact': 16, 'grading': 0.4})",
+        meshing))
+    assert scene["loaded"] == list(meshing)  # the check sees the modules when they are loaded
