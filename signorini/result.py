@@ -22,7 +22,7 @@ import numpy as np
 
 from signorini.certification.kkt import Certificate
 from signorini.derivatives import implicit as derivatives
-from signorini.fem.estimate import ErrorEstimate, estimate
+from signorini import fem  # the estimate's module loaded at first use: a QP has no mesh
 from signorini.numerics.work import stage_times, time_line, timed
 from signorini.problem.contact import ContactProblem
 from signorini.problem.scales import record_units
@@ -187,7 +187,7 @@ class Result:
         return self.comparison if self.reference is not None and self.reference.key == "hertz" else None
 
     @property
-    def estimate(self) -> ErrorEstimate | None:
+    def estimate(self) -> fem.ErrorEstimate | None:
         """The a posteriori estimate of the discretisation error in the energy norm.
 
         ``total`` (physical units, √(force · length)), ``relative`` = η / ‖u_h‖_E
@@ -198,7 +198,8 @@ class Result:
         if not hasattr(self, "_estimate"):
             log.info("estimating the discretisation error (ZZ)")
             with timed(self.solution.seconds, "estimate"):
-                self._estimate = estimate(self.problem, self.solution) if self.finite else None
+                self._estimate = (fem.estimate.estimate(self.problem, self.solution)
+                                  if self.finite else None)
         return self._estimate
 
     # -- records ----------------------------------------------------------------------------

@@ -25,6 +25,12 @@ OUT = ROOT / "docs" / "speed" / "startup.json"
 REPEAT = 7
 GETFEM_SCRIPT = ROOT / "benchmarks" / "peers" / "getfem_hertz.py"
 
+def meshing(imports: str, disc: str) -> str:
+    """Code that imports ``imports`` and meshes the Hertz disc (n_contact, grading, mesher)."""
+    return (f"import {imports}\nfrom signorini.scenes.meshing import graded_quarter_disc\n"
+            f"graded_quarter_disc(1.0, 0.05, {disc})")
+
+
 #: (label, interpreter: "venv" or "system", argv after the interpreter)
 FLOOR = "import numpy, scipy.sparse"
 COMMAND_LINE = "import the package's command line"
@@ -42,15 +48,11 @@ STEPS = (
     (FEM_IMPORTS, "venv",
      ["-c", "import numpy, scipy.sparse, scipy.sparse.linalg, skfem"]),
     (COMMAND_LINE, "venv", ["-c", "import signorini.cli.app"]),
-    (DEFAULT_MESH, "venv",
-     ["-c", "import signorini.cli.app\nfrom signorini.scenes.meshing import graded_quarter_disc\n"
-      "graded_quarter_disc(1.0, 0.05, 24, 0.11, mesher='triangle')"]),
+    (DEFAULT_MESH, "venv", ["-c", meshing("signorini.cli.app", "24, 0.11, mesher='triangle'")]),
     (SOLVERS, "venv",
-     ["-c", "import signorini.cli.app, signorini.api\nfrom signorini.scenes.meshing import "
-      "graded_quarter_disc\ngraded_quarter_disc(1.0, 0.05, 24, 0.11, mesher='triangle')"]),
+     ["-c", meshing("signorini.cli.app, signorini.api", "24, 0.11, mesher='triangle'")]),
     ("… and mesh it by the relaxed mesher instead (n_contact=40, grading=0.15)", "venv",
-     ["-c", "import signorini.cli.app\nfrom signorini.scenes.meshing import graded_quarter_disc\n"
-      "graded_quarter_disc(1.0, 0.05, 40, 0.15, mesher='relaxed')"]),
+     ["-c", meshing("signorini.cli.app", "40, 0.15, mesher='relaxed'")]),
     (DEFAULT_SOLVE, "venv", ["-m", "signorini.cli", "solve", "hertz-cylinder"]),
     (STEEL, "venv", ["-m", "signorini.cli", "solve", "hertz-cylinder", "--set", "E=2.1e11", "--set",
                      "nu=0.3", "--set", "R=0.02", "--set", "a_over_R=0.05"]),

@@ -17,7 +17,7 @@ mesh, never loads scikit-fem.
 
 import lazy_loader
 
-__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs={
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submodules=["estimate"], submod_attrs={
     "assembly": ["assemble"], "checks": ["check_model"], "contact_estimate": ["PressureEstimate"],
     "estimate": ["ErrorEstimate"], "model": ["CutLoad", "FlatObstacle", "FlatObstacle3D", "SceneModel"],
     "obstacles": ["Circle", "FlatPunch", "HalfPlane", "Obstacle", "SignedDistance"]})

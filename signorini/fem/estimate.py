@@ -33,6 +33,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from skfem.models.elasticity import lame_parameters as lame  # Lamé's λ and μ of E and ν
+from skfem.quadrature import get_quadrature
 
 from signorini.fem.contact_estimate import PressureEstimate, candidate_nodes, contact_term, pressure_estimate
 from signorini.fem.stiffness import barycentric_gradients
@@ -105,18 +107,11 @@ class Quadrature:
     gradients: np.ndarray
 
 
-def lame(E: Any, nu: Any) -> tuple[Any, Any]:
-    """Lamé's λ and μ of Young's modulus E and Poisson's ratio ν (numbers or arrays)."""
-    return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
-
-
 def quadrature(mesh: Any, axisymmetric: bool = False, order: int | None = None) -> Quadrature:
     """The quadrature of order ``order`` on every simplex of ``mesh`` (triangles or tetrahedra);
     by default :data:`QUADRATURE_ORDER`, or :data:`AXISYMMETRIC_ORDER` when axisymmetric."""
     if order is None:
         order = AXISYMMETRIC_ORDER if axisymmetric else QUADRATURE_ORDER
-    from skfem.quadrature import get_quadrature  # scikit-fem at first use (start-up)
-
     X, W = get_quadrature(mesh.refdom, order)
     bary = np.vstack([1.0 - X.sum(axis=0), X])
     gradients, jacobian = simplex_gradients(mesh)

@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTri
 
 from signorini.fem.topology import _entities, sort_order
 
@@ -126,9 +128,6 @@ def hoop_terms(p: np.ndarray, t: np.ndarray, grads: np.ndarray, area: np.ndarray
     ``(λ + 2μ) ∫ φₐ φ_b / r``, integrated with scikit-fem's rule of order
     :data:`HOOP_ORDER` (its quadrature points lie inside, where r > 0).
     """
-    from skfem.quadrature import get_quadrature  # scikit-fem at first use (start-up)
-    from skfem.refdom import RefTri
-
     first, second = pairs
     points, weights = get_quadrature(RefTri, HOOP_ORDER)
     shape = np.array([1.0 - points[0] - points[1], points[0], points[1]])  # φₐ at the points

@@ -35,11 +35,11 @@ import os
 from pathlib import Path
 
 import numpy as np
+from skfem.models.elasticity import lame_parameters
 
 from signorini.errors import InputError
 from signorini.files import atomic_write, check_output_file
 from signorini.fem.contact_estimate import candidate_nodes as mesh_nodes_at
-from signorini.fem.estimate import lame
 from signorini.references.profile import contact_profile
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -82,7 +82,7 @@ def element_stress(problem: ContactProblem, solution: ContactSolution,
     if problem.model.mesh is None:
         raise InputError("stresses need the mesh and the material: this problem has neither")
     E, nu = problem.model.element_materials()  # one per element for several bodies
-    lam, mu = (np.reshape(value, (-1, 1, 1)) for value in lame(E, nu))
+    lam, mu = (np.reshape(value, (-1, 1, 1)) for value in lame_parameters(E, nu))
     mesh = problem.model.mesh
     points = mesh.p * problem.scales.length
     dim = points.shape[0]
