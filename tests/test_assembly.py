@@ -456,12 +456,16 @@ def test_triangle_stiffness_has_scikit_fems_pattern_and_entries(make_mesh, axisy
         np.testing.assert_array_equal(indices[upper[edge_of[k]]], ends[1])
 
 
-@pytest.mark.parametrize("bound", [50, 2 ** 62])  # packed into one value sort; too wide: argsort
-def test_sort_order_is_a_stable_argsort(bound):
+@pytest.mark.parametrize("bound", [50, 2 ** 58, 2 ** 62])  # one value sort; too wide: two
+def test_sort_order_is_a_stable_argsort_without_an_index_sort(monkeypatch, bound):
     from signorini.fem.stiffness import sort_order
 
-    keys = np.random.default_rng(5).integers(0, 50, 1000) * (bound // 50)
-    np.testing.assert_array_equal(sort_order(keys, bound), np.argsort(keys, kind="stable"))
+    rng = np.random.default_rng(5)
+    keys = np.concatenate([rng.integers(0, 50, 1000) * (bound // 50),  # ties, and low bits
+                           rng.integers(0, bound, 200_000)])  # that differ below the high ones
+    expected = np.argsort(keys, kind="stable")
+    monkeypatch.setattr(np, "argsort", lambda *a, **k: pytest.fail("an index sort was called"))
+    np.testing.assert_array_equal(sort_order(keys, bound), expected)
 
 
 def _ball():
@@ -488,3 +492,26 @@ def test_stiffness_reads_the_edges_a_mesh_already_has_and_is_bit_identical(make_
     A, B = simplex_stiffness(fresh, 1.3, 0.7), simplex_stiffness(known, 1.3, 0.7)
     for name in ("data", "indices", "indptr"):
         assert getattr(A, name).tobytes() == getattr(B, name).tobytes()
+
+
+def test_tetrahedron_gradients_are_the_cross_products_to_the_bit():
+    """Written into one array, the gradients are ``np.cross``'s rows over the determinant, and
+    the edge matrix times them is the identity."""
+    from skfem import MeshTet
+
+    from signorini.fem.stiffness import tetrahedron_gradients
+
+    mesh = MeshTet.init_ball(2)
+    x = mesh.p[:, mesh.t]  # (3, 4, elements)
+    e1, e2, e3 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0], x[:, 3] - x[:, 0]
+    rows = np.stack([np.cross(e2, e3, axis=0), np.cross(e3, e1, axis=0),
+                     np.cross(e1, e2, axis=0)], axis=1)
+    det = np.einsum("ie,ie->e", e1, rows[:, 0])
+    grads, volume = tetrahedron_gradients(mesh.p, mesh.t)
+    np.testing.assert_array_equal(grads, np.concatenate([-rows.sum(axis=1, keepdims=True), rows],
+                                                        axis=1) / det)
+    np.testing.assert_array_equal(volume, np.abs(det) / 6.0)
+    edges = np.stack([e1, e2, e3], axis=1)  # (3 components, 3 edges, elements)
+    np.testing.assert_allclose(np.einsum("ike,ile->kle", edges, grads[:, 1:]),
+                               np.broadcast_to(np.eye(3)[..., None], (3, 3, mesh.t.shape[1])),
+                               atol=1e-12)

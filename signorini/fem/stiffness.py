@@ -47,13 +47,21 @@ def corner_coordinates(p: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 def tetrahedron_gradients(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gradients (3 components, 4 nodes, elements) of each tetrahedron's barycentric coordinates
-    and its volume: rows of the inverse of the edge matrix, by cross products."""
+    and its volume: rows of the inverse of the edge matrix, by cross products (``np.cross``'s
+    arithmetic, written into the gradients' array: no stacked copies)."""
     x = corner_coordinates(p, t)  # (3, 4, e)
     e1, e2, e3 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0], x[:, 3] - x[:, 0]
-    rows = np.stack([np.cross(e2, e3, axis=0), np.cross(e3, e1, axis=0), np.cross(e1, e2, axis=0)],
-                    axis=1)  # (3, 3, e): det · ∇λ₁..₃
-    det = np.einsum("ie,ie->e", e1, rows[:, 0])
-    grads = np.concatenate([-rows.sum(axis=1, keepdims=True), rows], axis=1) / det
+    grads = np.empty((3, 4, t.shape[1]))
+    for node, (a, b) in enumerate(((e2, e3), (e3, e1), (e1, e2)), start=1):  # det · ∇λ₁..₃
+        for i in range(3):
+            j, k = (i + 1) % 3, (i + 2) % 3
+            np.multiply(a[j], b[k], out=grads[i, node])
+            grads[i, node] -= a[k] * b[j]
+    det = e1[0] * grads[0, 1]
+    det += e1[1] * grads[1, 1]
+    det += e1[2] * grads[2, 1]
+    np.negative(grads[:, 1] + grads[:, 2] + grads[:, 3], out=grads[:, 0])
+    grads /= det
     return grads, np.abs(det) / 6.0
 
 

@@ -44,12 +44,19 @@ def sort_order(keys: np.ndarray, bound: int) -> np.ndarray:
 
     When a key and its position fit in 63 bits together, by one sort of the
     values ``key · 2ᵇ + position`` (numpy's SIMD value sort, several times
-    faster than an index sort); else by ``argsort``.
+    faster than an index sort); when its high and its low bits each fit with
+    the position, by two such sorts (low bits, then high bits: a radix sort
+    of two digits, each sort stable); else by ``argsort``.
     """
     shift = max(keys.size - 1, 1).bit_length()
-    if max(bound - 1, 1).bit_length() + shift > 63:
+    bits = max(bound - 1, 1).bit_length()
+    if bits + shift <= 63:
+        return np.sort((keys.astype(np.int64) << shift) | np.arange(keys.size)) & ((1 << shift) - 1)
+    low = 63 - shift  # too long: sorted by its low bits, then stably by its high bits
+    if low < 1 or bits - low + shift > 63:
         return np.argsort(keys, kind="stable")
-    return np.sort((keys.astype(np.int64) << shift) | np.arange(keys.size)) & ((1 << shift) - 1)
+    first = sort_order(keys & ((1 << low) - 1), 1 << low)
+    return np.take(first, sort_order(np.take(keys >> low, first), 1 << (bits - low)))
 
 
 #: compare-and-swap pairs that sort 2, 3 or 4 rows
