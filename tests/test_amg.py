@@ -4,6 +4,7 @@ Work is counted, never timed: hierarchies built (one per solve), CG
 iterations, factorisations (none without a coarse model to solve).
 """
 
+import dataclasses
 import importlib.util
 
 import numpy as np
@@ -89,6 +90,25 @@ def test_no_factorisation_and_the_certificate_uses_the_multigrid(problems):
     assert np.isnan(cert.force_error_floor) and cert.back_solves == 1
     assert work.factorisations == 0
     assert problem.cached_factor is None
+
+
+def test_the_certificates_cg_stops_at_its_tolerance_and_still_resolves_the_force_error(
+        monkeypatch):
+    """The certificate's one multigrid solve stops at CERTIFICATE_RTOL: fewer CG iterations than
+    a ten times tighter solve, and a forward error within 1 % of it."""
+    problem = signorini.at_load(build_problem("hertz-sphere-3d", params={"delta": 0.0025}))
+    solution = amg.pdas_amg(problem, amg="pyamg")  # the method's answer, not yet judged
+    assert solution.status == "converged" and isinstance(solution.factor, amg_system.PinnedCG)
+    solution.keep_factor = True  # judged again below, at two tolerances
+    runs = {}
+    for rtol in (amg_system.CERTIFICATE_RTOL, amg_system.CERTIFICATE_RTOL / 10):
+        monkeypatch.setattr(amg_system, "CERTIFICATE_RTOL", rtol)
+        solution.factor.iterations = 0
+        cert = certificate(problem, dataclasses.replace(solution, factor=solution.factor))
+        runs[rtol] = solution.factor.iterations, cert.force_error
+    (loose, error), (tight, reference) = runs.values()
+    assert 0 < loose < tight
+    assert error == pytest.approx(reference, rel=1e-2)
 
 
 def test_cg_iterations_are_counted_and_bounded(problems):
