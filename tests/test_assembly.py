@@ -458,7 +458,7 @@ def test_triangle_stiffness_has_scikit_fems_pattern_and_entries(make_mesh, axisy
 
 @pytest.mark.parametrize("bound", [50, 2 ** 62])  # packed into one value sort; too wide: argsort
 def test_sort_order_is_a_stable_argsort(bound):
-    from signorini.fem.stiffness import sort_order
+    from signorini.fem.topology import sort_order
 
     keys = np.random.default_rng(5).integers(0, 50, 1000) * (bound // 50)
     np.testing.assert_array_equal(sort_order(keys, bound), np.argsort(keys, kind="stable"))

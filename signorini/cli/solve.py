@@ -146,3 +146,6 @@ def add_parsers(sub) -> None:
     solve.add_argument("--max-dofs", type=int, metavar="N", help="with --target-error: no mesh "
                        "beyond N dofs (default 100000)")
     solve.set_defaults(run=cmd_solve)
+
+
+__all__ = ["cmd_solve", "add_parsers"]

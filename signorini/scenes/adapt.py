@@ -322,3 +322,6 @@ def _row(step: int, problem: ContactProblem, solution: ContactSolution,
             "pressure_estimate": found.pressure.relative
             if found is not None and found.pressure is not None else float("nan"),
             "marked": marked, "seconds": seconds, "action": action}
+
+
+__all__ = ["AdaptiveRun", "parse_target", "measured", "beyond_candidates", "solve_adaptive"]
