@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # what the names below are, for readers and type checkers
     from signorini.problem.contact import ContactProblem, ContactSolution, Model, Scales
     from signorini.problem.solution import WarmStart
     from signorini.scenes.build import build_problem, with_load
-    from signorini.solvers.base import DEFAULT_TOL
+    from signorini.solvers.options import DEFAULT_TOL
 
 __version__ = "0.1.0"
 
@@ -51,7 +51,7 @@ __getattr__, _, _ = lazy_loader.attach(__name__, submod_attrs={
     "problem.contact": ["ContactProblem", "ContactSolution", "Model", "Scales"],
     "problem.solution": ["WarmStart"],
     "scenes.build": ["build_problem", "with_load"],
-    "solvers.base": ["DEFAULT_TOL"]})
+    "solvers.options": ["DEFAULT_TOL"]})
 
 __all__ = ["DEFAULT_METHOD", "DEFAULT_TOL", "BackendNotInstalled", "Certificate", "ContactProblem",
            "ContactSolution", "CrossCheck", "InputError", "Model", "Result", "Scales",

@@ -34,7 +34,8 @@ from signorini.errors import BackendNotInstalled, InputError
 from signorini.certification.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify, compare
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import reference_metrics, reference_of
-from signorini.solvers.base import DEFAULT_TOL, check_tol
+from signorini.solvers.base import check_tol
+from signorini.solvers.options import DEFAULT_TOL
 from signorini.solvers.registry import REGISTRY, get_method, given
 
 #: the methods compared when none are named: the paper's, the two named QP backends,

@@ -47,3 +47,7 @@ def install_hint(extra: str, modules: tuple[str, ...] | list[str] = ()) -> str:
     if extra:
         return f"pip install 'signorini[{extra}]'"
     return "pip install " + " ".join(DISTRIBUTIONS.get(m, m) for m in modules)
+
+
+__all__ = ["SignoriniError", "InputError", "BackendNotInstalled", "SolverError", "OutputError",
+           "docs_page", "install_hint", "DOCS_SITE", "DISTRIBUTIONS"]

@@ -91,6 +91,13 @@ class Result:
         return int(self.solution.iterations)
 
     @property
+    def target_met(self) -> bool | None:
+        """Adaptive refinement met its target error (:func:`signorini.solve_adaptive`); None
+        for a solve without one. ``converged`` judges the last mesh's answer, this its accuracy."""
+        met = self.solution.extras.get("target_met")
+        return None if met is None else bool(met)
+
+    @property
     def finite(self) -> bool:
         """The method returned finite vectors (a failed run carries NaN)."""
         return bool(np.all(np.isfinite(self.solution.lam)) and np.all(np.isfinite(self.solution.u)))
@@ -277,8 +284,13 @@ def solve_summary(record: dict[str, Any]) -> str:
                      f"forces in {units['force']}")
     steps = record["extras"].get("adaptive", [])
     if steps:
+        extras = record["extras"]
+        met = "" if "target_met" not in extras else (
+            f", target {100 * extras['target_error']:.3g} % ({extras['target_on'] or 'none reached'}) "
+            f"{'met' if extras['target_met'] else 'NOT met'}")
         lines.append(f"  adaptive refinement, {len(steps)} solve{'s' * (len(steps) != 1)} in "
-                     f"{sum(step['seconds'] for step in steps):.2f} s (estimates: energy norm, pressure):")
+                     f"{sum(step['seconds'] for step in steps):.2f} s{met} (estimates: energy norm, "
+                     "pressure):")
         lines += [f"    step {step['step']}: {step['dofs']:,} dofs, {step['candidates']} candidates, "
                   f"{100 * step['estimate']:.3g} %, {100 * step['pressure_estimate']:.3g} %: "
                   f"{step['action']}" for step in steps]

@@ -59,6 +59,7 @@ def test_the_cylinder_refines_until_the_energy_target():
     result = signorini.solve_adaptive("hertz-cylinder", "2%", target_on="energy")
     steps = result.solution.extras["adaptive"]
     assert result.status == "converged" and "target energy-norm error 2 % met" in result.message
+    assert result.target_met is True and signorini.solve("hertz-cylinder").target_met is None
     assert result.estimate.relative <= 0.02 and result.problem.n < 30_000
     estimates = [s["estimate"] for s in steps]
     assert all(later < earlier for earlier, later in zip(estimates, estimates[1:]))
@@ -76,7 +77,7 @@ def test_the_cylinder_refines_until_the_energy_target():
 def test_the_dof_limit_stops_the_loop_and_says_so():
     result = signorini.solve_adaptive("hertz-sphere", 0.001, max_dofs=10_000)
     assert result.status == "converged"
-    assert "max dofs 10000 reached" in result.message
+    assert "max dofs 10000 reached" in result.message and result.target_met is False
     assert result.problem.n <= 10_000 and result.estimate.pressure.relative > 0.001
 
 
@@ -170,6 +171,15 @@ def test_the_command_line_refines_and_reports(tmp_path):
     steps = [line for line in shown.stdout.splitlines() if line.startswith("    step ")]
     assert shown.returncode == 0 and "adaptive refinement, " in shown.stdout
     assert len(steps) >= 2 and steps[-1].endswith("target met") and steps[0].endswith("refined")
+    assert record["extras"]["target_met"] is True and record["extras"]["target_error"] == 0.03
+    short = tmp_path / "short.json"
+    missed = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",
+                             "--target-error", "0.01%", "--max-dofs", "8000", "--json", str(short)],
+                            capture_output=True, text=True)
+    assert missed.returncode == 1 and "target error was not met (max dofs)" in missed.stderr
+    record = json.loads(short.read_text())
+    assert record["status"] == "converged" and record["extras"]["target_met"] is False
+    assert record["estimate"]["pressure"] > 1e-4 and record["dofs"] <= 8000
     bad = subprocess.run([sys.executable, "-m", "signorini.cli", "solve", "hertz-cylinder",
                           "--max-dofs", "1000"], capture_output=True, text=True)
     assert bad.returncode == 2 and "--target-error" in bad.stderr

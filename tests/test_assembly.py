@@ -458,7 +458,7 @@ def test_triangle_stiffness_has_scikit_fems_pattern_and_entries(make_mesh, axisy
 
 @pytest.mark.parametrize("bound", [50, 2 ** 58, 2 ** 62])  # one value sort; too wide: two
 def test_sort_order_is_a_stable_argsort_without_an_index_sort(monkeypatch, bound):
-    from signorini.fem.stiffness import sort_order
+    from signorini.fem.topology import sort_order
 
     rng = np.random.default_rng(5)
     keys = np.concatenate([rng.integers(0, 50, 1000) * (bound // 50),  # ties, and low bits

@@ -14,7 +14,7 @@ import signorini
 from signorini.fem.assembly import axisymmetric_elasticity
 from signorini.fem.stiffness import plane_strain_stiffness
 from signorini.fem.contact_estimate import contact_term, zone_and_neighbours
-from signorini.fem.estimate import (_by_quadrature, _constant_strains, element_energies, estimate, lame,
+from signorini.fem.estimate import (_by_quadrature, _constant_strains, element_energies, estimate,
                                     material_units, quadrature, recover, strains)
 from signorini.fem.transfer import uniform_prolongation
 from signorini.files import to_json
@@ -309,7 +309,7 @@ def test_the_closed_form_for_constant_strains_is_the_quadrature(scene, params):
     problem = result.problem
     mesh, dim = problem.model.mesh, problem.model.mesh.p.shape[0]
     u = problem.model.expand(result.solution.u).reshape(-1, dim)
-    material = lame(*material_units(problem))
+    material = lame_parameters(*material_units(problem))
     closed = _constant_strains(mesh, u, *material)
     by_points = _by_quadrature(problem, mesh, u, *material)
     for fast, reference in zip(closed, by_points[:3]):

@@ -103,3 +103,6 @@ def warnings(problem: ContactProblem, solution: ContactSolution | None = None) -
                         f"body, more than the push ({push * problem.scales.displacement:.3g}): check "
                         "its position")
     return said
+
+
+__all__ = ["Adequacy", "adequacy", "warnings"]

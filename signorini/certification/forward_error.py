@@ -293,3 +293,6 @@ def refined_on_active_set(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np
     out = np.zeros(lam.shape, dtype=ld)
     out[rows] = mu
     return x, out
+
+
+__all__ = ["ForwardError", "WithDelassus", "forward_error", "refined_on_active_set"]

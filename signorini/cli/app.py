@@ -282,3 +282,7 @@ def _run(argv: Sequence[str] | None, ranks: int, process: bool = False) -> int:
         _say(f"error: the run was ended by {type(exc).__name__}: {exc} (a method raised it; "
              "it must return a ContactSolution)")
         return EXIT_FAILED
+
+
+__all__ = ["add_verbosity", "build_parser", "set_up_logging", "main", "run", "keep_freed_memory",
+           "Stopped"]

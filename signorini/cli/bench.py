@@ -195,3 +195,6 @@ def add_parsers(sub) -> None:
     bench.add_argument("--out", help="default bench-report (with --peer: peer-report)")
     bench.add_argument("--report-only", action="store_true", help="rewrite the report from the CSV")
     bench.set_defaults(run=cmd_bench)
+
+
+__all__ = ["cmd_bench", "add_parsers"]

@@ -198,3 +198,9 @@ def family_of(scene: str, params: dict[str, Any], command: str) -> tuple[str, di
                          "refine: give a scene name (see 'signorini scenes') or a scene file "
                          "that names one (scene = \"hertz-cylinder\")")
     return found
+
+
+__all__ = ["add_command", "Parser", "pairs", "method_options", "parse_tol", "parse_time_limit",
+           "write_output", "out_folder", "input_files", "user_methods_in_workers",
+           "stdout_to_stderr", "process_seconds", "family_of", "EXIT_FAILED", "EXIT_USAGE",
+           "PROBLEM_FILES", "SCENE_HELP", "OPT_METAVAR"]

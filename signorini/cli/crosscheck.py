@@ -75,3 +75,6 @@ def add_parsers(sub) -> None:
     cross.add_argument("--json", metavar="FILE", help="write the record as JSON ('-' for stdout)")
     cross.add_argument("--md", metavar="FILE", help="write the tables as Markdown ('-' for stdout)")
     cross.set_defaults(run=cmd_crosscheck)
+
+
+__all__ = ["cmd_crosscheck", "add_parsers"]

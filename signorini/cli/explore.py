@@ -79,3 +79,6 @@ def add_parsers(sub) -> None:
     parser.add_argument("--no-browser", action="store_true",
                         help="serve without opening a browser")
     parser.set_defaults(run=cmd_explore)
+
+
+__all__ = ["free", "server_command", "cmd_explore", "add_parsers"]

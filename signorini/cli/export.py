@@ -60,3 +60,6 @@ def add_parsers(sub) -> None:
     qpb.add_argument("--only", action="append", default=[], metavar="NAME",
                      help="only this problem, e.g. --only HERTZCYL0 (repeat)")
     qpb.set_defaults(run=cmd_export_qpbenchmark)
+
+
+__all__ = ["cmd_export_qpbenchmark", "add_parsers"]

@@ -45,3 +45,6 @@ def add_parsers(sub) -> None:
                 "it when not) and what it is, and the factorisation backend in use.",
                 ["signorini methods", "SIGNORINI_FACTOR=superlu signorini methods"],
                 {0: "listed"}).set_defaults(run=cmd_methods)
+
+
+__all__ = ["cmd_scenes", "cmd_methods", "add_parsers"]

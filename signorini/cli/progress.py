@@ -77,3 +77,6 @@ def progress(quiet: bool = False, verbose: bool = False, stream: TextIO | None =
     finally:
         logger.removeHandler(handler)
         logger.setLevel(level)
+
+
+__all__ = ["StepProgress", "wanted", "progress"]

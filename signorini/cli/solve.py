@@ -103,7 +103,11 @@ def cmd_solve(args: argparse.Namespace) -> int:
         return EXIT_FAILED
     if vtk_path:
         print(f"written: {args.vtk}", file=sys.stderr if json_path == STDOUT else sys.stdout)
-    return 0 if result.converged else EXIT_FAILED
+    if result.target_met is False:
+        print(f"signorini: the target error was not met ({result.solution.extras['adaptive'][-1]['action']}"
+              "): raise --max-dofs or relax --target-error; the last mesh's answer is reported",
+              file=sys.stderr)
+    return 0 if result.converged and result.target_met is not False else EXIT_FAILED
 
 
 def add_parsers(sub) -> None:
@@ -118,7 +122,8 @@ def add_parsers(sub) -> None:
          "signorini solve examples/hertz-cylinder.toml --method qp-clarabel --tol 1e-9 --json r.json",
          "signorini solve my.npz --method mine.py:solve --time-limit 60"],
         {0: "the method converged and the certificate agrees",
-         1: "it did not (failed, max_iter, inaccurate), or --vtk had no finite answer to write"})
+         1: "it did not (failed, max_iter, inaccurate), --target-error was not met, or --vtk had "
+            "no finite answer to write"})
     solve.add_argument("scene", help=SCENE_HELP)
     solve.add_argument("--method", default="auto",
                        help="method name (see 'signorini methods'; auto: pdas in 2D, pdas-amg for large 3D)")
@@ -146,3 +151,6 @@ def add_parsers(sub) -> None:
     solve.add_argument("--max-dofs", type=int, metavar="N", help="with --target-error: no mesh "
                        "beyond N dofs (default 100000)")
     solve.set_defaults(run=cmd_solve)
+
+
+__all__ = ["cmd_solve", "add_parsers"]

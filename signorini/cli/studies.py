@@ -265,3 +265,6 @@ def add_parsers(sub) -> None:
     stability.add_argument("--in-process", action="store_true",
                            help="run in this process, without worker processes or time limits")
     stability.set_defaults(run=cmd_stability)
+
+
+__all__ = ["cmd_converge", "cmd_validate", "cmd_sweep", "cmd_stability", "add_parsers"]

@@ -365,3 +365,8 @@ def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
                 f_load=f_load, offset_load=offset_load if f_load is not None else 0.0,
                 load=load if f_load is not None else 0.0, target=load,
                 resultant=resultant, delta=delta, P=P)
+
+
+__all__ = ["boundary_weights", "axisymmetric_elasticity", "contact_weights", "stiffness_form",
+           "stiffness", "lame_stiffness", "nodal_dofs", "force_exponent", "displacement_scale",
+           "assemble", "cut_traction", "boundary_watch"]

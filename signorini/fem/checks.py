@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.fem.topology import _packed, sort_order, sorted_columns, with_topology
+from signorini.fem.topology import packed_keys, sort_order, sorted_columns, with_topology
 
 #: an element whose measure is at most this times its longest edge to the dimension is degenerate
 DEGENERATE = 1e-12
@@ -127,7 +127,7 @@ def _first_equal_neighbours(keys: np.ndarray, count: int,
         order = sort_order(ids, int(ids.max(initial=0)) + 1)
         ordered = np.take(ids, order)
         return order, ordered[1:] == ordered[:-1]
-    packed = _packed(keys, count)
+    packed = packed_keys(keys, count)
     if packed is None:
         order = np.lexsort(keys[::-1])
         ordered = keys[:, order]
@@ -317,3 +317,7 @@ def check_model(model: Any) -> None:
     check_mesh(model.mesh.p, model.mesh.t, facet_ids=opposite_facets(model.mesh))
     check_units(model)
     check_obstacle_outside(model)
+
+
+__all__ = ["signed_measures", "check_mesh", "opposite_facets", "check_obstacle_outside",
+           "check_units", "check_model", "LENGTH_RANGE"]

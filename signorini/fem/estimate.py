@@ -306,3 +306,8 @@ def estimate(problem: ContactProblem, solution: ContactSolution,
                          scale=float(np.sqrt(s.force * s.displacement)),
                          pressure=pressure_estimate(problem, solution, nodal, Lambda, Mu, theta)
                          if contact else None, bodies=bodies)
+
+
+__all__ = ["ErrorEstimate", "Quadrature", "quadrature", "strains", "energy_density",
+           "nodal_recovery", "constant_recovery", "recover", "element_energies", "material_units",
+           "estimate"]

@@ -99,3 +99,6 @@ class SceneModel:
 
         The scene's ``volumetric_choice`` (``auto`` by default: nodal from ν = 0.4 on in 2D)."""
         return resolve(self.volumetric_choice, self.nu, self.mesh.p.shape[0])
+
+
+__all__ = ["FlatObstacle", "CutLoad", "SceneModel", "FlatObstacle3D"]

@@ -254,3 +254,7 @@ class ScaledQuery:
                 normals, gaps = self.obstacle.normals_and_gaps(reference)
                 return normals, gaps / unit
         raise ValueError("obstacle queried at points other than the scene's contact candidates")
+
+
+__all__ = ["Obstacle", "rows_from_gradient", "HalfPlane", "Circle", "FlatPunch", "SignedDistance",
+           "ScaledQuery"]

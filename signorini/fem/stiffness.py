@@ -19,7 +19,7 @@ import scipy.sparse as sp
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
-from signorini.fem.topology import _entities, sort_order
+from signorini.fem.topology import distinct_entities, sort_order
 
 #: the quadrature order scikit-fem's basis takes for P1 (twice the degree): the axisymmetric
 #: hoop term ∫ φₐ φ_b / r is no polynomial, and :func:`hoop_terms` integrates it with that rule
@@ -86,11 +86,12 @@ def node_pairs(t: np.ndarray, nodes: int,
     each edge, edges in the order of their (low, high), and ``edge_of`` (pairs, elements) the
     edge of each element's local node pair (a, b), a < b, in ``combinations`` order. The edges
     are ``edges`` (``(edges, edge_of)`` as returned, from :func:`mesh_edges`) when given, else
-    found as the mesh's facets are (one sort of packed keys, :func:`_entities`); row i holds
+    found as the mesh's facets are (one sort of packed keys,
+    :func:`~signorini.fem.topology.distinct_entities`); row i holds
     its lower entries, its diagonal, then its upper entries.
     """
     found = edges if edges is not None else \
-        _entities(t, combinations(range(t.shape[0]), 2), nodes)
+        distinct_entities(t, combinations(range(t.shape[0]), 2), nodes)
     if found is None:
         raise ValueError(f"K's pattern: {nodes:,} nodes are too many to pack an edge in an int64")
     (edge_low, edge_high), edge_of = found[0].astype(np.int64), found[1]
@@ -272,3 +273,8 @@ def _csr_from_blocks(dim: int, nodes: int, indptr: np.ndarray, indices: np.ndarr
 plane_strain_stiffness = simplex_stiffness
 #: the stiffness of a tetrahedral mesh
 solid_stiffness = simplex_stiffness
+
+
+__all__ = ["triangle_gradients", "corner_coordinates", "tetrahedron_gradients",
+           "barycentric_gradients", "node_pairs", "mesh_edges", "hoop_terms", "simplex_stiffness",
+           "plane_strain_stiffness", "solid_stiffness"]

@@ -27,7 +27,7 @@ import numpy as np
 TOPOLOGY = ("_facets", "_t2f", "_f2t")
 
 
-def _packed(nodes: np.ndarray, count: int) -> np.ndarray | None:
+def packed_keys(nodes: np.ndarray, count: int) -> np.ndarray | None:
     """One int64 per column of sorted node indices (k, m), ordered as the columns are
     lexicographically; None when ``count`` nodes do not fit."""
     k = nodes.shape[0]
@@ -77,14 +77,14 @@ def sorted_columns(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.array(rows), odd
 
 
-def _entities(t: np.ndarray, local_entities, count: int):
+def distinct_entities(t: np.ndarray, local_entities, count: int):
     """The distinct sorted node tuples of the sub-simplices ``local_entities`` of each element
     of ``t`` (edges or facets), ordered lexicographically, each element's index into them
     (entities, elements), and the sort that found them: ``(entities, inverse, order, starts)``;
     None when ``count`` nodes do not pack into one int64 per entity."""
     local = [list(f) for f in local_entities]
     corners, _ = sorted_columns(np.hstack([t[f] for f in local]))  # (nodes, per_element · ne)
-    key = _packed(corners, count)
+    key = packed_keys(corners, count)
     if key is None:
         return None
     order = sort_order(key, count ** corners.shape[0])
@@ -101,7 +101,7 @@ def _entities(t: np.ndarray, local_entities, count: int):
 def facet_topology(t: np.ndarray, local_facets, count: int):
     """``(facets, t2f, f2t)`` of the connectivity ``t`` (scikit-fem's layout), or None when the
     node count is too large to pack (scikit-fem then computes them itself)."""
-    found = _entities(t, local_facets, count)
+    found = distinct_entities(t, local_facets, count)
     if found is None:
         return None
     facets, t2f, order, starts = found
@@ -120,7 +120,7 @@ def with_edges(mesh: Any) -> Any:
     edges = getattr(mesh.elem.refdom, "edges", None)
     if edges is None or hasattr(mesh, "_edges") or mesh.t.shape[0] != mesh.p.shape[0] + 1:
         return mesh
-    found = _entities(mesh.t, edges, mesh.p.shape[1])
+    found = distinct_entities(mesh.t, edges, mesh.p.shape[1])
     if found is not None:
         object.__setattr__(mesh, "_edges", found[0])
         object.__setattr__(mesh, "_t2e", found[1])
@@ -153,3 +153,7 @@ def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
     boundary = with_topology(mesh).boundary_facets()
     inside = np.isin(mesh.facets[:, boundary], nodes).all(axis=0)
     return boundary[inside]
+
+
+__all__ = ["packed_keys", "distinct_entities", "sort_order", "sorted_columns", "facet_topology",
+           "with_edges", "with_topology", "moved", "facets_on", "TOPOLOGY"]

@@ -161,3 +161,7 @@ def with_candidates(model: Any, extra: np.ndarray, in_contact: np.ndarray | None
     if in_contact is not None:
         changes["predicted_contact"] = np.isin(candidates, old[np.asarray(in_contact, dtype=bool)])
     return replace(model, **changes)
+
+
+__all__ = ["edge_keys", "uniform_parents", "prolongation", "uniform_prolongation",
+           "boundary_children", "extend_nodes", "refined_model", "with_candidates"]

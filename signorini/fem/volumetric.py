@@ -107,3 +107,7 @@ def nodal_volumetric_strain(mesh: Any, u: np.ndarray, axisymmetric: bool = False
     """θₙ of the nodal displacement ``u`` (nodes, dim): the volumetric strain each node carries."""
     G, volumes = averaging(mesh, axisymmetric)
     return G @ np.asarray(u, dtype=float).ravel() / np.where(volumes > 0, volumes, 1.0)
+
+
+__all__ = ["resolve", "simplex_gradients", "averaging", "volumetric_stiffness",
+           "nodal_volumetric_strain", "CHOICES", "NODAL_FROM_NU"]

@@ -132,3 +132,7 @@ def points_argument(value: Any, N: sp.csr_matrix) -> np.ndarray:
         raise InputError(f"contact_points have {points.shape[1]} columns but N's rows are those of a "
                          f"{dim}D problem (each on {dim} consecutive dofs of one node): give ({m}, {dim})")
     return points
+
+
+__all__ = ["sparse_argument", "symmetric_argument", "vector_argument", "flag_argument",
+           "multiplicity_argument", "dimension_of", "points_argument"]

@@ -312,3 +312,9 @@ _CLASSES = {"superlu": Factor, "cholmod": CholmodFactor, "pardiso": PardisoFacto
 def factorize(K: sp.spmatrix, backend: str | None = None) -> Factor:
     """Factorise the SPD matrix ``K`` once for repeated solves."""
     return _CLASSES[resolve_backend(backend, K.shape[0], K.nnz)](K)
+
+
+__all__ = ["available_backends", "resolve_backend", "Factor", "cholmod_analysis",
+           "cholmod_numeric", "CholmodFactor", "FactorTooLarge", "gigabytes_from",
+           "factor_memory_limit", "pardiso_factor_bytes", "upper_csr", "PardisoFactor",
+           "factorize", "BACKENDS", "EXTRAS", "PARDISO_OVER_CHOLMOD_FROM", "FACTOR_MEMORY_VARIABLE"]

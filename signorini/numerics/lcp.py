@@ -136,3 +136,7 @@ def delassus_max_eigenvalue(N: sp.csr_matrix, factor, rtol: float = 1e-6, max_it
             return new_estimate, step
         estimate = new_estimate
     return estimate, max_iter
+
+
+__all__ = ["delassus", "forces_on", "solve_lcp", "least_index_lcp", "delassus_max_eigenvalue",
+           "BLOCK_BYTES"]

@@ -215,3 +215,7 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
             break
     count("cg_iterations", iterations)
     return CGResult(iterations, initial, *norms(r))
+
+
+__all__ = ["pinned_matrix", "PyamgHierarchy", "RowBlocks", "threaded", "CGResult", "Bordered",
+           "pinned_cg", "AMG_FROM_DOFS"]

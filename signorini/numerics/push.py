@@ -131,3 +131,7 @@ def push_for_load_condensed(W: np.ndarray, b1: np.ndarray, b0: np.ndarray, d0: n
     """The push on the condensed problem, ``b(s) = s b₁ + b₀``: dense work only, no back-solve."""
     return push_for_load(condensed_pair(W, np.column_stack([b1, b0])), first_contact(d0), target,
                          summed(multiplicity))
+
+
+__all__ = ["summed", "first_contact", "push_for_load", "condensed_pair", "calibrate_push",
+           "push_for_load_condensed"]

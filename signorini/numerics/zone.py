@@ -311,3 +311,7 @@ def _band_push(W: np.ndarray, b: np.ndarray, R: np.ndarray, G: np.ndarray, targe
     s, lam = push_for_load(condensed_pair(W, b), np.ones(W.shape[0], dtype=bool), target,
                            lambda pair: fixed + weight @ pair, max_iter=200, empty_allowed=True)
     return s, np.maximum(lam, 0.0)
+
+
+__all__ = ["Zone", "predict_zone", "zone_around", "radial_distance", "zone_around_points",
+           "ZoneSolver", "COLUMN_BYTES"]

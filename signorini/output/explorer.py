@@ -150,3 +150,6 @@ def _(picked, tolerance):
 
 if __name__ == "__main__":
     app.run()
+
+
+__all__ = ["screen"]

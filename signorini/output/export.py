@@ -207,3 +207,7 @@ def export_vtk(problem: ContactProblem, solution: ContactSolution, path: str | o
                  suffix=Path(path).suffix)
     log.info("wrote %s (%d points, %d cells)", target, data.points.shape[0], len(data.cells[0].data))
     return Path(target)
+
+
+__all__ = ["nodal_displacement", "element_gradients", "element_stress", "von_mises",
+           "project_to_nodes", "candidate_nodes", "export_mesh", "check_vtk_path", "export_vtk"]

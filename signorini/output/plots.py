@@ -307,3 +307,8 @@ def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     return ax
+
+
+__all__ = ["series_style", "axes", "pressure_profile", "kkt_against_time", "bench_speed_accuracy",
+           "bench_time_vs_dofs", "peer_times", "deformed_bodies", "plot_punch_pressure",
+           "plot_punch_edge"]

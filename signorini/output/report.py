@@ -192,3 +192,7 @@ def readme_validation(report: dict[str, Any], case: str = "hertz-cylinder") -> s
             f"{_fmt(vs.get('lam_rel') if finite else None) if vs.get('lam_rel') != 0 else '0'} | "
             f"{vs.get('misclassified', '–') if finite else '–'} |")
     return "\n".join(lines)
+
+
+__all__ = ["provenance", "runs_table", "write_suite_report", "checks_summary", "readme_validation",
+           "REPORT_FILES"]

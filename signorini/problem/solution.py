@@ -122,3 +122,6 @@ class ContactSolution:
         """A solution carrying no answer (NaN vectors) and a reason."""
         return cls(method=method, u=np.full(problem.n, np.nan), lam=np.full(problem.m, np.nan),
                    status=status, message=message, **kwargs)
+
+
+__all__ = ["WarmStart", "ContactSolution", "STATUSES"]

@@ -90,3 +90,7 @@ def punch_load_between(x0: float, x1: float, a: float, P: float) -> float:
     x0, x1 = np.clip([x0, x1], -a, a)
     return float(P / np.pi * (np.arcsin(x1 / a) - np.arcsin(x0 / a)))
 
+
+__all__ = ["contact_modulus", "hertz_cylinder_half_width", "hertz_cylinder_load",
+           "hertz_cylinder_peak", "hertz_pressure", "hertz_sphere_radius", "hertz_sphere_load",
+           "hertz_sphere_peak", "punch_pressure", "punch_load_between"]

@@ -213,3 +213,6 @@ def reference_metrics(problem: ContactProblem, solution: ContactSolution) -> dic
     """Errors of ``solution`` against the reference ``problem`` declares ({} when none)."""
     reference = reference_of(problem)
     return reference.metrics(problem, solution) if reference else {}
+
+
+__all__ = ["Claim", "Reference", "summary_lines", "reference_of", "reference_metrics", "REFERENCES"]

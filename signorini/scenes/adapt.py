@@ -70,6 +70,8 @@ class AdaptiveRun:
     estimate: ErrorEstimate | None
     steps: list[dict[str, Any]] = field(default_factory=list)
     reason: str = ""
+    #: the estimate met the target (False when a limit, a failed solve or the step count stopped it)
+    target_met: bool = False
 
 
 def parse_target(value: Any) -> float:
@@ -260,6 +262,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
         log.info("step %d: %d dofs, %s estimate %.3g %% (target %.3g %%), %.2f s", step, problem.n,
                  what, 100 * value, 100 * target, seconds)
         if value <= target:
+            run.target_met = True
             run.reason = (f"target {what} error {100 * target:.3g} % met: estimate {100 * value:.3g} % "
                           f"at {problem.n} dofs after {step + 1} solve{'s' * (step > 0)}")
             steps.append(_row(step, problem, solution, found, 0, seconds, "target met"))
@@ -281,6 +284,8 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
     run.reason += _steeper_than_measured(scene)
     run.solution.message = f"{run.solution.message}; {run.reason}".lstrip("; ")
     run.solution.extras["adaptive"] = steps
+    run.solution.extras.update(target_error=target, target_on=quantity or "",
+                               target_met=run.target_met)
     log.info("%s", run.reason)
     return run
 
@@ -322,3 +327,6 @@ def _row(step: int, problem: ContactProblem, solution: ContactSolution,
             "pressure_estimate": found.pressure.relative
             if found is not None and found.pressure is not None else float("nan"),
             "marked": marked, "seconds": seconds, "action": action}
+
+
+__all__ = ["AdaptiveRun", "parse_target", "measured", "beyond_candidates", "solve_adaptive"]

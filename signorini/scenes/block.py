@@ -230,3 +230,7 @@ def force_controlled_exact(problem: ContactProblem) -> ContactSolution:
     lam = q * problem.weights * s.weight / s.force
     return ContactSolution(method="exact", u=u, lam=lam, status="converged",
                            message="patch solution of the force-controlled block")
+
+
+__all__ = ["HeightProfile", "build", "mesh_dofs", "force_controlled_problem",
+           "force_controlled_exact", "FAMILY"]

@@ -159,3 +159,5 @@ def with_load(problem: ContactProblem, **load: float) -> ContactProblem:
     return problem.with_target(target, recorded, radial_distance(moved.contact_points)
                                < a / moved.scales.length)
 
+
+__all__ = ["coarse_values", "coarse_problem", "build_problem", "with_load"]

@@ -128,3 +128,6 @@ FAMILY = SceneFamily(
     coarse=two_refinements_coarser, snap=quarter_disc_snap, validation=VALIDATION,
     convergence_start={"n_contact": 15, "grading": 0.6},
     adaptive_start=ADAPTIVE_START)
+
+
+__all__ = ["build", "graded_ratio", "PARAMS", "SIZE", "FAMILY"]

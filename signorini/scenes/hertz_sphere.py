@@ -144,3 +144,6 @@ FAMILY = SceneFamily(
     validation=(Case("hertz-sphere", "hertz-sphere", {"a_over_R": 0.05}),),
     convergence_start={"n_contact": 12, "grading": 0.6},
     adaptive_start=ADAPTIVE_START)
+
+
+__all__ = ["load_choice", "build", "graded_ratio", "COMMON_PARAMS", "SIZE", "FAMILY"]

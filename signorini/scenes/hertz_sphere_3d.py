@@ -163,3 +163,6 @@ FAMILY = SceneFamily(
     coarse=two_refinements_coarser,
     validation=(Case("hertz-sphere-3d", "hertz-sphere-3d", {"a_over_R": 0.05},
                      agrees_with="hertz-sphere"),))
+
+
+__all__ = ["build", "GradedOctant", "octant_density", "FAMILY"]

@@ -41,7 +41,8 @@ from signorini.scenes.meshing import GradedDisc, graded_quarter_disc
 from signorini.scenes.size import CountedSize
 from signorini.scenes.two_block_patch import DISCRETISATION, materials
 
-__all__ = ["CYLINDERS", "FAMILY", "HertzPair", "body", "disc", "pair_modulus", "pair_radius"]
+__all__ = ["CYLINDERS", "FAMILY", "HertzPair", "body", "disc", "pair_modulus", "pair_radius",
+           "PARAMS"]
 
 #: hertz-cylinder's parameters by name: its mesh parameters are this family's, for each disc,
 #: with a finer default (the two discs' errors add: docs/two-bodies.md)

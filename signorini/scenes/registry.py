@@ -101,3 +101,7 @@ class ValidationCases(Sequence):
 
     def __repr__(self) -> str:
         return f"ValidationCases({', '.join(case.name for case in self._cases())})"
+
+
+__all__ = ["register", "unregister", "get_scene", "scene_reference", "FamilyField",
+           "ValidationCases", "SCENES"]

@@ -111,3 +111,6 @@ def relax(points: np.ndarray, distance: Field, size: Field, fixed: np.ndarray,
     index = np.full(p.shape[1], -1)
     index[used] = np.arange(used.size)
     return MeshTri(np.ascontiguousarray(p[:, used]), np.ascontiguousarray(index[t].T))
+
+
+__all__ = ["relax"]

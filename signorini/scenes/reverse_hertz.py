@@ -99,3 +99,6 @@ FAMILY = SceneFamily(
                          margin=1.16, block=True),
     coarse=two_refinements_coarser, validation=(Case("reverse-hertz", "reverse-hertz"),),
     convergence_start={"n_contact": 16, "grading": 0.6})
+
+
+__all__ = ["load_choice", "build", "FAMILY"]

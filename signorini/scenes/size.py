@@ -253,3 +253,8 @@ def _push_hint(dim: int, dofs: float, params: dict[str, Any], limit: float) -> s
         return ""
     return (f"; or solve it with --method auto (the default) or pdas-amg, which match the load "
             f"without a factorisation: about {pushed / 1e9:,.1f} GB")
+
+
+__all__ = ["Solver", "bytes_per_dof", "SizeModel", "CountedSize", "estimate_dofs",
+           "physical_memory", "memory_limit", "check_size", "over_limit", "MEMORY_VARIABLE",
+           "SIZE_MODELS"]

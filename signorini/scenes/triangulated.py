@@ -118,3 +118,7 @@ def triangulated_quarter_disc(size: Field, max_elements: int) -> MeshTri:
             break
     return MeshTri(np.ascontiguousarray(mesh["vertices"].T, dtype=float),
                    np.ascontiguousarray(mesh["triangles"].T))
+
+
+__all__ = ["arc", "top_cut", "axis_cut", "triangle_size", "boundary_points",
+           "triangulated_quarter_disc"]

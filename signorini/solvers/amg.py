@@ -222,3 +222,6 @@ METHODS = (
            matches_load=lambda problem: border_factor(problem) is not None,
            prediction="active set", bound_rows=True, factor_free_from=0),
 )
+
+
+__all__ = ["pdas_amg", "DEFAULTS", "METHODS"]

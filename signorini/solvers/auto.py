@@ -85,3 +85,6 @@ METHODS = (
                                                                        warm_start)[0]],
            typed_options={**nested.DEFAULTS, **amg.DEFAULTS, **pdas.DEFAULTS}),
 )
+
+
+__all__ = ["dimension", "choose", "auto", "METHODS"]

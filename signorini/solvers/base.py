@@ -317,3 +317,8 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
     for warning in warnings(problem, solution):
         solution.message = f"{solution.message}; warning: {warning}".lstrip("; ")
     return solution
+
+
+__all__ = ["acceptance", "Method", "rows_share_dofs", "check_tol", "check_max_iter",
+           "hold_to_contract", "fingerprint", "changed", "held_to_problem", "certify", "judge",
+           "ACCEPT_FACTOR", "MAX_ITER"]

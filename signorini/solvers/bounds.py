@@ -202,3 +202,6 @@ def bound_form(problem: ContactProblem) -> BoundForm:
     return BoundForm(K=K_full, f=T.T @ (embed @ problem.f), lower=lower,
                      upper=upper, T=T, free_dofs=free, bound_index=index, bound_coef=coef,
                      block=block, coordinates=coordinates)
+
+
+__all__ = ["NoBoundForm", "InfeasibleBounds", "BoundForm", "bound_form"]

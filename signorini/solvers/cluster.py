@@ -144,3 +144,7 @@ def release() -> None:
         comm = _comm()
         comm.Ibarrier().Wait()
         comm.bcast(None, root=0)
+
+
+__all__ = ["launched_size", "mpirun_command", "size", "rank", "peak_memory_mb", "distribute",
+           "serve", "release"]

@@ -57,3 +57,6 @@ METHODS = (
            summary="condensed dual: Delassus operator by back-solves + exact dense LCP",
            typed_options=DEFAULTS),
 )
+
+
+__all__ = ["condensed", "METHODS"]

@@ -155,3 +155,6 @@ METHODS = (
            requires=("cvxpy",), extra="", family="cvxpy", exact=False,
            typed_options=TYPED_OPTIONS),
 )
+
+
+__all__ = ["qp_solvers", "solver_options", "solve_cvxpy", "METHODS"]

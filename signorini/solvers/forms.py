@@ -269,3 +269,6 @@ def solution_from(problem: ContactProblem, form: Formulation, method: str, statu
     solution = ContactSolution(method=method, u=u, lam=lam, status=status, factor=form.factor,
                                **common)
     return polish(problem, form, solution, tol) if polishing else solution
+
+
+__all__ = ["Formulation", "warned", "resolve", "formulate", "polish", "solution_from", "FORMS"]

@@ -115,3 +115,6 @@ METHODS = (
            typed_options=DEFAULTS, prediction="zone",
            warm_from_load=True),
 )
+
+
+__all__ = ["nested", "DEFAULTS", "METHODS"]

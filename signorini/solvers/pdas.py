@@ -117,3 +117,6 @@ METHODS = (
            summary="primal-dual active set / semismooth Newton, exact when it converges",
            typed_options=DEFAULTS),
 )
+
+
+__all__ = ["pdas", "DEFAULTS", "METHODS"]

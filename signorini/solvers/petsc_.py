@@ -106,3 +106,6 @@ METHODS = tuple(
            requires=("petsc4py", "mpi4py"), extra="petsc", family="petsc",
            exact=exact, typed_options=DEFAULTS, bound_rows=True)
     for name, (_, _, exact, summary) in KINDS.items())
+
+
+__all__ = ["solve_petsc", "METHODS"]

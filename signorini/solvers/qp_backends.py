@@ -19,7 +19,7 @@ from signorini.solvers.qp_reports import (Reader, read_clarabel, read_cvxopt, re
                                           solve_clarabel)
 
 __all__ = ["BACKENDS", "BACKEND_BY_NAME", "COMMON_TYPES", "DEFAULT_MAX_DENSE_DOFS",
-           "Backend"]
+           "Backend", "FAILED", "MAX_ITER"]
 
 log = logging.getLogger(__name__)
 

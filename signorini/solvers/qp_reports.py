@@ -124,3 +124,7 @@ def solve_clarabel(qp: Any, **settings: Any) -> Any:
                        "solve_time": result.solve_time}
     solution.build_time, solution.solve_time = built - start, time.perf_counter() - built
     return solution
+
+
+__all__ = ["Report", "read_info", "read_clarabel", "read_scs", "read_ecos", "read_found",
+           "read_quadprog", "read_cvxopt", "read_gurobi", "solve_clarabel", "Reader"]

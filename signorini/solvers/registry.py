@@ -36,9 +36,9 @@ from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.scales import Scales
 from signorini.problem.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, user, uzawa
-from signorini.solvers.base import (ACCEPT_FACTOR, DEFAULT_TOL, Method, certify, check_max_iter,
-                                    check_tol, fingerprint, held_to_problem, hold_to_contract,
-                                    judge)
+from signorini.solvers.base import (ACCEPT_FACTOR, Method, certify, check_max_iter, check_tol,
+                                    fingerprint, held_to_problem, hold_to_contract, judge)
+from signorini.solvers.options import DEFAULT_TOL
 
 log = logging.getLogger(__name__)
 

@@ -235,3 +235,6 @@ METHODS = (
            summary="accelerated Uzawa: FISTA momentum with gradient restart, ρ = 1/λ_max(W)",
            typed_options=NESTEROV_DEFAULTS),
 )
+
+
+__all__ = ["dual_residuals", "uzawa", "METHODS"]

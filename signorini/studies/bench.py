@@ -275,3 +275,8 @@ def write_report(csv_path: Path, command: str) -> Path:
     path = directory / "bench.md"
     atomic_write_text(path, "\n".join(md) + "\n")
     return path
+
+
+__all__ = ["Run", "reference_policy", "task_of", "bench_row", "done_keys", "append_row",
+           "problem_file", "stored_size", "run_benchmark", "read_rows", "shifted_geometric_mean",
+           "summary", "write_report", "TOLERANCES"]

@@ -219,3 +219,9 @@ def whole_process(argv: list[str], record: bool = False, ranks: int = 1) -> dict
             "wall_s": sum(float(part) * 60 ** i for i, part in enumerate(reversed(clock))),
             "peak_gb": float(timing.get("Maximum resident set size (kbytes)", "nan")) / 1024 ** 2,
             "said": said[-1] if said else "", "output": out[-1] if out else "", "record": written}
+
+
+__all__ = ["certificate_of", "hertz_errors", "bound_at_solution", "force_error",
+           "weak_but_penetrating", "factorisation_time", "pressure_profile", "answer_record",
+           "answer_from", "forward_error", "resident", "factor_memory", "estimate_record",
+           "energy_error", "whole_process"]

@@ -264,3 +264,8 @@ def exact_attempt(problem: ContactProblem, spec: dict[str, Any], other: ContactP
 def trusted(answer: ContactSolution | None) -> ContactSolution | None:
     """``answer`` when it converged, else None (nothing to hold a run to)."""
     return answer if answer is not None and answer.status == "converged" else None
+
+
+__all__ = ["build_spec", "candidate_spacing", "ill_posed_problem", "ReferencePolicy",
+           "reference_policy", "exact_attempt", "trusted", "REFERENCE_TOL", "PROBLEM_KINDS",
+           "ILL_POSED_CASES", "REFERENCE_POLICIES"]

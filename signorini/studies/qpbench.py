@@ -41,7 +41,7 @@ from signorini.errors import InputError
 from signorini.problem.contact import ContactProblem
 from signorini.studies import qpbench_files
 
-__all__ = ["DENSE_MAX_DOFS", "FAMILIES", "Entry", "Reference", "entries", "export", "reference"]
+__all__ = ["CERTIFIED_TOL", "DENSE_MAX_DOFS", "FAMILIES", "Entry", "Reference", "entries", "export", "reference"]
 
 log = logging.getLogger(__name__)
 

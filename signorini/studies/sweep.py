@@ -140,3 +140,6 @@ def plot_sweep(levels: list[SweepLevel], ax=None):
     axes.grid(alpha=0.3)
     axes.set_xlim(left=0.0)
     return axes
+
+
+__all__ = ["SweepLevel", "parse_loads", "sweep_loads", "plot_sweep"]

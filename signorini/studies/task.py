@@ -12,7 +12,7 @@ import logging
 from dataclasses import asdict, dataclass, field
 from typing import Any, TypedDict
 
-from signorini.solvers.base import DEFAULT_TOL
+from signorini.solvers.options import DEFAULT_TOL
 from signorini.studies.problems import REFERENCE_TOL, reference_policy
 
 log = logging.getLogger(__name__)
@@ -209,3 +209,7 @@ def failed_row(task: Task, exc: Exception) -> Row:
     return verdict(Row(**task_row(task), status="crashed", claimed_status="",
                        wrapper="runner error",
                        message=f"runner error {type(exc).__name__}: {exc}"), task)
+
+
+__all__ = ["Task", "task_row", "verdict", "failed_row", "ATLAS_TOL", "DEFAULT_TIME_LIMIT",
+           "BUILD_ONLY", "CROSSCHECK", "COMMAND", "MEASURES", "Row"]

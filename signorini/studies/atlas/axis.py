@@ -178,3 +178,7 @@ def nodes_text(row: dict[str, Any]) -> str:
     if isinstance(hidden, (int, float)) and np.isfinite(hidden) and hidden > 0:
         text += f"+{hidden:.0f}p"
     return text
+
+
+__all__ = ["Axis", "scene_spec", "capped", "every_method", "num", "plural", "cell", "pivot",
+           "wrong_nodes", "nodes_text", "Rows", "TINY_HERTZ", "SHORT"]

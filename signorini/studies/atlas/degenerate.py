@@ -92,3 +92,6 @@ AXIS = Axis(
     legend="Cells: status, misclassified nodes (weak left out) / counted strictly / "
            "weakly active nodes.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
+
+
+__all__ = ["tasks", "findings", "table", "figure", "headline"]

@@ -148,3 +148,6 @@ def atlas_weak_nodes(rows: list[dict], *, ax=None):
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=6)
     return ax
+
+
+__all__ = ["atlas_step_sweep", "atlas_series", "atlas_outcomes", "atlas_weak_nodes"]

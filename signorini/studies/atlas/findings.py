@@ -169,3 +169,8 @@ def findings(data: dict[str, Any], axes: Sequence[Axis]) -> str:
     lines = [f"- {by_name[axis].headline(by_name[axis].rows(data['rows']))}"
              for axis in data["axes"] if axis in by_name]
     return "\n".join(lines) + "\n\n" + status_finding(data)
+
+
+__all__ = ["StaleFinding", "claim", "name", "names", "pick", "one", "pct", "power", "times",
+           "span", "right", "methods_of", "run_headline", "rates_text", "status_finding",
+           "findings", "VERBS"]

@@ -151,3 +151,6 @@ AXIS = Axis(
            "`signorini.certification.diagnosis.diagnose(problem)` to see whether K is singular.",
     legend="Cells: status, λ error against the exact patch solution.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline, counts=counts)
+
+
+__all__ = ["counts", "tasks", "findings", "table", "figure", "headline"]

@@ -103,3 +103,6 @@ AXIS = Axis(
            "The package refuses an empty contact set and zero-weight candidates outright.",
     legend="Cells: status.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
+
+
+__all__ = ["tasks", "findings", "table", "figure", "headline"]

@@ -127,3 +127,6 @@ AXIS = Axis(
            "backends only those shown right here reach tol 1e-8 honestly; check the status.",
     legend="Cells: status, iterations, time.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
+
+
+__all__ = ["tasks", "per_halving", "findings", "table", "figure", "headline"]

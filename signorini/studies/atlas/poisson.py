@@ -179,3 +179,6 @@ AXIS = Axis(
            "docs/certificate.md): no method is converged there.",
     legend="Mesh A; cells: status, λ error against PDAS on the same mesh.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
+
+
+__all__ = ["tasks", "findings", "table", "figure", "headline"]

@@ -14,7 +14,7 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output.report import provenance
-from signorini.solvers.base import DEFAULT_TOL
+from signorini.solvers.options import DEFAULT_TOL
 from signorini.studies.atlas.axis import Axis, capped, nodes_text, num
 from signorini.studies.atlas.summary import (AtlasResult, method_rows, method_summary, share, verdicts,
                                              wrapper_record)
@@ -224,3 +224,6 @@ def report_markdown(result: AtlasResult, command: str, info: dict[str, Any]) -> 
         md += _axis_section(result, axis)
     md += ["", "## Known limitations", ""] + LIMITATIONS
     return "\n".join(md) + "\n"
+
+
+__all__ = ["reproduction", "csv_text", "write_report", "method_axis_table", "report_markdown"]

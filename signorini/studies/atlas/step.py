@@ -167,3 +167,6 @@ AXIS = Axis(
     legend="Cells: status and iterations.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline, counts=counts,
     caps=STEP_CAPS)
+
+
+__all__ = ["tasks", "counts", "cycles", "findings", "table", "figure", "headline"]

@@ -87,3 +87,6 @@ def verdicts(rows: Rows, axes: Sequence[Axis]) -> dict[tuple[str, str], str]:
         word = "works" if right == len(mine) else ("fails" if right == 0 else "degrades")
         out[key] = f"{word} {right}/{len(mine)}"
     return out
+
+
+__all__ = ["AtlasResult", "method_rows", "method_summary", "wrapper_record", "share", "verdicts"]

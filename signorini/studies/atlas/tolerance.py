@@ -142,3 +142,6 @@ AXIS = Axis(
     legend="Cells: status, λ error / misclassified nodes (`+kp`: k more nodes with zero "
            "force that penetrate, which `kkt.classify` labels weakly active).",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
+
+
+__all__ = ["tasks", "findings", "table", "figure", "headline"]

@@ -112,3 +112,6 @@ AXIS = Axis(
            "backends' absolute tolerances at the mercy of E and the length unit.",
     legend="Cells: status, λ error.",
     tasks=tasks, findings=findings, table=table, figure=figure, headline=headline)
+
+
+__all__ = ["tasks", "assembled", "findings", "table", "figure", "headline"]
