@@ -13,8 +13,9 @@ method can do without; that factorisation is also timed in a process of its own 
 whole commands (the reference the command is held to). Each stage of the command's own record (its JSON ``time``) is reported
 against its budget (:data:`BUDGETS_2D`, shares of that factorisation); in 3D against
 :data:`BUDGETS_3D`, shares of the method's own time. 3D: the command's whole process, at 350k and at 10⁶ dofs, and at 10⁶ its
-parts in one process: the model built, the solve through the API, the estimate, and the one
-multigrid solve of K no method without a factorisation can avoid (:func:`in_process_amg`).
+parts in one process: the model built, the solve through the API, the estimate, the certificate
+alone, and the one multigrid solve of K no method without a factorisation can avoid
+(:func:`in_process_amg`).
 docs/speed.md quotes the JSON (tests/test_readme_numbers.py holds it).
 """
 
@@ -189,7 +190,8 @@ def in_process(scene: str, params: dict) -> dict:
 def in_process_amg(scene: str, params: dict) -> dict:
     """The 3D command's parts in one process: the model built, the whole solve through the API
     (``pdas-amg``: its method time, steps, hierarchy set-up and CG iterations), the estimate,
-    and one multigrid solve of K: K of the solved problem (at the push found) with the
+    the certificate once more alone (its CG iterations with the method's multigrid), and one
+    multigrid solve of K: K of the solved problem (at the push found) with the
     prescribed dofs and the answer's active set pinned, a GAMG hierarchy of it set up with
     the package's options (:class:`~signorini.solvers.amg_system.GamgHierarchy`), and CG
     (:func:`~signorini.numerics.multigrid.pinned_cg`, with the method's products by K) from the
@@ -202,13 +204,22 @@ def in_process_amg(scene: str, params: dict) -> dict:
     from signorini.solvers.bounds import bound_form
     from signorini.solvers.options import resolved
 
-    parts, result = built_and_solved(scene, params, solved_by="auto")  # as the command builds it
+    import signorini
+
+    parts, result = built_and_solved(scene, params, solved_by="auto",  # as the command builds it
+                                     keep_factor=True)
     extras = result.solution.extras
     parts.update(method=result.method, status=result.status,
                  method_s=result.solution.seconds["method"], steps=result.iterations,
                  hierarchy_s=extras["hierarchy_s"], cg_iterations=extras["cg_iterations"])
+    factor = result.solution.factor  # the method's multigrid CG on the active set (PinnedCG)
+    iterations = getattr(factor, "iterations", 0)
+    start = time.perf_counter()  # a copy of the answer: the judged one keeps its certificate
+    signorini.certificate(result.problem, dataclasses.replace(result.solution))
+    parts["certificate_s"] = time.perf_counter() - start
+    parts["certificate_cg_iterations"] = getattr(factor, "iterations", 0) - iterations
     problem, lam = result.problem, result.solution.lam
-    del result
+    del result, factor
     system = amg_system.PinnedSystem(bound_form(problem))
     active = lam > 0
     x = np.zeros(system.form.n)
@@ -303,6 +314,9 @@ def amg_lines(wall: float, parts: dict) -> list[str]:
     return lines + part_rows(parts, wall, (
         (BUILT, "build_s"), (SOLVED, "solve_s"),
         (f"`{parts['method']}` alone (within the solve)", "method_s"),
+        *(((f"the certificate, once more alone ({parts['certificate_cg_iterations']} CG "
+            "iterations of the method's multigrid)", "certificate_s"),)
+          if "certificate_s" in parts else ()),
         ("the error estimate", "estimate_s"),
         ("K pinned, and its rigid-body modes", "amg_pin_s"),
         ("GAMG: set up the hierarchy of K", "amg_setup_s"),
