@@ -159,6 +159,12 @@ class Bordered:
         return out
 
 
+def _inner(r: np.ndarray, z: np.ndarray) -> float:
+    """``r · z``, infinite or NaN (and quiet) where the preconditioned residual overflowed."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(r @ z)
+
+
 def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
               precondition: Callable[[np.ndarray], np.ndarray],
               done: Callable[[float, float, float], bool], max_iter: int = 2000,
@@ -190,7 +196,9 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
         z = precondition(r)
         z *= mask
         p = z.copy()
-        rz = float(r @ z)
+        rz = _inner(r, z)
+        if not 0 < rz < np.inf:  # nothing to correct, or a preconditioner that overflowed
+            break
         while iterations < max_iter:  # in place where a product would only make a copy
             q = K @ p
             q *= mask
@@ -205,8 +213,8 @@ def pinned_cg(K: sp.csr_matrix, f: np.ndarray, x: np.ndarray, free: np.ndarray,
                 break
             z = precondition(r)
             z *= mask
-            rz, rz_old = float(r @ z), rz
-            if not rz > 0:  # the preconditioned residual vanished: nothing left to correct
+            rz, rz_old = _inner(r, z), rz
+            if not 0 < rz < np.inf:  # vanished: nothing left to correct; or overflowed
                 break
             p *= rz / rz_old
             p += z
