@@ -20,6 +20,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.certification.kkt import certificate  # per command (start-up)
     from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
+    from signorini.numerics.work import timed  # per command (start-up)
 
     # the process's start-up (interpreter, imports, parsing), when this command is the process
     startup = process_seconds() if getattr(args, "process", False) else None
@@ -78,13 +79,19 @@ def cmd_solve(args: argparse.Namespace) -> int:
             else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
                 from signorini.studies.runner import solve_within  # per command (start-up)
 
-                problem = at_load(problem)  # the worker builds it again, matched the same way
+                seconds: dict[str, float] = {}
+                with timed(seconds, "load control"):
+                    problem = at_load(problem)  # the worker builds it again, matched the same way
                 spec = {"kind": "stored", "path": os.path.abspath(args.scene)} if from_file else \
                     {"kind": "scene", "scene": args.scene, "params": params,
                      "nondimensionalise": not args.raw_units}
-                solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
-                                        max_iter=max_iter, options=request.options)
-                result = Result(problem, solution, certificate(problem, solution))
+                with timed(seconds, "method"):  # the worker's whole run, its start-up included
+                    solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
+                                            max_iter=max_iter, options=request.options)
+                with timed(seconds, "certificate"):
+                    judged = certificate(problem, solution)
+                solution.seconds = {**solution.seconds, **seconds}
+                result = Result(problem, solution, judged)
     if startup is not None:
         result.solution.seconds["startup"] = startup
     record = result.to_dict()

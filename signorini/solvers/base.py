@@ -59,9 +59,9 @@ class Method:
     ``push0`` for a pending load); ``warm_from_load``, that it takes load control's answer as
     its warm start. ``chooses(problem, options, warm_start)`` returns the method it runs
     instead (:meth:`runs`). A ``scaled`` method is handed a view of the problem in units of
-    order one, its answer mapped back before it is judged; a user's is not. A ``bound_rows``
-    method takes each contact row as a bound on dofs of its own and refuses rows that share a
-    dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
+    order one, its answer mapped back before it is judged; a user's (any method not registered)
+    is not. A ``bound_rows`` method takes each contact row as a bound on dofs of its own and
+    refuses rows that share a dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
     model with a target load without a factorisation (None: never), for a scene's memory
     estimate (:mod:`signorini.scenes.size`).
     """

@@ -1,0 +1,73 @@
+"""The surfaces of one door and of the slider, attacked as a hostile user would.
+
+A method of the user's, in whatever form it is given, receives the problem in the user's units;
+the record's time accounts for the wall time of the command, a worker process included.
+"""
+
+import json
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+import signorini
+from signorini import ContactProblem
+from signorini.cli import main
+from signorini.solvers.registry import Method
+
+
+def steel_qp():
+    """Two dofs in SI units (K ~ 1e11 N/m, gaps ~ 0.1 mm): far from order one."""
+    K = np.array([[2e11, -1e11], [-1e11, 2e11]])
+    return ContactProblem.from_qp(K, np.array([1e8, 1e8]), np.array([[1.0, 0.0]]),
+                                  np.array([2.5e-4]))
+
+
+def pdas_answer(problem):
+    answer = signorini.solve(problem, "pdas").solution
+    return answer.u, answer.lam
+
+
+@pytest.mark.parametrize("form", ["callable", "Method"])
+def test_a_users_method_in_any_form_receives_the_problem_in_the_users_units(form):
+    problem, received = steel_qp(), {}
+
+    def mine(given, *, tol, max_iter, **options):
+        received.update(K=given.K.toarray(), f=given.f.copy(), d=given.d.copy(), tol=tol,
+                        max_iter=max_iter)
+        return pdas_answer(given)
+
+    method = mine if form == "callable" else Method(name="mine", function=mine, summary="mine")
+    result = signorini.solve(problem, method)
+    assert result.status == "converged"
+    assert np.array_equal(received["K"], problem.K.toarray())
+    assert np.array_equal(received["f"], problem.f) and np.array_equal(received["d"], problem.d)
+    assert isinstance(received["tol"], float) and isinstance(received["max_iter"], int)
+
+
+SLEEPER = textwrap.dedent("""
+    import time
+
+    from signorini.solvers.pdas import pdas
+
+
+    def sleeps(problem, **options):
+        time.sleep(1.0)
+        answer = pdas(problem)
+        return answer.u, answer.lam
+""")
+
+
+@pytest.mark.parametrize("limit", [[], ["--time-limit", "60"]])
+def test_the_time_of_a_solve_in_a_worker_adds_up_to_its_wall_time(tmp_path, monkeypatch, limit):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine.py").write_text(SLEEPER)
+    steel_qp().save(tmp_path / "qp.npz")
+    start = time.perf_counter()
+    code = main(["solve", "qp.npz", "--method", "mine.py:sleeps", "--json", "r.json", *limit])
+    wall = time.perf_counter() - start
+    times = json.loads((tmp_path / "r.json").read_text())["time"]
+    assert code == 0
+    assert times["method_s"] >= 1.0  # the worker's run, its sleep included
+    assert times["total_s"] >= 0.9 * wall
