@@ -40,6 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from signorini.errors import InputError, docs_page
+from signorini.numerics.work import timed
 from signorini.fem.assembly import assemble
 from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.fem.transfer import refined_model, with_candidates
@@ -216,7 +217,8 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
 
     ``quantity`` is ``"pressure"`` (the default where the scene has contact
     pressures) or ``"energy"``.
-    Returns the last step's problem, solution and estimate; ``reason`` says
+    Returns the last step's problem, solution (its ``seconds`` every step's, by stage) and
+    estimate; ``reason`` says
     why the loop stopped (the target met, the dof or memory limit, or a solve
     that did not converge) and is appended to the solution's message. ``on_step`` is
     called with every step's problem, solution and estimate (studies use it).
@@ -226,26 +228,33 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
     max_dofs = DEFAULT_MAX_DOFS if max_dofs is None else int(max_dofs)
     if max_dofs <= 0:
         raise InputError(f"max dofs {max_dofs} must be positive")
-    scene = _scene(name, values, solved_by)
+    stages: dict[str, float] = {}  # every step's seconds by stage: the record's time
+    with timed(stages, "mesh"):
+        scene = _scene(name, values, solved_by)
+        _check_first(scene, solved_by)
     model = scene.model
-    _check_first(scene, solved_by)
     run = None
     steps: list[dict[str, Any]] = []
     growths = 0
     for step in range(MAX_STEPS):
         start = time.perf_counter()
-        problem = assemble(model)
+        with timed(stages, "assemble"):
+            problem = assemble(model)
         problem.name = scene.name
         problem, solution = solver(problem)
+        for stage, spent in solution.seconds.items():
+            stages[stage] = stages.get(stage, 0.0) + spent
         seconds = time.perf_counter() - start
         if solution.status == "model_inadequate" and growths < MAX_GROWTH:
-            grown = _grown(scene, model, problem, solution)
+            with timed(stages, "mesh"):
+                grown = _grown(scene, model, problem, solution)
             if grown is not None:
                 growths += 1
                 model = grown
                 steps.append(_row(step, problem, solution, None, 0, seconds, "candidates widened"))
                 continue
-        found = estimate(problem, solution) if solution.success else None
+        with timed(stages, "estimate"):
+            found = estimate(problem, solution) if solution.success else None
         if on_step is not None:
             on_step(problem, solution, found)
         run = AdaptiveRun(problem, solution, found, steps)
@@ -267,8 +276,9 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
                           f"at {problem.n} dofs after {step + 1} solve{'s' * (step > 0)}")
             steps.append(_row(step, problem, solution, found, 0, seconds, "target met"))
             break
-        marked = mark(model.mesh, found, quantity, theta)
-        mesh = model.mesh.refined(marked)
+        with timed(stages, "mesh"):
+            marked = mark(model.mesh, found, quantity, theta)
+            mesh = model.mesh.refined(marked)
         limit = _limit_reached(mesh.p.size, max_dofs, model, solved_by)
         if limit is not None:
             action, reached, next_mesh = limit
@@ -278,12 +288,14 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
             steps.append(_row(step, problem, solution, found, 0, seconds, action))
             break
         steps.append(_row(step, problem, solution, found, len(marked), seconds, "refined"))
-        model = scene.on(model, mesh, solution)
+        with timed(stages, "mesh"):
+            model = scene.on(model, mesh, solution)
     else:
         run.reason = f"adaptive refinement stopped after {MAX_STEPS} steps"
     run.reason += _steeper_than_measured(scene)
     run.solution.message = f"{run.solution.message}; {run.reason}".lstrip("; ")
     run.solution.extras["adaptive"] = steps
+    run.solution.seconds = stages
     run.solution.extras.update(target_error=target, target_on=quantity or "",
                                target_met=run.target_met)
     log.info("%s", run.reason)
