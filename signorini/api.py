@@ -103,6 +103,9 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
 def at_load(problem: ContactProblem) -> ContactProblem:
     """``problem`` at its target load, or itself when it has none: the QP any method (or your
     own code) can then solve as it is. Load control matches the push (:mod:`signorini.load_control`)."""
+    if not isinstance(problem, ContactProblem):
+        raise InputError(f"at_load takes a ContactProblem, got {type(problem).__name__}: build one "
+                         "with signorini.build_problem('hertz-cylinder') first")
     return load_control.at_load(problem, scenes.coarse_problem)
 
 

@@ -82,3 +82,25 @@ def test_the_time_of_adaptive_refinement_covers_every_step():
     assert len(steps) > 1  # refined at least once: earlier steps to account for
     assert record["time"]["total_s"] >= sum(step["seconds"] for step in steps)
     assert abs(record["time"]["total_s"] / wall - 1) < 0.05
+
+
+@pytest.fixture(scope="module")
+def cylinder():
+    return signorini.build_problem("hertz-cylinder", params={"n_contact": 12, "grading": 0.4})
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda p: signorini.at_load("hertz-cylinder"), ["at_load", "ContactProblem", "build_problem"]),
+    (lambda p: signorini.at_load(None), ["at_load", "ContactProblem"]),
+    (lambda p: signorini.with_load(p, P=None), ["P=None", "number"]),
+    (lambda p: p.model.at_push(float("nan")), ["scale=nan", "finite"]),
+    (lambda p: p.model.at_push(float("inf")), ["scale=inf", "finite"]),
+    (lambda p: p.model.at_push("1"), ["scale='1'", "finite"]),
+    (lambda p: p.model.at_push(1.0, load=float("nan")), ["load=nan", "finite"]),
+    (lambda p: p.pushed(float("nan")), ["scale=nan"]),
+    (lambda p: steel_qp().model.at_push(1.0), ["push", "as it is"]),
+])
+def test_the_sliders_doors_refuse_bad_input_naming_it(cylinder, call, words):
+    with pytest.raises(signorini.InputError) as refused:
+        call(cylinder)
+    assert all(word in str(refused.value) for word in words), str(refused.value)

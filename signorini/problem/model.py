@@ -11,7 +11,9 @@ the empty model :meth:`Model.of_arrays` (no mesh, every unknown free).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -229,7 +231,13 @@ class Model:
         and ``d`` there; nothing is pending."""
         pu = self.push
         if pu is None:
-            raise ValueError("this model does not record how its load depends on the push")
+            raise InputError("this model does not record how its load depends on the push (a QP "
+                             "given as arrays, or a scene without a push): solve it as it is")
+        for name, value in (("scale", scale), ("load", load)):
+            if value is not None and (isinstance(value, bool) or not isinstance(value, Real)
+                                      or not math.isfinite(value)):
+                raise InputError(f"at_push: {name}={value!r} must be a finite number (the "
+                                 f"push's {name} in the model's units, e.g. {name}={pu.scale:g})")
         ratio = scale / pu.scale
         load = pu.load if load is None else load
         changed: dict[str, float] = {}  # δ and P in the scene's units, where the scene names them

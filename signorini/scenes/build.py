@@ -140,6 +140,10 @@ def with_load(problem: ContactProblem, **load: float) -> ContactProblem:
         raise InputError("with_load moves the target load of a scene built by name with one "
                          "(P or a_over_R): build this problem again with the new load instead")
     moved = sorted(set(load) - set(LOAD_NAMES))
+    unset = [name for name, value in load.items() if value is None and name not in moved]
+    if unset:
+        raise InputError(f"with_load: {unset[0]}=None moves no load: give it a number, e.g. "
+                         f"with_load(problem, {unset[0]}=...)")
     if not load or moved:
         raise InputError(f"with_load takes the scene's load ({', '.join(LOAD_NAMES)}), got "
                          f"{', '.join(moved) or 'none'}: e.g. with_load(problem, P=2.5)")
