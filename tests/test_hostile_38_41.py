@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 import signorini
 from signorini import ContactProblem
@@ -104,3 +105,36 @@ def test_the_sliders_doors_refuse_bad_input_naming_it(cylinder, call, words):
     with pytest.raises(signorini.InputError) as refused:
         call(cylinder)
     assert all(word in str(refused.value) for word in words), str(refused.value)
+
+
+def saddle_point(K):
+    """A QP with ``K`` and a point meeting its KKT conditions: u given, contact force 1 on the
+    first dof, f chosen to balance them."""
+    K = sp.csr_matrix(K)
+    n = K.shape[0]
+    u = np.linspace(1.0, 2.0, n)
+    N = sp.csr_matrix(([1.0], ([0], [0])), shape=(1, n))
+    lam = np.array([1.0])
+    problem = ContactProblem.from_qp(K, K @ u + N.T @ lam, N, np.array([u[0]]))
+    return problem, u, lam
+
+
+@pytest.mark.parametrize("K", [
+    np.array([[1.0, 2.0], [2.0, 1.0]]),  # a positive diagonal, an eigenvalue −1
+    np.diag([1.0, -1.0]),
+    sp.diags(np.r_[np.full(799, 2.0), -1e-3]),  # by Lanczos
+], ids=["positive diagonal", "negative diagonal", "800 dofs"])
+def test_a_kkt_point_of_an_indefinite_k_is_never_converged(K):
+    problem, u, lam = saddle_point(K)
+    assert not signorini.certificate(problem, u=u, force=lam).passed(1e-8)
+    result = signorini.solve(problem, lambda given, **options: (u, lam))
+    assert result.status != "converged" and "positive semidefinite" in result.solution.message
+
+
+def test_a_semidefinite_k_bounded_by_its_contact_is_still_certified():
+    K = np.diag([1.0, 0.0])  # free along the second dof, held there by the contact
+    problem = ContactProblem.from_qp(K, np.array([0.0, 1.0]), np.array([[0.0, 1.0]]),
+                                     np.array([0.25]))
+    result = signorini.solve(problem, lambda given, **options: (np.array([0.0, 0.25]),
+                                                                 np.array([1.0])))
+    assert result.status == "converged"
