@@ -138,3 +138,36 @@ def test_a_semidefinite_k_bounded_by_its_contact_is_still_certified():
     result = signorini.solve(problem, lambda given, **options: (np.array([0.0, 0.25]),
                                                                  np.array([1.0])))
     assert result.status == "converged"
+
+
+BROKEN_CSR = (np.array([2.0, 2.0]), np.array([0, 1]), np.array([0, 5, 2]))  # indptr decreases
+
+
+@pytest.mark.parametrize("matrix", [sp.csr_matrix, sp.csc_matrix, sp.csr_array])
+def test_a_compressed_matrix_with_broken_indices_is_refused_not_read_out_of_bounds(matrix):
+    K = matrix(BROKEN_CSR, shape=(2, 2))  # SciPy builds it unchecked; its C code would crash
+    with pytest.raises(signorini.InputError, match="K is not a valid .* matrix .indptr"):
+        ContactProblem.from_qp(K, [1.0, 1.0], [[1.0, 0.0]], [0.25])
+
+
+@pytest.mark.parametrize("arrays, words", [
+    ({"K_data": BROKEN_CSR[0], "K_indices": BROKEN_CSR[1], "K_indptr": BROKEN_CSR[2]},
+     ["K is not a valid CSR matrix"]),
+    ({"K_row": np.array([0, 1.5]), "K_col": np.array([0, 1]), "K_data": np.array([2.0, 2.0])},
+     ["K_row", "whole numbers"]),
+    ({"K": np.eye(2), "force_multiplicity": np.array("two")}, ["force_multiplicity", "one number"]),
+], ids=["decreasing indptr", "a fractional index", "a word for a number"])
+def test_a_hostile_problem_file_is_one_line_exit_2(tmp_path, capsys, arrays, words):
+    shape = {} if "K" in arrays else {"K_shape": np.array([2, 2])}
+    np.savez(tmp_path / "qp.npz", f=np.ones(2), N=np.array([[1.0, 0.0]]), d=np.array([0.25]),
+             **arrays, **shape)
+    assert main(["solve", str(tmp_path / "qp.npz")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and all(word in err for word in words), err
+
+
+def test_whole_numbers_stored_as_floats_still_index_a_file(tmp_path):
+    np.savez(tmp_path / "qp.npz", K_row=np.array([0.0, 0, 1, 1]), K_col=np.array([0.0, 1, 0, 1]),
+             K_data=np.array([2.0, -1, -1, 2]), K_shape=np.array([2.0, 2]), f=np.ones(2),
+             N=np.array([[1.0, 0.0]]), d=np.array([0.25]))
+    assert main(["solve", str(tmp_path / "qp.npz")]) == 0

@@ -241,6 +241,15 @@ def _sparse(arrays: dict[str, Any], key: str, expected: tuple[int, int]) -> Any:
         missing = "shape" if "shape" not in parts else "data"
         raise InputError(f"{key} is stored sparse without {key}_{missing}: store {key}_data "
                          f"and {key}_shape with its indices")
+    for part in ("row", "col", "indices", "indptr", "shape"):
+        values = np.asarray(parts.get(part, np.zeros(0, dtype=int)))
+        whole = values.dtype.kind in "iu" or (values.dtype.kind == "f" and bool(
+            np.all(np.isfinite(values)) and np.all(values == np.round(values))))
+        if not whole:
+            raise InputError(f"{key}_{part} must hold whole numbers (it counts or indexes), got "
+                             f"a {values.dtype} array: store it as an integer array")
+        if part in parts:
+            parts[part] = values.astype(np.int64)
     shape = tuple(int(v) for v in np.ravel(parts["shape"]))
     if shape != expected:
         sizes = "f has length" if key == "K" else f"d has length {expected[0]} and f"
@@ -303,8 +312,9 @@ def _from_arrays(path: Path, arrays: dict[str, Any], name: str) -> ContactProble
         if values is not None:
             _finite(key, values)
     multiplicity = arrays.get("force_multiplicity", 1.0)
-    if np.size(multiplicity) != 1:
-        raise InputError(f"force_multiplicity must be one number, got shape {np.shape(multiplicity)}")
+    if np.size(multiplicity) != 1 or np.asarray(multiplicity).dtype.kind not in "fiu":
+        raise InputError(f"force_multiplicity must be one number, got {np.asarray(multiplicity).dtype} "
+                         f"of shape {np.shape(multiplicity)}")
     return ContactProblem.from_qp(K, vectors["f"], N, vectors["d"], weights=vectors["weights"],
                                   contact_points=arrays.get("contact_points"),
                                   force_multiplicity=float(np.ravel(multiplicity)[0]), name=name)

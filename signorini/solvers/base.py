@@ -59,9 +59,10 @@ class Method:
     ``push0`` for a pending load); ``warm_from_load``, that it takes load control's answer as
     its warm start. ``chooses(problem, options, warm_start)`` returns the method it runs
     instead (:meth:`runs`). A ``scaled`` method is handed a view of the problem in units of
-    order one, its answer mapped back before it is judged; a user's (any method not registered)
-    is not. A ``bound_rows`` method takes each contact row as a bound on dofs of its own and
-    refuses rows that share a dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
+    order one, its answer mapped back before it is judged; not said, a method of a ``family``
+    is scaled and one without (a user's) is handed the problem in the user's units. A
+    ``bound_rows`` method takes each contact row as a bound on dofs of its own and refuses rows
+    that share a dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
     model with a target load without a factorisation (None: never), for a scene's memory
     estimate (:mod:`signorini.scenes.size`).
     """
@@ -79,9 +80,13 @@ class Method:
     prediction: str = ""
     warm_from_load: bool = False
     chooses: Callable[..., "Method"] | None = None
-    scaled: bool = True
+    scaled: bool | None = None
     bound_rows: bool = False
     factor_free_from: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.scaled is None:  # a user's method without a family gets the problem as given
+            object.__setattr__(self, "scaled", self.family not in ("", "user"))
 
     @property
     def options(self) -> tuple[str, ...]:

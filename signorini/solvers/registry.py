@@ -70,11 +70,10 @@ def get_method(name: str | Callable[..., Any] | Method) -> Method:
     """Look a method up by name, or take a :class:`Method` or a callable as a method; unknown
     names list the known ones.
 
-    A callable is named by its ``__name__`` (:func:`signorini.solvers.user.of_callable`); a
-    :class:`Method` that is not a registered one is the user's, handed the problem as given.
+    A callable is named by its ``__name__`` (:func:`signorini.solvers.user.of_callable`).
     """
     if isinstance(name, Method):
-        return name if REGISTRY.get(name.name) is name else dataclasses.replace(name, scaled=False)
+        return name
     if callable(name) and not isinstance(name, str):
         return user.of_callable(name, REGISTRY)
     if not isinstance(name, str):
