@@ -171,3 +171,19 @@ def test_whole_numbers_stored_as_floats_still_index_a_file(tmp_path):
              K_data=np.array([2.0, -1, -1, 2]), K_shape=np.array([2.0, 2]), f=np.ones(2),
              N=np.array([[1.0, 0.0]]), d=np.array([0.25]))
     assert main(["solve", str(tmp_path / "qp.npz")]) == 0
+
+
+def test_the_vtk_export_is_timed_in_the_record_it_precedes(tmp_path, monkeypatch):
+    from signorini.output import export
+
+    def slow_export(problem, solution, path):
+        time.sleep(0.5)
+        (tmp_path / "r.vtu").write_text("stand-in")
+
+    monkeypatch.setattr(export, "export_vtk", slow_export)
+    code = main(["solve", "block", "--json", str(tmp_path / "r.json"), "--vtk",
+                 str(tmp_path / "r.vtu")])
+    times = json.loads((tmp_path / "r.json").read_text())["time"]
+    assert code == 0 and times["output_s"] >= 0.5
+    assert times["total_s"] == pytest.approx(sum(v for k, v in times.items()
+                                                 if k not in ("total_s", "build_s", "solve_s")))

@@ -94,15 +94,16 @@ def cmd_solve(args: argparse.Namespace) -> int:
                 result = Result(problem, solution, judged)
     if startup is not None:
         result.solution.seconds["startup"] = startup
-    record = result.to_dict()
-    finite = record["contact"] is not None
+    finite = result.finite
     with all_or_none():  # every output, or none of them
-        if json_path:
-            write_output(json_path, to_json(record) + "\n")
-        if vtk_path and finite:
+        if vtk_path and finite:  # before the record, whose output stage counts it
             from signorini.output.export import export_vtk  # per command (start-up)
 
-            export_vtk(problem, result.solution, vtk_path)
+            with timed(result.solution.seconds, "output"):
+                export_vtk(problem, result.solution, vtk_path)
+        record = result.to_dict()
+        if json_path:
+            write_output(json_path, to_json(record) + "\n")
     if json_path != STDOUT:
         print(solve_summary(record))
     if vtk_path and not finite:
