@@ -187,3 +187,9 @@ def test_the_vtk_export_is_timed_in_the_record_it_precedes(tmp_path, monkeypatch
     assert code == 0 and times["output_s"] >= 0.5
     assert times["total_s"] == pytest.approx(sum(v for k, v in times.items()
                                                  if k not in ("total_s", "build_s", "solve_s")))
+
+
+def test_a_first_mesh_beyond_max_dofs_is_refused_before_it_is_solved(capsys):
+    assert main(["solve", "hertz-cylinder", "--target-error", "1%", "--max-dofs", "100"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "max dofs 100" in err and "--max-dofs" in err

@@ -231,7 +231,7 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
     stages: dict[str, float] = {}  # every step's seconds by stage: the record's time
     with timed(stages, "mesh"):
         scene = _scene(name, values, solved_by)
-        _check_first(scene, solved_by)
+        _check_first(scene, solved_by, max_dofs)
     model = scene.model
     run = None
     steps: list[dict[str, Any]] = []
@@ -307,8 +307,13 @@ def _memory_params(model: SceneModel) -> dict[str, Any]:
     return {**model.params, "nu": model.nu, "volumetric": model.volumetric}
 
 
-def _check_first(scene: _Scene, solved_by: Solver | None) -> None:
-    """InputError when the first model (a mesh scene file's, say) is already over the memory limit."""
+def _check_first(scene: _Scene, solved_by: Solver | None, max_dofs: int) -> None:
+    """InputError when the first model (a mesh scene file's, say) is already over ``max_dofs``
+    or the memory limit."""
+    if scene.model.mesh.p.size > max_dofs:
+        raise InputError(f"scene {scene.name!r} starts with {scene.model.mesh.p.size:,} dofs, over "
+                         f"max dofs {max_dofs:,}: raise max dofs (--max-dofs) or start from a "
+                         "coarser mesh (a smaller n_contact)")
     over = over_limit(scene.model.mesh.p.size, 2, _memory_params(scene.model), solved_by)
     if over is not None:
         raise InputError(f"scene {scene.name!r} has {scene.model.mesh.p.size:,} dofs, about "
