@@ -5,6 +5,7 @@ the record's time accounts for the wall time of the command, a worker process in
 """
 
 import json
+import os
 import textwrap
 import time
 
@@ -193,3 +194,50 @@ def test_a_first_mesh_beyond_max_dofs_is_refused_before_it_is_solved(capsys):
     assert main(["solve", "hertz-cylinder", "--target-error", "1%", "--max-dofs", "100"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "max dofs 100" in err and "--max-dofs" in err
+
+
+ESCAPER = textwrap.dedent("""
+    import os
+    import time
+
+    from signorini.solvers.pdas import pdas
+
+
+    def escapes(problem, **options):
+        if os.fork() == 0:  # a child that leaves the worker's process group and session
+            os.setsid()
+            with open("escaped.pid", "w") as out:
+                out.write(str(os.getpid()))
+            time.sleep(300)
+            os._exit(0)
+        while not os.path.exists("escaped.pid"):
+            time.sleep(0.01)
+        answer = pdas(problem)
+        return answer.u, answer.lam
+""")
+
+
+def gone(pid, within=10.0):
+    """Whether process ``pid`` ends (or is a zombie) within ``within`` seconds."""
+    end = time.monotonic() + within
+    while time.monotonic() < end:
+        try:
+            with open(f"/proc/{pid}/stat", "rb") as stat:
+                if stat.read().rsplit(b")", 1)[1].split()[0] == b"Z":
+                    return True
+        except FileNotFoundError:
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="descendants are found in /proc (Linux)")
+def test_a_process_a_method_moved_out_of_its_group_ends_with_the_worker(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine.py").write_text(ESCAPER)
+    steel_qp().save(tmp_path / "qp.npz")
+    assert main(["solve", "qp.npz", "--method", "mine.py:escapes"]) == 0
+    pid = int((tmp_path / "escaped.pid").read_text())
+    if not gone(pid):
+        os.kill(pid, 9)  # the test's own leftover
+        pytest.fail("the method's setsid child outlived the solve")
