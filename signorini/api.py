@@ -92,7 +92,7 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
         raise InputError(f"problem must be a ContactProblem or a scene name, got "
                          f"{type(problem).__name__}: build one with signorini.build_problem(...) "
                          "or ContactProblem.from_qp(K, f, N, d)")
-    start = None if warm_start is None else WarmStart.of(warm_start)
+    start = None if warm_start is None else WarmStart.of(warm_start).check_fits(problem.n, problem.m)
     if problem.model.pending or request.method.runs(problem, request.options, start).prediction:
         # a target load to match, or the scene's prediction of the contact for the method
         return Result(*load_control.solve(problem, request, warm_start=start,

@@ -241,3 +241,23 @@ def test_a_process_a_method_moved_out_of_its_group_ends_with_the_worker(tmp_path
     if not gone(pid):
         os.kill(pid, 9)  # the test's own leftover
         pytest.fail("the method's setsid child outlived the solve")
+
+
+@pytest.fixture(scope="module")
+def block_answer():
+    return signorini.solve("block", "pdas")
+
+
+@pytest.mark.parametrize("method", ["pdas", "nested", "auto"])
+@pytest.mark.parametrize("field, spoil", [("lam", lambda v: v * np.nan), ("u", lambda v: v + np.inf)])
+def test_a_non_finite_warm_start_is_refused_naming_it(block_answer, method, field, spoil):
+    solution = block_answer.solution
+    given = {"lam": solution.lam, "u": solution.u}
+    given[field] = spoil(given[field])
+    with pytest.raises(signorini.InputError, match=f"warm_start: its {field} is not finite"):
+        signorini.solve(block_answer.problem, method, warm_start=signorini.WarmStart(**given))
+
+
+def test_a_warm_start_given_as_lists_is_taken_as_arrays(block_answer):
+    start = signorini.WarmStart(lam=list(block_answer.solution.lam))
+    assert signorini.solve(block_answer.problem, "nested", warm_start=start).status == "converged"
