@@ -261,3 +261,48 @@ def test_a_non_finite_warm_start_is_refused_naming_it(block_answer, method, fiel
 def test_a_warm_start_given_as_lists_is_taken_as_arrays(block_answer):
     start = signorini.WarmStart(lam=list(block_answer.solution.lam))
     assert signorini.solve(block_answer.problem, "nested", warm_start=start).status == "converged"
+
+
+def compressed_bomb(path, key, count, others):
+    """An .npz whose compressed member ``key`` unpacks to ``count`` zeros (a few hundred kB on
+    disk, a consistent header and zip entry), beside the small arrays ``others``."""
+    import io
+    import zipfile
+
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False,
+                                                  "shape": (count,)})
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        with archive.open(f"{key}.npy", "w", force_zip64=True) as member:
+            member.write(header.getvalue())
+            for _ in range(count // 1_000_000):
+                member.write(bytes(8_000_000))
+        for name, value in others.items():
+            buffer = io.BytesIO()
+            np.save(buffer, value)
+            archive.writestr(f"{name}.npy", buffer.getvalue())
+
+
+@pytest.mark.parametrize("key, others, words", [
+    ("f", {"K": np.eye(2), "N": np.array([[1.0, 0.0]]), "d": np.array([0.25])},
+     ["f must have shape (2,), got (30000000,)"]),
+    ("f", {"K_row": np.array([0, 1]), "K_col": np.array([0, 1]), "K_data": np.ones(2),
+           "K_shape": np.array([2, 2]), "N_row": np.array([0]), "N_col": np.array([0]),
+           "N_data": np.ones(1), "N_shape": np.array([1, 2]), "d": np.array([0.25])},
+     ["K_shape declares 2 × 2", "f has length 30000000"]),
+    ("K_data", {"K_row": np.array([0, 1]), "K_col": np.array([0, 1]), "K_shape": np.array([2, 2]),
+                "f": np.ones(2), "N": np.array([[1.0, 0.0]]), "d": np.array([0.25])},
+     ["K_data declares 30,000,000 entries", "2 unknowns"]),
+], ids=["dense K", "sparse K", "sparse part"])
+def test_a_compressed_member_is_held_to_the_others_before_it_is_read(tmp_path, capsys,
+                                                                    monkeypatch, key, others, words):
+    path = tmp_path / "bomb.npz"
+    compressed_bomb(path, key, 30_000_000, others)
+    read = []
+    original = np.lib.npyio.NpzFile.__getitem__
+    monkeypatch.setattr(np.lib.npyio.NpzFile, "__getitem__",
+                        lambda self, name: read.append(name) or original(self, name))
+    assert main(["solve", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and all(word in err for word in words), err
+    assert key not in read
