@@ -206,7 +206,7 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     residual = Ku - problem.f + NT_lam
     stationarity = _inf_norm(residual) / _positive(max(_inf_norm(NT_lam), floor))
     dual_sign = max(float(np.max(-lam, initial=0.0)), 0.0) / lam_norm + 0.0
-    complementarity = _inf_norm(lam * violation) / (lam_norm * scale_gap)
+    complementarity = _inf_norm((lam / lam_norm) * (violation / scale_gap))
     natural = _inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))
     gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:

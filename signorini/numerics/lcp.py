@@ -130,10 +130,10 @@ def delassus_max_eigenvalue(N: sp.csr_matrix, factor, rtol: float = 1e-6, max_it
     estimate = 0.0
     for step in range(1, max_iter + 1):
         y = apply_W(x)
-        new_estimate = float(x @ y)
-        x = y / np.linalg.norm(y)
-        if abs(new_estimate - estimate) <= rtol * abs(new_estimate):
-            return new_estimate, step
+        new_estimate, size = float(x @ y), float(np.linalg.norm(y))
+        if abs(new_estimate - estimate) <= rtol * abs(new_estimate) or not 0.0 < size < np.inf:
+            return new_estimate, step  # settled, or W x is zero or not finite: nothing to iterate
+        x = y / size
         estimate = new_estimate
     return estimate, max_iter
 
