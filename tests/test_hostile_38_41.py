@@ -123,7 +123,7 @@ def saddle_point(K):
 @pytest.mark.parametrize("K", [
     np.array([[1.0, 2.0], [2.0, 1.0]]),  # a positive diagonal, an eigenvalue −1
     np.diag([1.0, -1.0]),
-    sp.diags(np.r_[np.full(799, 2.0), -1e-3]),  # by Lanczos
+    sp.diags(np.r_[np.full(799, 2.0), -1e-3]),  # by LOBPCG
 ], ids=["positive diagonal", "negative diagonal", "800 dofs"])
 def test_a_kkt_point_of_an_indefinite_k_is_never_converged(K):
     problem, u, lam = saddle_point(K)
