@@ -306,3 +306,13 @@ def test_a_compressed_member_is_held_to_the_others_before_it_is_read(tmp_path, c
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and all(word in err for word in words), err
     assert key not in read
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--set", "nx=4", "--set", "nx=6"], ["--set nx is given twice (4 and 6)"]),
+    (["--method", "pdas", "--opt", "c=1", "--opt", "c=2"], ["--opt c is given twice (1 and 2)"]),
+], ids=["set", "opt"])
+def test_a_setting_given_twice_with_two_values_is_refused(capsys, argv, words):
+    assert main(["solve", "block", *argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and all(word in err for word in words), err
