@@ -316,3 +316,22 @@ def test_a_setting_given_twice_with_two_values_is_refused(capsys, argv, words):
     assert main(["solve", "block", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and all(word in err for word in words), err
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda: signorini.solve(steel_qp(), "pdas", keep_factor="yes"), ["keep_factor='yes'"]),
+    (lambda: signorini.solve_adaptive("block", 0.5, max_dofs=True), ["max dofs True", "whole"]),
+    (lambda: signorini.solve_adaptive("block", 0.5, max_dofs=1e5), ["max dofs 100000.0", "whole"]),
+    (lambda: signorini.with_load("hertz-cylinder", P=1.0), ["with_load", "ContactProblem"]),
+    (lambda: ContactProblem.load("no-such-problem.npz"), ["no-such-problem.npz", "does not exist"]),
+], ids=["keep_factor", "max_dofs bool", "max_dofs float", "with_load of a name", "load missing"])
+def test_more_api_doors_refuse_bad_input_naming_it(call, words):
+    with pytest.raises(signorini.InputError) as refused:
+        call()
+    assert all(word in str(refused.value) for word in words), str(refused.value)
+
+
+def test_a_file_that_is_not_an_archive_is_refused_by_load(tmp_path):
+    (tmp_path / "p.npz").write_bytes(b"not a zip")
+    with pytest.raises(signorini.InputError, match="not an archive"):
+        ContactProblem.load(tmp_path / "p.npz")

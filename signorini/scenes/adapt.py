@@ -225,9 +225,11 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
     """
     if quantity is not None and quantity not in QUANTITIES:
         raise InputError(f"target quantity {quantity!r} is not one of {', '.join(QUANTITIES)}")
-    max_dofs = DEFAULT_MAX_DOFS if max_dofs is None else int(max_dofs)
-    if max_dofs <= 0:
-        raise InputError(f"max dofs {max_dofs} must be positive")
+    if max_dofs is None:
+        max_dofs = DEFAULT_MAX_DOFS
+    elif isinstance(max_dofs, bool) or not isinstance(max_dofs, (int, np.integer)) or max_dofs <= 0:
+        raise InputError(f"max dofs {max_dofs!r} must be a positive whole number, e.g. "
+                         f"max_dofs={DEFAULT_MAX_DOFS}")
     stages: dict[str, float] = {}  # every step's seconds by stage: the record's time
     with timed(stages, "mesh"):
         scene = _scene(name, values, solved_by)

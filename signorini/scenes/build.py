@@ -135,6 +135,9 @@ def with_load(problem: ContactProblem, **load: float) -> ContactProblem:
     the answer is that mesh's; a contact zone that outgrows the candidates is
     judged ``model_inadequate`` as in any solve.
     """
+    if not isinstance(problem, ContactProblem):
+        raise InputError(f"with_load takes a ContactProblem, got {type(problem).__name__}: build "
+                         "one first, problem = signorini.build_problem('hertz-cylinder')")
     family = SCENES.get(problem.name or "")
     if family is None or family.loads is None or problem.model.push is None or problem.model.push.target is None:
         raise InputError("with_load moves the target load of a scene built by name with one "
