@@ -85,7 +85,7 @@ def of_callable(function: Callable[..., Any], taken: Mapping[str, Method]) -> Me
 
 
 def _method(name: str, function: Callable[..., Any]) -> Method:
-    return Method(name=name, function=function, family="user", scaled=False,
+    return Method(name=name, function=function, family="user",
                   summary=(getattr(function, "__doc__", None) or "").strip().split("\n")[0])
 
 
