@@ -335,3 +335,14 @@ def test_a_file_that_is_not_an_archive_is_refused_by_load(tmp_path):
     (tmp_path / "p.npz").write_bytes(b"not a zip")
     with pytest.raises(signorini.InputError, match="not an archive"):
         ContactProblem.load(tmp_path / "p.npz")
+
+
+@pytest.mark.parametrize("spoil, kind", [
+    (lambda u: np.ma.masked_array(u, [True, False]), "MaskedArray"),
+    (lambda u: np.asmatrix(u).T, "matrix"),
+], ids=["masked", "matrix"])
+def test_an_ndarray_subclass_that_is_not_a_vector_of_floats_breaks_the_contract(spoil, kind):
+    problem = steel_qp()
+    u, lam = pdas_answer(problem)
+    result = signorini.solve(problem, lambda given, **options: (spoil(u), lam))
+    assert result.status == "failed" and f"got a {kind}" in result.solution.message

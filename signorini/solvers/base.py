@@ -207,13 +207,13 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
         return failed(f"status {solution.status!r} is not one of {', '.join(STATUSES)}")
     for name, size in (("u", problem.n), ("lam", problem.m)):
         value = getattr(solution, name)
-        if not isinstance(value, np.ndarray) or value.shape != (size,) \
-                or value.dtype.kind not in "fiu":
-            got = (f"{value.dtype} array of shape {value.shape}" if isinstance(value, np.ndarray)
+        if not isinstance(value, np.ndarray) or isinstance(value, np.ma.MaskedArray) \
+                or value.shape != (size,) or value.dtype.kind not in "fiu":
+            got = (f"{value.dtype} array of shape {value.shape}" if type(value) is np.ndarray
                    else type(value).__name__)
             return failed(f"{name} must be an array of {size} floats, got a {got}")
-        if value.dtype.kind != "f":
-            setattr(solution, name, value.astype(float))
+        if value.dtype.kind != "f" or type(value) is not np.ndarray:  # a memmap, ints
+            setattr(solution, name, np.array(value, dtype=float))
     if solution.status == "converged" and not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
         return failed(f"status {solution.status!r} with non-finite entries in u or lam")
     return solution
