@@ -346,3 +346,20 @@ def test_an_ndarray_subclass_that_is_not_a_vector_of_floats_breaks_the_contract(
     u, lam = pdas_answer(problem)
     result = signorini.solve(problem, lambda given, **options: (spoil(u), lam))
     assert result.status == "failed" and f"got a {kind}" in result.solution.message
+
+
+@pytest.mark.parametrize("field, value", [
+    ("iterations", "many"), ("iterations", float("nan")), ("iterations", -1), ("extras", [1]),
+    ("message", 3), ("history", 3), ("solve_time", "x"), ("build_time", float("inf")),
+])
+def test_what_a_method_reports_beside_its_answer_is_held_to_the_contract(field, value):
+    problem = steel_qp()
+    u, lam = pdas_answer(problem)
+
+    def mine(given, **options):
+        answer = signorini.ContactSolution("mine", u.copy(), lam.copy(), "converged", "")
+        setattr(answer, field, value)
+        return answer
+
+    result = signorini.solve(problem, mine)
+    assert result.status == "failed" and f"its {field} must be" in result.solution.message

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import math
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -180,6 +182,24 @@ def check_max_iter(max_iter: Any) -> int | None:
     return int(number)
 
 
+def _count(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= 0
+
+
+def _seconds(value: Any) -> bool:
+    return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value) \
+        and value >= 0
+
+
+#: what a method reports beside its answer, by field: (the test it passes, what it must be)
+REPORTED = {"iterations": (_count, "a whole number ≥ 0"),
+            "build_time": (_seconds, "seconds, a finite number ≥ 0"),
+            "solve_time": (_seconds, "seconds, a finite number ≥ 0"),
+            "message": (lambda v: isinstance(v, str), "a str"),
+            "extras": (lambda v: isinstance(v, dict), "a dict"),
+            "history": (lambda v: isinstance(v, dict), "a dict of lists")}
+
+
 def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> ContactSolution:
     """``solution`` when it is what a method must return, else a ``failed`` one saying why.
 
@@ -205,6 +225,9 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
         return failed(f"it returned {type(solution).__name__}, not a ContactSolution")
     if solution.status not in STATUSES:
         return failed(f"status {solution.status!r} is not one of {', '.join(STATUSES)}")
+    for name, (fits, said) in REPORTED.items():
+        if not fits(getattr(solution, name)):
+            return failed(f"its {name} must be {said}, got {getattr(solution, name)!r}")
     for name, size in (("u", problem.n), ("lam", problem.m)):
         value = getattr(solution, name)
         if not isinstance(value, np.ndarray) or isinstance(value, np.ma.MaskedArray) \
@@ -324,6 +347,6 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
     return solution
 
 
-__all__ = ["acceptance", "Method", "rows_share_dofs", "check_tol", "check_max_iter",
+__all__ = ["REPORTED", "acceptance", "Method", "rows_share_dofs", "check_tol", "check_max_iter",
            "hold_to_contract", "fingerprint", "changed", "held_to_problem", "certify", "judge",
            "ACCEPT_FACTOR", "MAX_ITER"]
