@@ -8,6 +8,7 @@ import json
 import os
 import textwrap
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -363,3 +364,17 @@ def test_what_a_method_reports_beside_its_answer_is_held_to_the_contract(field, 
 
     result = signorini.solve(problem, mine)
     assert result.status == "failed" and f"its {field} must be" in result.solution.message
+
+
+@pytest.mark.parametrize("u, lam", [
+    ([-1.7e308, -1.7e308], [0.0]),  # K u overflows to inf − inf: NaN stationarity
+    ([-1e300, -1.7e308], [1.125e8]),
+    ([1e200, 1e200], [1e200]),
+])
+def test_an_answer_beyond_double_precision_is_never_converged(u, lam):
+    problem = steel_qp()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nor does judging it warn
+        result = signorini.solve(problem, lambda given, **options: (np.array(u), np.array(lam)))
+    assert result.status != "converged"
+    assert not signorini.certificate(problem, u=np.array(u), force=np.array(lam)).passed(0.5)

@@ -160,9 +160,11 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     if kept is not None and kept[0] == key:
         return kept[1]
     try:
-        cert = _certificate(problem, solution, duality_gap)
+        with np.errstate(all="ignore"):  # an answer beyond double precision: inf residuals say so
+            cert = _certificate(problem, solution, duality_gap)
     except np.linalg.LinAlgError:  # K singular or indefinite: no dual function, no Newton step
-        cert = _certificate(problem, solution, False)
+        with np.errstate(all="ignore"):
+            cert = _certificate(problem, solution, False)
         if np.isfinite(cert.primal) and indefinite(problem.K):  # no minimum: no answer to certify
             cert = replace(cert, duality_gap=float("inf"))
     solution._certificate = (key, cert)
@@ -224,6 +226,11 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
         if not solution.keep_factor:  # used: a kept solution no longer keeps a factorisation alive
             solution.factor = None
         gap = abs(absolute) / _positive(max(abs(energy), abs(energy - absolute)))
+    # a residual that overflowed (inf − inf) is NaN, which would read as "not computed": it is inf
+    primal, stationarity, dual_sign, complementarity, natural = (
+        float("inf") if np.isnan(value) else value
+        for value in (primal, stationarity, dual_sign, complementarity, natural))
+    gap = float("inf") if duality_gap and np.isnan(gap) else gap
     return Certificate(primal, stationarity, dual_sign, complementarity, natural, gap,
                        forward.force, forward.displacement, forward.floor, forward.back_solves)
 

@@ -326,7 +326,8 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
     cert = certify(problem, solution) if cert is None else cert
     reason = shortfall(cert, accept)
     if reason is not None:  # which candidates fail and how, with the advice that fits
-        by_constraint = explain(problem, solution, accept)
+        with np.errstate(all="ignore"):  # an answer beyond double precision is named, not warned of
+            by_constraint = explain(problem, solution, accept)
         if by_constraint is not None:
             reason = f"{shortfall(cert, accept, advice='')}: {by_constraint}"
         solution.claimed_status = "converged"
