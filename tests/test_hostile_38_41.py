@@ -378,3 +378,28 @@ def test_an_answer_beyond_double_precision_is_never_converged(u, lam):
         result = signorini.solve(problem, lambda given, **options: (np.array(u), np.array(lam)))
     assert result.status != "converged"
     assert not signorini.certificate(problem, u=np.array(u), force=np.array(lam)).passed(0.5)
+
+
+@pytest.mark.parametrize("module, code, words", [
+    ("import os\nos._exit(0)\n", 1, ["failed", "worker process died"]),
+    ("import time\ntime.sleep(60)\n", 1, ["failed", "no answer within 2 s"]),
+], ids=["ends the process", "hangs"])
+def test_what_a_method_file_does_when_imported_costs_its_run_not_the_command(
+        tmp_path, monkeypatch, capsys, module, code, words):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine.py").write_text(module + "def solve(problem, **options):\n    return None\n")
+    steel_qp().save(tmp_path / "qp.npz")
+    assert main(["solve", "qp.npz", "--method", "mine.py:solve", "--time-limit", "2",
+                 "--json", "r.json"]) == code
+    record = json.loads((tmp_path / "r.json").read_text())
+    assert all(word in f"{record['status']} {record['message']}" for word in words), record["message"]
+
+
+def test_a_method_file_that_prints_when_imported_leaves_stdout_to_the_json(tmp_path, monkeypatch,
+                                                                           capfd):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine.py").write_text(SLEEPER.replace("time.sleep(1.0)", "pass")
+                                      + "\nprint('imported')\n")
+    steel_qp().save(tmp_path / "qp.npz")
+    assert main(["solve", "qp.npz", "--method", "mine.py:sleeps", "--json", "-"]) == 0
+    assert json.loads(capfd.readouterr().out)["status"] == "converged"

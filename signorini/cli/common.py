@@ -151,10 +151,13 @@ def user_methods_in_workers(names: Sequence[str]) -> Iterator[None]:
     """While the block runs, each user method (``file.py:function``) named runs in a worker
     process (:func:`signorini.studies.runner.in_worker`): a method that ends its process,
     closes stdout or raises what is not an Exception cannot take this run down or fake its exit."""
+    from signorini.solvers import user  # per command (start-up)
     from signorini.solvers.registry import REGISTRY, get_method, given  # per command (start-up)
     from signorini.studies.runner import in_worker  # per command (start-up)
 
-    found = {name: get_method(name) for name in dict.fromkeys(names) if name not in REGISTRY}
+    # a user's method is imported in its worker, not here (its import cannot take the run down)
+    found = {name: user.deferred(name) if ":" in name else get_method(name)
+             for name in dict.fromkeys(names) if name not in REGISTRY}
     with given({name: in_worker(method) for name, method in found.items()
                 if method.family == "user"}):
         yield

@@ -20,6 +20,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.certification.kkt import certificate  # per command (start-up)
     from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
+    from signorini.solvers import user  # per command (start-up)
     from signorini.numerics.work import timed  # per command (start-up)
 
     # the process's start-up (interpreter, imports, parsing), when this command is the process
@@ -37,7 +38,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
             raise InputError(f"{given[0]} applies to a scene; problem file {args.scene!r} is "
                              f"solved as stored: drop {given[0]}")
     # every option read as its declared kind and checked before the scene is built
-    method = get_method(args.method)
+    # a method of the user's is imported in the worker process that runs it, not here
+    method = user.deferred(args.method) if ":" in args.method else get_method(args.method)
     request = check_request(method, tol, max_iter, method.parse_options(texts))  # once: solve takes it
     time_limit = parse_time_limit(args.time_limit)
     if time_limit is not None and args.target_error is not None:
