@@ -230,7 +230,6 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     primal, stationarity, dual_sign, complementarity, natural = (
         float("inf") if np.isnan(value) else value
         for value in (primal, stationarity, dual_sign, complementarity, natural))
-    gap = float("inf") if duality_gap and np.isnan(gap) else gap
     return Certificate(primal, stationarity, dual_sign, complementarity, natural, gap,
                        forward.force, forward.displacement, forward.floor, forward.back_solves)
 

@@ -261,6 +261,9 @@ class Model:
         if pu is None or pu.target is None:
             raise InputError("this problem has no target load to change: build the scene with a "
                              "load P (or a_over_R), or build it again with the new load")
+        if isinstance(P, bool) or not isinstance(P, Real) or not (math.isfinite(P) and P > 0):
+            raise InputError(f"the target load P={P!r} must be a finite number > 0 (the scene's "
+                             "units, full body), e.g. with_load(problem, P=2.5)")
         load = target if pu.f_load is not None else pu.load  # a cut's traction is the load itself
         model = self.with_basis(
             load_offset=pu.offset(pu.scale, load), mesh_s=0.0, assemble_s=0.0,
