@@ -21,7 +21,7 @@ from signorini import load_control
 from signorini.certification import kkt
 from signorini.certification.kkt import Certificate
 from signorini.errors import InputError
-from signorini.numerics.arrays import flag_argument, vector_argument
+from signorini.numerics.arrays import vector_argument
 from signorini.problem.contact import ContactProblem
 from signorini.problem.scales import record_units
 from signorini.problem.solution import ContactSolution, WarmStart
@@ -82,7 +82,8 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
         raise InputError(f"{', '.join(adaptive)} steer{'s' * (len(adaptive) == 1)} adaptive "
                          "refinement: call signorini.solve_adaptive(scene, target_error, ...)")
     request = checked(method, tol, max_iter, options)  # once, before the scene is built
-    keep_factor = flag_argument(keep_factor, "keep_factor")
+    if not isinstance(keep_factor, bool):  # here, not numerics.arrays: one file fewer per solve
+        raise InputError(f"keep_factor={keep_factor!r} must be True or False")
     if isinstance(problem, str):
         problem = scenes.build_problem(problem, params=scenes.scene_params(params),
                                        solved_by=request.method)

@@ -406,3 +406,23 @@ def test_a_method_file_that_prints_when_imported_leaves_stdout_to_the_json(tmp_p
     steel_qp().save(tmp_path / "qp.npz")
     assert main(["solve", "qp.npz", "--method", "mine.py:sleeps", "--json", "-"]) == 0
     assert json.loads(capfd.readouterr().out)["status"] == "converged"
+
+
+@pytest.mark.parametrize("change, name", [
+    (lambda p: setattr(p, "scales", signorini.Scales(displacement=1e3, force=1e3)), "scales"),
+    (lambda p: setattr(p, "force_multiplicity", 100.0), "force_multiplicity"),
+    (lambda p: p.weights.__setitem__(slice(None), 1e-9), "weights"),
+    (lambda p: p.contact_points.__setitem__(slice(None), 7.0), "contact_points"),
+], ids=["units", "multiplicity", "weights", "positions"])
+def test_a_method_that_changes_how_its_answer_is_reported_fails(change, name):
+    problem = ContactProblem.from_qp(steel_qp().K, steel_qp().f, steel_qp().N, steel_qp().d,
+                                     weights=[0.5], contact_points=[[0.0, 0.0]])
+
+    def mine(given, **options):
+        answer = pdas_answer(given)
+        change(given)
+        return answer
+
+    result = signorini.solve(problem, mine)
+    assert result.status == "failed" and f"changed the problem it was given: {name}" in \
+        result.solution.message

@@ -10,6 +10,7 @@ success becomes ``converged`` only when the KKT certificate backs it
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import importlib.util
 import math
@@ -253,24 +254,34 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
 #: ``K x`` before and after a method agree to this (relative): summation order only
 SAME_PRODUCT_RTOL = 1e-12
 #: what each array is, for the message
-MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps"}
+MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps",
+           "weights": "the candidates' boundary weights", "contact_points": "their positions",
+           "force_multiplicity": "the copies of the model in the body", "scales": "the units",
+           "prescribed": "the prescribed displacements"}
 
 
 def _summary(array: Any, x: np.ndarray) -> Any:
-    """``A x`` of a matrix (K or N); a hash of the bytes of a vector (f or d)."""
-    if np.ndim(array) == 2:
+    """``A x`` of a sparse matrix (K or N); a hash of the bytes of any other array."""
+    if sp.issparse(array):
         return array @ x
     return hashlib.blake2b(np.ascontiguousarray(array, dtype=float).view(np.uint8),
                            digest_size=16).hexdigest()
 
 
 def _arrays(problem: ContactProblem) -> dict[str, Any]:
-    return {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d}
+    """What the answer is judged and reported by: the QP, and what turns it into forces,
+    pressures, positions and units."""
+    return {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d,
+            "weights": np.zeros(0) if problem.weights is None else problem.weights,
+            "contact_points": problem.contact_points,
+            "force_multiplicity": np.array([problem.force_multiplicity], dtype=float),
+            "scales": np.array(dataclasses.astuple(problem.scales), dtype=float),
+            "prescribed": getattr(problem.model, "prescribed", np.zeros(0))}
 
 
 def fingerprint(problem: ContactProblem) -> dict[str, tuple]:
-    """Of each of K, f, N and d: its shape and its :func:`_summary` with a fixed random x (a few
-    vectors, no copy of K)."""
+    """Of each of :func:`_arrays`: its shape and its :func:`_summary` with a fixed random x (a
+    few vectors, no copy of K)."""
     x = np.random.default_rng(1).uniform(0.5, 1.5, problem.K.shape[1])
     return {name: (np.shape(a), _summary(a, x)) for name, a in _arrays(problem).items()}
 
@@ -298,7 +309,7 @@ def held_to_problem(problem: ContactProblem, before: dict[str, tuple], solution:
         return ContactSolution.failure(
             method, problem, "failed",
             f"the method changed the problem it was given: {names}; a method must not change "
-            "K, f, N or d (copy them first), so its answer cannot be judged")
+            "the problem (copy what it changes first), so its answer cannot be judged")
     return solution
 
 
