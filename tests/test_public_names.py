@@ -81,3 +81,93 @@ def test_importing_the_packages_starts_no_heavy_backend():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout.strip().splitlines()[-1]) == []
+
+
+# -- every module: its public names in ``__all__``, and what other modules read of it listed --
+
+MODULES = {".".join(p.with_suffix("").relative_to(PACKAGE.parent).parts): p
+           for p in sorted(PACKAGE.rglob("*.py")) if p.name not in ("__init__.py", "__main__.py")}
+
+
+def module_all(tree: ast.Module) -> list[str] | None:
+    """The literal ``__all__`` of a module's syntax tree (None when it has none)."""
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "__all__" for t in node.targets):
+            return ast.literal_eval(node.value)
+    return None
+
+
+def bound(tree: ast.Module) -> set[str]:
+    """Every name a module binds at its top level (definitions, assignments, imports)."""
+    names = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            names |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            for target in node.targets if isinstance(node, ast.Assign) else [node.target]:
+                names |= {n.id for n in ast.walk(target) if isinstance(n, ast.Name)}
+    return names
+
+
+def public_definitions(tree: ast.Module) -> list[str]:
+    return [node.name for node in tree.body
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))
+            and not node.name.startswith("_")]
+
+
+def read_from_others(modules: dict[str, Path]) -> dict[str, set[tuple[str, str]]]:
+    """``{module: {(name, reader)}}``: the names each package module imports from another one,
+    or reads as an attribute of it (``from signorini.solvers import pdas`` … ``pdas.METHODS``)."""
+    read = {name: set() for name in modules}
+    for reader, path in modules.items():
+        tree, aliases = ast.parse(path.read_text()), {}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module in modules:
+                read[node.module] |= {(a.name, reader) for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("signorini"):
+                aliases |= {a.asname or a.name: f"{node.module}.{a.name}" for a in node.names
+                            if f"{node.module}.{a.name}" in modules}
+            elif isinstance(node, ast.Import):
+                aliases |= {a.asname: a.name for a in node.names if a.name in modules and a.asname}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute) and getattr(node.value, "id", None) in aliases:
+                read[aliases[node.value.id]].add((node.attr, reader))
+    return read
+
+
+def unlisted(modules: dict[str, Path]) -> dict[str, list[str]]:
+    """Per module, what breaks the rule: no ``__all__`` beside public definitions, a listed name
+    it does not bind, or a name another package module reads that ``__all__`` does not list."""
+    trees = {name: ast.parse(path.read_text()) for name, path in modules.items()}
+    read = read_from_others(modules)
+    found = {}
+    for name, tree in trees.items():
+        listed = module_all(tree)
+        if listed is None:
+            problems = [f"no __all__ ({d})" for d in public_definitions(tree)[:1]]
+        else:
+            problems = [f"lists unbound {n}" for n in listed if n not in bound(tree)]
+            problems += [f"{reader} reads {n}" for n, reader in sorted(read[name])
+                         if reader != name and n not in listed]
+        if problems:
+            found[name] = problems
+    return found
+
+
+def test_every_module_lists_its_public_names_and_what_others_read_of_it():
+    assert unlisted(MODULES) == {}
+
+
+def test_the_module_rule_can_fail(tmp_path):
+    root = tmp_path / "signorini"
+    root.mkdir()
+    (root / "maker.py").write_text('__all__ = ["make", "gone"]\n\ndef make():\n    pass\n\n'
+                                   'def _inner():\n    pass\n')
+    (root / "user.py").write_text("from signorini.maker import _inner, make\n")
+    (root / "bare.py").write_text("def open_door():\n    pass\n")
+    modules = {f"signorini.{p.stem}": p for p in root.glob("*.py")}
+    assert unlisted(modules) == {"signorini.maker": ["lists unbound gone",
+                                                      "signorini.user reads _inner"],
+                                 "signorini.bare": ["no __all__ (open_door)"]}

@@ -9,7 +9,8 @@ from skfem import MeshTet, MeshTri
 
 from signorini.fem.topology import (TOPOLOGY, facet_topology, moved, sorted_columns,
                                     with_edges, with_topology)
-from signorini.scenes.meshing import coarse_ball_octant, refine_simplices_to_size
+from signorini.scenes.ball_octant import coarse_ball_octant
+from signorini.scenes.meshing import refine_simplices_to_size
 
 
 def graded_octant() -> MeshTet:
@@ -81,7 +82,7 @@ def test_the_sorting_network_sorts_columns_and_counts_swaps():
 
 def test_snapping_refuses_a_move_that_turns_a_tetrahedron_inside_out():
     from signorini.fem.checks import signed_measures
-    from signorini.scenes.meshing import on_ball_octant_surface, snap_to_sphere
+    from signorini.scenes.ball_octant import on_ball_octant_surface, snap_to_sphere
 
     snap, centre = snap_to_sphere((0.0, 0.0, 1.0), 1.0), np.array([[0.0], [0.0], [1.0]])
     mesh = snap(graded_octant())

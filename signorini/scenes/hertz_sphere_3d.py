@@ -40,14 +40,9 @@ from signorini.scenes.base import (
     two_refinements_coarser,
 )
 from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice
-from signorini.scenes.meshing import (
-    coarse_ball_octant,
-    curved_boundary_facets,
-    distance_to_disc,
-    on_ball_octant_surface,
-    refine_simplices_to_size,
-    snap_to_sphere,
-)
+from signorini.scenes.ball_octant import (coarse_ball_octant, curved_boundary_facets, distance_to_disc,
+                                         on_ball_octant_surface, snap_to_sphere)
+from signorini.scenes.meshing import refine_simplices_to_size
 
 PARAMS = COMMON_PARAMS + (
     Param("n_contact", 10, "elements across the contact radius (mesh fineness)", kind=int,
