@@ -179,6 +179,7 @@ def test_a_process_a_method_moved_out_of_its_group_ends_with_the_worker(tmp_path
     (lambda u: np.ma.masked_array(u, [True, False]), "MaskedArray"),
     (lambda u: np.asmatrix(u).T, "matrix"),
 ], ids=["masked", "matrix"])
+@pytest.mark.filterwarnings("ignore:the matrix subclass:PendingDeprecationWarning")  # NumPy on np.asmatrix
 def test_an_ndarray_subclass_that_is_not_a_vector_of_floats_breaks_the_contract(spoil, kind):
     problem = steel_qp()
     u, lam = pdas_answer(problem)
