@@ -44,6 +44,7 @@ def cylinder():
     (lambda p: steel_qp().model.at_push(1.0), ["push", "as it is"]),
     (lambda p: p.with_target(float("nan")), ["P=nan", "finite number > 0"]),
     (lambda p: p.with_target(-1.0), ["P=-1.0", "finite number > 0"]),
+    (lambda p: p.with_target("1"), ["P='1'", "finite number > 0"]),
 ])
 def test_the_sliders_doors_refuse_bad_input_naming_it(cylinder, call, words):
     with pytest.raises(signorini.InputError) as refused:

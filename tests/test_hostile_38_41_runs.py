@@ -261,3 +261,14 @@ def test_a_method_that_changes_how_its_answer_is_reported_fails(change, name):
     result = signorini.solve(problem, mine)
     assert result.status == "failed" and f"changed the problem it was given: {name}" in \
         result.solution.message
+
+
+def test_condensed_out_of_steps_and_uzawa_far_beyond_its_bound_say_so_quietly():
+    """condensed at one LCP step ends max_iter with its last iterate (not a failed run); Uzawa at
+    ρ = 1e300 overflows λ and ends diverged without a floating-point warning (pytest turns one
+    raised in the package into an error)."""
+    short = signorini.solve("hertz-cylinder", "condensed", max_iter=1)
+    assert short.status == "max_iter" and "still changing after 1" in short.message
+    assert np.all(np.isfinite(short.solution.u)) and np.all(np.isfinite(short.solution.lam))
+    far = signorini.solve("hertz-cylinder", "uzawa", rho=1e300)
+    assert far.status == "diverged" and "beyond the bound" in far.message

@@ -251,12 +251,12 @@ class Model:
             push=dataclasses.replace(pu, scale=scale, load=load, **changed), pending=False)
         return model, pu.f(scale, load), pu.d0 + scale * pu.d1
 
-    def with_target(self, P: float, target: float, params: dict[str, Any] | None = None,
+    def with_target(self, P: float, force_scale: float, params: dict[str, Any] | None = None,
                     predicted_contact: np.ndarray | None = None
                     ) -> tuple["Model", np.ndarray, np.ndarray]:
-        """The model with the target load ``P`` (the scene's units; ``target`` dimensionless),
-        pending, at its nominal push, with its QP's ``f`` and ``d`` there. Nothing is meshed or
-        assembled (``mesh_s`` and ``assemble_s`` are 0)."""
+        """The model with the target load ``P`` (the scene's units; ``force_scale`` its unit in
+        them), pending, at its nominal push, with its QP's ``f`` and ``d`` there. Nothing is
+        meshed or assembled (``mesh_s`` and ``assemble_s`` are 0)."""
         pu = self.push
         if pu is None or pu.target is None:
             raise InputError("this problem has no target load to change: build the scene with a "
@@ -264,6 +264,7 @@ class Model:
         if isinstance(P, bool) or not isinstance(P, Real) or not (math.isfinite(P) and P > 0):
             raise InputError(f"the target load P={P!r} must be a finite number > 0 (the scene's "
                              "units, full body), e.g. with_load(problem, P=2.5)")
+        target = P / force_scale
         load = target if pu.f_load is not None else pu.load  # a cut's traction is the load itself
         model = self.with_basis(
             load_offset=pu.offset(pu.scale, load), mesh_s=0.0, assemble_s=0.0,
