@@ -272,3 +272,19 @@ def test_condensed_out_of_steps_and_uzawa_far_beyond_its_bound_say_so_quietly():
     assert np.all(np.isfinite(short.solution.u)) and np.all(np.isfinite(short.solution.lam))
     far = signorini.solve("hertz-cylinder", "uzawa", rho=1e300)
     assert far.status == "diverged" and "beyond the bound" in far.message
+
+
+def test_a_constraint_given_twice_is_named_by_the_active_set_methods_and_solved_by_the_others():
+    """Two equal rows of N (both active): PDAS's saddle-point system is singular, and the message
+    names the two rows and what to do; the dual methods and the condensed LCP solve it, quietly."""
+    problem = ContactProblem.from_qp(K=np.diag([2.0, 1.0]), f=np.ones(2),
+                                     N=np.array([[1.0, 0.0], [1.0, 0.0]]), d=np.array([0.25, 0.25]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for method in ("pdas", "nested"):
+            said = signorini.solve(problem, method)
+            assert said.status == "failed" and "rows 0 and 1 of N are the same constraint" in said.message
+        for method in ("condensed", "uzawa"):
+            solved = signorini.solve(problem, method)
+            assert solved.converged and np.allclose(solved.solution.u, [0.25, 1.0])
+            assert np.isclose(solved.solution.lam.sum(), 0.5)

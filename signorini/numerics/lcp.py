@@ -11,6 +11,8 @@ i.e. the bound-constrained QP ``min ½λᵀWλ − bᵀλ`` over ``λ ≥ 0``.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -45,7 +47,9 @@ def forces_on(W: np.ndarray, b: np.ndarray, active: np.ndarray) -> np.ndarray:
     """λ with ``W_AA λ_A = b_A`` on the active set A and zero off it (b: m, or m × k)."""
     lam = np.zeros(np.shape(b))
     if active.any():
-        lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
+        with warnings.catch_warnings():  # dependent rows make W_AA singular: the certificate judges λ
+            warnings.simplefilter("ignore", sla.LinAlgWarning)
+            lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
     return lam
 
 
