@@ -82,6 +82,8 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
         raise InputError(f"{', '.join(adaptive)} steer{'s' * (len(adaptive) == 1)} adaptive "
                          "refinement: call signorini.solve_adaptive(scene, target_error, ...)")
     request = checked(method, tol, max_iter, options)  # once, before the scene is built
+    if not isinstance(keep_factor, bool):  # here, not numerics.arrays: one file fewer per solve
+        raise InputError(f"keep_factor={keep_factor!r} must be True or False")
     if isinstance(problem, str):
         problem = scenes.build_problem(problem, params=scenes.scene_params(params),
                                        solved_by=request.method)
@@ -92,7 +94,7 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
         raise InputError(f"problem must be a ContactProblem or a scene name, got "
                          f"{type(problem).__name__}: build one with signorini.build_problem(...) "
                          "or ContactProblem.from_qp(K, f, N, d)")
-    start = None if warm_start is None else WarmStart.of(warm_start)
+    start = None if warm_start is None else WarmStart.of(warm_start).check_fits(problem.n, problem.m)
     if problem.model.pending or request.method.runs(problem, request.options, start).prediction:
         # a target load to match, or the scene's prediction of the contact for the method
         return Result(*load_control.solve(problem, request, warm_start=start,
@@ -103,6 +105,9 @@ def solve(problem: ContactProblem | str, method: MethodLike = DEFAULT_METHOD, *,
 def at_load(problem: ContactProblem) -> ContactProblem:
     """``problem`` at its target load, or itself when it has none: the QP any method (or your
     own code) can then solve as it is. Load control matches the push (:mod:`signorini.load_control`)."""
+    if not isinstance(problem, ContactProblem):
+        raise InputError(f"at_load takes a ContactProblem, got {type(problem).__name__}: build one "
+                         "with signorini.build_problem('hertz-cylinder') first")
     return load_control.at_load(problem, scenes.coarse_problem)
 
 

@@ -9,7 +9,7 @@ a factorisation the method already holds when it can (:mod:`signorini.certificat
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -101,7 +101,8 @@ class Certificate:
     Force norms are floored at ``FORCE_FLOOR · ‖f‖∞`` so that a problem with
     no contact (λ = 0 up to round-off) is judged against its loads (not a
     contact force: see :func:`force_scale`).
-    Residuals are ``inf`` when ``u`` or ``λ`` is not finite.
+    Residuals are ``inf`` when ``u`` or ``λ`` is not finite, and the duality gap when K is
+    indefinite (:func:`indefinite`: the QP has no minimum).
     """
 
     primal: float
@@ -159,11 +160,43 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     if kept is not None and kept[0] == key:
         return kept[1]
     try:
-        cert = _certificate(problem, solution, duality_gap)
+        with np.errstate(all="ignore"):  # an answer beyond double precision: inf residuals say so
+            cert = _certificate(problem, solution, duality_gap)
     except np.linalg.LinAlgError:  # K singular or indefinite: no dual function, no Newton step
-        cert = _certificate(problem, solution, False)
+        with np.errstate(all="ignore"):
+            cert = _certificate(problem, solution, False)
+        if np.isfinite(cert.primal) and indefinite(problem.K):  # no minimum: no answer to certify
+            cert = replace(cert, duality_gap=float("inf"))
     solution._certificate = (key, cert)
     return cert
+
+
+#: K is indefinite when an eigenvalue lies below this fraction of its largest diagonal entry
+NEGATIVE_CURVATURE = 1e-10
+#: up to this many dofs the lowest eigenvalue of K is found densely, beyond it is bounded above
+#: by LOBPCG's Rayleigh quotient after at most :data:`CURVATURE_STEPS` iterations
+DENSE_EIGEN_DOFS = 500
+CURVATURE_STEPS = 50
+
+
+def indefinite(K) -> bool:
+    """Whether ``K`` has a negative eigenvalue (below ``−NEGATIVE_CURVATURE · max|Kᵢᵢ|``): then
+    ``½uᵀKu − fᵀu`` has no minimum and a KKT point is no answer. Exact up to
+    :data:`DENSE_EIGEN_DOFS` dofs; beyond, a Rayleigh quotient below the bound proves it (one
+    above says nothing: False)."""
+    import warnings
+
+    from scipy.sparse.linalg import lobpcg
+
+    scale = float(np.max(np.abs(K.diagonal()), initial=0.0)) or 1.0
+    if K.shape[0] <= DENSE_EIGEN_DOFS:
+        lowest = np.linalg.eigvalsh(K.toarray())[0]
+    else:
+        start = np.random.default_rng(0).standard_normal((K.shape[0], 1))
+        with warnings.catch_warnings():  # an unconverged quotient still bounds the lowest above
+            warnings.simplefilter("ignore")
+            lowest = lobpcg(K, start, largest=False, maxiter=CURVATURE_STEPS, tol=1e-8)[0][0]
+    return bool(lowest < -NEGATIVE_CURVATURE * scale)
 
 
 def _certificate(problem: ContactProblem, solution: ContactSolution,
@@ -193,6 +226,10 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
         if not solution.keep_factor:  # used: a kept solution no longer keeps a factorisation alive
             solution.factor = None
         gap = abs(absolute) / _positive(max(abs(energy), abs(energy - absolute)))
+    # a residual that overflowed (inf − inf) is NaN, which would read as "not computed": it is inf
+    primal, stationarity, dual_sign, complementarity, natural = (
+        float("inf") if np.isnan(value) else value
+        for value in (primal, stationarity, dual_sign, complementarity, natural))
     return Certificate(primal, stationarity, dual_sign, complementarity, natural, gap,
                        forward.force, forward.displacement, forward.floor, forward.back_solves)
 
@@ -251,6 +288,10 @@ def shortfall(cert: Certificate, accept: float,
             name = "force_error_floor"  # the first step is noise of the same size: conditioning
         said.append(FORCE_SHORTFALL[name].format(value=errors[name], accept=accept,
                                                  force=cert.force_error, floor=floor))
+    if np.isinf(cert.duality_gap) and np.isfinite(cert.primal):
+        said.append("K is not positive semidefinite (an eigenvalue is negative): the QP has no "
+                    "minimum, and a point meeting its KKT conditions is no answer; give an SPD K")
+        return "; ".join(said)
     others = {k: v for k, v in cert.residuals().items() if k not in FORCE_SHORTFALL
               and not np.isnan(v)}
     name = max(others, key=others.get)
@@ -327,6 +368,6 @@ def compare(problem: ContactProblem, first: ContactSolution, second: ContactSolu
     return Comparison(u_rel, lam_rel, misclassified, int(np.sum(weak)))
 
 
-__all__ = ["ACTIVE", "FORCE_FLOOR", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "WEAK", "WEAK_TOL",
+__all__ = ["ACTIVE", "CURVATURE_STEPS", "DENSE_EIGEN_DOFS", "NEGATIVE_CURVATURE", "FORCE_FLOOR", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "WEAK", "WEAK_TOL",
            "Certificate", "Comparison", "active_set", "certificate", "classify", "compare", "force_scale",
-           "gap_scale", "shortfall"]
+           "gap_scale", "indefinite", "shortfall"]

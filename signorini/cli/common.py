@@ -49,8 +49,16 @@ def pairs(items: Sequence[str], flag: str) -> dict[str, Any]:
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
             raise InputError(f"{flag} {item!r} is not key=value: write {flag} name=value")
-        out[key.strip()] = value.strip()
+        _set_once(out, key.strip(), value.strip(), flag)
     return out
+
+
+def _set_once(out: dict[str, Any], key: str, value: str, flag: str) -> None:
+    """``out[key] = value``; InputError when ``key`` already holds another value (the command
+    line would otherwise keep whichever came last, without a word)."""
+    if key in out and out[key] != value:
+        raise InputError(f"{flag} {key} is given twice ({out[key]} and {value}): give it once")
+    out[key] = value
 
 
 #: the one spelling of a method's option on every command
@@ -70,7 +78,8 @@ def method_options(items: Sequence[str], methods: Sequence[str]) -> dict[str, di
         if not colon and len(methods) != 1:
             raise InputError(f"--opt {item!r} names no method: write --opt METHOD:key=value, "
                              f"here --opt METHOD:{item} (or name one --method)")
-        out.setdefault(method if colon else methods[0], {})[key.strip()] = value.strip()
+        _set_once(out.setdefault(method if colon else methods[0], {}), key.strip(), value.strip(),
+                  "--opt")
     stray = sorted(set(out) - set(methods)) if methods else []
     if stray:
         raise InputError(f"--opt for {stray[0]!r}, which is not among the --method: add "
@@ -142,10 +151,13 @@ def user_methods_in_workers(names: Sequence[str]) -> Iterator[None]:
     """While the block runs, each user method (``file.py:function``) named runs in a worker
     process (:func:`signorini.studies.runner.in_worker`): a method that ends its process,
     closes stdout or raises what is not an Exception cannot take this run down or fake its exit."""
+    from signorini.solvers import user  # per command (start-up)
     from signorini.solvers.registry import REGISTRY, get_method, given  # per command (start-up)
     from signorini.studies.runner import in_worker  # per command (start-up)
 
-    found = {name: get_method(name) for name in dict.fromkeys(names) if name not in REGISTRY}
+    # a user's method is imported in its worker, not here (its import cannot take the run down)
+    found = {name: user.deferred(name) if ":" in name else get_method(name)
+             for name in dict.fromkeys(names) if name not in REGISTRY}
     with given({name: in_worker(method) for name, method in found.items()
                 if method.family == "user"}):
         yield

@@ -20,6 +20,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.certification.kkt import certificate  # per command (start-up)
     from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
+    from signorini.solvers import user  # per command (start-up)
+    from signorini.numerics.work import timed  # per command (start-up)
 
     # the process's start-up (interpreter, imports, parsing), when this command is the process
     startup = process_seconds() if getattr(args, "process", False) else None
@@ -36,7 +38,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
             raise InputError(f"{given[0]} applies to a scene; problem file {args.scene!r} is "
                              f"solved as stored: drop {given[0]}")
     # every option read as its declared kind and checked before the scene is built
-    method = get_method(args.method)
+    # a method of the user's is imported in the worker process that runs it, not here
+    method = user.deferred(args.method) if ":" in args.method else get_method(args.method)
     request = check_request(method, tol, max_iter, method.parse_options(texts))  # once: solve takes it
     time_limit = parse_time_limit(args.time_limit)
     if time_limit is not None and args.target_error is not None:
@@ -78,24 +81,31 @@ def cmd_solve(args: argparse.Namespace) -> int:
             else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
                 from signorini.studies.runner import solve_within  # per command (start-up)
 
-                problem = at_load(problem)  # the worker builds it again, matched the same way
+                seconds: dict[str, float] = {}
+                with timed(seconds, "load control"):
+                    problem = at_load(problem)  # the worker builds it again, matched the same way
                 spec = {"kind": "stored", "path": os.path.abspath(args.scene)} if from_file else \
                     {"kind": "scene", "scene": args.scene, "params": params,
                      "nondimensionalise": not args.raw_units}
-                solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
-                                        max_iter=max_iter, options=request.options)
-                result = Result(problem, solution, certificate(problem, solution))
+                with timed(seconds, "method"):  # the worker's whole run, its start-up included
+                    solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
+                                            max_iter=max_iter, options=request.options)
+                with timed(seconds, "certificate"):
+                    judged = certificate(problem, solution)
+                solution.seconds = {**solution.seconds, **seconds}
+                result = Result(problem, solution, judged)
     if startup is not None:
         result.solution.seconds["startup"] = startup
-    record = result.to_dict()
-    finite = record["contact"] is not None
+    finite = result.finite
     with all_or_none():  # every output, or none of them
-        if json_path:
-            write_output(json_path, to_json(record) + "\n")
-        if vtk_path and finite:
+        if vtk_path and finite:  # before the record, whose output stage counts it
             from signorini.output.export import export_vtk  # per command (start-up)
 
-            export_vtk(problem, result.solution, vtk_path)
+            with timed(result.solution.seconds, "output"):
+                export_vtk(problem, result.solution, vtk_path)
+        record = result.to_dict()
+        if json_path:
+            write_output(json_path, to_json(record) + "\n")
     if json_path != STDOUT:
         print(solve_summary(record))
     if vtk_path and not finite:

@@ -189,6 +189,23 @@ class PinnedFactor:
         return self._coupling.T @ u
 
 
+def _singular_said(N_A: sp.spmatrix, rows: np.ndarray, exc: Exception) -> str:
+    """Why the saddle-point system of the active rows ``rows`` of N is singular, and what to do."""
+    seen: dict[bytes, int] = {}
+    N_A = sp.csr_matrix(N_A)
+    N_A.sort_indices()
+    for k in range(N_A.shape[0]):
+        row = slice(N_A.indptr[k], N_A.indptr[k + 1])
+        key = N_A.indices[row].tobytes() + N_A.data[row].tobytes()
+        if key in seen:
+            return (f"rows {rows[seen[key]]} and {rows[k]} of N are the same constraint, both active: "
+                    "the multipliers are not unique and the active-set system is singular; keep one "
+                    "of them (with the smaller d), or solve with condensed, uzawa or a QP backend")
+        seen[key] = k
+    return (f"the active-set system is singular ({exc}): the active rows of N are linearly "
+            "dependent, or K is singular where they leave u free")
+
+
 class SaddlePoint:
     """The factorised saddle-point matrix ``[K N_Aᵀ; N_A 0]`` of one active set (LU).
 
@@ -216,7 +233,10 @@ class SaddlePoint:
         self.scale = float(np.mean(np.abs(K.diagonal()))) or 1.0
         system = sp.bmat([[K, self.scale * N_A.T], [self.scale * N_A, None]], format="csc")
         count("factorisations")
-        self._lu, self.stiffness = spla.splu(system), 1.0
+        try:
+            self._lu, self.stiffness = spla.splu(system), 1.0
+        except RuntimeError as exc:  # SuperLU: "Factor is exactly singular"
+            raise ArithmeticError(_singular_said(N_A, np.flatnonzero(active), exc)) from None
 
     def solve(self, f: np.ndarray, d_A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(u, λ_A)`` with ``K u + N_Aᵀ λ_A = f`` and ``N_A u = d_A`` (n × k, |A| × k alike)."""

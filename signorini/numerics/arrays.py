@@ -40,10 +40,35 @@ def _refuse_complex_or_none(value: Any, name: str) -> None:
             raise InputError(f"{name} must be real, got complex values: pass its real part")
 
 
+def _compressed_fault(value: Any) -> str | None:
+    """What is wrong with the index arrays of a CSR or CSC matrix (None when they are sound):
+    SciPy builds one without looking at them, and its C code then reads out of bounds."""
+    major, minor = value.shape if value.format == "csr" else value.shape[::-1]
+    indptr, indices = np.asarray(value.indptr), np.asarray(value.indices)
+    if indptr.ndim != 1 or indices.ndim != 1 or indptr.dtype.kind not in "iu" \
+            or indices.dtype.kind not in "iu":
+        return "indptr and indices must be 1-D arrays of integers"
+    if indptr.size != major + 1 or indptr[0] != 0:
+        return f"indptr must have {major + 1} entries starting at 0"
+    if np.any(np.diff(indptr) < 0):
+        return "indptr must not decrease"
+    if indptr[-1] > min(indices.size, np.size(value.data)):
+        return f"indptr ends at {int(indptr[-1])}, beyond the {indices.size} stored entries"
+    used = indices[:indptr[-1]]
+    if used.size and (used.min() < 0 or used.max() >= minor):
+        return f"an index lies outside 0..{minor - 1}"
+    return None
+
+
 def sparse_argument(value: Any, name: str) -> sp.csr_matrix:
     """``value`` (a SciPy sparse matrix or a 2D array of numbers) as CSR floats, or InputError."""
     if value is None:
         raise InputError(f"{name} is None: give a sparse matrix or a 2D array of numbers")
+    if sp.issparse(value) and value.format in ("csr", "csc"):
+        fault = _compressed_fault(value)
+        if fault is not None:
+            raise InputError(f"{name} is not a valid {value.format.upper()} matrix ({fault}): "
+                             f"build it from (data, (row, col)) with scipy.sparse.coo_matrix")
     _refuse_complex_or_none(value, name)
     try:
         matrix = sp.csr_matrix(value, dtype=float)

@@ -11,6 +11,8 @@ i.e. the bound-constrained QP ``min ½λᵀWλ − bᵀλ`` over ``λ ≥ 0``.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -45,7 +47,9 @@ def forces_on(W: np.ndarray, b: np.ndarray, active: np.ndarray) -> np.ndarray:
     """λ with ``W_AA λ_A = b_A`` on the active set A and zero off it (b: m, or m × k)."""
     lam = np.zeros(np.shape(b))
     if active.any():
-        lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
+        with warnings.catch_warnings():  # dependent rows make W_AA singular: the certificate judges λ
+            warnings.simplefilter("ignore", sla.LinAlgWarning)
+            lam[active] = sla.solve(W[np.ix_(active, active)], b[active], assume_a="pos")
     return lam
 
 
@@ -58,6 +62,14 @@ def _slack(lam: np.ndarray, gap: np.ndarray, b: np.ndarray) -> float:
                worst(gap, float(np.max(np.abs(b), initial=0.0))))
 
 
+class StillChanging(ArithmeticError):
+    """The LCP's active set still changed after its step limit; ``lam`` is the last iterate."""
+
+    def __init__(self, message: str, lam: np.ndarray):
+        super().__init__(message)
+        self.lam = lam
+
+
 def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
               lam0: np.ndarray | None = None, tol: float = 0.0) -> tuple[np.ndarray, int]:
     """Primal-dual active set on ``min ½λᵀWλ − bᵀλ, λ ≥ 0``.
@@ -67,8 +79,8 @@ def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
     repeats, or sooner when the answer on A meets the other conditions to
     ``tol`` (no force below ``−tol·‖λ‖∞``, no gap below ``−tol·‖b‖∞``: A
     repeating is this test at ``tol = 0``); returns ``(λ, iterations)``, or
-    raises ``ArithmeticError`` when the active set keeps changing for
-    ``max_iter`` steps.
+    raises :class:`StillChanging` (an ``ArithmeticError`` with the last λ) when the active set
+    keeps changing for ``max_iter`` steps.
     """
     m = len(b)
     lam = np.zeros(m) if lam0 is None else np.maximum(lam0, 0.0)
@@ -86,7 +98,7 @@ def solve_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 200,
         seen.add(new_active.tobytes())
         active = new_active
         lam = forces_on(W, b, active)
-    raise ArithmeticError(f"active set still changing after {max_iter} PDAS steps")
+    raise StillChanging(f"active set still changing after {max_iter} PDAS steps", lam)
 
 
 def least_index_lcp(W: np.ndarray, b: np.ndarray, max_iter: int = 100_000) -> tuple[np.ndarray, int]:
@@ -138,5 +150,5 @@ def delassus_max_eigenvalue(N: sp.csr_matrix, factor, rtol: float = 1e-6, max_it
     return estimate, max_iter
 
 
-__all__ = ["delassus", "forces_on", "solve_lcp", "least_index_lcp", "delassus_max_eigenvalue",
+__all__ = ["StillChanging", "delassus", "forces_on", "solve_lcp", "least_index_lcp", "delassus_max_eigenvalue",
            "BLOCK_BYTES"]

@@ -233,7 +233,7 @@ class ContactProblem:
         body), pending until load control matches it; mesh, K and its factorisation are shared.
         ``params`` are the parameters the model records (default: its own with ``P``),
         ``predicted_contact`` the candidates load control starts from (default: as before)."""
-        model, f, d = self.model.with_target(P, P / self.scales.force, params, predicted_contact)
+        model, f, d = self.model.with_target(P, self.scales.force, params, predicted_contact)
         return self._same_k(f, d, model)
 
     def _same_k(self, f: np.ndarray, d: np.ndarray, model: Model) -> "ContactProblem":

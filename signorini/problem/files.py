@@ -125,7 +125,10 @@ def _npz(path: Path) -> dict[str, np.ndarray]:
                          f"numpy.savez ({FORMATS})")
     try:
         with np.load(path, allow_pickle=False) as stored:
-            _check_declared_sizes(path, stored.zip)
+            declared = _check_declared_sizes(path, stored.zip)
+            sizes = {key: stored[key] for key in ("K_shape", "N_shape")  # a few numbers each
+                     if key in stored.files and math.prod(declared.get(key, ())) <= 3}
+            _check_declared_fit(declared, sizes)
             return {key: stored[key] for key in stored.files}
     except InputError:
         raise
@@ -137,9 +140,49 @@ def _npz(path: Path) -> dict[str, np.ndarray]:
                          "store plain numeric arrays") from None
 
 
-def _check_declared_sizes(path: Path, archive: zipfile.ZipFile) -> None:
-    """InputError for an array whose header declares more bytes than its member of the archive
-    holds (read before the array is allocated)."""
+def _check_declared_fit(declared: dict[str, tuple[int, ...]], sizes: dict[str, np.ndarray]) -> None:
+    """InputError when the shapes the headers declare (and ``K_shape``, ``N_shape``: a few
+    numbers, read first) cannot make one problem: f n values and d m, K n × n and N m × n,
+    their sparse parts no more entries than that, weights m values and contact points m rows.
+    Checked before any array is read, for a compressed member may unpack to far more than the
+    archive's size."""
+    if "f" not in declared or "d" not in declared:
+        return  # reading says which is missing
+    n, m = math.prod(declared["f"]), math.prod(declared["d"])
+    if len(declared.get("K", ())) == 2:  # a dense K sets n, as it does for ContactProblem
+        k = declared["K"][0]
+        if declared["K"] != (k, k) or n != k:
+            raise InputError(f"f must have shape ({k},), got ({n},)" if declared["K"] == (k, k)
+                             else f"K must be square, got shape {declared['K']}")
+    if len(declared.get("N", ())) == 2 and declared["N"] != (m, n):
+        raise InputError(f"N must have shape (m, {n}), got {declared['N']}")
+    for key, expected in (("K", (n, n)), ("N", (m, n))):
+        if f"{key}_shape" in sizes and np.asarray(sizes[f"{key}_shape"]).dtype.kind in "iu":
+            _check_shape(key, tuple(int(v) for v in np.ravel(sizes[f"{key}_shape"])), expected)
+    most = {"weights": m, "contact_points": 3 * m, "force_multiplicity": 1,
+            **{f"{key}_{part}": count for key, count in (("K", n * n), ("N", m * n))
+               for part in ("row", "col", "data", "indices")},
+            "K_indptr": n + 1, "N_indptr": m + 1}
+    for key, count in most.items():
+        if key in declared and math.prod(declared[key]) > count:
+            raise InputError(f"{key} declares {math.prod(declared[key]):,} entries, more than a "
+                             f"problem of {n:,} unknowns (f) and {m:,} candidates (d) holds: "
+                             "write it again with numpy.savez")
+
+
+def _check_shape(key: str, shape: tuple[int, ...], expected: tuple[int, int]) -> None:
+    """InputError when the declared ``{key}_shape`` is not ``expected`` (from f and d)."""
+    if shape != expected:
+        sizes = "f has length" if key == "K" else f"d has length {expected[0]} and f"
+        raise InputError(f"{key}_shape declares {' × '.join(map(str, shape))}, but {sizes} "
+                         f"{expected[1]}: {key} must be {expected[0]} × {expected[1]}; fix "
+                         f"{key}_shape (or the vectors)")
+
+
+def _check_declared_sizes(path: Path, archive: zipfile.ZipFile) -> dict[str, tuple[int, ...]]:
+    """The shape each array's header declares, by name; InputError for an array whose header
+    declares more bytes than its member of the archive holds (read before it is allocated)."""
+    declared = {}
     for info in archive.infolist():
         with archive.open(info) as member:
             try:
@@ -153,6 +196,8 @@ def _check_declared_sizes(path: Path, archive: zipfile.ZipFile) -> None:
             raise InputError(f"problem file {str(path)!r}: {info.filename.removesuffix('.npy')!r} "
                              f"declares shape {shape} ({dtype}), more than the {info.file_size} "
                              "bytes stored: write it again with numpy.savez")
+        declared[info.filename.removesuffix(".npy")] = shape
+    return declared
 
 
 def _saved(path: Path) -> ContactProblem:
@@ -241,12 +286,17 @@ def _sparse(arrays: dict[str, Any], key: str, expected: tuple[int, int]) -> Any:
         missing = "shape" if "shape" not in parts else "data"
         raise InputError(f"{key} is stored sparse without {key}_{missing}: store {key}_data "
                          f"and {key}_shape with its indices")
+    for part in ("row", "col", "indices", "indptr", "shape"):
+        values = np.asarray(parts.get(part, np.zeros(0, dtype=int)))
+        whole = values.dtype.kind in "iu" or (values.dtype.kind == "f" and bool(
+            np.all(np.isfinite(values)) and np.all(values == np.round(values))))
+        if not whole:
+            raise InputError(f"{key}_{part} must hold whole numbers (it counts or indexes), got "
+                             f"a {values.dtype} array: store it as an integer array")
+        if part in parts:
+            parts[part] = values.astype(np.int64)
     shape = tuple(int(v) for v in np.ravel(parts["shape"]))
-    if shape != expected:
-        sizes = "f has length" if key == "K" else f"d has length {expected[0]} and f"
-        raise InputError(f"{key}_shape declares {' × '.join(map(str, shape))}, but {sizes} "
-                         f"{expected[1]}: {key} must be {expected[0]} × {expected[1]}; fix "
-                         f"{key}_shape (or the vectors)")
+    _check_shape(key, shape, expected)
     try:
         if "row" in parts and "col" in parts:
             return sp.coo_matrix((parts["data"], (parts["row"], parts["col"])), shape=shape).tocsr()
@@ -303,8 +353,9 @@ def _from_arrays(path: Path, arrays: dict[str, Any], name: str) -> ContactProble
         if values is not None:
             _finite(key, values)
     multiplicity = arrays.get("force_multiplicity", 1.0)
-    if np.size(multiplicity) != 1:
-        raise InputError(f"force_multiplicity must be one number, got shape {np.shape(multiplicity)}")
+    if np.size(multiplicity) != 1 or np.asarray(multiplicity).dtype.kind not in "fiu":
+        raise InputError(f"force_multiplicity must be one number, got {np.asarray(multiplicity).dtype} "
+                         f"of shape {np.shape(multiplicity)}")
     return ContactProblem.from_qp(K, vectors["f"], N, vectors["d"], weights=vectors["weights"],
                                   contact_points=arrays.get("contact_points"),
                                   force_multiplicity=float(np.ravel(multiplicity)[0]), name=name)

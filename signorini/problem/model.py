@@ -11,7 +11,9 @@ the empty model :meth:`Model.of_arrays` (no mesh, every unknown free).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -229,7 +231,13 @@ class Model:
         and ``d`` there; nothing is pending."""
         pu = self.push
         if pu is None:
-            raise ValueError("this model does not record how its load depends on the push")
+            raise InputError("this model does not record how its load depends on the push (a QP "
+                             "given as arrays, or a scene without a push): solve it as it is")
+        for name, value in (("scale", scale), ("load", load)):
+            if value is not None and (isinstance(value, bool) or not isinstance(value, Real)
+                                      or not math.isfinite(value)):
+                raise InputError(f"at_push: {name}={value!r} must be a finite number (the "
+                                 f"push's {name} in the model's units, e.g. {name}={pu.scale:g})")
         ratio = scale / pu.scale
         load = pu.load if load is None else load
         changed: dict[str, float] = {}  # δ and P in the scene's units, where the scene names them
@@ -243,16 +251,20 @@ class Model:
             push=dataclasses.replace(pu, scale=scale, load=load, **changed), pending=False)
         return model, pu.f(scale, load), pu.d0 + scale * pu.d1
 
-    def with_target(self, P: float, target: float, params: dict[str, Any] | None = None,
+    def with_target(self, P: float, force_scale: float, params: dict[str, Any] | None = None,
                     predicted_contact: np.ndarray | None = None
                     ) -> tuple["Model", np.ndarray, np.ndarray]:
-        """The model with the target load ``P`` (the scene's units; ``target`` dimensionless),
-        pending, at its nominal push, with its QP's ``f`` and ``d`` there. Nothing is meshed or
-        assembled (``mesh_s`` and ``assemble_s`` are 0)."""
+        """The model with the target load ``P`` (the scene's units; ``force_scale`` its unit in
+        them), pending, at its nominal push, with its QP's ``f`` and ``d`` there. Nothing is
+        meshed or assembled (``mesh_s`` and ``assemble_s`` are 0)."""
         pu = self.push
         if pu is None or pu.target is None:
             raise InputError("this problem has no target load to change: build the scene with a "
                              "load P (or a_over_R), or build it again with the new load")
+        if isinstance(P, bool) or not isinstance(P, Real) or not (math.isfinite(P) and P > 0):
+            raise InputError(f"the target load P={P!r} must be a finite number > 0 (the scene's "
+                             "units, full body), e.g. with_load(problem, P=2.5)")
+        target = P / force_scale
         load = target if pu.f_load is not None else pu.load  # a cut's traction is the load itself
         model = self.with_basis(
             load_offset=pu.offset(pu.scale, load), mesh_s=0.0, assemble_s=0.0,

@@ -12,6 +12,7 @@ import io
 import json
 import logging
 import os
+import zipfile
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from signorini.problem.model import Model, Push, ReferenceData
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
 from signorini.numerics.arrays import symmetric_argument
+from signorini.paths import check_input_file
 from signorini.problem.scales import Scales
 
 log = logging.getLogger(__name__)
@@ -67,8 +69,13 @@ def save(problem: Any, path: str | os.PathLike) -> None:
 
 def load(path: str | os.PathLike, problem_type: type) -> Any:
     """The problem (a ``problem_type``, :class:`signorini.ContactProblem`) :func:`save` stored in
-    ``path``; InputError when its meta or K is not what :func:`save` writes."""
-    z = np.load(path)
+    ``path``; InputError when it is missing, not a regular file or not an archive, or when its
+    meta or K is not what :func:`save` writes."""
+    check_input_file(os.fspath(path), "problem file", "give the path ContactProblem.save wrote")
+    if not zipfile.is_zipfile(path):  # np.load would try it as a pickle
+        raise InputError(f"problem file {os.fspath(path)!r} is not an archive ContactProblem.save "
+                         "wrote: give the path it wrote")
+    z = np.load(path, allow_pickle=False)
     meta = json.loads(bytes(z["meta"]).decode())
     if not isinstance(meta, dict):
         raise InputError(f"problem file {os.fspath(path)!r}: its meta holds a JSON "

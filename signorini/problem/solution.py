@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from signorini.errors import InputError
+from signorini.numerics.arrays import vector_argument
 from signorini.reprs import short_repr
 
 #: the statuses a :class:`ContactSolution` can carry
@@ -48,13 +49,21 @@ class WarmStart:
         return cls(lam=solution.lam, u=solution.u)
 
     def check_fits(self, n: int, m: int) -> "WarmStart":
-        """Itself, when its ``u`` has ``n`` entries and its ``lam`` ``m``; InputError otherwise."""
+        """Itself with float arrays, when its ``u`` has ``n`` finite entries and its ``lam``
+        ``m``; InputError otherwise."""
+        arrays = {}
         for name, value, size in (("u", self.u, n), ("lam", self.lam, m)):
-            if value is not None and np.shape(value) != (size,):
+            if value is None:
+                continue
+            arrays[name] = vector_argument(value, f"warm_start's {name}")
+            if arrays[name].shape != (size,):
                 raise InputError(f"warm_start: its {name} has shape {np.shape(value)} and this "
                                  f"problem needs ({size},): start from an answer of this problem "
                                  "(the same mesh and candidates), or give no warm_start")
-        return self
+            if not np.all(np.isfinite(arrays[name])):
+                raise InputError(f"warm_start: its {name} is not finite (NaN or inf, as a failed "
+                                 "run's): start from a finite answer, or give no warm_start")
+        return replace(self, **arrays)
 
 
 @dataclass

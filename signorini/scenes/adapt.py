@@ -40,6 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from signorini.errors import InputError, docs_page
+from signorini.numerics.work import timed
 from signorini.fem.assembly import assemble
 from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.fem.transfer import refined_model, with_candidates
@@ -216,36 +217,46 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
 
     ``quantity`` is ``"pressure"`` (the default where the scene has contact
     pressures) or ``"energy"``.
-    Returns the last step's problem, solution and estimate; ``reason`` says
+    Returns the last step's problem, solution (its ``seconds`` every step's, by stage) and
+    estimate; ``reason`` says
     why the loop stopped (the target met, the dof or memory limit, or a solve
     that did not converge) and is appended to the solution's message. ``on_step`` is
     called with every step's problem, solution and estimate (studies use it).
     """
     if quantity is not None and quantity not in QUANTITIES:
         raise InputError(f"target quantity {quantity!r} is not one of {', '.join(QUANTITIES)}")
-    max_dofs = DEFAULT_MAX_DOFS if max_dofs is None else int(max_dofs)
-    if max_dofs <= 0:
-        raise InputError(f"max dofs {max_dofs} must be positive")
-    scene = _scene(name, values, solved_by)
+    if max_dofs is None:
+        max_dofs = DEFAULT_MAX_DOFS
+    elif isinstance(max_dofs, bool) or not isinstance(max_dofs, (int, np.integer)) or max_dofs <= 0:
+        raise InputError(f"max dofs {max_dofs!r} must be a positive whole number, e.g. "
+                         f"max_dofs={DEFAULT_MAX_DOFS}")
+    stages: dict[str, float] = {}  # every step's seconds by stage: the record's time
+    with timed(stages, "mesh"):
+        scene = _scene(name, values, solved_by)
+        _check_first(scene, solved_by, max_dofs)
     model = scene.model
-    _check_first(scene, solved_by)
     run = None
     steps: list[dict[str, Any]] = []
     growths = 0
     for step in range(MAX_STEPS):
         start = time.perf_counter()
-        problem = assemble(model)
+        with timed(stages, "assemble"):
+            problem = assemble(model)
         problem.name = scene.name
         problem, solution = solver(problem)
+        for stage, spent in solution.seconds.items():
+            stages[stage] = stages.get(stage, 0.0) + spent
         seconds = time.perf_counter() - start
         if solution.status == "model_inadequate" and growths < MAX_GROWTH:
-            grown = _grown(scene, model, problem, solution)
+            with timed(stages, "mesh"):
+                grown = _grown(scene, model, problem, solution)
             if grown is not None:
                 growths += 1
                 model = grown
                 steps.append(_row(step, problem, solution, None, 0, seconds, "candidates widened"))
                 continue
-        found = estimate(problem, solution) if solution.success else None
+        with timed(stages, "estimate"):
+            found = estimate(problem, solution) if solution.success else None
         if on_step is not None:
             on_step(problem, solution, found)
         run = AdaptiveRun(problem, solution, found, steps)
@@ -267,8 +278,9 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
                           f"at {problem.n} dofs after {step + 1} solve{'s' * (step > 0)}")
             steps.append(_row(step, problem, solution, found, 0, seconds, "target met"))
             break
-        marked = mark(model.mesh, found, quantity, theta)
-        mesh = model.mesh.refined(marked)
+        with timed(stages, "mesh"):
+            marked = mark(model.mesh, found, quantity, theta)
+            mesh = model.mesh.refined(marked)
         limit = _limit_reached(mesh.p.size, max_dofs, model, solved_by)
         if limit is not None:
             action, reached, next_mesh = limit
@@ -278,12 +290,14 @@ def solve_adaptive(name: str, values: dict[str, Any], target: float,
             steps.append(_row(step, problem, solution, found, 0, seconds, action))
             break
         steps.append(_row(step, problem, solution, found, len(marked), seconds, "refined"))
-        model = scene.on(model, mesh, solution)
+        with timed(stages, "mesh"):
+            model = scene.on(model, mesh, solution)
     else:
         run.reason = f"adaptive refinement stopped after {MAX_STEPS} steps"
     run.reason += _steeper_than_measured(scene)
     run.solution.message = f"{run.solution.message}; {run.reason}".lstrip("; ")
     run.solution.extras["adaptive"] = steps
+    run.solution.seconds = stages
     run.solution.extras.update(target_error=target, target_on=quantity or "",
                                target_met=run.target_met)
     log.info("%s", run.reason)
@@ -295,8 +309,13 @@ def _memory_params(model: SceneModel) -> dict[str, Any]:
     return {**model.params, "nu": model.nu, "volumetric": model.volumetric}
 
 
-def _check_first(scene: _Scene, solved_by: Solver | None) -> None:
-    """InputError when the first model (a mesh scene file's, say) is already over the memory limit."""
+def _check_first(scene: _Scene, solved_by: Solver | None, max_dofs: int) -> None:
+    """InputError when the first model (a mesh scene file's, say) is already over ``max_dofs``
+    or the memory limit."""
+    if scene.model.mesh.p.size > max_dofs:
+        raise InputError(f"scene {scene.name!r} starts with {scene.model.mesh.p.size:,} dofs, over "
+                         f"max dofs {max_dofs:,}: raise max dofs (--max-dofs) or start from a "
+                         "coarser mesh (a smaller n_contact)")
     over = over_limit(scene.model.mesh.p.size, 2, _memory_params(scene.model), solved_by)
     if over is not None:
         raise InputError(f"scene {scene.name!r} has {scene.model.mesh.p.size:,} dofs, about "

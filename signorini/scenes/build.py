@@ -83,7 +83,9 @@ def build_problem(name: str, params: dict[str, Any] | None = None, *, nondimensi
         if not nondimensionalise:
             raise InputError(f"problem file {name!r} is solved in the units it was written in: "
                              "drop nondimensionalise=False (--raw-units)")
-        return read_problem(name)
+        problem = read_problem(name)  # reading it is what building it costs
+        problem.model = problem.model.with_basis(mesh_s=time.perf_counter() - start, assemble_s=0.0)
+        return problem
     if name.lower().endswith(".toml"):  # a scene file: signorini.scenes.scenefile
         log.info("meshing %s", name)
         name, model = build_scene_model(name, values)
@@ -135,11 +137,18 @@ def with_load(problem: ContactProblem, **load: float) -> ContactProblem:
     the answer is that mesh's; a contact zone that outgrows the candidates is
     judged ``model_inadequate`` as in any solve.
     """
+    if not isinstance(problem, ContactProblem):
+        raise InputError(f"with_load takes a ContactProblem, got {type(problem).__name__}: build "
+                         "one first, problem = signorini.build_problem('hertz-cylinder')")
     family = SCENES.get(problem.name or "")
     if family is None or family.loads is None or problem.model.push is None or problem.model.push.target is None:
         raise InputError("with_load moves the target load of a scene built by name with one "
                          "(P or a_over_R): build this problem again with the new load instead")
     moved = sorted(set(load) - set(LOAD_NAMES))
+    unset = [name for name, value in load.items() if value is None and name not in moved]
+    if unset:
+        raise InputError(f"with_load: {unset[0]}=None moves no load: give it a number, e.g. "
+                         f"with_load(problem, {unset[0]}=...)")
     if not load or moved:
         raise InputError(f"with_load takes the scene's load ({', '.join(LOAD_NAMES)}), got "
                          f"{', '.join(moved) or 'none'}: e.g. with_load(problem, P=2.5)")

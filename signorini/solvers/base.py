@@ -10,9 +10,12 @@ success becomes ``converged`` only when the KKT certificate backs it
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import importlib.util
+import math
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -59,9 +62,10 @@ class Method:
     ``push0`` for a pending load); ``warm_from_load``, that it takes load control's answer as
     its warm start. ``chooses(problem, options, warm_start)`` returns the method it runs
     instead (:meth:`runs`). A ``scaled`` method is handed a view of the problem in units of
-    order one, its answer mapped back before it is judged; a user's is not. A ``bound_rows``
-    method takes each contact row as a bound on dofs of its own and refuses rows that share a
-    dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
+    order one, its answer mapped back before it is judged; not said, a method of a ``family``
+    is scaled and one without (a user's) is handed the problem in the user's units. A
+    ``bound_rows`` method takes each contact row as a bound on dofs of its own and refuses rows
+    that share a dof (:meth:`check_rows`). ``factor_free_from`` is the size (dofs) from which it solves a 3D
     model with a target load without a factorisation (None: never), for a scene's memory
     estimate (:mod:`signorini.scenes.size`).
     """
@@ -79,9 +83,13 @@ class Method:
     prediction: str = ""
     warm_from_load: bool = False
     chooses: Callable[..., "Method"] | None = None
-    scaled: bool = True
+    scaled: bool | None = None
     bound_rows: bool = False
     factor_free_from: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.scaled is None:  # a user's method without a family gets the problem as given
+            object.__setattr__(self, "scaled", self.family not in ("", "user"))
 
     @property
     def options(self) -> tuple[str, ...]:
@@ -175,6 +183,24 @@ def check_max_iter(max_iter: Any) -> int | None:
     return int(number)
 
 
+def _count(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= 0
+
+
+def _seconds(value: Any) -> bool:
+    return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value) \
+        and value >= 0
+
+
+#: what a method reports beside its answer, by field: (the test it passes, what it must be)
+REPORTED = {"iterations": (_count, "a whole number ≥ 0"),
+            "build_time": (_seconds, "seconds, a finite number ≥ 0"),
+            "solve_time": (_seconds, "seconds, a finite number ≥ 0"),
+            "message": (lambda v: isinstance(v, str), "a str"),
+            "extras": (lambda v: isinstance(v, dict), "a dict"),
+            "history": (lambda v: isinstance(v, dict), "a dict of lists")}
+
+
 def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> ContactSolution:
     """``solution`` when it is what a method must return, else a ``failed`` one saying why.
 
@@ -200,15 +226,18 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
         return failed(f"it returned {type(solution).__name__}, not a ContactSolution")
     if solution.status not in STATUSES:
         return failed(f"status {solution.status!r} is not one of {', '.join(STATUSES)}")
+    for name, (fits, said) in REPORTED.items():
+        if not fits(getattr(solution, name)):
+            return failed(f"its {name} must be {said}, got {getattr(solution, name)!r}")
     for name, size in (("u", problem.n), ("lam", problem.m)):
         value = getattr(solution, name)
-        if not isinstance(value, np.ndarray) or value.shape != (size,) \
-                or value.dtype.kind not in "fiu":
-            got = (f"{value.dtype} array of shape {value.shape}" if isinstance(value, np.ndarray)
+        if not isinstance(value, np.ndarray) or isinstance(value, np.ma.MaskedArray) \
+                or value.shape != (size,) or value.dtype.kind not in "fiu":
+            got = (f"{value.dtype} array of shape {value.shape}" if type(value) is np.ndarray
                    else type(value).__name__)
             return failed(f"{name} must be an array of {size} floats, got a {got}")
-        if value.dtype.kind != "f":
-            setattr(solution, name, value.astype(float))
+        if value.dtype.kind != "f" or type(value) is not np.ndarray:  # a memmap, ints
+            setattr(solution, name, np.array(value, dtype=float))
     if solution.status == "converged" and not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):
         return failed(f"status {solution.status!r} with non-finite entries in u or lam")
     return solution
@@ -225,24 +254,34 @@ def hold_to_contract(problem: ContactProblem, method: str, solution: Any) -> Con
 #: ``K x`` before and after a method agree to this (relative): summation order only
 SAME_PRODUCT_RTOL = 1e-12
 #: what each array is, for the message
-MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps"}
+MEANING = {"K": "the stiffness", "f": "the load", "N": "the contact normals", "d": "the gaps",
+           "weights": "the candidates' boundary weights", "contact_points": "their positions",
+           "force_multiplicity": "the copies of the model in the body", "scales": "the units",
+           "prescribed": "the prescribed displacements"}
 
 
 def _summary(array: Any, x: np.ndarray) -> Any:
-    """``A x`` of a matrix (K or N); a hash of the bytes of a vector (f or d)."""
-    if np.ndim(array) == 2:
+    """``A x`` of a sparse matrix (K or N); a hash of the bytes of any other array."""
+    if sp.issparse(array):
         return array @ x
     return hashlib.blake2b(np.ascontiguousarray(array, dtype=float).view(np.uint8),
                            digest_size=16).hexdigest()
 
 
 def _arrays(problem: ContactProblem) -> dict[str, Any]:
-    return {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d}
+    """What the answer is judged and reported by: the QP, and what turns it into forces,
+    pressures, positions and units."""
+    return {"K": problem.K, "f": problem.f, "N": problem.N, "d": problem.d,
+            "weights": np.zeros(0) if problem.weights is None else problem.weights,
+            "contact_points": problem.contact_points,
+            "force_multiplicity": np.array([problem.force_multiplicity], dtype=float),
+            "scales": np.array(dataclasses.astuple(problem.scales), dtype=float),
+            "prescribed": getattr(problem.model, "prescribed", np.zeros(0))}
 
 
 def fingerprint(problem: ContactProblem) -> dict[str, tuple]:
-    """Of each of K, f, N and d: its shape and its :func:`_summary` with a fixed random x (a few
-    vectors, no copy of K)."""
+    """Of each of :func:`_arrays`: its shape and its :func:`_summary` with a fixed random x (a
+    few vectors, no copy of K)."""
     x = np.random.default_rng(1).uniform(0.5, 1.5, problem.K.shape[1])
     return {name: (np.shape(a), _summary(a, x)) for name, a in _arrays(problem).items()}
 
@@ -270,7 +309,7 @@ def held_to_problem(problem: ContactProblem, before: dict[str, tuple], solution:
         return ContactSolution.failure(
             method, problem, "failed",
             f"the method changed the problem it was given: {names}; a method must not change "
-            "K, f, N or d (copy them first), so its answer cannot be judged")
+            "the problem (copy what it changes first), so its answer cannot be judged")
     return solution
 
 
@@ -298,7 +337,8 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
     cert = certify(problem, solution) if cert is None else cert
     reason = shortfall(cert, accept)
     if reason is not None:  # which candidates fail and how, with the advice that fits
-        by_constraint = explain(problem, solution, accept)
+        with np.errstate(all="ignore"):  # an answer beyond double precision is named, not warned of
+            by_constraint = explain(problem, solution, accept)
         if by_constraint is not None:
             reason = f"{shortfall(cert, accept, advice='')}: {by_constraint}"
         solution.claimed_status = "converged"
@@ -319,6 +359,6 @@ def judge(problem: ContactProblem, solution: ContactSolution, tol: float | None,
     return solution
 
 
-__all__ = ["acceptance", "Method", "rows_share_dofs", "check_tol", "check_max_iter",
+__all__ = ["REPORTED", "acceptance", "Method", "rows_share_dofs", "check_tol", "check_max_iter",
            "hold_to_contract", "fingerprint", "changed", "held_to_problem", "certify", "judge",
            "ACCEPT_FACTOR", "MAX_ITER"]

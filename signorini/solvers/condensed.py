@@ -18,7 +18,7 @@ from typing import Any
 from signorini.errors import InputError
 from signorini.certification.forward_error import WithDelassus
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS, factorize
-from signorini.numerics.lcp import delassus, solve_lcp
+from signorini.numerics.lcp import StillChanging, delassus, solve_lcp
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare, resolved, take_options
@@ -41,12 +41,16 @@ def condensed(problem: ContactProblem, *, tol: float | None = None, max_iter: in
     b = problem.N @ factor.solve(problem.f) - problem.d
     build_time = time.perf_counter() - start
     tol, max_iter = resolved("condensed", "active set", tol, max_iter)
-    lam, steps = solve_lcp(W, b, max_iter=max_iter, tol=tol)
+    try:
+        lam, steps = solve_lcp(W, b, max_iter=max_iter, tol=tol)
+        status, said = "converged", f"LCP on {problem.m} candidates solved in {steps} active-set steps"
+    except StillChanging as stopped:
+        lam, steps, status = stopped.lam, max_iter, "max_iter"
+        said = f"LCP on {problem.m} candidates: {stopped}"
     u = factor.solve(problem.f - problem.N.T @ lam)
     return ContactSolution(
-        method="condensed", u=u, lam=lam, status="converged",
-        message=f"LCP on {problem.m} candidates solved in {steps} active-set steps "
-                f"({factor.backend} factorisation)",
+        method="condensed", u=u, lam=lam, status=status,
+        message=f"{said} ({factor.backend} factorisation)",
         iterations=steps, build_time=build_time,
         solve_time=time.perf_counter() - start - build_time,
         extras={"backend": factor.backend}, factor=WithDelassus(factor, problem.N, W))

@@ -39,10 +39,7 @@ def load(spec: str) -> Method:
     a file's folder is put first on ``sys.path`` before it is imported.
     InputError names ``--method`` and the fix for every way this can fail.
     """
-    module_name, _, attr = spec.rpartition(":")
-    if not module_name.strip() or not attr.strip():
-        missing = "module or file" if not module_name.strip() else "function"
-        raise InputError(f"--method {spec!r} names no {missing}: give {FORMS}")
+    module_name, attr = _parts(spec)
     try:
         if module_name.endswith(".py"):
             path = Path(module_name)
@@ -75,6 +72,30 @@ def load(spec: str) -> Method:
     return _method(spec, func)
 
 
+def _parts(spec: str) -> tuple[str, str]:
+    """``(module or file, function)`` of ``spec``; InputError when either is missing."""
+    module_name, _, attr = spec.rpartition(":")
+    if not module_name.strip() or not attr.strip():
+        missing = "module or file" if not module_name.strip() else "function"
+        raise InputError(f"--method {spec!r} names no {missing}: give {FORMS}")
+    return module_name, attr
+
+
+def deferred(spec: str) -> Method:
+    """The method named ``spec`` (as :func:`load` takes it), imported when first called and not
+    now: a command that runs it in a worker process imports it there alone, so that what its
+    module does on import (exits, prints, hangs, fails) costs that run and not the command."""
+    module_name, _ = _parts(spec)
+    if module_name.endswith(".py") and not Path(module_name).is_file():
+        raise InputError(f"--method {spec!r}: cannot import {module_name!r} (no file "
+                         f"{module_name}); give {FORMS}")
+
+    def imported(problem: Any, **options: Any) -> Any:
+        return load(spec).function(problem, **options)
+
+    return _method(spec, imported)
+
+
 def of_callable(function: Callable[..., Any], taken: Mapping[str, Method]) -> Method:
     """A callable as a method, named by its ``__name__`` (``module:qualname`` when a different
     method already has that name in ``taken``, the registry)."""
@@ -85,7 +106,7 @@ def of_callable(function: Callable[..., Any], taken: Mapping[str, Method]) -> Me
 
 
 def _method(name: str, function: Callable[..., Any]) -> Method:
-    return Method(name=name, function=function, family="user", scaled=False,
+    return Method(name=name, function=function, family="user",
                   summary=(getattr(function, "__doc__", None) or "").strip().split("\n")[0])
 
 
@@ -112,4 +133,4 @@ def raised(exc: BaseException) -> tuple[str, str]:
     return line, "".join(traceback.format_exception(type(exc), exc, tb)).rstrip()
 
 
-__all__ = ["FORMS", "load", "of_callable", "raised", "where"]
+__all__ = ["FORMS", "deferred", "load", "of_callable", "raised", "where"]

@@ -119,6 +119,9 @@ def _uncertified(problem: ContactProblem, lam: np.ndarray, u: np.ndarray, factor
     return shortfall(certificate(problem, candidate), acceptance(tol))
 
 
+# a step beyond the bound grows λ until it overflows: the loop reads the non-finite λ as
+# diverged and says why, so NumPy's overflow warnings would only repeat it
+@np.errstate(over="ignore", invalid="ignore")
 def uzawa(problem: ContactProblem, *, tol: float | None = None, max_iter: int | None = None,
           _name: str = "uzawa", _defaults: dict[str, Any] = DEFAULTS,
           **options: Any) -> ContactSolution:

@@ -58,6 +58,24 @@ def die_with_parent() -> None:
         ctypes.CDLL(None).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
+def descendants(pid: int) -> list[int]:
+    """Every living process below ``pid`` (children first), by the parent each names in
+    ``/proc`` (Linux; elsewhere none): a method's process that left the group (``setsid``)
+    is found too while the worker lives."""
+    parents: dict[int, int] = {}
+    for entry in os.scandir("/proc") if os.path.isdir("/proc") else ():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError, IndexError, ValueError):
+                with open(f"/proc/{entry.name}/stat", "rb") as stat:
+                    parents[int(entry.name)] = int(stat.read().rsplit(b")", 1)[1].split()[1])
+    found, frontier = [], [pid]
+    while frontier:
+        children = [child for child, parent in parents.items() if parent in frontier]
+        found += children
+        frontier = children
+    return found
+
+
 class Worker:
     """A child process that runs tasks, stopped and replaced when one exceeds ``time_limit``.
 
@@ -93,6 +111,12 @@ class Worker:
         """Stop the worker (it is restarted by the next task): end of input, then a kill."""
         _LIVE.discard(self)
         if self._proc is not None:
+            # what a method started and moved out of the group (setsid), found while the worker
+            # lives and its descendants are still known as such; the group is killed below
+            for pid in descendants(self._proc.pid):
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    if os.getpgid(pid) != self._proc.pid:
+                        os.kill(pid, signal.SIGKILL)
             with contextlib.suppress(OSError, subprocess.TimeoutExpired):
                 self._proc.stdin.close()
                 if grace > 0:
@@ -239,4 +263,4 @@ def in_worker(method: Method, time_limit: float = float("inf")) -> Method:
     return dataclasses.replace(method, function=function)
 
 
-__all__ = ["OUTPUT_KEPT", "Worker", "die_with_parent", "in_worker", "solve_within", "stop_all"]
+__all__ = ["OUTPUT_KEPT", "Worker", "descendants", "die_with_parent", "in_worker", "solve_within", "stop_all"]
