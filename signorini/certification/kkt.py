@@ -38,30 +38,34 @@ def _positive(x: float) -> float:
     return x if x > 0 else 1.0
 
 
-def force_scale(problem: ContactProblem, lam: np.ndarray, u: np.ndarray | None = None) -> float:
+def force_scale(problem: ContactProblem, lam: np.ndarray, u: np.ndarray | None = None,
+                Nu: np.ndarray | None = None) -> float:
     """``max(‖λ‖∞, FORCE_FLOOR · ‖f‖∞)``: the force against which forces are judged.
 
     With ``u`` given, ``‖λ‖∞`` alone when the candidate carrying the largest force
     touches (its gap within :data:`WEAK_TOL` of the gap scale) and that force is
     above ``FORCE_ROUNDOFF · ‖f‖∞``: a contact force is never floored by a load
-    that does not reach the contact (see :data:`FORCE_ROUNDOFF`).
+    that does not reach the contact (see :data:`FORCE_ROUNDOFF`). ``Nu``, when the caller
+    has it, is ``N u`` (not formed again).
     """
     norm, load = _inf_norm(lam), _inf_norm(problem.f)
     if u is not None and lam.size and norm > FORCE_ROUNDOFF * load and np.all(np.isfinite(u)):
+        Nu = problem.N @ u if Nu is None else Nu
         top = int(np.argmax(np.abs(lam)))
-        gap = float(problem.d[top] - (problem.N[top] @ u)[0])
-        if lam[top] > 0 and gap <= WEAK_TOL * gap_scale(problem, u):
+        if lam[top] > 0 and problem.d[top] - Nu[top] <= WEAK_TOL * gap_scale(problem, u, Nu):
             return norm
     return _positive(max(norm, FORCE_FLOOR * load))
 
 
-def gap_scale(problem: ContactProblem, u: np.ndarray) -> float:
-    """Length against which gaps are judged: ``max(‖Nu‖∞, ‖d‖∞, ‖u‖∞)``.
+def gap_scale(problem: ContactProblem, u: np.ndarray, Nu: np.ndarray | None = None) -> float:
+    """Length against which gaps are judged: ``max(‖Nu‖∞, ‖d‖∞, ‖u‖∞)`` (``Nu`` formed
+    unless given).
 
     ``‖u‖∞`` keeps the scale meaningful when the contact nodes neither move
     nor start apart (a block resting on the flat: ``d = 0``, ``Nu = 0``).
     """
-    return _positive(max(_inf_norm(problem.N @ u), _inf_norm(problem.d), _inf_norm(u)))
+    Nu = problem.N @ u if Nu is None else Nu
+    return _positive(max(_inf_norm(Nu), _inf_norm(problem.d), _inf_norm(u)))
 
 
 @dataclass(frozen=True)

@@ -76,17 +76,18 @@ def pdas(problem: ContactProblem, *, tol: float | None = None, max_iter: int | N
     seen: set[bytes] = set()
     status, message = "max_iter", f"active set still changing after {max_iter} steps"
     for iteration in range(1, max_iter + 1):
-        violation = problem.N @ u - problem.d
+        Nu = problem.N @ u
+        violation = Nu - problem.d
         new_active = lam + c * violation > 0
         changes = problem.m if active is None else int(np.sum(new_active != active))
         history["changes"].append(changes)
-        history["primal"].append(float(max(violation.max(), 0.0)) / gap_scale(problem, u))
+        history["primal"].append(float(max(violation.max(), 0.0)) / gap_scale(problem, u, Nu))
         history["active"].append(int(new_active.sum()))
         if opts["callback"] is not None:
             opts["callback"](iteration, u, lam)
         if active is not None:
             slack = 0.0 if changes == 0 else max(
-                history["primal"][-1], float(np.max(-lam, initial=0.0)) / force_scale(problem, lam, u))
+                history["primal"][-1], float(np.max(-lam, initial=0.0)) / force_scale(problem, lam, u, Nu))
             if slack <= tol:
                 status, iteration = "converged", iteration - 1
                 message = (f"active set of {int(active.sum())} nodes repeated after {iteration} steps"
