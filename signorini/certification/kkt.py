@@ -9,9 +9,11 @@ a factorisation the method already holds when it can (:mod:`signorini.certificat
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
+from scipy.sparse.linalg import lobpcg
 
 from signorini.errors import InputError
 from signorini.certification.duality_gap import Offers, primal_dual_gap
@@ -188,10 +190,6 @@ def indefinite(K) -> bool:
     ``½uᵀKu − fᵀu`` has no minimum and a KKT point is no answer. Exact up to
     :data:`DENSE_EIGEN_DOFS` dofs; beyond, a Rayleigh quotient below the bound proves it (one
     above says nothing: False)."""
-    import warnings
-
-    from scipy.sparse.linalg import lobpcg
-
     scale = float(np.max(np.abs(K.diagonal()), initial=0.0)) or 1.0
     if K.shape[0] <= DENSE_EIGEN_DOFS:
         lowest = np.linalg.eigvalsh(K.toarray())[0]
