@@ -246,10 +246,13 @@ def solve(problem: ContactProblem, request: Request, *, warm_start: Any = None,
             matched = match(problem, zone)
         stages["load_control"] = matched.work
         problem = matched.problem
-    if matched is not None and start is None and request.method.warm_from_load and (
+    if matched is not None and request.method.warm_from_load and (
             runs.prediction != "zone" or matched.warm_start.zone_solver is not None):
         # load control's answer, taken as an explicit warm start (by a method that predicts a
-        # zone, only with K factorised around one: else it takes the scene's prediction)
+        # zone, only with K factorised around one: else it takes the scene's prediction); it is
+        # exact at this load, so it replaces a start given from another (a slider's last answer)
+        if start is not None:
+            log.info("load control's answer at the matched load replaces the warm start given")
         start = matched.warm_start
     elif runs.prediction:  # a method that starts cold, from the scene's predictions only
         with counting() as work, timed(seconds, "prediction"):

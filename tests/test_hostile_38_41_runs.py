@@ -288,3 +288,17 @@ def test_a_constraint_given_twice_is_named_by_the_active_set_methods_and_solved_
             solved = signorini.solve(problem, method)
             assert solved.converged and np.allclose(solved.solution.u, [0.25, 1.0])
             assert np.isclose(solved.solution.lam.sum(), 0.5)
+
+
+def test_a_sliders_last_answer_as_warm_start_costs_the_default_route_no_factorisation():
+    """The slider's natural call, the last answer as the warm start at the next load: load
+    control matches the load and its exact answer, not the one from the other load, starts
+    the method, so the method factorises nothing (it did five times from the old answer)."""
+    base = signorini.build_problem("hertz-cylinder")
+    before = signorini.solve(signorini.with_load(base, a_over_R=0.04))
+    problem = signorini.with_load(base, a_over_R=0.05)
+    warm, cold = signorini.solve(problem, warm_start=before), signorini.solve(problem)
+    assert warm.converged and warm.solution.work["method"].get("factorisations", 0) == 0
+    assert np.array_equal(warm.solution.u, cold.solution.u)
+    named = signorini.solve(problem, "pdas", warm_start=before)  # a method named starts from it
+    assert named.converged and named.iterations > cold.iterations
