@@ -302,3 +302,17 @@ def test_a_sliders_last_answer_as_warm_start_costs_the_default_route_no_factoris
     assert np.array_equal(warm.solution.u, cold.solution.u)
     named = signorini.solve(problem, "pdas", warm_start=before)  # a method named starts from it
     assert named.converged and named.iterations > cold.iterations
+
+
+def test_a_deferred_method_file_is_imported_once_per_process(tmp_path):
+    """A method given as ``file.py:function`` is imported at its first call, then kept."""
+    from signorini.solvers import user
+
+    log = tmp_path / "imports.txt"
+    mine = tmp_path / "counted.py"
+    mine.write_text(f"open({str(log)!r}, 'a').write('imported\\n')\n"
+                    "def solve(problem, **options):\n    return problem\n")
+    method = user.deferred(f"{mine}:solve")
+    assert not log.exists()  # nothing imported yet
+    method.function("a"), method.function("b")
+    assert log.read_text().splitlines() == ["imported"]

@@ -118,9 +118,14 @@ def flag_argument(value: Any, name: str) -> bool:
     return bool(value)
 
 
+def finite_real(value: Any) -> bool:
+    """``value`` is a finite real number (a bool is not one)."""
+    return not isinstance(value, bool) and isinstance(value, Real) and math.isfinite(value)
+
+
 def multiplicity_argument(value: Any) -> float:
     """A model's ``force_multiplicity`` (copies of it in the whole body): a finite number > 0."""
-    if isinstance(value, bool) or not isinstance(value, Real) or not (math.isfinite(value) and value > 0):
+    if not (finite_real(value) and value > 0):
         raise InputError(f"force_multiplicity={value!r} must be a finite number > 0: how many "
                          "copies of the model make the whole body (1 for the whole body, 2 for a "
                          "half model)")
@@ -160,4 +165,4 @@ def points_argument(value: Any, N: sp.csr_matrix) -> np.ndarray:
 
 
 __all__ = ["sparse_argument", "symmetric_argument", "vector_argument", "flag_argument",
-           "multiplicity_argument", "dimension_of", "points_argument"]
+           "finite_real", "multiplicity_argument", "dimension_of", "points_argument"]

@@ -11,15 +11,14 @@ the empty model :meth:`Model.of_arrays` (no mesh, every unknown free).
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
-from numbers import Real
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
+from signorini.numerics.arrays import finite_real
 
 __all__ = ["Model", "Push", "ReferenceData", "Watch"]
 
@@ -234,8 +233,7 @@ class Model:
             raise InputError("this model does not record how its load depends on the push (a QP "
                              "given as arrays, or a scene without a push): solve it as it is")
         for name, value in (("scale", scale), ("load", load)):
-            if value is not None and (isinstance(value, bool) or not isinstance(value, Real)
-                                      or not math.isfinite(value)):
+            if value is not None and not finite_real(value):
                 raise InputError(f"at_push: {name}={value!r} must be a finite number (the "
                                  f"push's {name} in the model's units, e.g. {name}={pu.scale:g})")
         ratio = scale / pu.scale
@@ -261,7 +259,7 @@ class Model:
         if pu is None or pu.target is None:
             raise InputError("this problem has no target load to change: build the scene with a "
                              "load P (or a_over_R), or build it again with the new load")
-        if isinstance(P, bool) or not isinstance(P, Real) or not (math.isfinite(P) and P > 0):
+        if not (finite_real(P) and P > 0):
             raise InputError(f"the target load P={P!r} must be a finite number > 0 (the scene's "
                              "units, full body), e.g. with_load(problem, P=2.5)")
         target = P / force_scale

@@ -90,8 +90,12 @@ def deferred(spec: str) -> Method:
         raise InputError(f"--method {spec!r}: cannot import {module_name!r} (no file "
                          f"{module_name}); give {FORMS}")
 
+    loaded: list[Method] = []  # imported once, at the first call, in the process that runs it
+
     def imported(problem: Any, **options: Any) -> Any:
-        return load(spec).function(problem, **options)
+        if not loaded:
+            loaded.append(load(spec))
+        return loaded[0].function(problem, **options)
 
     return _method(spec, imported)
 
