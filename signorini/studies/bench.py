@@ -49,6 +49,8 @@ COLUMNS = ("scene", "size", "dofs", "candidates", "method", "ranks", "tolerance"
            "claimed_status",
            "iterations", "build_s", "solve_s", "time_s", "factor_s", "ratio_to_factor",
            "kkt_worst", "lam_rel", "misclassified", "p0_rel", "a_rel", "message")
+#: the columns that hold text (the others hold numbers)
+TEXT_COLUMNS = ("scene", "size", "method", "tolerance", "status", "claimed_status", "message")
 #: what the benchmark measures of each run besides the runner's row
 MEASURES = ("factorisation", "times", "vs_reference", "reference")
 #: the runner's statuses for a run that gave no answer of its own, written as "failed"
@@ -189,17 +191,16 @@ def read_rows(path: Path) -> list[dict[str, Any]]:
     with open(path, newline="") as handle:
         rows = list(csv.DictReader(handle))
     for row in rows:
-        for key in COLUMNS:
-            if key in ("scene", "size", "method", "tolerance", "status", "claimed_status", "message"):
-                continue
-            if key == "ranks" and not row.get(key):  # rows written before the column existed
-                row[key] = 1.0
-                continue
-            try:
-                row[key] = float(row[key])
-            except (TypeError, ValueError):
-                row[key] = float("nan")
+        row["ranks"] = row.get("ranks") or 1.0  # rows written before the column existed
+        row.update({key: _float(row[key]) for key in COLUMNS if key not in TEXT_COLUMNS})
     return rows
+
+
+def _float(text: Any) -> float:
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return float("nan")
 
 
 def shifted_geometric_mean(values: np.ndarray, shift: float = 10.0) -> float:

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-from signorini.output.plots import axes
+from signorini.output.plots import axes, framed
 from signorini.studies.convergence import ESTIMATES, LABELS, ConvergenceStudy, GradingComparison
 
 __all__ = ["plot_convergence", "plot_grading", "study_table", "write_study"]
@@ -27,11 +27,9 @@ def plot_convergence(study: ConvergenceStudy, ax=None, metrics: tuple[str, ...] 
             ax.loglog(h, np.abs(err), style, color=f"C{i}", marker=markers[i % len(markers)],
                       ms=5 if j == 0 else 9, mfc="none" if j else None,
                       label=f"{LABELS.get(metric, metric)} ({method}): rate {rate:.2f}")
-    ax.set_xlabel("h (spacing of the contact candidates)")
-    ax.set_ylabel("relative error" if "edge_over_centre" not in (metrics or study.metrics)
-                  else "relative error; edge pressure / (P/πa)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
+    framed(ax, "h (spacing of the contact candidates)",
+           "relative error" if "edge_over_centre" not in (metrics or study.metrics)
+           else "relative error; edge pressure / (P/πa)", "both")
     ax.set_title(f"{study.scene}: convergence under uniform refinement", fontsize=9)
     return ax
 
@@ -50,10 +48,7 @@ def plot_grading(comparison: GradingComparison, ax=None):
         if np.isfinite(dofs):
             ax.plot([dofs], [comparison.target], "x", color=color, ms=10,
                     label=f"{dofs:,.0f} dofs ({how})")
-    ax.set_xlabel("dofs")
-    ax.set_ylabel(LABELS.get(comparison.metric, comparison.metric))
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
+    framed(ax, "dofs", LABELS.get(comparison.metric, comparison.metric), "both")
     ax.set_title(f"{comparison.scene}: graded against uniform meshes "
                  f"(grading saves {comparison.saving:,.0f}× the dofs)", fontsize=9)
     return ax
