@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-from signorini.output.report import provenance
+from signorini.output.report import provenance, provenance_lines
+from signorini.reprs import markdown_table
 from signorini.solvers.options import DEFAULT_TOL
 from signorini.studies.atlas.axis import Axis, capped, nodes_text, num
 from signorini.studies.atlas.summary import (AtlasResult, method_rows, method_summary, share, verdicts,
@@ -98,8 +99,7 @@ def _header(result: AtlasResult, command: str, info: dict[str, Any], runs: int) 
         f"Run time: {result.elapsed_s:.0f} s ({minutes:.1f} min) for {runs} runs"
         + (" (quick: tiny meshes, few methods)" if result.quick else "") + "; per axis: "
         + ", ".join(f"{name} {sec:.0f} s" for name, sec in result.axis_seconds.items()) + "  ",
-        f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",
-        "Versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()), "",
+        *provenance_lines(info),
         ("Every run is a method at a tolerance on one problem, in its own worker process with a "
          "time limit. Data: [`stability/runs.csv`](stability/runs.csv) and "
          "[`stability/runs.json`](stability/runs.json) (one row per run, with the problem's "
@@ -175,11 +175,9 @@ def method_axis_table(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]
     """
     table = verdicts(rows, axes)
     methods = list(dict.fromkeys(r["method"] for r in method_rows(rows)))
-    md = ["| method | " + " | ".join(f"{a.number}. {a.name}" for a in axes) + " |",
-          "|---|" + "---|" * len(axes)]
-    for method in methods:
-        md.append(f"| {method} | " + " | ".join(table.get((method, a.name), "–") for a in axes) + " |")
-    return md
+    return markdown_table(["method", *(f"{a.number}. {a.name}" for a in axes)], "l" * (len(axes) + 1),
+                          ([method, *(table.get((method, a.name), "–") for a in axes)]
+                           for method in methods))
 
 
 def _method_by_axis(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]:
