@@ -86,6 +86,11 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
     directory = writable_directory(out)
     info = provenance()
     figures: dict[str, Path] = {}
+
+    def keep(key: str, ax) -> None:
+        figures[key] = directory / f"{key}.png"
+        save_figure(ax.figure, figures[key])
+
     for result in suite.results:
         problem, ref = result.problem, result.reference
         name = result.case.name
@@ -99,13 +104,9 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
             ax = plots.pressure_profile(profile.x, profile.pressure, a_ref=hertz.a_ref,
                                         p0_ref=hertz.p0_ref, label="pdas", others=others)
             ax.set_title(f"{name}: contact pressure, every method against Hertz", fontsize=9)
-            path = directory / f"{name}-pressure.png"
-            save_figure(ax.figure, path)
-            figures[f"{name}-pressure"] = path
-        ax = plots.kkt_against_time(result.runs, title=f"{name}: accuracy against time")
-        path = directory / f"{name}-kkt-time.png"
-        save_figure(ax.figure, path)
-        figures[f"{name}-kkt-time"] = path
+            keep(f"{name}-pressure", ax)
+        keep(f"{name}-kkt-time", plots.kkt_against_time(result.runs,
+                                                        title=f"{name}: accuracy against time"))
     md = ["# signorini validation report", "",
           f"Command: `{command}`  ", f"Result: **{'PASS' if suite.passed else 'FAIL'}** "
           f"({sum(c.passed for c in suite.checks)}/{len(suite.checks)} checks) in {suite.elapsed_s:.1f} s  ",

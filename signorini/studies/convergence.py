@@ -87,10 +87,11 @@ class ConvergenceStudy:
     rates: dict[str, dict[str, float]] = field(default_factory=dict)
     fit_from: int = 0
 
-    def series(self, method: str, metric: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(h, dofs, error)`` of one method's converged levels."""
+    def series(self, method: str, metric: str,
+               from_level: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(h, dofs, error)`` of one method's converged levels (from ``from_level`` on)."""
         rows = [r for r in self.rows if r.method == method and r.status == "converged"
-                and np.isfinite(r.errors.get(metric, np.nan))]
+                and np.isfinite(r.errors.get(metric, np.nan)) and r.level >= from_level]
         return (np.array([r.h for r in rows]), np.array([r.dofs for r in rows], dtype=float),
                 np.array([r.errors[metric] for r in rows]))
 
@@ -240,13 +241,8 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     study = ConvergenceStudy(scene, {**base, "levels": levels}, reference.convergence + ESTIMATES, rows,
                              fit_from=fit_from)
     for name in study.methods:
-        study.rates[name] = {}
-        for metric in study.metrics:
-            h, _, err = study.series(name, metric)
-            keep = np.array([r.level >= fit_from for r in rows if r.method == name
-                             and r.status == "converged" and np.isfinite(r.errors.get(metric, np.nan))],
-                            dtype=bool)
-            study.rates[name][metric] = fitted_rate(h[keep], err[keep]) if keep.size else float("nan")
+        study.rates[name] = {metric: fitted_rate(*study.series(name, metric, fit_from)[::2])
+                             for metric in study.metrics}
     return study
 
 
