@@ -49,9 +49,8 @@ from signorini.numerics.push import calibrate_push
 from signorini.numerics.work import counting, timed
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
                                      zone_around_points)
-from signorini.problem.contact import ContactProblem
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.references.catalogue import reference_of
-from signorini.problem.solution import ContactSolution, WarmStart
 from signorini.solvers import registry
 from signorini.solvers.registry import Request
 

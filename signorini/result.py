@@ -24,9 +24,8 @@ from signorini.certification.kkt import Certificate
 from signorini.derivatives import implicit as derivatives
 from signorini import fem  # the estimate's module loaded at first use: a QP has no mesh
 from signorini.numerics.work import stage_times, time_line, timed
-from signorini.problem.contact import ContactProblem
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.scales import record_units
-from signorini.problem.solution import ContactSolution
 from signorini.references.catalogue import Reference, reference_of, summary_lines
 from signorini.references.pressure import ContactProfile, contact_profile, load_resultant
 

@@ -21,7 +21,7 @@ import pytest
 
 import signorini
 from signorini.cli import main
-from signorini.certification.forward_error import refined_on_active_set
+from signorini.certification.comparison import refined_on_active_set
 from signorini.certification.kkt import ACTIVE, FORCE_FLOOR, active_set, certificate, classify, force_scale
 from signorini.numerics.factor import factorize
 from signorini.numerics.work import counting

@@ -153,7 +153,7 @@ class PinnedCG:
     active rows' dofs when each row bounds one dof, else none) and
     ``solve(rhs)``: u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``, to the
     relative residual :data:`CERTIFICATE_RTOL` (``exact`` is False: the forward error takes
-    one Newton step with it, :mod:`signorini.certification.forward_error`).
+    one Newton step with it, :mod:`signorini.certification.inverse`).
     """
 
     exact = False
