@@ -8,6 +8,7 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output.plots import axes, framed
+from signorini.reprs import markdown_table, number
 from signorini.studies.convergence import ESTIMATES, LABELS, ConvergenceStudy, GradingComparison
 
 __all__ = ["plot_convergence", "plot_grading", "study_table", "write_study"]
@@ -57,22 +58,19 @@ def plot_grading(comparison: GradingComparison, ax=None):
 def study_table(study: ConvergenceStudy) -> list[str]:
     """Markdown table of a study: one row per level and method."""
     metrics = list(study.metrics)
-    lines = ["| level | method | status | dofs | candidates | h | " +
-             " | ".join(LABELS.get(m, m) for m in metrics) + " | λ vs first | solve [s] |",
-             "|---:|---|---|---:|---:|---:|" + "---:|" * len(metrics) + "---:|---:|"]
-    for r in study.rows:
-        values = " | ".join(f"{r.errors[m]:.3e}" if m in r.errors else "–" for m in metrics)
-        lam = f"{r.lam_rel_vs_first:.1e}" if np.isfinite(r.lam_rel_vs_first) else "–"
-        lines.append(f"| {r.level} | {r.method} | {r.status} | {r.dofs} | {r.candidates} | "
-                     f"{r.h:.3g} | {values} | {lam} | {r.solve_s:.2f} |")
+    labels = [LABELS.get(m, m) for m in metrics]
+    right = "r" * len(metrics)
+    lines = markdown_table(
+        ["level", "method", "status", "dofs", "candidates", "h", *labels, "λ vs first", "solve [s]"],
+        f"rllrrr{right}rr",
+        ([r.level, r.method, r.status, r.dofs, r.candidates, f"{r.h:.3g}",
+          *(f"{r.errors[m]:.3e}" if m in r.errors else "–" for m in metrics),
+          number(r.lam_rel_vs_first), f"{r.solve_s:.2f}"] for r in study.rows))
     lines += ["", "Fitted rates (slope of log error against log h"
-              + (f", levels ≥ {study.fit_from}" if study.fit_from else "") + "):", "",
-              "| method | " + " | ".join(LABELS.get(m, m) for m in metrics) + " |",
-              "|---|" + "---:|" * len(metrics)]
-    for method, rates in study.rates.items():
-        lines.append(f"| {method} | " + " | ".join(f"{rates.get(m, float('nan')):.2f}" for m in metrics)
-                     + " |")
-    return lines
+              + (f", levels ≥ {study.fit_from}" if study.fit_from else "") + "):", ""]
+    return lines + markdown_table(["method", *labels], f"l{right}",
+                                  ([method, *(f"{rates.get(m, float('nan')):.2f}" for m in metrics)]
+                                   for method, rates in study.rates.items()))
 
 
 def write_study(study: ConvergenceStudy, out, command: str,

@@ -18,6 +18,7 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output import plots
+from signorini.reprs import number
 
 __all__ = ["MEASURES", "NAMES", "TARGETS", "at_accuracy", "matching_table", "peer_figure", "peer_table",
            "write_peer"]
@@ -39,10 +40,6 @@ def _error(row: dict[str, Any]) -> float:
 NAMES = {"getfem": "GetFEM", "signorini": "signorini"}
 #: the two measures of time: a row's key and its name in the tables
 MEASURES = {"wall_s": "whole process", "in_process_s": "in process"}
-
-
-def _seconds(value: Any) -> str:
-    return "–" if value is None else f"{value:.2f}"
 
 
 def at_accuracy(rows: list[dict[str, Any]], scene: str, target: float,
@@ -79,7 +76,7 @@ def peer_table(rows: list[dict[str, Any]]) -> list[str]:
             f"| {r['scene']} | {NAMES[r['code']]} | {r['mesh']} | {r.get('dofs', 0):,} "
             f"| {r.get('contact_nodes', '–')} ({r.get('active_nodes', '–')}) | {_pct(r.get('p0_rel'))} "
             f"| {_pct(r.get('a_rel'))} | {_pct(r.get('force_rel'))} | {r['wall_s']:.2f} "
-            f"| {_seconds(r.get('in_process_s'))} | {r.get('inner_s', math.nan):.2f} | {r['status']} |")
+            f"| {number(r.get('in_process_s'), '.2f')} | {r.get('inner_s', math.nan):.2f} | {r['status']} |")
     lines += ["", "| scene | p₀ and a within | time | GetFEM: fastest run | signorini: fastest run "
               "| signorini / GetFEM |", "|---|---:|---|---|---|---:|"]
     # a run recorded before the in-process measure (or with --in-process 0) has no such rows
