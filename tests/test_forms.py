@@ -15,7 +15,7 @@ import signorini
 from signorini.errors import InputError
 from signorini.certification.comparison import compare
 from signorini.certification.kkt import force_scale, gap_scale
-from signorini.numerics.work import Work, counting
+from signorini.numerics.factor import Work, counting
 from signorini.problem.contact import ContactSolution
 from signorini.solvers import forms, qp
 from signorini.solvers.registry import get_method, solve

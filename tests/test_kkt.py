@@ -22,8 +22,7 @@ from signorini.certification.kkt import (
     gap_scale,
 )
 from signorini.numerics.active_set import selection_dofs
-from signorini.numerics.factor import factorize
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting, factorize
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.scenes import build as scene_build
 from signorini.scenes import build_problem

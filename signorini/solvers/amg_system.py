@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from signorini.numerics.active_set import selection_dofs
 from signorini.numerics.multigrid import (Bordered, PyamgHierarchy, pinned_cg, pinned_matrix,
                                           threaded)
-from signorini.numerics.work import count
+from signorini.numerics.factor import count
 from signorini.problem.contact import ContactProblem
 from signorini.solvers import petsc_piece
 from signorini.solvers.bounds import BoundForm

@@ -25,7 +25,7 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.numerics.active_set import selection_dofs
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
 from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.solvers import pdas
