@@ -8,9 +8,11 @@ keys and any other object as its type: a :class:`~signorini.api.Result` whose ar
 
 from __future__ import annotations
 
+import csv
 import dataclasses
+import io
 import math
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -67,4 +69,13 @@ def plain_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]
     return ["  ".join(x.ljust(w) for x, w in zip(line, widths)).rstrip() for line in [head, *rows]]
 
 
-__all__ = ["brief", "short_repr", "number", "markdown_table", "plain_table"]
+def csv_text(rows: Iterable[Mapping[str, Any]], columns: Sequence[str]) -> str:
+    """``rows`` as CSV: a header of ``columns``, then a line for each row (other keys left out)."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=columns, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buffer.getvalue()
+
+
+__all__ = ["brief", "short_repr", "number", "markdown_table", "plain_table", "csv_text"]

@@ -7,8 +7,6 @@ accuracies :data:`TARGETS`, by each measure of time (:data:`MEASURES`).
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import os
 from pathlib import Path
@@ -18,7 +16,7 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output import plots
-from signorini.reprs import number
+from signorini.reprs import csv_text, number
 
 __all__ = ["MEASURES", "NAMES", "TARGETS", "at_accuracy", "matching_table", "peer_figure", "peer_table",
            "write_peer"]
@@ -115,14 +113,9 @@ def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
     """peer.csv, peer.json, peer.md and peer.png in ``out``, each written whole or not at all."""
     directory = writable_directory(out)
     paths = {k: directory / f"peer.{k}" for k in ("csv", "json", "md", "png")}
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore",
-                            lineterminator="\n")
-    writer.writeheader()
     # every run's times in one cell each, separated by spaces
-    writer.writerows({k: " ".join(f"{t:.6f}" for t in v) if isinstance(v, list) else v
-                      for k, v in r.items()} for r in rows)
-    atomic_write_text(paths["csv"], buffer.getvalue())
+    atomic_write_text(paths["csv"], csv_text(({k: " ".join(f"{t:.6f}" for t in v) if isinstance(v, list)
+                                               else v for k, v in r.items()} for r in rows), CSV_COLUMNS))
     atomic_write_text(paths["json"], to_json({"command": command, **meta, "rows": rows}) + "\n")
     save_figure(peer_figure(rows), paths["png"])
     machine = meta.get("machine", {})

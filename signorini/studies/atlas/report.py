@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import os
@@ -14,7 +12,7 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output.report import provenance, provenance_lines
-from signorini.reprs import markdown_table
+from signorini.reprs import csv_text, markdown_table
 from signorini.solvers.options import DEFAULT_TOL
 from signorini.studies.atlas.axis import Axis, capped, nodes_text, num
 from signorini.studies.atlas.summary import (AtlasResult, method_rows, method_summary, share, verdicts,
@@ -46,19 +44,10 @@ def reproduction(row: dict[str, Any], axis: Axis | None = None) -> str:
 
 
 def _csv_value(value: Any) -> Any:
+    """A cell of ``runs.csv``: a missing number left empty."""
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return ""
     return value
-
-
-def csv_text(rows: list[dict[str, Any]]) -> str:
-    """The rows as CSV, one line per run in :data:`COLUMNS` (missing numbers left empty)."""
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, extrasaction="ignore", lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: _csv_value(row.get(k)) for k in COLUMNS})
-    return buffer.getvalue()
 
 
 def write_report(result: AtlasResult, out: str | os.PathLike, command: str) -> dict[str, Path]:
@@ -73,7 +62,8 @@ def write_report(result: AtlasResult, out: str | os.PathLike, command: str) -> d
     paths = {"csv": data / "runs.csv", "json": data / "runs.json", "report": directory / "stability.md"}
     right, runs, _faults = wrapper_record(rows)
     summary = method_summary(rows)
-    atomic_write_text(paths["csv"], csv_text(rows))
+    atomic_write_text(paths["csv"], csv_text(({k: _csv_value(r.get(k)) for k in COLUMNS} for r in rows),
+                                             COLUMNS))
     atomic_write_text(paths["json"], to_json({
         "command": command, "provenance": info, "elapsed_s": result.elapsed_s,
         "axis_seconds": result.axis_seconds, "quick": result.quick,
@@ -224,4 +214,4 @@ def report_markdown(result: AtlasResult, command: str, info: dict[str, Any]) -> 
     return "\n".join(md) + "\n"
 
 
-__all__ = ["reproduction", "csv_text", "write_report", "method_axis_table", "report_markdown"]
+__all__ = ["reproduction", "write_report", "method_axis_table", "report_markdown"]
