@@ -200,5 +200,5 @@ def readme_validation(report: dict[str, Any], case: str = "hertz-cylinder") -> s
     return "\n".join(lines)
 
 
-__all__ = ["provenance", "provenance_lines", "status_claimed", "runs_table", "write_suite_report", "checks_summary", "readme_validation",
-           "REPORT_FILES"]
+__all__ = ["provenance", "provenance_lines", "status_claimed", "runs_table", "write_suite_report",
+           "checks_summary", "readme_validation", "REPORT_FILES"]
