@@ -125,7 +125,32 @@ def test_nested_reuses_the_factorisation_load_control_hands_it():
     before = system.factorisations
     nested = solve(matched.problem, "nested", warm_start=matched.warm_start)
     assert system.factorisations == before and "0 factorisation" in nested.message
+    # the load at the push found combines load control's two: its solution is theirs combined
+    assert "0 back-solves" in nested.message
     assert_same_answer(matched.problem, solve(matched.problem, "pdas"), nested)
+
+
+def test_the_zone_solver_solves_a_combination_of_its_last_loads_without_a_back_solve(cylinder):
+    """Loads f₁, f₀ solved together; then s f₁ + f₀ (gaps likewise) costs no back-solve and
+    gives a fresh solver's answer, and a load outside their span is solved."""
+    from signorini.numerics.factor import counting
+
+    K, N, d, f = cylinder.K, cylinder.N, cylinder.d, cylinder.f
+    zone = analytic_zone(cylinder)
+    system = ZoneSolver(K, N)
+    f1, d1 = 0.5 * f, 0.25 * d
+    system.push_for_load(f1, d, d1, 1.0, 1.0, zone, f0=f)  # solves the columns [f₁, f], [d₁, d]
+    with counting() as work:
+        u, lam, _ = system.solve(2.0 * f1 + f, d + 2.0 * d1, zone)
+    assert work.back_solves == 0 and work.factorisations == 0
+    fresh_u, fresh_lam, _ = ZoneSolver(K, N).solve(2.0 * f, 1.5 * d, zone)
+    assert np.allclose(lam, fresh_lam, rtol=1e-9, atol=1e-12 * np.abs(fresh_lam).max())
+    assert np.allclose(u, fresh_u, rtol=1e-9, atol=1e-12 * np.abs(fresh_u).max())
+    other = np.zeros_like(f)
+    other[np.flatnonzero(f)[:1]] = f[np.flatnonzero(f)[:1]]
+    with counting() as work:
+        system.solve(other, d, zone)
+    assert work.back_solves >= 1
 
 
 @pytest.mark.parametrize("scene,params", [

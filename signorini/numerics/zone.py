@@ -42,6 +42,10 @@ BLOCK = 32
 #: costs one back-solve more: kept whole, the columns of a large 3D band do not fit in memory
 #: (chosen from measurements, docs/calibration.md)
 COLUMN_BYTES = 512 * 2 ** 20
+#: a load (and gaps) is taken as a combination of the last ones solved when the combination
+#: reproduces it to this, relative to its largest entry: its solution is then that combination
+#: of theirs, to round-off, and costs no back-solve
+SPAN_RTOL = 1e-13
 
 
 @dataclass
@@ -136,9 +140,11 @@ def zone_around_points(points: np.ndarray, a: float, margin: float) -> Zone | No
 class ZoneSolver:
     """``min ½uᵀKu − fᵀu, Nu ≤ d`` solved exactly around a predicted zone (see module doc).
 
-    Keeps its pinned factorisation (``factor``, which the certificate reuses) and its band
-    columns ``K̃⁻¹N_jᵀ`` between calls, so the same K solved for other loads costs back-solves
-    only while the core stays the same.
+    Keeps its pinned factorisation (``factor``, which the certificate reuses), its band
+    columns ``K̃⁻¹N_jᵀ`` and its last loads' solutions between calls, so the same K solved for
+    other loads costs back-solves only while the core stays the same, and none for a load that
+    combines the last ones (load control's two, the push's and the fixed load's, then the
+    method's at the push found).
     """
 
     def __init__(self, K: sp.spmatrix, N: sp.spmatrix, backend: str | None = None):
@@ -160,6 +166,8 @@ class ZoneSolver:
         #: per band node: ``N z_j`` and the core's reactions to ``z_j``, and ``z_j`` while it fits
         self._columns: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
         self._whole = 0
+        #: the last loads and gaps solved on this core: (F, D, U0, right-hand sides)
+        self._loads: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.factorisations = 0  # numeric factorisations made (one per core)
 
     # --- linear algebra on the pinned factorisation -------------------------------------------
@@ -171,7 +179,25 @@ class ZoneSolver:
         self._core = core.copy()
         self._columns.clear()
         self._whole = 0
+        self._loads = None
         self.factorisations += 1
+
+    def _combination(self, F: np.ndarray, D: np.ndarray) -> np.ndarray | None:
+        """Weights w with ``F = F₀ w`` and ``D = D₀ w`` (F₀, D₀ the last loads and gaps solved on
+        this core, see :data:`SPAN_RTOL`), or None."""
+        if self._loads is None:
+            return None
+        pairs = list(zip(self._loads[:2], (F, D)))
+        gram = sum(old.T @ old for old, _ in pairs)  # the normal equations: k × k, k ≤ 2 here
+        weights = np.zeros((gram.shape[0], F.shape[1]))
+        for _ in range(2):  # solved, then refined once on its residual
+            weights += np.linalg.lstsq(gram, sum(old.T @ (new - old @ weights)
+                                                 for old, new in pairs), rcond=None)[0]
+        for old, new in pairs:  # loads and gaps each to their own scale
+            miss = np.max(np.abs(old @ weights - new), axis=0, initial=0.0)
+            if np.any(miss > SPAN_RTOL * np.max(np.abs(new), axis=0, initial=0.0)):
+                return None
+        return weights
 
     def _units(self, band) -> np.ndarray:
         """``N_Bᵀ`` as dense columns (n × |B|): a unit force along each band node's normal."""
@@ -184,14 +210,21 @@ class ZoneSolver:
         """``U0``: u (n × k) with the core's gaps closed, loads F and no band forces, and the
         right-hand sides it solves; the band columns ``z_j = K̃⁻¹ N_jᵀ`` not kept from an earlier
         call are solved with U0 (one pass over the factor for both) and kept (:data:`COLUMN_BYTES`).
+        Loads that combine the last ones solved take U0 from theirs (:meth:`_combination`).
         """
         core = zone.core
-        rhs = np.array(F, dtype=float).reshape(self.n, -1)
-        rhs[self.dofs[core]] = D[core].reshape(-1, rhs.shape[1]) / self.coef[core][:, None]
+        F = np.array(F, dtype=float).reshape(self.n, -1)
+        D = np.array(D, dtype=float).reshape(self.m, -1)
+        weights = self._combination(F, D)
+        U0 = None
+        if weights is not None:
+            U0, rhs = self._loads[2] @ weights, self._loads[3] @ weights
+        else:
+            rhs = F.copy()
+            rhs[self.dofs[core]] = D[core] / self.coef[core][:, None]
         missing = [j for j in band if j not in self._columns]
         chunks = [missing[first:first + BLOCK] for first in range(0, len(missing), BLOCK)]
-        U0 = None
-        for chunk in chunks or [[]]:
+        for chunk in chunks or ([] if U0 is not None else [[]]):
             units = self._units(chunk)
             block = self.factor.solve(units if U0 is not None else np.hstack([rhs, units]))
             if U0 is None:
@@ -204,6 +237,8 @@ class ZoneSolver:
                 self._columns[j] = (gaps[:, k], reactions[:, k], column)
                 if whole:  # the certificate's bordering reads it back (forward_error)
                     self.factor.kept[int(self.dofs[j])] = (column, self.coef[j])
+        if weights is None:
+            self._loads = (F, D, U0, rhs)
         return U0, rhs
 
     def _displacement(self, U0: np.ndarray, rhs: np.ndarray, band: np.ndarray,
