@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import tempfile
 
 from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, SCENE_HELP, add_command, input_files,
                                   method_options, pairs, parse_time_limit, parse_tol, process_seconds,
@@ -15,7 +14,7 @@ from signorini.solvers.options import DEFAULT_TOL, guess_value
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.api import Result, at_load, solve, solve_adaptive, solve_summary  # per command
+    from signorini.api import Result, solve, solve_adaptive, solve_summary  # per command
     from signorini.scenes import build_problem  # per command (start-up)
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
     from signorini.certification.kkt import certificate  # per command (start-up)
@@ -82,16 +81,18 @@ def cmd_solve(args: argparse.Namespace) -> int:
             else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
                 from signorini.studies.runner import solve_within  # per command (start-up)
 
+                # the worker builds the problem again and solves it as signorini.solve does (load
+                # control with the scene's predictions, then the method), and says the push matched
+                spec = {"kind": "stored", "path": os.path.abspath(args.scene)} if from_file else \
+                    {"kind": "scene", "scene": args.scene, "params": params,
+                     "nondimensionalise": not args.raw_units}
                 seconds: dict[str, float] = {}
-                with timed(seconds, "load control"):
-                    problem = at_load(problem)
-                with timed(seconds, "method"), tempfile.TemporaryDirectory(prefix="signorini-") as folder:
-                    # the worker solves the problem matched here, stored (its start-up included)
-                    path = os.path.join(folder, "problem.npz")
-                    problem.save(path)
-                    solution = solve_within(problem, {"kind": "stored", "path": path}, args.method,
+                with timed(seconds, "method"):  # the worker's whole run, its start-up included
+                    solution = solve_within(problem, {**spec, "matched": False}, args.method,
                                             time_limit, tol=tol, max_iter=max_iter,
                                             options=request.options)
+                if problem.model.pending and "push" in solution.extras:
+                    problem = problem.pushed(float(solution.extras["push"]))
                 with timed(seconds, "certificate"):
                     judged = certificate(problem, solution)
                 solution.seconds = {**solution.seconds, **seconds}
