@@ -39,7 +39,7 @@ from signorini.scenes.base import (
     refinements,
     two_refinements_coarser,
 )
-from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice
+from signorini.scenes.hertz_sphere import COMMON_PARAMS, REFERENCE, graded_ratio, load_choice
 from signorini.scenes.ball_octant import (coarse_ball_octant, curved_boundary_facets, distance_to_disc,
                                          on_ball_octant_surface, snap_to_sphere)
 from signorini.scenes.meshing import refine_simplices_to_size
@@ -57,13 +57,10 @@ PARAMS = COMMON_PARAMS + (
 MAX_SIZE = 0.3
 
 
-#: the analytic reference (signorini.references.catalogue) this family's problems compare with
-REFERENCE = "hertz-3d"
-
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The quarter model of Hertz's sphere in physical units (z vertical, contact at the origin)."""
     R = p["R"]
-    target, a_est = load_choice(p, set() if given is None else given)
+    target, _, a_est = load_choice(p, set() if given is None else given)
     h_contact = a_est / p["n_contact"]
 
     def target_size(points: np.ndarray) -> np.ndarray:
