@@ -44,7 +44,7 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.stiffness import simplex_stiffness
-from signorini.fem.topology import moved
+from signorini.fem.topology import moved, outward_normals
 from signorini.fem.volumetric import volumetric_stiffness
 from signorini.problem.contact import ContactProblem, Model, Push, Scales, Watch
 
@@ -294,20 +294,6 @@ def cut_traction(model: SceneModel, mesh: Any, dof_table: np.ndarray,
     return f_load, float(-model.force_multiplicity * f_load[dofs[others]].sum())
 
 
-def _facing_normals(mesh: Any, facets: np.ndarray) -> np.ndarray:
-    """Outward unit normals (dim, k) of boundary ``facets`` (edges in 2D, triangles in 3D)."""
-    p = mesh.p
-    ends = mesh.facets[:, facets]
-    if p.shape[0] == 2:
-        tangent = p[:, ends[1]] - p[:, ends[0]]
-        normal = np.array([tangent[1], -tangent[0]])
-    else:
-        normal = np.cross(p[:, ends[1]] - p[:, ends[0]], p[:, ends[2]] - p[:, ends[0]], axis=0)
-    inside = p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
-    outward = np.sign(np.einsum("ij,ij->j", normal, p[:, ends].mean(axis=1) - inside))
-    return normal * outward / np.linalg.norm(normal, axis=0)
-
-
 def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch | None:
     """The boundary nodes beyond the candidates and the candidates at their edge (see Watch).
 
@@ -336,7 +322,7 @@ def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch 
     mixed = is_candidate[ends].any(axis=0) & ~is_candidate[ends].all(axis=0)
     edge_nodes = np.array([], dtype=int)
     if mixed.any():
-        outward = _facing_normals(mesh, facets[mixed])
+        outward = outward_normals(mesh, facets[mixed])
         towards, _ = obstacle.normals_and_gaps(mesh.p[:, ends[:, mixed]].mean(axis=1).T)
         facing = np.einsum("ij,ji->i", np.asarray(towards, dtype=float), outward) > 0.1
         edge_nodes = np.unique(ends[:, mixed][:, facing])

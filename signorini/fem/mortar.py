@@ -44,7 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.fem.topology import with_topology
+from signorini.fem.topology import outward_normals, with_topology
 
 log = logging.getLogger(__name__)
 
@@ -87,12 +87,8 @@ class Face:
         nodes = _along(ends)
         local = np.searchsorted(np.sort(nodes), ends)
         local = np.argsort(nodes)[local]
-        tangent = mesh.p[:, ends[1]] - mesh.p[:, ends[0]]
-        normal = np.array([tangent[1], -tangent[0]])
-        inside = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
-        outward = np.sign(np.einsum("ij,ij->j", normal, mesh.p[:, ends].mean(axis=1) - inside))
         return cls(nodes=nodes, points=mesh.p[:, nodes], segments=local.reshape(ends.shape),
-                   normals=normal * outward / np.linalg.norm(normal, axis=0))
+                   normals=outward_normals(mesh, facets))
 
     @property
     def lengths(self) -> np.ndarray:

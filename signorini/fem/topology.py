@@ -148,6 +148,22 @@ def moved(mesh: Any, p: np.ndarray) -> Any:
     return new
 
 
+def outward_normals(mesh: Any, facets: np.ndarray, unit: bool = True) -> np.ndarray:
+    """The normals (dim, k) of the boundary ``facets`` (edges in 2D, triangles in 3D) pointing
+    out of the body: of unit length, or (``unit=False``) as long as the edge (twice the
+    triangle's area)."""
+    mesh = with_topology(mesh)
+    p, ends = mesh.p, mesh.facets[:, facets]
+    if p.shape[0] == 2:
+        tangent = p[:, ends[1]] - p[:, ends[0]]
+        normal = np.array([tangent[1], -tangent[0]])
+    else:
+        normal = np.cross(p[:, ends[1]] - p[:, ends[0]], p[:, ends[2]] - p[:, ends[0]], axis=0)
+    inside = p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
+    normal = normal * np.sign(np.einsum("ij,ij->j", normal, p[:, ends].mean(axis=1) - inside))
+    return normal / np.linalg.norm(normal, axis=0) if unit else normal
+
+
 def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
     """The boundary facets whose ends are all among ``nodes`` (triangles or tetrahedra)."""
     boundary = with_topology(mesh).boundary_facets()
@@ -156,4 +172,4 @@ def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
 
 
 __all__ = ["packed_keys", "distinct_entities", "sort_order", "sorted_columns", "facet_topology",
-           "with_edges", "with_topology", "moved", "facets_on", "TOPOLOGY"]
+           "with_edges", "with_topology", "moved", "facets_on", "outward_normals", "TOPOLOGY"]

@@ -101,4 +101,4 @@ FAMILY = SceneFamily(
     adaptive_start=ADAPTIVE_START)
 
 
-__all__ = ["SPHERE", "load_choice", "build", "graded_ratio", "COMMON_PARAMS", "SIZE", "FAMILY"]
+__all__ = ["SPHERE", "load_choice", "build", "graded_ratio", "COMMON_PARAMS", "REFERENCE", "SIZE", "FAMILY"]
