@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.fem.model import CutLoad, FlatObstacle3D, SceneModel
+from signorini.fem.model import CutLoad, FlatObstacle, SceneModel
 from signorini.fem.topology import facets_on, moved, with_edges
 from signorini.scenes.base import (
     CANDIDATE_REMEDY,
@@ -93,7 +93,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
                    (1, np.nonzero(np.abs(y) < tol)[0], 0.0),
                    (2, pushed, -delta_nominal)],
         contact_nodes=candidates, contact_facets=curved,
-        obstacle=FlatObstacle3D(0.0),
+        obstacle=FlatObstacle(0.0),
         load_dofs=(2, pushed), length_scale=R, force_multiplicity=4.0,
         target_load=target, **hertz_record(p, REFERENCE, target, a_est, delta_nominal),
         cut_load=cut_load, predicted_contact=rho[candidates] < a_est * R,
