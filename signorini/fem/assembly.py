@@ -51,16 +51,6 @@ from signorini.problem.contact import ContactProblem, Model, Push, Scales, Watch
 log = logging.getLogger(__name__)
 
 
-def boundary_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """Lumped weights ``wᵢ = ∫_Γ φᵢ ds`` of ``nodes`` over the boundary ``facets`` (2D)."""
-    ends = mesh.facets[:, facets]
-    lengths = np.linalg.norm(mesh.p[:, ends[0]] - mesh.p[:, ends[1]], axis=0)
-    per_node = np.zeros(mesh.p.shape[1])
-    np.add.at(per_node, ends[0], 0.5 * lengths)
-    np.add.at(per_node, ends[1], 0.5 * lengths)
-    return per_node[nodes]
-
-
 def axisymmetric_elasticity(Lambda: float = 1.0, Mu: float = 1.0) -> BilinearForm:
     """Weak form of axisymmetric linear elasticity, per radian.
 
@@ -97,14 +87,14 @@ def contact_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray,
     gives the same to round-off, 25 times slower at 1M dofs).
     """
     if mesh.p.shape[0] == 2:
-        if not axisymmetric:
-            return boundary_weights(mesh, facets, nodes)
         ends = mesh.facets[:, facets]
-        (r0, r1), lengths = mesh.p[0, ends], np.linalg.norm(np.diff(mesh.p[:, ends], axis=1)[:, 0],
-                                                             axis=0)
+        lengths = np.linalg.norm(mesh.p[:, ends[0]] - mesh.p[:, ends[1]], axis=0)
+        r0, r1 = mesh.p[0, ends]
+        shares = ((lengths * (2 * r0 + r1) / 6, lengths * (2 * r1 + r0) / 6) if axisymmetric
+                  else (0.5 * lengths, 0.5 * lengths))
         per_node = np.zeros(mesh.p.shape[1])
-        np.add.at(per_node, ends[0], lengths * (2 * r0 + r1) / 6)
-        np.add.at(per_node, ends[1], lengths * (2 * r1 + r0) / 6)
+        for end, share in zip(ends, shares):
+            np.add.at(per_node, end, share)
         return per_node[nodes]
     corners = mesh.facets[:, facets]  # (3, k)
     edges = mesh.p[:, corners[1:]] - mesh.p[:, corners[:1]]  # (3, 2, k)
@@ -284,14 +274,22 @@ def cut_traction(model: SceneModel, mesh: Any, dof_table: np.ndarray,
     if cut is None:
         return None, 0.0
     weights = contact_weights(mesh, cut.facets, cut.nodes, bool(model.axisymmetric))
-    area = float(weights.sum())
-    if not area > 0:
+    if not weights.sum() > 0:
         raise InputError("the loaded cut has no area: check the scene's cut facets")
-    f_load = np.zeros(dof_table.size)
-    dofs = dof_table[cut.component, cut.nodes]
-    f_load[dofs] = -weights / (model.force_multiplicity * area)
+    return cut_forces(weights, dof_table[cut.component, cut.nodes], -1.0, model.force_multiplicity,
+                      load_dofs, dof_table.size)
+
+
+def cut_forces(weights: np.ndarray, dofs: np.ndarray, direction: float, multiplicity: float,
+               load_dofs: np.ndarray, size: int) -> tuple[np.ndarray, float]:
+    """Nodal forces (``size`` dofs) of a uniform traction along ``direction`` (±1) on a cut whose
+    nodes have the lumped weights ``weights`` and the ``dofs`` along it, per unit load of the
+    full body (``multiplicity`` copies of the model), and the part of that load the reactions
+    of ``load_dofs`` do not see: the traction on the cut's other nodes."""
+    f_load = np.zeros(size)
+    f_load[dofs] = direction * weights / (multiplicity * weights.sum())
     others = ~np.isin(dofs, load_dofs)
-    return f_load, float(-model.force_multiplicity * f_load[dofs[others]].sum())
+    return f_load, float(multiplicity * direction * f_load[dofs[others]].sum())
 
 
 def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch | None:
@@ -353,6 +351,6 @@ def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
                 resultant=resultant, delta=delta, P=P)
 
 
-__all__ = ["boundary_weights", "axisymmetric_elasticity", "contact_weights", "stiffness_form",
+__all__ = ["axisymmetric_elasticity", "contact_weights", "cut_forces", "stiffness_form",
            "stiffness", "lame_stiffness", "nodal_dofs", "force_exponent", "displacement_scale",
            "assemble", "cut_traction", "boundary_watch"]

@@ -29,7 +29,7 @@ from skfem.models.elasticity import lame_parameters
 from signorini.references.analytic import contact_modulus
 from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
-from signorini.fem.assembly import lame_stiffness, nodal_dofs
+from signorini.fem.assembly import contact_weights, cut_forces, lame_stiffness, nodal_dofs
 from signorini.fem.mortar import Face, couple
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import resolve
@@ -100,19 +100,20 @@ def _cut_traction(bodies: tuple[Body, Body], offsets: tuple[int, int], L: float,
     area per radian when ``axisymmetric``); its
     consistent nodal forces are the lumped weights times it (exact for P1).
     """
-    f_load = np.zeros(dof_table.size)
-    offset_load, loaded = 0.0, False
+    f_load, offset_load, loaded = np.zeros(dof_table.size), 0.0, False
     for body, first in zip(bodies, offsets):
         if body.traction is None:
             continue
         facets, direction = body.traction
-        cut = Face.of(moved(body.mesh, body.mesh.p / L), facets)
-        weights = cut.weights(axisymmetric)
-        dofs = dof_table[1, cut.nodes + first]
-        f_load[dofs] = direction * weights / (multiplicity * weights.sum())
+        mesh = moved(body.mesh, body.mesh.p / L)
+        nodes = np.unique(mesh.facets[:, facets])
+        forces, offset = cut_forces(contact_weights(mesh, facets, nodes, axisymmetric),
+                                    dof_table[1, nodes + first], direction, multiplicity,
+                                    load_dofs, dof_table.size)
+        f_load += forces
         loaded = True
         if len(body.load_nodes):  # the traction on the loaded body's other nodes
-            offset_load += multiplicity * direction * f_load[dofs[~np.isin(dofs, load_dofs)]].sum()
+            offset_load += offset
     return (f_load if loaded else None), offset_load
 
 
