@@ -251,11 +251,7 @@ def graded_unit_disc(a_over_R: float, n_contact: int, grading: float,
     if mesher == "relaxed":
         corners = [int(np.argmin(np.hypot(mesh.p[0] - x, mesh.p[1] - y))) for x, y in ((0, 0), (0, 1), (1, 1))]
         mesh = relax(mesh.p, quarter_disc_distance, target_size, corners, snap_quarter_disc)
-    arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
-    ends = np.nonzero((np.hypot(*mesh.p) < 1e-12)  # the first point of contact, the top corner
-                      | (np.hypot(mesh.p[0] - 1.0, mesh.p[1] - 1.0) < 1e-12))[0]
-    chain = np.union1d(arc, ends)
-    chain = chain[np.argsort(np.arctan2(mesh.p[1, chain] - 1.0, mesh.p[0, chain]))]  # from the bottom
+    chain = arc_chain(mesh, 1.0)
     mesh.p.flags.writeable = mesh.t.flags.writeable = chain.flags.writeable = False
     return mesh.p, mesh.t, chain
 
@@ -290,6 +286,16 @@ def facet_indices(mesh: MeshTri, first: np.ndarray, second: np.ndarray) -> np.nd
     return found
 
 
+def arc_chain(mesh: MeshTri, R: float) -> np.ndarray:
+    """The nodes of the arc of the quarter disc of radius R below (0, R), with its two ends (the
+    first point of contact and the top corner), in order from the bottom."""
+    x, y = mesh.p
+    arc = on_circle_arc(mesh, (0.0, R), R, tol=1e-9 * R)
+    ends = np.nonzero((np.hypot(x, y) < 1e-9 * R) | (np.hypot(x - R, y - R) < 1e-9 * R))[0]
+    chain = np.union1d(arc, ends)
+    return chain[np.argsort(np.arctan2(y[chain] - R, x[chain]))]
+
+
 def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
                     candidate_extent: float = 2.0) -> GradedDisc:
     """The parts of any triangulation of the quarter disc of radius R below (0, R), by position.
@@ -300,10 +306,7 @@ def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
     """
     mesh = with_topology(mesh)
     x, y = mesh.p
-    arc = on_circle_arc(mesh, (0.0, R), R, tol=1e-9 * R)
-    ends = np.nonzero((np.hypot(x, y) < 1e-9 * R) | (np.hypot(x - R, y - R) < 1e-9 * R))[0]
-    chain = np.union1d(arc, ends)
-    chain = chain[np.argsort(np.arctan2(y[chain] - R, x[chain]))]
+    chain = arc_chain(mesh, R)
     candidates = chain[(x[chain] <= candidate_extent * a_over_R * R * (1 + 1e-9))
                        & (y[chain] < R * (1 - 1e-12))]
     top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
@@ -317,4 +320,4 @@ __all__ = ["refine_to_size", "distance_to_segment", "coarse_quarter_disc", "on_c
            "snap_to_circle", "quarter_disc_snap", "longest_simplex_edges",
            "refine_simplices_to_size", "GradedDisc", "disc_loading", "quarter_disc_distance",
            "snap_quarter_disc", "graded_quarter_disc", "graded_unit_disc", "refine_uniformly",
-           "facet_indices", "quarter_disc_on", "MAX_TRIANGLES", "MESHERS", "MAX_ELEMENTS"]
+           "facet_indices", "arc_chain", "quarter_disc_on", "MAX_TRIANGLES", "MESHERS", "MAX_ELEMENTS"]
