@@ -31,8 +31,7 @@ if TYPE_CHECKING:  # what the names below are, for readers and type checkers
     from signorini.crosschecking import CrossCheck, crosscheck
     from signorini.derivatives.scene import derivative
     from signorini.errors import BackendNotInstalled, InputError, SignoriniError, SolverError
-    from signorini.problem.contact import ContactProblem, ContactSolution, Model, Scales
-    from signorini.problem.solution import WarmStart
+    from signorini.problem.contact import ContactProblem, ContactSolution, Model, Scales, WarmStart
     from signorini.scenes.build import build_problem, with_load
     from signorini.solvers.options import DEFAULT_TOL
 
@@ -48,8 +47,7 @@ __getattr__, _, _ = lazy_loader.attach(__name__, submod_attrs={
     "crosschecking": ["CrossCheck", "crosscheck"],
     "derivatives.scene": ["derivative"],
     "errors": ["BackendNotInstalled", "InputError", "SignoriniError", "SolverError"],
-    "problem.contact": ["ContactProblem", "ContactSolution", "Model", "Scales"],
-    "problem.solution": ["WarmStart"],
+    "problem.contact": ["ContactProblem", "ContactSolution", "Model", "Scales", "WarmStart"],
     "scenes.build": ["build_problem", "with_load"],
     "solvers.options": ["DEFAULT_TOL"]})
 

@@ -22,9 +22,8 @@ from signorini.certification import kkt
 from signorini.certification.kkt import Certificate
 from signorini.errors import InputError
 from signorini.numerics.arrays import vector_argument
-from signorini.problem.contact import ContactProblem
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.problem.scales import record_units
-from signorini.problem.solution import ContactSolution, WarmStart
 from signorini.result import SCHEMA_VERSION, Result, solve_summary
 from signorini import scenes  # loaded at first use: a QP given as arrays needs no scene
 from signorini.solvers import registry

@@ -1,7 +1,7 @@
 """Cross-checking methods against each other: the paper's Uzawa, QP backends, the exact answer.
 
 ``crosscheck(problem, methods)`` solves one problem with every method at one relative KKT
-tolerance and compares every pair of answers (:func:`signorini.certification.kkt.compare`):
+tolerance and compares every pair of answers (:func:`signorini.certification.comparison.compare`):
 λ and u by their relative ∞-norm distance (``lam_rel``, ``u_rel``), and the candidates
 classified ``apart`` (active in one answer, inactive in the other). A node is **weakly active**
 in an answer when its scaled force and gap are both at most ``max(kkt.WEAK_TOL, tol_a, tol_b)``:
@@ -31,7 +31,8 @@ from signorini.api import SCHEMA_VERSION, Result, record_units, solve
 from signorini import scenes  # loaded at first use: a QP given as arrays needs no scene
 from signorini.crosscheck_tables import render, render_candidates, render_markdown
 from signorini.errors import BackendNotInstalled, InputError
-from signorini.certification.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify, compare
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import ACTIVE, INACTIVE, WEAK_TOL, classify
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import reference_metrics, reference_of
 from signorini.solvers.base import check_tol

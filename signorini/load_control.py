@@ -44,14 +44,13 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.certification.kkt import Certificate
 from signorini.numerics.active_set import ActiveSetSolver, selection_dofs
-from signorini.numerics.factor import FactorTooLarge
+from signorini.numerics.factor import FactorTooLarge, counting
 from signorini.numerics.push import calibrate_push
-from signorini.numerics.work import counting, timed
+from signorini.numerics.stages import timed
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
                                      zone_around_points)
-from signorini.problem.contact import ContactProblem
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.references.catalogue import reference_of
-from signorini.problem.solution import ContactSolution, WarmStart
 from signorini.solvers import registry
 from signorini.solvers.registry import Request
 

@@ -23,10 +23,9 @@ import numpy as np
 from signorini.certification.kkt import Certificate
 from signorini.derivatives import implicit as derivatives
 from signorini import fem  # the estimate's module loaded at first use: a QP has no mesh
-from signorini.numerics.work import stage_times, time_line, timed
-from signorini.problem.contact import ContactProblem
+from signorini.numerics.stages import stage_times, time_line, timed
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.scales import record_units
-from signorini.problem.solution import ContactSolution
 from signorini.references.catalogue import Reference, reference_of, summary_lines
 from signorini.references.pressure import ContactProfile, contact_profile, load_resultant
 
@@ -216,7 +215,7 @@ class Result:
         ``time`` has the seconds of every stage of a solve (``mesh_s``, ..., ``output_s``:
         building this record, the estimate apart, and the exports already timed into
         ``solution.seconds["output"]``) and their sum ``total_s``
-        (:func:`signorini.numerics.work.stage_times`).
+        (:func:`signorini.numerics.stages.stage_times`).
         """
         problem, solution, estimated = self.problem, self.solution, self.estimate  # timed apart
         start = time.perf_counter()

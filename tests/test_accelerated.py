@@ -4,7 +4,7 @@ import pytest
 
 import signorini
 from signorini.errors import InputError
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve
 

@@ -14,9 +14,10 @@ import scipy.sparse as sp
 import signorini
 from signorini import load_control
 from signorini.errors import InputError
-from signorini.certification.kkt import certificate, compare
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import certificate
 from signorini.numerics import multigrid
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting
 from signorini.scenes import build_problem
 from signorini.solvers import amg, amg_system, auto
 from signorini.solvers.bounds import bound_form

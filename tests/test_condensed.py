@@ -5,7 +5,7 @@ import pytest
 
 import signorini
 from signorini.errors import InputError
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus
 from signorini.scenes import build_problem

@@ -8,7 +8,7 @@ import pytest
 
 import signorini
 from signorini.errors import InputError
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting
 
 
 def _rel(a, b) -> float:

@@ -14,7 +14,8 @@ import pytest
 import signorini
 from signorini.cli import main
 from signorini.certification.diagnosis import explain, violations
-from signorini.certification.kkt import INACTIVE, WEAK, classify, compare
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import INACTIVE, WEAK, classify
 
 IGNORES = textwrap.dedent("""
     import numpy as np

@@ -127,7 +127,7 @@ def test_every_result_reports_its_estimate():
 
 def test_the_estimate_solves_nothing():
     """The estimate is local work: no factorisation, no back-solve, no CG (counted, not timed)."""
-    from signorini.numerics.work import Work, counting
+    from signorini.numerics.factor import Work, counting
 
     result = signorini.solve("hertz-cylinder")
     with counting() as work:

@@ -9,8 +9,7 @@ from pathlib import Path
 import pytest
 
 from signorini.cli import main
-from signorini.numerics.factor import FACTOR_MEMORY_VARIABLE, FactorTooLarge
-from signorini.numerics.work import counting
+from signorini.numerics.factor import FACTOR_MEMORY_VARIABLE, FactorTooLarge, counting
 
 ROOT = Path(__file__).resolve().parents[1]
 

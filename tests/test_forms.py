@@ -13,8 +13,9 @@ import pytest
 
 import signorini
 from signorini.errors import InputError
-from signorini.certification.kkt import compare, force_scale, gap_scale
-from signorini.numerics.work import Work, counting
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import force_scale, gap_scale
+from signorini.numerics.factor import Work, counting
 from signorini.problem.contact import ContactSolution
 from signorini.solvers import forms, qp
 from signorini.solvers.registry import get_method, solve

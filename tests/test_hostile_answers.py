@@ -21,10 +21,9 @@ import pytest
 
 import signorini
 from signorini.cli import main
-from signorini.certification.forward_error import refined_on_active_set
+from signorini.certification.comparison import refined_on_active_set
 from signorini.certification.kkt import ACTIVE, FORCE_FLOOR, active_set, certificate, classify, force_scale
-from signorini.numerics.factor import factorize
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting, factorize
 from signorini.references.pressure import compare_hertz
 from signorini.problem.contact import ContactSolution
 from signorini import at_load

@@ -8,8 +8,9 @@ import scipy.sparse as sp
 
 import signorini
 from signorini import load_control
-from signorini.certification import duality_gap, kkt
-from signorini.certification.duality_gap import MAX_RELEASED, primal_dual_gap
+from signorini.certification import kkt
+from signorini.certification.comparison import compare
+from signorini.certification.inverse import MAX_RELEASED, primal_dual_gap
 from signorini.certification.kkt import (
     ACTIVE,
     INACTIVE,
@@ -18,12 +19,10 @@ from signorini.certification.kkt import (
     active_set,
     certificate,
     classify,
-    compare,
     gap_scale,
 )
 from signorini.numerics.active_set import selection_dofs
-from signorini.numerics.factor import factorize
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting, factorize
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.scenes import build as scene_build
 from signorini.scenes import build_problem
@@ -401,7 +400,7 @@ def test_the_forward_error_multiplies_by_all_of_k_once_given_k_u(zoned):
     """On a pinned factorisation each Newton step reads only the rows of K x it needs (the
     border's, the active set's): given K u, the one product by the whole K is the second
     step's residual."""
-    from signorini.certification.forward_error import forward_error
+    from signorini.certification.inverse import forward_error
 
     class Counted(sp.csr_matrix):
         products = 0
@@ -456,7 +455,7 @@ def test_a_remembered_back_solve_gives_what_solving_again_gives(zoned, method, m
 
     solution = keep(registry.get_method(method).function(zoned))
     remembered = spent(lambda: kkt._certificate(zoned, solution, True))
-    monkeypatch.setattr(duality_gap.Remembering, "solve", lambda self, rhs: self.factor.solve(rhs))
+    monkeypatch.setattr(kkt.Remembering, "solve", lambda self, rhs: self.factor.solve(rhs))
     solved = spent(lambda: kkt._certificate(zoned, solution, True))
     assert solved[0]["back_solves"] == remembered[0]["back_solves"] + 1
     for name, value in solved[1].residuals().items():

@@ -10,7 +10,8 @@ import signorini
 from signorini import load_control
 
 from signorini.fem.assembly import assemble
-from signorini.certification.kkt import certificate, compare
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import certificate
 from signorini.references.catalogue import reference_of
 from signorini.numerics.active_set import PinnedFactor
 from signorini.numerics.factor import factorize

@@ -8,7 +8,7 @@ import signorini
 from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery, SignedDistance
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.references.pressure import compare_reverse_hertz, contact_profile, load_resultant
 from signorini.scenes import build_problem
 from signorini.fem.model import FlatObstacle, SceneModel

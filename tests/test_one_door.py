@@ -25,8 +25,8 @@ from signorini.cli import main
 
 ROOT = os.path.dirname(signorini.__file__)
 #: package files a solve enters: a scene with a target load, and a QP given as arrays
-SCENE_FILES = 31
-QP_FILES = 13
+SCENE_FILES = 29
+QP_FILES = 10
 
 
 def traced(step):

@@ -11,7 +11,7 @@ import pytest
 import signorini
 from signorini.cli import main
 from signorini.errors import InputError
-from signorini.numerics.work import Work, counting
+from signorini.numerics.factor import Work, counting
 from signorini.solvers import condensed, cvxpy_, nested, pdas, petsc_, qp, uzawa
 from signorini.solvers.options import KINDS, Option
 from signorini.solvers.registry import get_method

@@ -27,8 +27,7 @@ except ModuleNotFoundError:  # Python 3.10
 
 import signorini
 from signorini.errors import DISTRIBUTIONS, install_hint
-from signorini.numerics.factor import _MODULES as FACTOR_MODULES
-from signorini.numerics.factor import EXTRAS as FACTOR_EXTRAS
+from signorini.numerics.factor import _MODULES as FACTOR_MODULES, EXTRAS as FACTOR_EXTRAS
 from signorini.solvers.registry import methods
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -18,8 +18,9 @@ import scipy.sparse as sp
 
 import signorini
 from signorini import load_control
-from signorini.certification.kkt import certificate, compare
-from signorini.numerics.work import counting
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import certificate
+from signorini.numerics.factor import counting
 from signorini.numerics.multigrid import Bordered
 from signorini.problem.contact import ContactProblem
 from signorini.scenes import build_problem

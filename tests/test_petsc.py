@@ -18,7 +18,8 @@ import scipy.sparse as sp
 
 import signorini
 from signorini.errors import InputError
-from signorini.certification.kkt import active_set, compare
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import active_set
 from signorini.scenes import build_problem
 from signorini.solvers.bounds import InfeasibleBounds, NoBoundForm, bound_form
 from signorini.solvers.cluster import mpirun_command

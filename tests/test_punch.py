@@ -7,7 +7,7 @@ import pytest
 import signorini
 from signorini.references.analytic import punch_load_between, punch_pressure
 from signorini.errors import InputError
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.references.pressure import compare_punch, contact_profile, load_resultant
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve

@@ -7,7 +7,8 @@ import pytest
 
 import signorini
 from signorini.errors import InputError
-from signorini.certification.kkt import certificate, compare
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import certificate
 from signorini.numerics.lcp import solve_lcp
 from signorini.scenes import build_problem
 from signorini.solvers import pdas, registry

@@ -16,7 +16,8 @@ import pytest
 import signorini
 from signorini.certification.diagnosis import diagnose, regularise
 from signorini.errors import InputError
-from signorini.certification.kkt import certificate, classify, compare
+from signorini.certification.comparison import compare
+from signorini.certification.kkt import certificate, classify
 from signorini.problem.contact import ContactSolution
 from signorini.scenes import build_problem
 from signorini.scenes.block import force_controlled_exact, force_controlled_problem

@@ -6,10 +6,11 @@ import time
 
 import signorini
 from signorini.api import solve_summary
-from signorini.numerics.work import STAGES, stage_key
+from signorini.numerics.stages import STAGES, stage_key
 
 
 def test_the_stages_sum_to_the_wall_time_of_a_solve_and_its_record():
+    signorini.solve("hertz-cylinder")  # the modules a first solve imports are start-up, not its stages
     start = time.perf_counter()
     record = signorini.solve("hertz-cylinder").to_dict()
     wall = time.perf_counter() - start

@@ -99,7 +99,7 @@ def test_a_material_of_the_wrong_body_count_is_refused_in_one_line(scene, wrt, w
 def test_two_bodies_cost_at_most_a_third_more_than_one_body_of_as_many_dofs(method):
     """Counted in factorisations and back-solves, the certificate's included: the method's
     saddle-point system serves the certificate (no factorisation of K, no Delassus operator)."""
-    from signorini.numerics.work import counting
+    from signorini.numerics.factor import counting
 
     cost = {}
     one_body = {"refine": 1, "mesher": "relaxed", "n_contact": 40, "grading": 0.15}  # as the two's

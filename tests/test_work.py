@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 import signorini
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting
 
 
 @pytest.mark.parametrize("scene", ["hertz-cylinder", "hertz-sphere"])

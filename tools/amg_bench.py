@@ -195,7 +195,7 @@ def crossover() -> dict:
 
 
 def petsc_350k(params: dict = SPHERE_350K, method: str = "pdas-amg") -> dict:
-    from signorini.certification.kkt import compare
+    from signorini.certification.comparison import compare
     from signorini import solve as solve_scene
     from signorini.scenes import build_problem
     from signorini.solvers.registry import solve

@@ -6,7 +6,7 @@ Hertz's cylinder (``n_contact=20``, the default volumetric treatment, its load m
 for each ν of ``NUS`` and each method of ``METHODS``, each a task of the studies' runner:
 the method's status, the true relative error of λ against pdas's answer refined in long
 double on its active set (the ``refined`` reference policy,
-:func:`signorini.certification.forward_error.refined_on_active_set`), and the certificate's estimate
+:func:`signorini.certification.comparison.refined_on_active_set`), and the certificate's estimate
 (``force_error``) and its floor (``force_error_floor``): the ``forward_error`` measure. ``table`` renders
 the page's table from the JSON; tests/test_hostile_answers.py holds the page to it.
 """

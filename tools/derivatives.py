@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 import signorini
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "derivatives"

@@ -173,7 +173,7 @@ def load() -> list[dict]:
 def cost() -> dict:
     """In-process time and work of two bodies against one body of about as many dofs."""
     import signorini
-    from signorini.numerics.work import counting
+    from signorini.numerics.factor import counting
 
     rows, before = [], os.getloadavg()[0]
     for method in ("pdas", "auto"):

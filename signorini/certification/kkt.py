@@ -1,10 +1,13 @@
-"""KKT certificates, active sets and comparisons: computed here, never by a solver.
+"""KKT certificates and active sets: computed here, never by a solver.
 
 For ``min ½uᵀKu − fᵀu  s.t.  Nu ≤ d`` with multipliers ``λ`` every residual is
 relative, so that the same threshold means the same thing in any units; the forward
-error of λ itself comes from one Newton correction on the active set
-(:mod:`signorini.certification.forward_error`, docs/certificate.md), and the duality gap from
-a factorisation the method already holds when it can (:mod:`signorini.certification.duality_gap`).
+error of λ itself comes from one Newton correction on the active set, and the duality gap from
+a factorisation the method already holds when it can (:mod:`signorini.certification.inverse`,
+docs/certificate.md). The factorisations on offer to one certificate (the method's, the
+problem's cached one) are wrapped once (:class:`Offers`), and each remembers what it solved
+(:class:`Remembering`), so that the forward error's back-solve and the gap's, of opposite
+right-hand sides, cost one.
 """
 
 from __future__ import annotations
@@ -16,8 +19,7 @@ import numpy as np
 from scipy.sparse.linalg import lobpcg
 
 from signorini.errors import InputError
-from signorini.certification.duality_gap import Offers, primal_dual_gap
-from signorini.certification.forward_error import ForwardError, forward_error
+from signorini.certification.inverse import ForwardError, forward_error, pinned_rows, primal_dual_gap
 from signorini.problem.contact import ContactProblem, ContactSolution
 
 #: normalised force and gap below which a node counts as touching with zero force
@@ -101,7 +103,7 @@ class Certificate:
     - ``force_error_floor``: the force change of a second Newton step: what
       double precision resolves of λ on this system (about ``force_error``
       when the system is too ill-conditioned for the first step to be trusted).
-      See :mod:`signorini.certification.forward_error` (no factorisation when the method
+      See :mod:`signorini.certification.inverse` (no factorisation when the method
       holds one; NaN when not estimated).
 
     Force norms are floored at ``FORCE_FLOOR · ‖f‖∞`` so that a problem with
@@ -141,6 +143,56 @@ class Certificate:
                 or not np.isfinite(tol) or tol <= 0:
             raise InputError(f"Certificate.passed: tol must be a positive number, got {tol!r}")
         return shortfall(self, float(tol)) is None
+
+
+#: right-hand sides a factorisation offered to the certificate remembers (see :class:`Remembering`)
+REMEMBERED_SOLVES = 3
+
+
+class Remembering:
+    """A factorisation offered to one certificate, which remembers what it was asked.
+
+    The forward error's first Newton step and the duality gap can solve the same system with
+    opposite right-hand sides (the method's pinned set is the active set and λ is zero off
+    it): a solve is linear and exactly odd in floating point, so a right-hand side that is
+    minus one already solved gets minus that answer instead of a second solve — the numbers
+    a second solve gives. Its pinned rows (:func:`~signorini.certification.inverse.pinned_rows`) are found once.
+    """
+
+    def __init__(self, problem: ContactProblem, factor):
+        self.factor, self.solved = factor, []
+        self.pinned = pinned_rows(problem, factor)
+
+    def __getattr__(self, name: str):
+        return getattr(self.factor, name)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        rhs = np.asarray(rhs)
+        if rhs.ndim == 1:
+            for asked, answer in self.solved:
+                if np.array_equal(asked, -rhs):
+                    return -answer
+        answer = self.factor.solve(rhs)
+        if rhs.ndim == 1:
+            self.solved = [(rhs.copy(), answer.copy())] + self.solved[:REMEMBERED_SOLVES - 1]
+        return answer
+
+
+class Offers:
+    """The factorisations on offer to one certificate — the method's, then the problem's cached
+    one — each wrapped once in :class:`Remembering`."""
+
+    def __init__(self, problem: ContactProblem, solution: ContactSolution):
+        self.problem, self.solution, self.wrapped = problem, solution, {}
+
+    def wrap(self, factor) -> Remembering:
+        if id(factor) not in self.wrapped:
+            self.wrapped[id(factor)] = (factor, Remembering(self.problem, factor))
+        return self.wrapped[id(factor)][1]
+
+    def __call__(self) -> list[Remembering]:
+        return [self.wrap(f) for f in (self.solution.factor, self.problem.cached_factor)
+                if f is not None]
 
 
 def certificate(problem: ContactProblem, solution: ContactSolution,
@@ -331,45 +383,7 @@ def active_set(problem: ContactProblem, solution: ContactSolution,
     return classify(problem, solution, weak_tol) == ACTIVE
 
 
-@dataclass(frozen=True)
-class Comparison:
-    """How far two solutions of one problem are apart.
-
-    ``u_rel`` and ``lam_rel`` are ∞-norm differences relative to the larger
-    norm; ``misclassified`` counts nodes active in one and inactive in the
-    other (weakly active nodes of either are left out and counted in ``weak``).
-    """
-
-    u_rel: float
-    lam_rel: float
-    misclassified: int
-    weak: int
-
-    @property
-    def same_active_set(self) -> bool:
-        return self.misclassified == 0
-
-    as_dict = asdict
-
-
-def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
-    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
-        return float("inf")
-    return _inf_norm(a - b) / _positive(max(_inf_norm(a), _inf_norm(b)))
-
-
-def compare(problem: ContactProblem, first: ContactSolution, second: ContactSolution,
-            weak_tol: float = WEAK_TOL) -> Comparison:
-    """Compare two solutions: displacements, multipliers and active sets."""
-    u_rel, lam_rel = _rel_diff(first.u, second.u), _rel_diff(first.lam, second.lam)
-    if not np.isfinite(lam_rel) or not np.isfinite(u_rel):
-        return Comparison(u_rel, lam_rel, problem.m, 0)
-    a, b = classify(problem, first, weak_tol), classify(problem, second, weak_tol)
-    weak = (a == WEAK) | (b == WEAK)
-    misclassified = int(np.sum((a != b) & ~weak))
-    return Comparison(u_rel, lam_rel, misclassified, int(np.sum(weak)))
-
-
 __all__ = ["ACTIVE", "CURVATURE_STEPS", "DENSE_EIGEN_DOFS", "NEGATIVE_CURVATURE", "FORCE_FLOOR", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "WEAK", "WEAK_TOL",
-           "Certificate", "Comparison", "active_set", "certificate", "classify", "compare", "force_scale",
+           "Certificate", "Offers", "REMEMBERED_SOLVES", "Remembering", "active_set", "certificate",
+           "classify", "force_scale",
            "gap_scale", "indefinite", "shortfall"]

@@ -29,9 +29,8 @@ import numpy as np
 from signorini.errors import InputError, SolverError
 from signorini.certification.kkt import ACTIVE, WEAK, classify
 from signorini.numerics.active_set import ActiveSetSolver
-from signorini.problem.contact import ContactProblem
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.reprs import short_repr
-from signorini.problem.solution import ContactSolution
 
 SIDES = ("auto", "in", "out")
 

@@ -19,12 +19,11 @@ from signorini.errors import InputError
 from signorini.fem.assembly import lame_stiffness, nodal_dofs
 from signorini import load_control
 from signorini.references.profile import contact_profile, hertz_fit, hertz_fit_tangent
-from signorini.problem.contact import ContactProblem
+from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.reprs import short_repr
 from signorini.scenes import build_problem
 from signorini.scenes.base import scene_params
 from signorini.scenes.build import coarse_problem
-from signorini.problem.solution import ContactSolution
 from signorini.solvers.registry import check_request
 
 OUTPUTS = ("total_force", "energy", "displacement", "pressure", "p0", "a")

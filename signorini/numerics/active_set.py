@@ -16,9 +16,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from signorini.numerics.factor import (CholmodFactor, Factor, PardisoFactor, cholmod_analysis,
-                                       factorize, resolve_backend, upper_csr)
-from signorini.numerics.work import count, count_solves
+from signorini.numerics.factor import (CholmodFactor, Factor, PardisoFactor, cholmod_analysis, count,
+                                       count_solves, factorize, resolve_backend, upper_csr)
 
 __all__ = ["ActiveSetSolver", "PinnedFactor", "Pinning", "SaddlePoint", "selection_dofs"]
 

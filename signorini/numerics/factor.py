@@ -14,8 +14,14 @@ docs/speed.md (§1) compares the backends' times and holds the measurements behi
 
 Every factorisation knows the matrix it factorised (``matrix``) and the dofs it
 pinned (``fixed``; none for a plain one), so that the certificate can reuse a
-method's factorisation of the same K; each factorisation and back-solve is counted into the
-stage's :class:`~signorini.numerics.work.Work` record (:mod:`signorini.numerics.work`).
+method's factorisation of the same K.
+
+Work as data: each factorisation and back-solve (and, elsewhere in the numerics, each multigrid
+hierarchy, CG iteration and load-control step) is counted (:func:`count`) into every
+:class:`Work` record open in the current context, which a stage opens with :func:`counting`.
+The open records live in a :class:`contextvars.ContextVar` (per thread and per task): two
+solves side by side never see each other's work, and outside any ``counting`` block nothing is
+kept. Tests count work instead of timing it.
 """
 
 from __future__ import annotations
@@ -24,15 +30,71 @@ import importlib.util
 import logging
 import os
 import sys
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import asdict, dataclass
+from typing import Iterator
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.errors import BackendNotInstalled, InputError, install_hint
-from signorini.numerics.work import count, count_solves
 
 log = logging.getLogger(__name__)
+
+@dataclass
+class Work:
+    """The work of one stage: every count starts at zero."""
+
+    factorisations: int = 0
+    back_solves: int = 0
+    hierarchies: int = 0
+    cg_iterations: int = 0
+    load_steps: int = 0
+
+    def as_dict(self) -> dict[str, int]:
+        """The counts that are not zero, by name."""
+        return {name: value for name, value in asdict(self).items() if value}
+
+    def listed(self, steps: int | None = None) -> dict[str, int]:
+        """The stage as ``solution.work`` lists it: its ``steps`` (given, else load control's
+        active-set steps when there were any), factorisations, back-solves, CG iterations and
+        hierarchies, the zero counts left out."""
+        counts = {"factorisations": self.factorisations, "back_solves": self.back_solves,
+                  "cg_iterations": self.cg_iterations, "hierarchies": self.hierarchies}
+        listed = {key: value for key, value in counts.items() if value}
+        if steps is None and not self.load_steps:
+            return listed
+        return {"steps": self.load_steps if steps is None else steps, **listed}
+
+
+_OPEN: ContextVar[tuple[Work, ...]] = ContextVar("signorini_work", default=())
+
+
+@contextmanager
+def counting() -> Iterator[Work]:
+    """A new :class:`Work` record that counts what the block does (and its inner stages)."""
+    work = Work()
+    token = _OPEN.set(_OPEN.get() + (work,))
+    try:
+        yield work
+    finally:
+        _OPEN.reset(token)
+
+
+def count(kind: str, amount: int = 1) -> None:
+    """Add ``amount`` of ``kind`` (a field of :class:`Work`) to every record open here."""
+    for work in _OPEN.get():
+        setattr(work, kind, getattr(work, kind) + amount)
+
+
+def count_solves(b: np.ndarray) -> np.ndarray:
+    """``b`` as floats, its right-hand sides (one, or its columns) counted as back-solves."""
+    b = np.asarray(b, dtype=float)
+    count("back_solves", 1 if b.ndim == 1 else b.shape[1])
+    return b
+
 
 BACKENDS = ("pardiso", "cholmod", "superlu")
 _MODULES = {"cholmod": "sksparse", "pardiso": "pypardiso", "superlu": "scipy"}
@@ -317,4 +379,5 @@ def factorize(K: sp.spmatrix, backend: str | None = None) -> Factor:
 __all__ = ["available_backends", "resolve_backend", "Factor", "cholmod_analysis",
            "cholmod_numeric", "CholmodFactor", "FactorTooLarge", "gigabytes_from",
            "factor_memory_limit", "pardiso_factor_bytes", "upper_csr", "PardisoFactor",
-           "factorize", "BACKENDS", "EXTRAS", "PARDISO_OVER_CHOLMOD_FROM", "FACTOR_MEMORY_VARIABLE"]
+           "factorize", "BACKENDS", "EXTRAS", "PARDISO_OVER_CHOLMOD_FROM", "FACTOR_MEMORY_VARIABLE",
+           "Work", "count", "count_solves", "counting"]

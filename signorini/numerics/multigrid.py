@@ -12,7 +12,7 @@ PETSc's GAMG in :mod:`signorini.solvers.amg_system`.
 values and the preconditioner's output is zeroed on them (so the operator CG sees, ``P M P``
 on the free subspace, stays SPD whatever pinned set the hierarchy was built for). Hierarchies
 built and CG iterations are counted into the stage's work record
-(:mod:`signorini.numerics.work`).
+(:class:`signorini.numerics.factor.Work`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.numerics.work import count
+from signorini.numerics.factor import count
 
 #: 3D models of at least this many free dofs are solved by multigrid (``auto`` picks pdas-amg when
 #: load control precedes the method, and leaves a pending target load to it): their

@@ -24,7 +24,7 @@ import scipy.sparse as sp
 from signorini.errors import InputError
 from signorini.numerics.active_set import ActiveSetSolver
 from signorini.numerics.lcp import forces_on
-from signorini.numerics.work import count
+from signorini.numerics.factor import count
 
 log = logging.getLogger(__name__)
 

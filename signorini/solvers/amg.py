@@ -42,12 +42,11 @@ from signorini.certification.kkt import certificate
 from signorini.numerics.push import first_contact
 from signorini.numerics.multigrid import pinned_cg
 from signorini.numerics.zone import predict_zone
-from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.solvers import pdas
 from signorini.solvers.bounds import NoBoundForm, bound_form
 from signorini.solvers.amg_system import (CG_MAX_ITER, PinnedCG, PinnedSystem, Unknowns,
                                           border_factor, load_border, rotated)
-from signorini.problem.solution import WarmStart
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare, per_candidate, resolved, take_options
 

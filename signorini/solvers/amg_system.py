@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from signorini.numerics.active_set import selection_dofs
 from signorini.numerics.multigrid import (Bordered, PyamgHierarchy, pinned_cg, pinned_matrix,
                                           threaded)
-from signorini.numerics.work import count
+from signorini.numerics.factor import count
 from signorini.problem.contact import ContactProblem
 from signorini.solvers import petsc_piece
 from signorini.solvers.bounds import BoundForm
@@ -153,7 +153,7 @@ class PinnedCG:
     active rows' dofs when each row bounds one dof, else none) and
     ``solve(rhs)``: u with ``u[fixed] = rhs[fixed]`` and ``(K u)[free] = rhs[free]``, to the
     relative residual :data:`CERTIFICATE_RTOL` (``exact`` is False: the forward error takes
-    one Newton step with it, :mod:`signorini.certification.forward_error`).
+    one Newton step with it, :mod:`signorini.certification.inverse`).
     """
 
     exact = False

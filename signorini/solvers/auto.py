@@ -20,8 +20,7 @@ from typing import Any
 import numpy as np
 
 from signorini.numerics.multigrid import AMG_FROM_DOFS
-from signorini.problem.contact import ContactProblem, ContactSolution
-from signorini.problem.solution import WarmStart
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.solvers import amg, nested, pdas
 from signorini.solvers.base import Method, rows_share_dofs
 

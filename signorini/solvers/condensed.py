@@ -16,7 +16,7 @@ import time
 from typing import Any
 
 from signorini.errors import InputError
-from signorini.certification.forward_error import WithDelassus
+from signorini.certification.inverse import WithDelassus
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS, factorize
 from signorini.numerics.lcp import StillChanging, delassus, solve_lcp
 from signorini.problem.contact import ContactProblem, ContactSolution

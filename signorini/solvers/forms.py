@@ -43,8 +43,7 @@ import scipy.sparse as sp
 from signorini.errors import InputError
 from signorini.certification.kkt import ACTIVE, certificate, classify
 from signorini.numerics.active_set import ActiveSetSolver
-from signorini.numerics.factor import factorize
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting, factorize
 from signorini.numerics.lcp import delassus, forces_on
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.solvers.base import acceptance

@@ -25,10 +25,9 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.numerics.active_set import selection_dofs
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS
-from signorini.numerics.work import counting
+from signorini.numerics.factor import counting
 from signorini.numerics.zone import Zone, ZoneSolver, predict_zone
-from signorini.problem.contact import ContactProblem, ContactSolution
-from signorini.problem.solution import WarmStart
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.solvers import pdas
 from signorini.solvers.base import Method, judge
 from signorini.solvers.options import Option, declare, resolved, take_options

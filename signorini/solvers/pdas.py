@@ -15,7 +15,7 @@ the answer on A already meets the remaining conditions to ``tol`` (no force on A
 a set seen before is a cycle, and the method finishes on the condensed LCP with Murty's
 least-index pivoting, which terminates for SPD W. After the first step ``c`` no longer
 matters, so it only weighs a warm start against the gaps. It starts cold, from no contact,
-or from ``warm_start`` (:class:`signorini.problem.solution.WarmStart`) or ``lam0``.
+or from ``warm_start`` (:class:`signorini.problem.contact.WarmStart`) or ``lam0``.
 
 Option ``callback(iteration, u, λ)`` is called with the iterate of each step.
 """
@@ -32,8 +32,7 @@ from signorini.certification.kkt import force_scale, gap_scale
 from signorini.numerics.active_set import ActiveSetSolver
 from signorini.numerics.factor import BACKENDS as FACTOR_BACKENDS, factorize
 from signorini.numerics.lcp import delassus, least_index_lcp
-from signorini.problem.contact import ContactProblem, ContactSolution
-from signorini.problem.solution import WarmStart
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.solvers.base import Method
 from signorini.solvers.options import Option, declare, per_candidate, resolved, take_options
 

@@ -31,10 +31,9 @@ import scipy.sparse as sp
 
 from signorini.errors import BackendNotInstalled, InputError
 from signorini.certification.kkt import Certificate
-from signorini.numerics.work import counting, timed
-from signorini.problem.contact import ContactProblem, ContactSolution
+from signorini.numerics.factor import counting
+from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart
 from signorini.problem.scales import Scales
-from signorini.problem.solution import WarmStart
 from signorini.solvers import amg, auto, condensed, cvxpy_, nested, pdas, petsc_, qp, user, uzawa
 from signorini.solvers.base import (ACCEPT_FACTOR, Method, certify, check_max_iter, check_tol,
                                     fingerprint, held_to_problem, hold_to_contract, judge)
@@ -183,17 +182,18 @@ def run(problem: ContactProblem, request: Request, *, warm_start: WarmStart | No
     if "auto" not in solution.extras:  # auto names the method it picked
         solution.method = method
     log.info("checking the answer: the KKT certificate")
-    with timed(seconds, "certificate"):
-        if problem.model.pending and "push" not in solution.extras:
-            solution = ContactSolution.failure(method, problem, solution.status if
-                                               solution.status != "converged" else "failed",
-                                               f"{solution.message}; the target load was not matched")
-            cert = certify(problem, solution)
-        else:
-            if problem.model.pending:
-                problem = problem.pushed(float(solution.extras["push"]))
-            cert = certify(problem, solution)
-            solution = judge(problem, solution, tol, cert)
+    judging = time.perf_counter()
+    if problem.model.pending and "push" not in solution.extras:
+        solution = ContactSolution.failure(method, problem, solution.status if
+                                           solution.status != "converged" else "failed",
+                                           f"{solution.message}; the target load was not matched")
+        cert = certify(problem, solution)
+    else:
+        if problem.model.pending:
+            problem = problem.pushed(float(solution.extras["push"]))
+        cert = certify(problem, solution)
+        solution = judge(problem, solution, tol, cert)
+    seconds["certificate"] = time.perf_counter() - judging
     solution.seconds = {**solution.seconds, **seconds}
     return problem, solution, cert
 
@@ -304,7 +304,7 @@ def solve(problem: ContactProblem, method: str = "pdas", *, tol: float | None = 
     message says by how much it missed. A backend exception becomes a
     ``failed`` solution; bad input (unknown options, non-positive tolerances)
     raises :class:`InputError`. ``warm_start`` is where the method starts
-    (see :class:`signorini.problem.solution.WarmStart`); without it every method
+    (see :class:`signorini.problem.contact.WarmStart`); without it every method
     starts cold. A problem whose target load is pending is matched by
     :func:`signorini.solve` (load control), not here.
     """

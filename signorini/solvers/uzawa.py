@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.certification.forward_error import WithDelassus
+from signorini.certification.inverse import WithDelassus
 from signorini.certification.kkt import certificate, shortfall
 from signorini.numerics.factor import factorize
 from signorini.numerics.lcp import delassus, delassus_max_eigenvalue

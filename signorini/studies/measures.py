@@ -84,7 +84,7 @@ def weak_but_penetrating(problem: ContactProblem, solution: ContactSolution) -> 
 
     ``classify`` measures the gap as ``(d − Nu)⁺``, so a node with zero force
     that overlaps the obstacle by more than the weak tolerance is labelled
-    weak and left out of :func:`signorini.certification.kkt.compare` — a misclassification
+    weak and left out of :func:`signorini.certification.comparison.compare` — a misclassification
     the comparison does not count. The atlas counts it here.
     """
     if not (np.all(np.isfinite(solution.u)) and np.all(np.isfinite(solution.lam))):

@@ -35,7 +35,7 @@ from signorini.errors import InputError
 from signorini.fem.assembly import assemble
 from signorini.fem.model import FlatObstacle
 from signorini.files import atomic_write_bytes
-from signorini.certification.forward_error import refined_on_active_set
+from signorini.certification.comparison import refined_on_active_set
 from signorini.certification.kkt import active_set
 from signorini.load_control import at_load
 from signorini.numerics.factor import factorize

@@ -11,7 +11,7 @@ answer it is held to. :func:`run_task` runs it and measures one :class:`Row`:
   (:func:`signorini.solvers.base.acceptance`: ``tol``, or ``DEFAULT_TOL`` without one);
 - the distance from the trusted exact answer ``(u*, λ*)``:
   ``‖λ − λ*‖∞ / max(‖λ*‖∞, 1e-5 ‖f‖∞)`` and the misclassified contact
-  nodes (weakly active nodes left out, :func:`signorini.certification.kkt.compare`, plus
+  nodes (weakly active nodes left out, :func:`signorini.certification.comparison.compare`, plus
   nodes with zero force that penetrate, which that comparison misses);
 - the Hertz errors of a and p₀ on Hertz's cylinder;
 - whatever else the task asks for by name in ``measure`` (:data:`MEASURES`).
@@ -46,7 +46,7 @@ from signorini.crosschecking import crosscheck
 from signorini.certification.diagnosis import diagnose
 from signorini.errors import InputError
 from signorini.files import plain
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.references.catalogue import reference_metrics
 from signorini.scenes.block import force_controlled_exact

@@ -24,7 +24,7 @@ from typing import Callable
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.certification.forward_error import WithDelassus
+from signorini.certification.inverse import WithDelassus
 from signorini.certification.kkt import certificate
 from signorini.numerics.lcp import delassus
 from signorini.numerics.push import push_for_load_condensed

@@ -39,7 +39,7 @@ MEASURES = {
     "kkt": "every relative residual of the certificate (kkt)",
     "times": "build, solve and the method's own time, not the certificate's (build_s, solve_s, "
              "method_s)",
-    "vs_reference": "signorini.certification.kkt.compare with the exact answer (vs_reference)",
+    "vs_reference": "signorini.certification.comparison.compare with the exact answer (vs_reference)",
     "reference": "the errors against the analytic reference the problem declares (reference)",
     "estimate": "the a posteriori estimates, energy norm and contact pressure, η and its parts, "
                 "η without the contact term, and its time (estimate)",

@@ -128,7 +128,7 @@ def _rectangle(x: float, y: float, colour: str):
 def atlas_weak_nodes(rows: list[dict], *, ax=None):
     """Misclassified contact nodes per run: weakly active nodes left out, and counted strictly.
 
-    The comparison of :func:`signorini.certification.kkt.compare` leaves out nodes that touch
+    The comparison of :func:`signorini.certification.comparison.compare` leaves out nodes that touch
     with zero force; counting them as well (weak tolerance 0) shows what a
     comparison without the weak label would have flagged.
     """

@@ -111,7 +111,7 @@ def _header(result: AtlasResult, command: str, info: dict[str, Any], runs: int) 
          f"passes when ≤ τ (the tolerance asked for; {DEFAULT_TOL:g} without one)."),
         ("- **exact answer**: PDAS at 1e-9 on the non-dimensionalised problem (or the patch "
          "solution where K is singular). An answer **agrees** when no contact node is "
-         "misclassified (`kkt.compare`, weakly active nodes left out — but a node with zero "
+         "misclassified (`comparison.compare`, weakly active nodes left out — but a node with zero "
          "force that penetrates the obstacle counts) and ‖λ − λ*‖∞ ≤ "
          f"min({AGREE_FACTOR:g} τ, {AGREE_CAP:g}) · max(‖λ*‖∞, 1e-5 ‖f‖∞) (the validation "
          "suite's ratio, capped so that a loose τ cannot excuse a wrong contact force)."),

@@ -1,5 +1,7 @@
-"""Forward error of the contact force: one Newton correction on the active set.
+"""What the certificate computes with K⁻¹: the forward error of the contact force (one Newton
+correction on the active set) and the duality gap, on a factorisation the method already holds.
 
+**The forward error.**
 On an active set A the exact answer ``(u*, λ*)`` (``λ* = 0`` off A) solves the
 saddle-point system ``M [u*; λ*_A] = [f; d_A]`` with::
 
@@ -37,6 +39,11 @@ A solve by an iterative method (an object with ``exact = False``: conjugate grad
 stopped at a relative residual) gives the first step to that residual, which is what
 the force error needs; a second step would measure where the iteration stopped, not
 double precision, so it is not taken and the floor is NaN.
+
+**The duality gap.** ``J(u) − D(λ̂)`` bounds how far the energy of ``u`` is above the optimum
+(:func:`primal_dual_gap`): one back-solve of the method's own factorisation when its matrix is
+this problem's K (:func:`same_matrix`) and its pinned dofs are rows of N (:func:`pinned_rows`),
+else ``½ rᵀK⁻¹r`` from the problem's own factorisation.
 """
 
 from __future__ import annotations
@@ -77,7 +84,7 @@ class ForwardError:
         return cls(nan, nan, nan, 0)
 
 
-class _Counted:
+class Counted:
     """A factorisation's ``solve`` that counts its right-hand sides."""
 
     def __init__(self, factor):
@@ -214,7 +221,7 @@ def _schur_system(K: sp.spmatrix, solve: Callable, N: sp.csr_matrix, rows: np.nd
     return apply, k
 
 
-def _system(K: sp.spmatrix, N: sp.csr_matrix, rows: np.ndarray, solve: _Counted):
+def newton_system(K: sp.spmatrix, N: sp.csr_matrix, rows: np.ndarray, solve: Counted):
     """``(r, g) ↦ M⁻¹(−r, −g)`` on the rows ``rows`` by the factorisation behind ``solve``
     (pinned or plain); None when it cannot (more than :data:`MAX_BORDER` rows to border, rows
     that are dependent, or a pinned factorisation while the rows of N do not each bound one dof)."""
@@ -240,9 +247,9 @@ def forward_error(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray
     one dof each); ``scale`` the force λ's error is measured against; ``Ku`` is K u when
     the caller has it.
     """
-    solve = _Counted(factor)
+    solve = Counted(factor)
     rows = np.flatnonzero(active)
-    apply = _system(K, N, rows, solve)
+    apply = newton_system(K, N, rows, solve)
     if apply is None:
         return ForwardError.unknown()
     N_A, d_A = N[rows], d[rows]
@@ -265,34 +272,120 @@ def forward_error(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray
     return ForwardError(force, float(np.max(np.abs(du), initial=0.0)) / u_norm, floor, solve.count)
 
 
-def refined_on_active_set(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray,
-                          u: np.ndarray, lam: np.ndarray, active: np.ndarray, factor,
-                          steps: int = 30) -> tuple[np.ndarray, np.ndarray]:
-    """``(u*, λ*)`` on ``active`` by iterative refinement with residuals in ``np.longdouble``.
+# -- the duality gap ---------------------------------------------------------------------------
 
-    The corrections come from ``factor`` in double precision (as in
-    :func:`forward_error`); the residuals and the sums are long double (80-bit
-    on x86: 11 more bits), so the refinement converges below double's round-off
-    wherever ``κ(M) ε_double < 1``. A reference for tests and studies, not for the
-    certificate (each step is a long-double product with K).
+#: a factorisation offered to the certificate is one of the problem's K when ``K x`` by both
+#: agrees to this (relative, for a fixed random x: the two sum in different orders)
+SAME_MATRIX_RTOL = 1e-12
+#: pinned nodes whose best force is negative (round-off on a node touching with no force) are
+#: released, a back-solve each; beyond this many the certificate gives up on the method's
+#: factorisation and takes the problem's own way to K⁻¹
+MAX_RELEASED = 16
+
+def primal_dual_gap(problem: ContactProblem, u: np.ndarray, lam: np.ndarray, factors=(),
+                Ku: np.ndarray | None = None) -> float:
+    """``J(u) − D(λ̂)``: how far the energy of ``u`` can be above the optimum, exactly.
+
+    ``D(μ) = min_v L(v, μ)`` is the dual function; for any ``μ ≥ 0``,
+    ``D(μ) ≤ J* ≤ J(u)``. The dual point is ``λ̂ = λ⁺`` with its entries on
+    the *pinned* rows ``C`` of a factorisation of K the method already holds
+    (:class:`~signorini.numerics.active_set.PinnedFactor`: each such row bounds
+    one dof, pinned; a plain factorisation of K pins none) replaced by their
+    best values, those that maximise ``D`` over ``λ_C`` with the others fixed.
+    Then, with ``r = Ku − f + N_Rᵀλ_R⁺`` (the stationarity residual without
+    the pinned rows' forces), one back-solve of the pinned factorisation gives
+    ``e`` with ``(Ke)_free = r_free`` and ``e_C = (N_C u − d_C)/n_C``;
+    ``v = u − e`` minimises ``L(·, λ̂)`` with ``N_C v = d_C``, and
+    ``λ̂_C = (Ke − r)_C / n_C``, so exactly::
+
+        J(u) − D(λ̂) = λ̂ᵀ(d − Nu) + ½ eᵀKe.
+
+    With nothing pinned this is the textbook ``λ⁺ᵀ(d − Nu) + ½ rᵀK⁻¹r``;
+    pinning only ever tightens it (``D(λ̂) ≥ D(λ⁺)``). It is a bound when
+    ``λ̂_C ≥ 0``; a pinned node whose best force is negative (round-off on a
+    node touching with no force) is released, its row rejoining the others
+    with force ``λ⁺``, and the identity evaluated again on the factorisation
+    with those dofs freed by a Schur complement (one back-solve each; at most
+    :data:`MAX_RELEASED`).
+
+    ``factors`` are the factorisations on offer, tried in turn; one is used
+    only when its matrix is this problem's K (``K x`` agrees for a random x)
+    and its pinned dofs are rows of N that bound one dof each: the
+    certificate trusts a method's linear algebra on the same K, never its
+    numbers. With none usable, ``½ rᵀK⁻¹r`` comes from
+    :meth:`ContactProblem.inverse_energy` (a factorisation of K, cached; from
+    300k dofs Jacobi-preconditioned CG).
     """
-    ld = np.longdouble
-    rows = np.flatnonzero(active)
-    apply = _system(K, N, rows, _Counted(factor))
-    if apply is None:
-        raise np.linalg.LinAlgError("no Newton step on this active set: its rows of N are "
-                                    "dependent, or too many to border")
-    K_l, N_l = K.astype(ld), N[rows].astype(ld)
-    f_l, d_l = f.astype(ld), d[rows].astype(ld)
-    x, mu = u.astype(ld), lam[rows].astype(ld)
-    for _ in range(steps):
-        r = K_l @ x - f_l + N_l.T @ mu
-        g = N_l @ x - d_l
-        du, dmu = apply(r.astype(float), g.astype(float))
-        x, mu = x + du.astype(ld), mu + dmu.astype(ld)
-    out = np.zeros(lam.shape, dtype=ld)
-    out[rows] = mu
-    return x, out
+    lam_plus = np.maximum(lam, 0.0)
+    Ku = problem.K @ u if Ku is None else Ku
+    for factor in factors:
+        pinned = factor.pinned if hasattr(factor, "pinned") else pinned_rows(problem, factor)
+        gap = None if pinned is None else _gap_on(problem, u, lam_plus, Ku, factor, *pinned)
+        if getattr(factor, "on", None) and factor.on(problem.K, problem.N):  # a saddle point's
+            gap = factor.gap(problem.K, problem.f, problem.N, problem.d, u, lam_plus, Ku)
+        if gap is not None:
+            return gap
+    r = Ku - problem.f + problem.N.T @ lam_plus
+    return float(lam_plus @ (problem.d - problem.N @ u)) + 0.5 * problem.inverse_energy(r)
 
 
-__all__ = ["ForwardError", "WithDelassus", "forward_error", "refined_on_active_set"]
+def pinned_rows(problem: ContactProblem, factor) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(rows C, their coefficients n_C)`` of ``factor``'s pinned dofs, or None when unusable."""
+    if getattr(factor, "fixed", None) is None or not same_matrix(problem.K, factor.matrix):
+        return None
+    fixed = np.asarray(factor.fixed, dtype=int)
+    if fixed.size == 0:
+        return fixed, np.zeros(0)
+    dofs = selection_dofs(problem.N)
+    if dofs is None:
+        return None
+    row_of = np.full(problem.n, -1)
+    row_of[dofs] = np.arange(problem.m)
+    rows = row_of[fixed]
+    return None if np.any(rows < 0) else (rows, np.asarray(problem.N[rows, fixed]).ravel())
+
+
+def same_matrix(K, other) -> bool:
+    """``other`` is ``K`` up to summation order (see :data:`SAME_MATRIX_RTOL`)."""
+    if other is K:
+        return True
+    if other is None or getattr(other, "shape", None) != K.shape or other.nnz != K.nnz:
+        return False
+    x = np.random.default_rng(0).uniform(0.5, 1.5, K.shape[0])
+    y = K @ x
+    scale = float(np.max(np.abs(y), initial=0.0)) or 1.0
+    return bool(np.max(np.abs(y - other @ x), initial=0.0) <= SAME_MATRIX_RTOL * scale)
+
+
+def _gap_on(problem: ContactProblem, u: np.ndarray, lam_plus: np.ndarray, Ku: np.ndarray,
+            factor, rows: np.ndarray, coef: np.ndarray) -> float | None:
+    """:func:`primal_dual_gap` on ``factor`` with its pinned ``rows``; None when it gives up."""
+    fixed, K = factor.fixed, problem.K
+    released = np.zeros(rows.size, dtype=bool)
+    while True:
+        held = rows[~released]
+        lam_hat = lam_plus.copy()
+        lam_hat[held] = 0.0
+        r = Ku - problem.f + problem.N.T @ lam_hat
+        rhs = r.copy()
+        rhs[fixed] = np.where(released, 0.0, (problem.N[rows] @ u - problem.d[rows]) / coef)
+        e = factor.solve(rhs)
+        if released.any():  # the released dofs are free again: a Schur complement on them
+            dofs = fixed[released]
+            unit = np.zeros((problem.n, dofs.size))
+            unit[dofs, np.arange(dofs.size)] = 1.0
+            Z = factor.solve(unit)
+            e += Z @ np.linalg.solve((K @ Z)[dofs], r[dofs] - (K @ e)[dofs])
+        Ke = K @ e
+        lam_hat[held] = (Ke - r)[fixed[~released]] / coef[~released]
+        pulling = np.zeros(rows.size, dtype=bool)
+        pulling[~released] = lam_hat[held] < 0
+        if not pulling.any():
+            return float(lam_hat @ (problem.d - problem.N @ u)) + 0.5 * float(e @ Ke)
+        released |= pulling
+        if released.sum() > MAX_RELEASED:
+            return None
+
+
+__all__ = ["MAX_BORDER", "MAX_RELEASED", "SAME_MATRIX_RTOL", "Counted", "ForwardError", "WithDelassus",
+           "forward_error", "newton_system", "pinned_rows", "primal_dual_gap", "same_matrix"]
