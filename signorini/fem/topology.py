@@ -39,6 +39,12 @@ def packed_keys(nodes: np.ndarray, count: int) -> np.ndarray | None:
     return key
 
 
+def edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
+    """One integer per undirected edge ``(first[k], second[k])`` of a mesh of ``n`` nodes."""
+    low, high = np.minimum(first, second), np.maximum(first, second)
+    return low.astype(np.int64) * n + high
+
+
 def sort_order(keys: np.ndarray, bound: int) -> np.ndarray:
     """``np.argsort(keys, kind="stable")`` of non-negative integer ``keys`` below ``bound``.
 
@@ -171,5 +177,5 @@ def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
     return boundary[inside]
 
 
-__all__ = ["packed_keys", "distinct_entities", "sort_order", "sorted_columns", "facet_topology",
+__all__ = ["packed_keys", "edge_keys", "distinct_entities", "sort_order", "sorted_columns", "facet_topology",
            "with_edges", "with_topology", "moved", "facets_on", "outward_normals", "TOPOLOGY"]

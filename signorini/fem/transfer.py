@@ -16,13 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.fem.obstacles import ScaledQuery
-from signorini.fem.topology import facets_on
-
-
-def edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
-    """One integer per undirected edge ``(first[k], second[k])`` of a mesh of ``n`` nodes."""
-    low, high = np.minimum(first, second), np.maximum(first, second)
-    return low.astype(np.int64) * n + high
+from signorini.fem.topology import edge_keys, facets_on
 
 
 def split_uniformly(t: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -157,5 +151,5 @@ def with_candidates(model: Any, extra: np.ndarray, in_contact: np.ndarray | None
     return replace(model, **changes)
 
 
-__all__ = ["edge_keys", "split_uniformly", "prolongation", "uniform_prolongation",
+__all__ = ["split_uniformly", "prolongation", "uniform_prolongation",
            "boundary_children", "extend_nodes", "refined_model", "with_candidates"]

@@ -23,8 +23,8 @@ import numpy as np
 from skfem import Mesh, MeshTri
 
 from signorini.fem.model import CutLoad
-from signorini.fem.topology import facets_on, moved, with_topology
-from signorini.fem.transfer import edge_keys, split_uniformly
+from signorini.fem.topology import edge_keys, facets_on, moved, with_topology
+from signorini.fem.transfer import split_uniformly
 from signorini.scenes.relax import relax
 from signorini.scenes.triangulated import triangle_size, triangulated_quarter_disc
 
