@@ -40,7 +40,7 @@ from signorini.scenes.base import (
     refinements,
     two_refinements_coarser,
 )
-from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
+from signorini.scenes.meshing import cut_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
 from signorini.scenes.size import SizeModel
 
 #: the analytic reference (signorini.references.catalogue) this family's problems compare with
@@ -102,7 +102,7 @@ class HertzDisc:
             disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
                                        p["candidates"], mesher=p["mesher"])
         delta_nominal = delta if delta is not None else a_est ** 2 * R
-        pushed, cut_load = disc_loading(disc, p["loading"], target)
+        pushed, cut_load = cut_loading(disc.top, disc.centre, disc.top_facets, p["loading"], target)
         return SceneModel(
             mesh=disc.mesh, E=p["E"], nu=p["nu"],
             dirichlet=[(0, disc.axis, 0.0), (1, pushed, -delta_nominal)],

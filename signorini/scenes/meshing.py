@@ -178,14 +178,15 @@ class GradedDisc:
         return int(np.intersect1d(self.axis, self.top)[0])
 
 
-def disc_loading(disc: GradedDisc, loading: str, target: float | None):
-    """The pushed nodes and the cut load of a disc: the whole top cut, or its centre and a traction.
-
-    With a prescribed displacement (no ``target``) the cut is always pushed flat.
+def cut_loading(top: np.ndarray, centre: int, top_facets: np.ndarray, loading: str,
+                target: float | None, component: int = 1):
+    """The pushed nodes and the cut load of a Hertz scene whose cut through the centre has the
+    nodes ``top`` and the ``top_facets``: the whole cut, or its ``centre`` node and a traction
+    along ``component``. With a prescribed displacement (no ``target``) the cut is pushed flat.
     """
     if loading == "displacement" or target is None:
-        return disc.top, None
-    return np.array([disc.centre]), CutLoad(component=1, nodes=disc.top, facets=disc.top_facets)
+        return top, None
+    return np.array([centre]), CutLoad(component=component, nodes=top, facets=top_facets)
 
 
 def quarter_disc_distance(p: np.ndarray) -> np.ndarray:
@@ -318,6 +319,6 @@ def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
 
 __all__ = ["refine_to_size", "distance_to_segment", "coarse_quarter_disc", "on_circle_arc",
            "snap_to_circle", "quarter_disc_snap", "longest_simplex_edges",
-           "refine_simplices_to_size", "GradedDisc", "disc_loading", "quarter_disc_distance",
+           "refine_simplices_to_size", "GradedDisc", "cut_loading", "quarter_disc_distance",
            "snap_quarter_disc", "graded_quarter_disc", "graded_unit_disc", "refine_uniformly",
            "facet_indices", "arc_chain", "quarter_disc_on", "MAX_TRIANGLES", "MESHERS", "MAX_ELEMENTS"]
