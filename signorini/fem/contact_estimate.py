@@ -128,8 +128,7 @@ class PressureEstimate:
     are both zero — the contact zone's edge lies between the last node in
     contact and the first free one — and what the recovered stress carries
     there is the recovery's smearing of the edge, not an error of the
-    pressure (counted, it made the estimate 3.1 times the true error on
-    Hertz's cylinder: docs/estimate.md). ``nodes`` are the candidates' mesh
+    pressure (counted, it overstates the error: docs/estimate.md). ``nodes`` are the candidates' mesh
     nodes, ``active`` those in contact, ``indicators`` their shares
     ``w (p_h − p*)²`` of the numerator (zero where not counted).
     """

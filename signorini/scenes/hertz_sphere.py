@@ -10,14 +10,10 @@ by a uniform δ (u_z = −δ, u_r free), adjusted until the contact force equals
 the target load. Forces are assembled per radian and the model's
 ``force_multiplicity`` is 2π, so reported loads are those of the whole sphere.
 The mesh is graded towards the first point of contact; only the arc nodes
-with ``r ≤ candidates · a`` are contact candidates. Default mesh (``n_contact=48``,
-``grading=0.15``, Triangle: 5,421 dofs): the fastest solve in process among the
-meshes that hold the sphere within 0.1 % of Hertz at ν = 0.3 and 0.45 and 0.15 %
-at ν = 0.499 (docs/mesher.md). A finite sphere is not Hertz's half-space: the
-converged model's a and p₀ differ from Hertz's in proportion to a/R, most at
-ν = 0; at a/R = 0.05 and ν = 0.3 a finer mesh moves p₀ away from Hertz's, not
-towards it, and within 0.05 % of Hertz the sphere needs a/R ≤ 0.0025
-(docs/accuracy.md §3).
+with ``r ≤ candidates · a`` are contact candidates. The default mesh is on the
+accuracy-time front of docs/mesher.md. A finite sphere is not Hertz's half-space:
+the converged model's a and p₀ differ from Hertz's in proportion to a/R, most at
+ν = 0, and a finer mesh need not bring them nearer (docs/accuracy.md §3).
 
 Hertz (Johnson 1985, §4.2): ``a = (3PR/(4E*))^(1/3)``, ``p₀ = 3P/(2πa²)``.
 """
