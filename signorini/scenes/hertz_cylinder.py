@@ -134,9 +134,8 @@ VALIDATION = (
          same_as="hertz-cylinder"),
 )
 
-#: adaptive refinement starts from the relaxed mesh: its pressure estimate is within a factor 2
-#: of the true error there, and 3-6 on Triangle's meshes, which would refine past the target
-#: (docs/estimate.md)
+#: adaptive refinement starts from the relaxed mesh: on Triangle's its pressure estimate
+#: overstates the error more and would refine past the target (docs/estimate.md)
 ADAPTIVE_START = {"mesher": "relaxed", "n_contact": 40, "grading": 0.15}
 
 FAMILY = SceneFamily(

@@ -82,9 +82,8 @@ graded_ratio = SPHERE.graded_ratio
 SIZE = SizeModel(6824, 60, 0.15, 0.05, uniform=5.2, alpha=0.65, beta=1.15, far_field=100.0,
                  margin=1.13, ratio=graded_ratio)
 
-#: adaptive refinement starts from the relaxed mesh: its pressure estimate is within a factor 2
-#: of the true error there, and 3-6 on Triangle's meshes, which would refine past the target
-#: (docs/estimate.md)
+#: adaptive refinement starts from the relaxed mesh: on Triangle's its pressure estimate
+#: overstates the error more and would refine past the target (docs/estimate.md)
 ADAPTIVE_START = {"mesher": "relaxed", "n_contact": 60, "grading": 0.15}
 
 FAMILY = SceneFamily(
