@@ -9,16 +9,10 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
+from signorini.reprs import markdown_table, number, plain_table
 
 REFERENCE_COLUMNS = (("p0_rel", "p0 err"), ("a_rel", "a err"), ("pressure_l2_rel", "L2 err"),
                      ("pressure_max_rel", "p max err"))
-
-
-def _num(value: Any, spec: str = ".1e") -> str:
-    if value is None or (isinstance(value, float) and not np.isfinite(value)):
-        return "–"
-    return format(value, spec)
 
 
 def _said(run: dict[str, Any]) -> str:
@@ -34,7 +28,7 @@ def _count(value: Any) -> str:
 def _polished(run: dict[str, Any]) -> str:
     if run.get("polished_status") is None:
         return "–"
-    return f"{_num(run.get('polished_lam_ref'))} ({run['polished_status']})"
+    return f"{number(run.get('polished_lam_ref'))} ({run['polished_status']})"
 
 
 def _form(run: dict[str, Any]) -> str:
@@ -57,23 +51,18 @@ def _tables(record: dict[str, Any]) -> tuple[str, list[str], list[list[str]], li
     rows = []
     for run in record["methods"]:
         row = [run["method"] + " (allowed)" * bool(run.get("allowed")), _said(run), _form(run),
-               f"{_num(run['kkt_worst'])} {run['kkt_worst_name']}".strip(),
-               _num(run.get("lam_ref")), _count(run.get("active")), _count(run.get("apart_ref")),
-               str(run["iterations"]), _num(run["time_s"], ".2f")]
+               f"{number(run['kkt_worst'])} {run['kkt_worst_name']}".strip(),
+               number(run.get("lam_ref")), _count(run.get("active")), _count(run.get("apart_ref")),
+               str(run["iterations"]), number(run["time_s"], ".2f")]
         if polish:
             row.append(_polished(run))
-        row += [_num(run["reference"].get(key), ".2e") for key, _ in present]
+        row += [number(run["reference"].get(key), ".2e") for key, _ in present]
         rows.append(row)
     pair_head = ["pair", "λ rel", "u rel", "nodes apart", "weak", "limit", "verdict"]
-    pair_rows = [[f"{p['first']} ~ {p['second']}", _num(p["lam_rel"]), _num(p["u_rel"]),
-                  str(p["apart"]), str(p["weak"]), _num(p["limit"]), p["verdict"]]
+    pair_rows = [[f"{p['first']} ~ {p['second']}", number(p["lam_rel"]), number(p["u_rel"]),
+                  str(p["apart"]), str(p["weak"]), number(p["limit"]), p["verdict"]]
                  for p in record["pairs"]]
     return title, head, rows, pair_head, pair_rows
-
-
-def _plain(head: list[str], rows: list[list[str]]) -> list[str]:
-    widths = [max(len(x) for x in column) for column in zip(head, *rows)]
-    return ["  ".join(x.ljust(w) for x, w in zip(line, widths)).rstrip() for line in [head, *rows]]
 
 
 def _verdict_line(record: dict[str, Any]) -> str:
@@ -91,13 +80,8 @@ def _verdict_line(record: dict[str, Any]) -> str:
 def render(record: dict[str, Any]) -> str:
     """The cross-check record as plain-text tables (see :meth:`CrossCheck.to_dict`)."""
     title, head, rows, pair_head, pair_rows = _tables(record)
-    return "\n".join([title, "", *_plain(head, rows), "", *_plain(pair_head, pair_rows), "",
+    return "\n".join([title, "", *plain_table(head, rows), "", *plain_table(pair_head, pair_rows), "",
                       _verdict_line(record)])
-
-
-def _md(head: list[str], rows: list[list[str]]) -> list[str]:
-    return ["| " + " | ".join(head) + " |", "|" + "---|" * len(head),
-            *("| " + " | ".join(x.replace("|", "\\|") for x in row) + " |" for row in rows)]
 
 
 def render_markdown(record: dict[str, Any]) -> str:
@@ -112,7 +96,7 @@ def render_markdown(record: dict[str, Any]) -> str:
              f"(their own claim); it disagrees when a node is active in one answer and "
              f"inactive in the other (weakly active nodes apart: force and gap both within "
              f"max(1e-6, tol)), or λ or u differ by more than {record['agree_factor']:.0e} × tol.")
-    return "\n".join([f"# {title}", "", notes, "", *_md(head, rows), "", *_md(pair_head, pair_rows),
+    return "\n".join([f"# {title}", "", notes, "", *markdown_table(head, "l" * len(head), rows), "", *markdown_table(pair_head, "l" * len(pair_head), pair_rows),
                       "", _verdict_line(record), ""])
 
 
@@ -124,11 +108,11 @@ def render_candidates(record: dict[str, Any]) -> str:
                                      for what in ("gap", "λ", "class")]
     rows = [[str(c["index"]), "(" + ", ".join(f"{x:.3g}" for x in c["point"]) + ")"
              if c["point"] is not None else "–"]
-            + [x for name in names for x in (_num(c["gap"][name], ".2e"),
-                                              _num(c["lam"][name], ".2e"), c["class"][name])]
+            + [x for name in names for x in (number(c["gap"][name], ".2e"),
+                                              number(c["lam"][name], ".2e"), c["class"][name])]
             for c in record["candidates"]]
     return "\n".join(["per candidate (gap > 0 apart, < 0 penetrating; λ the contact force):",
-                      *_plain(head, rows)])
+                      *plain_table(head, rows)])
 
 
 __all__ = ["REFERENCE_COLUMNS", "render", "render_candidates", "render_markdown"]

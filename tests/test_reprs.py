@@ -1,5 +1,6 @@
-"""Short reprs: a result, its solution, certificate and derivatives print as a line or a few,
-whatever the size of their arrays (status, sizes, key numbers)."""
+"""Records as text. Short reprs: a result, its solution, certificate and derivatives print as
+a line or a few, whatever the size of their arrays (status, sizes, key numbers); a missing number
+is a dash; tables in Markdown, plain text and CSV."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 import signorini
-from signorini.reprs import brief
+from signorini.reprs import brief, csv_text, markdown_table, number, plain_table
 
 
 @pytest.fixture(scope="module")
@@ -39,3 +40,23 @@ def test_records_of_arrays_show_shapes_not_values(result):
                                           ({"a": 1, "b": 2}, "{a, b}"), (list(range(9)), "<9 items>")])
 def test_brief_shows_a_value_in_a_few_characters(value, shown):
     assert shown in brief(value) and len(brief(value)) <= 90
+
+
+@pytest.mark.parametrize("value, shown", [(None, "–"), (float("nan"), "–"), (float("inf"), "–"),
+                                          (1.5e-3, "1.5e-03"), (7, "7.0e+00")])
+def test_a_missing_number_is_a_dash(value, shown):
+    assert number(value) == shown
+
+
+def test_a_markdown_table_aligns_its_columns_and_escapes_a_bar():
+    lines = markdown_table(["name", "value"], "lr", [["a|b", 1.5], ["c", "–"]])
+    assert lines == ["| name | value |", "|---|---:|", "| a\\|b | 1.5 |", "| c | – |"]
+
+
+def test_a_plain_table_pads_each_column_to_its_widest_cell():
+    assert plain_table(["a", "bb"], [["ccc", "d"]]) == ["a    bb", "ccc  d"]
+
+
+def test_csv_text_writes_the_columns_named_in_their_order():
+    text = csv_text([{"b": 2, "a": "x, y", "c": 3}], ["a", "b"])
+    assert text == 'a,b\n"x, y",2\n'

@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import signorini
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.references.pressure import compare_hertz, contact_profile
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve

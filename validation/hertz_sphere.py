@@ -26,7 +26,7 @@ import time
 from typing import Any
 
 import signorini
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.references.pressure import compare_hertz_sphere, symmetry_plane_profiles
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import signorini
 from signorini.errors import InputError
-from signorini.certification.kkt import compare
+from signorini.certification.comparison import compare
 from signorini.references.pressure import compare_hertz
 from signorini.scenes import build_problem
 from signorini.solvers.registry import solve

@@ -21,7 +21,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
     from signorini.solvers import user  # per command (start-up)
-    from signorini.numerics.stages import timed  # per command (start-up)
+    from signorini.numerics.factor import timed  # per command (start-up)
 
     # the process's start-up (interpreter, imports, parsing), when this command is the process
     startup = process_seconds() if getattr(args, "process", False) else None

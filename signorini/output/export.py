@@ -40,6 +40,7 @@ from skfem.models.elasticity import lame_parameters
 from signorini.errors import InputError
 from signorini.files import atomic_write, check_output_file
 from signorini.fem.contact_estimate import candidate_nodes as mesh_nodes_at
+from signorini.fem.stiffness import barycentric_gradients
 from signorini.references.profile import contact_profile
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -61,14 +62,12 @@ def element_gradients(points: np.ndarray, elements: np.ndarray, values: np.ndarr
     """Gradient of the P1 interpolant of nodal ``values`` on each simplex.
 
     ``points`` (dim, nodes), ``elements`` (dim + 1, k), ``values`` (nodes, c);
-    returns (k, c, dim) with entry ``[e, i, j] = ∂vᵢ/∂x_j`` on element e,
-    from ``J = [x₁ − x₀, …, x_d − x₀]`` and ``∇v = (v₁ − v₀, …) J⁻¹``.
+    returns (k, c, dim) with entry ``[e, i, j] = ∂vᵢ/∂x_j`` on element e:
+    ``∇v = Σₐ vₐ ∇λₐ`` over the barycentric coordinates' gradients
+    (:func:`signorini.fem.stiffness.barycentric_gradients`).
     """
-    corners = points[:, elements]  # (dim, dim + 1, k)
-    J = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)  # (k, dim, dim): columns are edges
-    dv = np.moveaxis(values[elements[1:]] - values[elements[:1]], 1, 0)  # (k, dim, c)
-    # ∇v J = dvᵀ  ⇒  ∇v = dvᵀ J⁻¹
-    return np.linalg.solve(np.transpose(J, (0, 2, 1)), dv).transpose(0, 2, 1)
+    gradients, _ = barycentric_gradients(points, elements)  # (dim, dim + 1, k)
+    return np.einsum("jak,akc->kcj", gradients, values[elements])
 
 
 def element_stress(problem: ContactProblem, solution: ContactSolution,
@@ -111,9 +110,7 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
 
 def project_to_nodes(points: np.ndarray, elements: np.ndarray, cell_values: np.ndarray) -> np.ndarray:
     """Lumped L2 projection of element-wise constants onto P1: measure-weighted nodal averages."""
-    corners = points[:, elements]
-    edges = np.moveaxis(corners[:, 1:] - corners[:, :1], -1, 0)
-    measure = np.abs(np.linalg.det(edges))  # proportional to the area or volume
+    _, measure = barycentric_gradients(points, elements)
     total = np.zeros(points.shape[1])
     weighted = np.zeros(points.shape[1])
     for row in elements:

@@ -5,7 +5,7 @@ The atlas's figures are in :mod:`signorini.studies.atlas.figures`; the tutorials
 
 from __future__ import annotations
 
-from typing import Iterable
+from typing import Any, Iterable
 
 import numpy as np
 
@@ -36,6 +36,16 @@ def axes(ax, size: tuple[float, float] = (6.4, 4.2)):
     return ax
 
 
+def framed(ax, xlabel: str, ylabel: str, which: str = "major", **legend: Any):
+    """``ax`` with its axis labels, a light grid at the ``which`` ticks and a legend (``legend``
+    its keywords, font size 7 unless given); returned."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3, which=which)
+    ax.legend(**{"fontsize": 7, **legend})
+    return ax
+
+
 def pressure_profile(x: np.ndarray, pressure: np.ndarray, *, a_ref: float | None = None,
                      p0_ref: float | None = None, label: str = "numeric", ax=None,
                      others: Iterable[tuple[str, np.ndarray]] = ()):
@@ -57,12 +67,9 @@ def pressure_profile(x: np.ndarray, pressure: np.ndarray, *, a_ref: float | None
         colour, marker = series_style(i)
         ax.plot(x / xs, values / ps, marker, color=colour, ms=3, mfc="none", label=name,
                 alpha=0.7, zorder=2 + i)
-    ax.set_xlabel("x / a (Hertz)" if a_ref is not None else "x")
-    ax.set_ylabel("p / p₀ (Hertz)" if p0_ref is not None else "p")
     ax.set_xlim(left=0.0)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
-    return ax
+    return framed(ax, "x / a (Hertz)" if a_ref is not None else "x",
+                  "p / p₀ (Hertz)" if p0_ref is not None else "p", ncol=2)
 
 
 def kkt_against_time(rows: list[dict], *, ax=None, title: str = ""):
@@ -278,12 +285,8 @@ def plot_punch_pressure(problem: ContactProblem, solution: ContactSolution, ax=N
     ax.plot(grid / a, punch_pressure(grid, a, P) / scale, "k-", lw=1.2, label="P / (π√(a² − x²))")
     ax.plot(x[order] / a, p[order] / scale, "o", ms=3, mfc="none", label=f"{solution.method}")
     ax.axvspan(0, comparison.inner, color="0.9", zorder=0, label=f"compared (|x| ≤ {comparison.inner:g}a)")
-    ax.set_xlabel("x / a")
-    ax.set_ylabel("p / (P / πa)")
     ax.set_ylim(0, max(4.0, float(np.max(p) / scale) * 1.05))
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    return ax
+    return framed(ax, "x / a", "p / (P / πa)")
 
 
 def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None):
@@ -302,13 +305,9 @@ def plot_punch_edge(problem: ContactProblem, solution: ContactSolution, ax=None)
     if np.any(edge):
         ax.axhline(float(profile.pressure[edge][0]) / scale, color="C3", lw=0.8, ls="--",
                    label="edge node (x = a)")
-    ax.set_xlabel("(a − |x|) / a")
-    ax.set_ylabel("p / (P / πa)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
-    return ax
+    return framed(ax, "(a − |x|) / a", "p / (P / πa)", "both")
 
 
-__all__ = ["series_style", "axes", "pressure_profile", "kkt_against_time", "bench_speed_accuracy",
+__all__ = ["series_style", "axes", "framed", "pressure_profile", "kkt_against_time", "bench_speed_accuracy",
            "bench_time_vs_dofs", "peer_times", "deformed_bodies", "plot_punch_pressure",
            "plot_punch_edge"]

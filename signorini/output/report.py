@@ -18,6 +18,7 @@ from signorini.certification.kkt import certificate
 from signorini.output import plots
 from signorini.references.profile import contact_profile
 from signorini.references.catalogue import reference_of
+from signorini.reprs import markdown_table, number
 
 PACKAGES = ("signorini", "numpy", "scipy", "scikit-fem", "qpsolvers", "osqp", "clarabel", "cvxpy",
             "proxsuite", "piqp", "scs", "ecos", "highspy", "daqp", "quadprog", "qpalm", "cvxopt")
@@ -41,31 +42,39 @@ def provenance() -> dict[str, Any]:
 
 
 def _fmt(value: Any, digits: int = 1) -> str:
-    if value is None or (isinstance(value, float) and not np.isfinite(value)):
-        return "–"
     if isinstance(value, bool):
         return "yes" if value else "no"
-    if isinstance(value, float):
-        return f"{value:.{digits}e}"
-    return str(value)
+    return number(value, f".{digits}e") if value is None or isinstance(value, float) else str(value)
+
+
+def provenance_lines(info: dict[str, Any]) -> list[str]:
+    """A report's lines on the machine and the versions (:func:`provenance`), then a blank one."""
+    return [f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",
+            "Versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()), ""]
+
+
+def status_claimed(run: dict[str, Any], claimed_word: str = "") -> str:
+    """The status, and the method's own claim in brackets where it differs."""
+    claimed = run.get("claimed_status")
+    if claimed in (None, "", run["status"]):
+        return run["status"]
+    return f"{run['status']} ({claimed_word}{claimed})"
 
 
 def runs_table(runs: list[dict[str, Any]]) -> list[str]:
     """Markdown table of the runs of one case."""
-    lines = ["| method @ tol | status (claimed) | iterations | time [s] | worst KKT | "
-             "λ vs pdas | misclassified | p0 err | a err |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    head = ["method @ tol", "status (claimed)", "iterations", "time [s]", "worst KKT", "λ vs pdas",
+            "misclassified", "p0 err", "a err"]
+    rows = []
     for row in runs:
         vs = row.get("vs_reference", {})
         ref = row.get("reference", {})
-        claimed = row.get("claimed_status", row["status"])
-        status = row["status"] if claimed == row["status"] else f"{row['status']} ({claimed})"
         p0 = ref.get("p0_rel", ref.get("pressure_max_rel"))
-        lines.append(
-            f"| {row['label']} | {status} | {row.get('iterations', '–')} | {row.get('time_s', 0):.2f} | "
-            f"{_fmt(row.get('kkt_worst'))} | {_fmt(vs.get('lam_rel'))} | {vs.get('misclassified', '–')} | "
-            f"{_fmt(p0, 2)} | {_fmt(ref.get('a_rel'), 2)} |")
-    return lines
+        rows.append([row["label"], status_claimed(row), row.get("iterations", "–"),
+                     f"{row.get('time_s', 0):.2f}", _fmt(row.get("kkt_worst")),
+                     _fmt(vs.get("lam_rel")), vs.get("misclassified", "–"), _fmt(p0, 2),
+                     _fmt(ref.get("a_rel"), 2)])
+    return markdown_table(head, "llrrrrrrr", rows)
 
 
 #: the files :func:`write_suite_report` writes into its folder
@@ -77,6 +86,11 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
     directory = writable_directory(out)
     info = provenance()
     figures: dict[str, Path] = {}
+
+    def keep(key: str, ax) -> None:
+        figures[key] = directory / f"{key}.png"
+        save_figure(ax.figure, figures[key])
+
     for result in suite.results:
         problem, ref = result.problem, result.reference
         name = result.case.name
@@ -90,28 +104,22 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
             ax = plots.pressure_profile(profile.x, profile.pressure, a_ref=hertz.a_ref,
                                         p0_ref=hertz.p0_ref, label="pdas", others=others)
             ax.set_title(f"{name}: contact pressure, every method against Hertz", fontsize=9)
-            path = directory / f"{name}-pressure.png"
-            save_figure(ax.figure, path)
-            figures[f"{name}-pressure"] = path
-        ax = plots.kkt_against_time(result.runs, title=f"{name}: accuracy against time")
-        path = directory / f"{name}-kkt-time.png"
-        save_figure(ax.figure, path)
-        figures[f"{name}-kkt-time"] = path
+            keep(f"{name}-pressure", ax)
+        keep(f"{name}-kkt-time", plots.kkt_against_time(result.runs,
+                                                        title=f"{name}: accuracy against time"))
     md = ["# signorini validation report", "",
           f"Command: `{command}`  ", f"Result: **{'PASS' if suite.passed else 'FAIL'}** "
           f"({sum(c.passed for c in suite.checks)}/{len(suite.checks)} checks) in {suite.elapsed_s:.1f} s  ",
-          f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",
-          "Versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()), "",
+          *provenance_lines(info),
           "Statuses are the package's: `converged` only when the method claimed success *and* the",
           "independent KKT certificate agrees; `inaccurate (converged)` means the method claimed",
           "success and the certificate did not back it. λ vs pdas is the relative ∞-norm distance",
           "from the exact primal-dual active-set answer; misclassified counts contact nodes whose",
           "active/inactive label differs from it.", "",
-          "## Checks", "", "| case | check | value | limit | pass |", "|---|---|---:|---:|---|"]
-    for c in suite.checks:
-        value = _fmt(c.value, 2) if not isinstance(c.value, bool) else _fmt(c.value)
-        md.append(f"| {c.case} | {c.name} | {value} | {_fmt(c.limit, 0)} | "
-                  f"{'✅' if c.passed else '❌ ' + c.detail} |")
+          "## Checks", ""]
+    md += markdown_table(["case", "check", "value", "limit", "pass"], "llrrl",
+                         ([c.case, c.name, _check_value(c), _fmt(c.limit, 0),
+                           "✅" if c.passed else "❌ " + c.detail] for c in suite.checks))
     for result in suite.results:
         p = result.problem
         md += ["", f"## {result.case.name}", "",
@@ -136,22 +144,20 @@ def write_suite_report(suite: Any, out: str | Path, command: str) -> dict[str, P
     return {"report.md": directory / "report.md", "report.json": directory / "report.json", **figures}
 
 
+def _check_value(check: Any) -> str:
+    return _fmt(check.value) if isinstance(check.value, bool) else _fmt(check.value, 2)
+
+
 def checks_summary(suite: Any) -> str:
     """The checks as a plain-text table for the terminal."""
     width = max(len(c.name) for c in suite.checks)
     lines = [f"{'case':<18} {'check':<{width}}  {'value':>9}  {'limit':>7}  result"]
     for c in suite.checks:
-        value = _fmt(c.value, 2) if not isinstance(c.value, bool) else _fmt(c.value)
-        lines.append(f"{c.case:<18} {c.name:<{width}}  {value:>9}  {_fmt(c.limit, 0):>7}  "
+        lines.append(f"{c.case:<18} {c.name:<{width}}  {_check_value(c):>9}  {_fmt(c.limit, 0):>7}  "
                      f"{'pass' if c.passed else 'FAIL ' + c.detail}")
     lines.append(f"{sum(c.passed for c in suite.checks)} of {len(suite.checks)} checks passed "
                  f"in {suite.elapsed_s:.1f} s")
     return "\n".join(lines)
-
-
-def _status_cell(run: dict[str, Any]) -> str:
-    claimed = run.get("claimed_status")
-    return run["status"] if claimed in (None, run["status"]) else f"{run['status']} (claimed {claimed})"
 
 
 def readme_validation(report: dict[str, Any], case: str = "hertz-cylinder") -> str:
@@ -187,12 +193,12 @@ def readme_validation(report: dict[str, Any], case: str = "hertz-cylinder") -> s
         tol = "defaults" if run["tol"] is None else f"{run['tol']:g}"
         finite = run["status"] != "failed"
         lines.append(
-            f"| {run['method']} @ {tol} | {_status_cell(run)} | {run['iterations']:,} | "
+            f"| {run['method']} @ {tol} | {status_claimed(run, 'claimed ')} | {run['iterations']:,} | "
             f"{run['time_s']:.2f} | {_fmt(run['kkt_worst'] if finite else None, 0)} | "
             f"{_fmt(vs.get('lam_rel') if finite else None) if vs.get('lam_rel') != 0 else '0'} | "
             f"{vs.get('misclassified', '–') if finite else '–'} |")
     return "\n".join(lines)
 
 
-__all__ = ["provenance", "runs_table", "write_suite_report", "checks_summary", "readme_validation",
-           "REPORT_FILES"]
+__all__ = ["provenance", "provenance_lines", "status_claimed", "runs_table", "write_suite_report",
+           "checks_summary", "readme_validation", "REPORT_FILES"]

@@ -33,7 +33,8 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.files import all_or_none, atomic_write_text, save_figure, writable_directory
 from signorini.output import plots
-from signorini.output.report import provenance
+from signorini.output.report import status_claimed, provenance, provenance_lines
+from signorini.reprs import markdown_table
 from signorini.scenes import build_problem
 from signorini.studies.runner import Row, Task, run_tasks
 
@@ -48,6 +49,8 @@ COLUMNS = ("scene", "size", "dofs", "candidates", "method", "ranks", "tolerance"
            "claimed_status",
            "iterations", "build_s", "solve_s", "time_s", "factor_s", "ratio_to_factor",
            "kkt_worst", "lam_rel", "misclassified", "p0_rel", "a_rel", "message")
+#: the columns that hold text (the others hold numbers)
+TEXT_COLUMNS = ("scene", "size", "method", "tolerance", "status", "claimed_status", "message")
 #: what the benchmark measures of each run besides the runner's row
 MEASURES = ("factorisation", "times", "vs_reference", "reference")
 #: the runner's statuses for a run that gave no answer of its own, written as "failed"
@@ -188,17 +191,16 @@ def read_rows(path: Path) -> list[dict[str, Any]]:
     with open(path, newline="") as handle:
         rows = list(csv.DictReader(handle))
     for row in rows:
-        for key in COLUMNS:
-            if key in ("scene", "size", "method", "tolerance", "status", "claimed_status", "message"):
-                continue
-            if key == "ranks" and not row.get(key):  # rows written before the column existed
-                row[key] = 1.0
-                continue
-            try:
-                row[key] = float(row[key])
-            except (TypeError, ValueError):
-                row[key] = float("nan")
+        row["ranks"] = row.get("ranks") or 1.0  # rows written before the column existed
+        row.update({key: _float(row[key]) for key in COLUMNS if key not in TEXT_COLUMNS})
     return rows
+
+
+def _float(text: Any) -> float:
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return float("nan")
 
 
 def shifted_geometric_mean(values: np.ndarray, shift: float = 10.0) -> float:
@@ -241,33 +243,32 @@ def write_report(csv_path: Path, command: str) -> Path:
     if not rows:
         raise InputError(f"{csv_path} has no rows to report")
     directory = csv_path.parent
-    info = provenance()
     for metric, name in (("kkt_worst", "kkt"), ("p0_rel", "p0")):
         save_figure(plots.bench_speed_accuracy(rows, metric=metric).figure,
                     directory / f"speed-vs-{name}.png")
     ax, slopes = plots.bench_time_vs_dofs(rows)
     save_figure(ax.figure, directory / "time-vs-dofs.png")
     md = ["# signorini benchmark", "", f"Command: `{command}`  ",
-          f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",
-          "Versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()), "",
+          *provenance_lines(provenance()),
           "Each run in its own process; `ratio` is the run's time over one factorisation + solve "
           "of the same K with the same backend, measured in the same process; the time is the "
           "method's alone (not the certificate that judges it). `λ vs exact` and `misclassified` "
           f"compare with the exact answer of `{REFERENCE}` (certified like every run).", "",
-          "## Summary by method and tolerance", "",
-          "| method | tolerance | runs | success rate | correct rate | shifted geometric mean of normalised time |",
-          "|---|---|---:|---:|---:|---:|"]
-    for s in summary(rows):
-        md.append(f"| {s['method']} | {s['tolerance']} | {s['runs']} | {s['success_rate']:.0%} | "
-                  f"{s['correct_rate']:.0%} | {s['shifted_gmean_time']:.2f} |")
-    md += ["", "## Every run", "",
-           "| size | dofs | method | tol | status (claimed) | iterations | time [s] | ratio to one factorisation | worst KKT | λ vs exact | misclassified | p0 err |",
-           "|---|---:|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
-    for r in rows:
-        status = r["status"] if r["claimed_status"] in (r["status"], "") else f"{r['status']} ({r['claimed_status']})"
-        md.append(f"| {r['size']} | {r['dofs']:.0f} | {r['method']} | {r['tolerance']} | {status} | "
-                  f"{r['iterations']:.0f} | {r['time_s']:.3g} | {r['ratio_to_factor']:.3g} | "
-                  f"{r['kkt_worst']:.1e} | {r['lam_rel']:.1e} | {r['misclassified']:.0f} | {r['p0_rel']:.2e} |")
+          "## Summary by method and tolerance", ""]
+    md += markdown_table(["method", "tolerance", "runs", "success rate", "correct rate",
+                          "shifted geometric mean of normalised time"], "llrrrr",
+                         ([s["method"], s["tolerance"], s["runs"], f"{s['success_rate']:.0%}",
+                           f"{s['correct_rate']:.0%}", f"{s['shifted_gmean_time']:.2f}"]
+                          for s in summary(rows)))
+    md += ["", "## Every run", ""]
+    md += markdown_table(["size", "dofs", "method", "tol", "status (claimed)", "iterations",
+                          "time [s]", "ratio to one factorisation", "worst KKT", "λ vs exact",
+                          "misclassified", "p0 err"], "lrlllrrrrrrr",
+                         ([r["size"], f"{r['dofs']:.0f}", r["method"], r["tolerance"],
+                           status_claimed(r), f"{r['iterations']:.0f}", f"{r['time_s']:.3g}",
+                           f"{r['ratio_to_factor']:.3g}", f"{r['kkt_worst']:.1e}",
+                           f"{r['lam_rel']:.1e}", f"{r['misclassified']:.0f}", f"{r['p0_rel']:.2e}"]
+                          for r in rows))
     md += ["", "## Time against dofs (fitted log–log slopes)", ""]
     md += [f"- {label}: slope {slope:.2f}" for label, slope in slopes.items()]
     md += ["", "![speed vs KKT](speed-vs-kkt.png)", "", "![speed vs p0](speed-vs-p0.png)", "",

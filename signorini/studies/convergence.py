@@ -4,10 +4,9 @@ A study solves a scene at levels 0, 1, …, k of uniform refinement (the
 scene's ``refine`` parameter: every element split in four, so the element
 size h halves and the dofs roughly quadruple) with every installed exact
 method, and measures the errors against the scene's analytic reference
-(:attr:`signorini.references.catalogue.Reference.convergence`). The rate of a metric is the
-slope s of the least-squares line ``log err = s log h + c``
-(``np.polyfit(np.log(h), np.log(err), 1)``); h is the median distance between
-neighbouring contact candidates (:func:`signorini.studies.problems.candidate_spacing`).
+(:attr:`signorini.references.catalogue.Reference.convergence`). The rate of a metric is
+:func:`fitted_rate` against h, the median distance between neighbouring contact candidates
+(:func:`signorini.studies.problems.candidate_spacing`).
 Exact methods solve the same discrete problem, so their errors must
 coincide; the study records how far their λ are apart. Every run goes
 through the study runner (:mod:`signorini.studies.runner`) with no exact
@@ -16,9 +15,7 @@ its spec, and λ is compared with the first converged method's in this process.
 
 :func:`grading_comparison` sets the graded default against a uniform mesh
 (the scene with ``grading`` → 0, i.e. the contact size everywhere) at equal
-dofs, and estimates how many dofs each needs for a given error by
-interpolating ``log err`` against ``log dofs`` (extrapolating with the fitted
-rate when a series does not reach it). The figures and files of a study:
+dofs (:func:`dofs_for_error`). The figures and files of a study:
 :mod:`signorini.studies.convergence_report`.
 """
 
@@ -87,10 +84,11 @@ class ConvergenceStudy:
     rates: dict[str, dict[str, float]] = field(default_factory=dict)
     fit_from: int = 0
 
-    def series(self, method: str, metric: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(h, dofs, error)`` of one method's converged levels."""
+    def series(self, method: str, metric: str,
+               from_level: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(h, dofs, error)`` of one method's converged levels (from ``from_level`` on)."""
         rows = [r for r in self.rows if r.method == method and r.status == "converged"
-                and np.isfinite(r.errors.get(metric, np.nan))]
+                and np.isfinite(r.errors.get(metric, np.nan)) and r.level >= from_level]
         return (np.array([r.h for r in rows]), np.array([r.dofs for r in rows], dtype=float),
                 np.array([r.errors[metric] for r in rows]))
 
@@ -240,13 +238,8 @@ def run_study(scene: str, levels: int, params: dict[str, Any] | None = None,
     study = ConvergenceStudy(scene, {**base, "levels": levels}, reference.convergence + ESTIMATES, rows,
                              fit_from=fit_from)
     for name in study.methods:
-        study.rates[name] = {}
-        for metric in study.metrics:
-            h, _, err = study.series(name, metric)
-            keep = np.array([r.level >= fit_from for r in rows if r.method == name
-                             and r.status == "converged" and np.isfinite(r.errors.get(metric, np.nan))],
-                            dtype=bool)
-            study.rates[name][metric] = fitted_rate(h[keep], err[keep]) if keep.size else float("nan")
+        study.rates[name] = {metric: fitted_rate(*study.series(name, metric, fit_from)[::2])
+                             for metric in study.metrics}
     return study
 
 

@@ -7,7 +7,8 @@ from typing import Any
 import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-from signorini.output.plots import axes
+from signorini.output.plots import axes, framed
+from signorini.reprs import markdown_table, number
 from signorini.studies.convergence import ESTIMATES, LABELS, ConvergenceStudy, GradingComparison
 
 __all__ = ["plot_convergence", "plot_grading", "study_table", "write_study"]
@@ -27,11 +28,9 @@ def plot_convergence(study: ConvergenceStudy, ax=None, metrics: tuple[str, ...] 
             ax.loglog(h, np.abs(err), style, color=f"C{i}", marker=markers[i % len(markers)],
                       ms=5 if j == 0 else 9, mfc="none" if j else None,
                       label=f"{LABELS.get(metric, metric)} ({method}): rate {rate:.2f}")
-    ax.set_xlabel("h (spacing of the contact candidates)")
-    ax.set_ylabel("relative error" if "edge_over_centre" not in (metrics or study.metrics)
-                  else "relative error; edge pressure / (P/πa)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
+    framed(ax, "h (spacing of the contact candidates)",
+           "relative error" if "edge_over_centre" not in (metrics or study.metrics)
+           else "relative error; edge pressure / (P/πa)", "both")
     ax.set_title(f"{study.scene}: convergence under uniform refinement", fontsize=9)
     return ax
 
@@ -50,10 +49,7 @@ def plot_grading(comparison: GradingComparison, ax=None):
         if np.isfinite(dofs):
             ax.plot([dofs], [comparison.target], "x", color=color, ms=10,
                     label=f"{dofs:,.0f} dofs ({how})")
-    ax.set_xlabel("dofs")
-    ax.set_ylabel(LABELS.get(comparison.metric, comparison.metric))
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
+    framed(ax, "dofs", LABELS.get(comparison.metric, comparison.metric), "both")
     ax.set_title(f"{comparison.scene}: graded against uniform meshes "
                  f"(grading saves {comparison.saving:,.0f}× the dofs)", fontsize=9)
     return ax
@@ -62,22 +58,19 @@ def plot_grading(comparison: GradingComparison, ax=None):
 def study_table(study: ConvergenceStudy) -> list[str]:
     """Markdown table of a study: one row per level and method."""
     metrics = list(study.metrics)
-    lines = ["| level | method | status | dofs | candidates | h | " +
-             " | ".join(LABELS.get(m, m) for m in metrics) + " | λ vs first | solve [s] |",
-             "|---:|---|---|---:|---:|---:|" + "---:|" * len(metrics) + "---:|---:|"]
-    for r in study.rows:
-        values = " | ".join(f"{r.errors[m]:.3e}" if m in r.errors else "–" for m in metrics)
-        lam = f"{r.lam_rel_vs_first:.1e}" if np.isfinite(r.lam_rel_vs_first) else "–"
-        lines.append(f"| {r.level} | {r.method} | {r.status} | {r.dofs} | {r.candidates} | "
-                     f"{r.h:.3g} | {values} | {lam} | {r.solve_s:.2f} |")
+    labels = [LABELS.get(m, m) for m in metrics]
+    right = "r" * len(metrics)
+    lines = markdown_table(
+        ["level", "method", "status", "dofs", "candidates", "h", *labels, "λ vs first", "solve [s]"],
+        f"rllrrr{right}rr",
+        ([r.level, r.method, r.status, r.dofs, r.candidates, f"{r.h:.3g}",
+          *(f"{r.errors[m]:.3e}" if m in r.errors else "–" for m in metrics),
+          number(r.lam_rel_vs_first), f"{r.solve_s:.2f}"] for r in study.rows))
     lines += ["", "Fitted rates (slope of log error against log h"
-              + (f", levels ≥ {study.fit_from}" if study.fit_from else "") + "):", "",
-              "| method | " + " | ".join(LABELS.get(m, m) for m in metrics) + " |",
-              "|---|" + "---:|" * len(metrics)]
-    for method, rates in study.rates.items():
-        lines.append(f"| {method} | " + " | ".join(f"{rates.get(m, float('nan')):.2f}" for m in metrics)
-                     + " |")
-    return lines
+              + (f", levels ≥ {study.fit_from}" if study.fit_from else "") + "):", ""]
+    return lines + markdown_table(["method", *labels], f"l{right}",
+                                  ([method, *(f"{rates.get(m, float('nan')):.2f}" for m in metrics)]
+                                   for method, rates in study.rates.items()))
 
 
 def write_study(study: ConvergenceStudy, out, command: str,

@@ -5,16 +5,11 @@
 ``benchmarks/peers/getfem_hertz.py`` (one body on a rigid flat) and
 ``getfem_two_cylinders.py`` (two bodies, non-matching meshes) in a checkout of the
 repository (:mod:`signorini.studies.peer_cases`; not part of the installed
-package); this package runs as ``signorini solve SCENE --json -``. Each point is timed two ways:
-
-- whole process: each code in its own process, timed from start to exit
-  (interpreter, imports, meshing, assembly, solve, output), ``repeat`` runs
-  interleaved over the points and the fastest kept;
-- in process: one fresh process per code and point that imports the code once
-  and then solves the same point ``1 + in_process`` times, each solve timed from
-  the mesh to the answer's record (the GetFEM script with ``"repeat"``, this
-  package through :func:`solve_repeatedly`, which calls :func:`signorini.solve`);
-  the first solve is a warm-up, the fastest of the others kept.
+package); this package runs as ``signorini solve SCENE --json -``. Each point is timed two ways
+(:func:`run_peer`): whole process, from start to exit (interpreter, imports, meshing,
+assembly, solve, output), and in process, each solve from the mesh to the answer's record
+after a warm-up (the GetFEM script with ``"repeat"``, this package through
+:func:`solve_repeatedly`).
 
 Both codes' p₀ and a come from the same least-squares fit (:func:`fit_hertz`)
 of their nodal pressures, and are compared with Hertz's values for the applied load.

@@ -7,8 +7,6 @@ accuracies :data:`TARGETS`, by each measure of time (:data:`MEASURES`).
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import os
 from pathlib import Path
@@ -18,6 +16,7 @@ import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
 from signorini.output import plots
+from signorini.reprs import csv_text, markdown_table, number
 
 __all__ = ["MEASURES", "NAMES", "TARGETS", "at_accuracy", "matching_table", "peer_figure", "peer_table",
            "write_peer"]
@@ -39,10 +38,6 @@ def _error(row: dict[str, Any]) -> float:
 NAMES = {"getfem": "GetFEM", "signorini": "signorini"}
 #: the two measures of time: a row's key and its name in the tables
 MEASURES = {"wall_s": "whole process", "in_process_s": "in process"}
-
-
-def _seconds(value: Any) -> str:
-    return "–" if value is None else f"{value:.2f}"
 
 
 def at_accuracy(rows: list[dict[str, Any]], scene: str, target: float,
@@ -71,25 +66,22 @@ def _fastest_cells(rows: list[dict[str, Any]], scene: str, target: float, by: st
 def peer_table(rows: list[dict[str, Any]]) -> list[str]:
     """The Markdown tables: every run, then both codes at the target accuracies by each measure
     of time the runs carry (whole process always, in process when it was measured)."""
-    lines = ["| scene | code | mesh | dofs | contact nodes (active) | p₀ − Hertz | a − Hertz "
-             "| force − P | whole process [s] | in process [s] | inside [s] | status |",
-             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
-    for r in rows:
-        lines.append(
-            f"| {r['scene']} | {NAMES[r['code']]} | {r['mesh']} | {r.get('dofs', 0):,} "
-            f"| {r.get('contact_nodes', '–')} ({r.get('active_nodes', '–')}) | {_pct(r.get('p0_rel'))} "
-            f"| {_pct(r.get('a_rel'))} | {_pct(r.get('force_rel'))} | {r['wall_s']:.2f} "
-            f"| {_seconds(r.get('in_process_s'))} | {r.get('inner_s', math.nan):.2f} | {r['status']} |")
-    lines += ["", "| scene | p₀ and a within | time | GetFEM: fastest run | signorini: fastest run "
-              "| signorini / GetFEM |", "|---|---:|---|---|---|---:|"]
+    runs = markdown_table(
+        ["scene", "code", "mesh", "dofs", "contact nodes (active)", "p₀ − Hertz", "a − Hertz",
+         "force − P", "whole process [s]", "in process [s]", "inside [s]", "status"], "lllrrrrrrrrl",
+        ([r["scene"], NAMES[r["code"]], r["mesh"], f"{r.get('dofs', 0):,}",
+          f"{r.get('contact_nodes', '–')} ({r.get('active_nodes', '–')})", _pct(r.get("p0_rel")),
+          _pct(r.get("a_rel")), _pct(r.get("force_rel")), f"{r['wall_s']:.2f}",
+          number(r.get("in_process_s"), ".2f"), f"{r.get('inner_s', math.nan):.2f}", r["status"]]
+         for r in rows))
     # a run recorded before the in-process measure (or with --in-process 0) has no such rows
     measures = {by: name for by, name in MEASURES.items() if any(r.get(by) is not None for r in rows)}
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        for target in TARGETS:
-            for by, measure in measures.items():
-                cells = " | ".join(_fastest_cells(rows, scene, target, by))
-                lines.append(f"| {scene} | {100 * target:g} % | {measure} | {cells} |")
-    return lines
+    return runs + [""] + markdown_table(
+        ["scene", "p₀ and a within", "time", "GetFEM: fastest run", "signorini: fastest run",
+         "signorini / GetFEM"], "lrlllr",
+        ([scene, f"{100 * target:g} %", measure, *_fastest_cells(rows, scene, target, by)]
+         for scene in dict.fromkeys(r["scene"] for r in rows) for target in TARGETS
+         for by, measure in measures.items()))
 
 
 def peer_figure(rows: list[dict[str, Any]]):
@@ -118,14 +110,9 @@ def write_peer(rows: list[dict[str, Any]], out: str | os.PathLike, command: str,
     """peer.csv, peer.json, peer.md and peer.png in ``out``, each written whole or not at all."""
     directory = writable_directory(out)
     paths = {k: directory / f"peer.{k}" for k in ("csv", "json", "md", "png")}
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore",
-                            lineterminator="\n")
-    writer.writeheader()
     # every run's times in one cell each, separated by spaces
-    writer.writerows({k: " ".join(f"{t:.6f}" for t in v) if isinstance(v, list) else v
-                      for k, v in r.items()} for r in rows)
-    atomic_write_text(paths["csv"], buffer.getvalue())
+    atomic_write_text(paths["csv"], csv_text(({k: " ".join(f"{t:.6f}" for t in v) if isinstance(v, list)
+                                               else v for k, v in r.items()} for r in rows), CSV_COLUMNS))
     atomic_write_text(paths["json"], to_json({"command": command, **meta, "rows": rows}) + "\n")
     save_figure(peer_figure(rows), paths["png"])
     machine = meta.get("machine", {})

@@ -17,12 +17,9 @@ answer it is held to. :func:`run_task` runs it and measures one :class:`Row`:
 - whatever else the task asks for by name in ``measure`` (:data:`MEASURES`).
 
 An answer **agrees** with the exact one when no node is misclassified and
-the force error is at most ``min(AGREE_FACTOR · τ, AGREE_CAP)`` (λ within
-1e-6 at a tolerance of 1e-9, capped). A method's claim of success is
-**correct** when its answer passes the certificate and agrees; the package's
-status is **right** when it says ``converged`` only for answers that agree,
-grants it whenever the claim was correct, calls no solvable problem
-``infeasible``, and never raises on a problem that was built.
+the force error is at most ``min(AGREE_FACTOR · τ, AGREE_CAP)``; whether the
+method's claim and the package's status were right:
+:func:`signorini.studies.task.verdict`.
 
 :func:`run_tasks` runs a list of tasks in a :class:`Worker` process with a
 time limit: a backend that hangs or crashes costs one row, the worker is

@@ -15,6 +15,7 @@ from typing import Any, Callable
 import numpy as np
 from matplotlib.figure import Figure
 
+from signorini.reprs import markdown_table
 from signorini.studies.runner import ITERATION_CAPS
 from signorini.studies.task import ATLAS_TOL, Task
 
@@ -152,16 +153,9 @@ def pivot(rows: Rows, row_key: str, col_key: str, show: Callable[[dict[str, Any]
     row_values = list(dict.fromkeys(r[row_key] for r in rows))
     col_values = list(dict.fromkeys(r[col_key] for r in rows))
     index = {(r[row_key], r[col_key]): r for r in rows}
-    lines = ["| " + " | ".join([corner] + [col_label(c) for c in col_values]) + " |",
-             "|" + "---|" * (len(col_values) + 1)]
-    for value in row_values:
-        cells = [_shown_or_blank(index.get((value, c)), show) for c in col_values]
-        lines.append("| " + " | ".join([str(value)] + cells) + " |")
-    return lines
-
-
-def _shown_or_blank(row: dict[str, Any] | None, show: Callable[[dict[str, Any]], str]) -> str:
-    return "" if row is None else show(row)
+    return markdown_table([corner, *map(col_label, col_values)], "l" * (len(col_values) + 1),
+                          ([value, *(show(index[value, c]) if (value, c) in index else ""
+                                     for c in col_values)] for value in row_values))
 
 
 def wrong_nodes(row: dict[str, Any]) -> float:

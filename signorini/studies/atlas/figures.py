@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from signorini.output.plots import axes, series_style
+from signorini.output.plots import axes, framed, series_style
 
 #: colours of the atlas's outcomes
 OUTCOME_COLOURS = {"right": "#4daf4a", "conservative": "#a6d96a", "caught": "#fdae61",
@@ -44,11 +44,8 @@ def atlas_step_sweep(rows: list[dict], *, ax=None):
     ax.axvline(0.5, color="0.5", lw=0.8, ls="--", label="ρ = 1/λ_max(W) (FISTA's bound)")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("step ρ / (2/λ_max(W))")
-    ax.set_ylabel("iterations (to 1e-8, or until stopped)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=6)
-    return ax
+    return framed(ax, "step ρ / (2/λ_max(W))", "iterations (to 1e-8, or until stopped)", "both",
+                  fontsize=6)
 
 
 def atlas_series(rows: list[dict], x: str, y: str, *, ax=None, xlabel: str = "",
@@ -80,11 +77,7 @@ def atlas_series(rows: list[dict], x: str, y: str, *, ax=None, xlabel: str = "",
         ax.set_xscale("log")
     if logy:
         ax.set_yscale("log")
-    ax.set_xlabel(xlabel or x)
-    ax.set_ylabel(ylabel or y)
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=5, ncol=2)
-    return ax
+    return framed(ax, xlabel or x, ylabel or y, "both", fontsize=5, ncol=2)
 
 
 def atlas_outcomes(rows: list[dict], *, column: str = "case", ax=None, title: str = ""):

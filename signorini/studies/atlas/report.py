@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import os
@@ -13,7 +11,8 @@ from typing import Any
 import numpy as np
 
 from signorini.files import atomic_write_text, save_figure, to_json, writable_directory
-from signorini.output.report import provenance
+from signorini.output.report import provenance, provenance_lines
+from signorini.reprs import csv_text, markdown_table
 from signorini.solvers.options import DEFAULT_TOL
 from signorini.studies.atlas.axis import Axis, capped, nodes_text, num
 from signorini.studies.atlas.summary import (AtlasResult, method_rows, method_summary, share, verdicts,
@@ -45,19 +44,10 @@ def reproduction(row: dict[str, Any], axis: Axis | None = None) -> str:
 
 
 def _csv_value(value: Any) -> Any:
+    """A cell of ``runs.csv``: a missing number left empty."""
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return ""
     return value
-
-
-def csv_text(rows: list[dict[str, Any]]) -> str:
-    """The rows as CSV, one line per run in :data:`COLUMNS` (missing numbers left empty)."""
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, extrasaction="ignore", lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: _csv_value(row.get(k)) for k in COLUMNS})
-    return buffer.getvalue()
 
 
 def write_report(result: AtlasResult, out: str | os.PathLike, command: str) -> dict[str, Path]:
@@ -72,7 +62,8 @@ def write_report(result: AtlasResult, out: str | os.PathLike, command: str) -> d
     paths = {"csv": data / "runs.csv", "json": data / "runs.json", "report": directory / "stability.md"}
     right, runs, _faults = wrapper_record(rows)
     summary = method_summary(rows)
-    atomic_write_text(paths["csv"], csv_text(rows))
+    atomic_write_text(paths["csv"], csv_text(({k: _csv_value(r.get(k)) for k in COLUMNS} for r in rows),
+                                             COLUMNS))
     atomic_write_text(paths["json"], to_json({
         "command": command, "provenance": info, "elapsed_s": result.elapsed_s,
         "axis_seconds": result.axis_seconds, "quick": result.quick,
@@ -98,8 +89,7 @@ def _header(result: AtlasResult, command: str, info: dict[str, Any], runs: int) 
         f"Run time: {result.elapsed_s:.0f} s ({minutes:.1f} min) for {runs} runs"
         + (" (quick: tiny meshes, few methods)" if result.quick else "") + "; per axis: "
         + ", ".join(f"{name} {sec:.0f} s" for name, sec in result.axis_seconds.items()) + "  ",
-        f"Machine: {info['cpu']}, {info['cores']} cores, Python {info['python']}, {info['date']}  ",
-        "Versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()), "",
+        *provenance_lines(info),
         ("Every run is a method at a tolerance on one problem, in its own worker process with a "
          "time limit. Data: [`stability/runs.csv`](stability/runs.csv) and "
          "[`stability/runs.json`](stability/runs.json) (one row per run, with the problem's "
@@ -175,11 +165,9 @@ def method_axis_table(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]
     """
     table = verdicts(rows, axes)
     methods = list(dict.fromkeys(r["method"] for r in method_rows(rows)))
-    md = ["| method | " + " | ".join(f"{a.number}. {a.name}" for a in axes) + " |",
-          "|---|" + "---|" * len(axes)]
-    for method in methods:
-        md.append(f"| {method} | " + " | ".join(table.get((method, a.name), "–") for a in axes) + " |")
-    return md
+    return markdown_table(["method", *(f"{a.number}. {a.name}" for a in axes)], "l" * (len(axes) + 1),
+                          ([method, *(table.get((method, a.name), "–") for a in axes)]
+                           for method in methods))
 
 
 def _method_by_axis(rows: list[dict[str, Any]], axes: list[Axis]) -> list[str]:
@@ -226,4 +214,4 @@ def report_markdown(result: AtlasResult, command: str, info: dict[str, Any]) -> 
     return "\n".join(md) + "\n"
 
 
-__all__ = ["reproduction", "csv_text", "write_report", "method_axis_table", "report_markdown"]
+__all__ = ["reproduction", "write_report", "method_axis_table", "report_markdown"]

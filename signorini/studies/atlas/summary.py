@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from typing import Any, Iterable, Sequence
 
@@ -39,16 +40,13 @@ def method_summary(rows: Rows) -> list[dict[str, Any]]:
         claims = [r for r in mine if r.get("claimed_status") == "converged"]
         correct = sum(bool(r.get("claim_correct")) for r in claims)
         wrapper = sum(bool(r.get("wrapper_right")) for r in mine)
-        statuses: dict[str, int] = {}
-        for r in mine:
-            statuses[r["status"]] = statuses.get(r["status"], 0) + 1
         out.append({"method": method, "runs": len(mine), "claims": len(claims),
                     "claims_correct": correct,
                     "correct_rate": correct / len(claims) if claims else float("nan"),
                     "right": sum(r.get("outcome") == "right" for r in mine),
                     "conservative": sum(bool(r.get("conservative")) for r in mine),
                     "wrapper_right": wrapper, "wrapper_rate": wrapper / len(mine),
-                    "statuses": statuses})
+                    "statuses": dict(Counter(r["status"] for r in mine))})
     return out
 
 
