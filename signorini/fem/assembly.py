@@ -77,25 +77,30 @@ def axisymmetric_elasticity(Lambda: float = 1.0, Mu: float = 1.0) -> BilinearFor
     return weakform
 
 
+def segment_weights(points: np.ndarray, ends: np.ndarray, radial: bool = False) -> np.ndarray:
+    """Lumped weights ``∫ φᵢ ds`` of the ``points`` (2, k) over the segments ``ends`` (2, e):
+    ``ℓ/2`` to each end of a segment of length ℓ, or (``radial``: ``∫ φᵢ r ds``, r the first
+    coordinate) ``ℓ (2 rᵢ + rⱼ)/6``."""
+    lengths = np.linalg.norm(points[:, ends[0]] - points[:, ends[1]], axis=0)
+    r0, r1 = points[0, ends]
+    shares = ((lengths * (2 * r0 + r1) / 6, lengths * (2 * r1 + r0) / 6) if radial
+              else (0.5 * lengths, 0.5 * lengths))
+    per_node = np.zeros(points.shape[1])
+    for end, share in zip(ends, shares):
+        np.add.at(per_node, end, share)
+    return per_node
+
+
 def contact_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray,
                     axisymmetric: bool = False) -> np.ndarray:
     """Lumped weights ``wᵢ = ∫_Γ φᵢ ds`` (``∫_Γ φᵢ r ds`` when axisymmetric) of ``nodes``.
 
-    In closed form per boundary facet: on 2D meshes per edge of length ℓ
-    ``ℓ/2`` to each end, or ``ℓ (2 rᵢ + rⱼ)/6`` with the radius r; in 3D per
-    triangle of area A ``A/3`` to each corner (scikit-fem's facet quadrature
-    gives the same to round-off, 25 times slower at 1M dofs).
+    In closed form per boundary facet: on 2D meshes per edge (:func:`segment_weights`), in 3D
+    per triangle of area A ``A/3`` to each corner (scikit-fem's facet quadrature gives the same
+    to round-off, 25 times slower at 1M dofs).
     """
     if mesh.p.shape[0] == 2:
-        ends = mesh.facets[:, facets]
-        lengths = np.linalg.norm(mesh.p[:, ends[0]] - mesh.p[:, ends[1]], axis=0)
-        r0, r1 = mesh.p[0, ends]
-        shares = ((lengths * (2 * r0 + r1) / 6, lengths * (2 * r1 + r0) / 6) if axisymmetric
-                  else (0.5 * lengths, 0.5 * lengths))
-        per_node = np.zeros(mesh.p.shape[1])
-        for end, share in zip(ends, shares):
-            np.add.at(per_node, end, share)
-        return per_node[nodes]
+        return segment_weights(mesh.p, mesh.facets[:, facets], axisymmetric)[nodes]
     corners = mesh.facets[:, facets]  # (3, k)
     edges = mesh.p[:, corners[1:]] - mesh.p[:, corners[:1]]  # (3, 2, k)
     area = 0.5 * np.linalg.norm(np.cross(edges[:, 0], edges[:, 1], axis=0), axis=0)
@@ -351,6 +356,6 @@ def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
                 resultant=resultant, delta=delta, P=P)
 
 
-__all__ = ["axisymmetric_elasticity", "contact_weights", "cut_forces", "stiffness_form",
+__all__ = ["axisymmetric_elasticity", "contact_weights", "cut_forces", "segment_weights", "stiffness_form",
            "stiffness", "lame_stiffness", "nodal_dofs", "force_exponent", "displacement_scale",
            "assemble", "cut_traction", "boundary_watch"]
