@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import tempfile
 
 from signorini.cli.common import (EXIT_FAILED, OPT_METAVAR, SCENE_HELP, add_command, input_files,
                                   method_options, pairs, parse_time_limit, parse_tol, process_seconds,
@@ -83,13 +84,14 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
                 seconds: dict[str, float] = {}
                 with timed(seconds, "load control"):
-                    problem = at_load(problem)  # the worker builds it again, matched the same way
-                spec = {"kind": "stored", "path": os.path.abspath(args.scene)} if from_file else \
-                    {"kind": "scene", "scene": args.scene, "params": params,
-                     "nondimensionalise": not args.raw_units}
-                with timed(seconds, "method"):  # the worker's whole run, its start-up included
-                    solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
-                                            max_iter=max_iter, options=request.options)
+                    problem = at_load(problem)
+                with timed(seconds, "method"), tempfile.TemporaryDirectory(prefix="signorini-") as folder:
+                    # the worker solves the problem matched here, stored (its start-up included)
+                    path = os.path.join(folder, "problem.npz")
+                    problem.save(path)
+                    solution = solve_within(problem, {"kind": "stored", "path": path}, args.method,
+                                            time_limit, tol=tol, max_iter=max_iter,
+                                            options=request.options)
                 with timed(seconds, "certificate"):
                     judged = certificate(problem, solution)
                 solution.seconds = {**solution.seconds, **seconds}
