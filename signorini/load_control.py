@@ -44,9 +44,8 @@ import numpy as np
 from signorini.errors import InputError
 from signorini.certification.kkt import Certificate
 from signorini.numerics.active_set import ActiveSetSolver, selection_dofs
-from signorini.numerics.factor import FactorTooLarge, counting
+from signorini.numerics.factor import FactorTooLarge, counting, timed
 from signorini.numerics.push import calibrate_push
-from signorini.numerics.stages import timed
 from signorini.numerics.zone import (Zone, ZoneSolver, predict_zone, radial_distance,
                                      zone_around_points)
 from signorini.problem.contact import ContactProblem, ContactSolution, WarmStart

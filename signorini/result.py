@@ -23,7 +23,7 @@ import numpy as np
 from signorini.certification.kkt import Certificate
 from signorini.derivatives import implicit as derivatives
 from signorini import fem  # the estimate's module loaded at first use: a QP has no mesh
-from signorini.numerics.stages import stage_times, time_line, timed
+from signorini.numerics.factor import timed
 from signorini.problem.contact import ContactProblem, ContactSolution
 from signorini.problem.scales import record_units
 from signorini.references.catalogue import Reference, reference_of, summary_lines
@@ -33,6 +33,32 @@ from signorini.references.pressure import ContactProfile, contact_profile, load_
 SCHEMA_VERSION = 3
 
 log = logging.getLogger(__name__)
+
+
+#: the stages of a solve, in the order they run (the solve record's ``time``); ``startup`` is the
+#: command's process before it builds the scene (interpreter, imports, parsing): 0 in a library call
+STAGES = ("startup", "mesh", "assemble", "load control", "prediction", "method", "certificate",
+          "estimate", "output")
+
+
+def stage_key(stage: str) -> str:
+    """The record's key of a stage's seconds: ``load_control_s``."""
+    return f"{stage.replace(' ', '_')}_s"
+
+
+def stage_times(seconds: dict[str, float]) -> dict[str, float]:
+    """Every stage of :data:`STAGES` by its key (0 for one that did not run) and their sum,
+    ``total_s``."""
+    stages = {stage_key(stage): seconds.get(stage, 0.0) for stage in STAGES}
+    return {**stages, "total_s": sum(stages.values())}
+
+
+def time_line(times: dict[str, float], parts: int = 3) -> str:
+    """``time 0.31 s: mesh 0.23, method 0.03, assemble 0.02``: the total of :func:`stage_times`
+    and its ``parts`` largest stages."""
+    largest = sorted(((times.get(stage_key(stage), 0.0), stage) for stage in STAGES),
+                     reverse=True)[:parts]
+    return f"time {times['total_s']:.2f} s: " + ", ".join(f"{stage} {s:.2f}" for s, stage in largest)
 
 
 def _scalar_rows(value: Any) -> bool:
@@ -215,7 +241,7 @@ class Result:
         ``time`` has the seconds of every stage of a solve (``mesh_s``, ..., ``output_s``:
         building this record, the estimate apart, and the exports already timed into
         ``solution.seconds["output"]``) and their sum ``total_s``
-        (:func:`signorini.numerics.stages.stage_times`).
+        (:func:`stage_times`).
         """
         problem, solution, estimated = self.problem, self.solution, self.estimate  # timed apart
         start = time.perf_counter()
@@ -302,4 +328,4 @@ def solve_summary(record: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["SCHEMA_VERSION", "Result", "solve_summary"]
+__all__ = ["SCHEMA_VERSION", "STAGES", "Result", "solve_summary", "stage_key", "stage_times", "time_line"]

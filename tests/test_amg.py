@@ -218,7 +218,7 @@ def test_rows_sharing_a_dof_are_refused_in_one_line_with_the_alternative():
     problem = random_problem(60, 20, seed=3, condition=50.0)
     with counting() as work, pytest.raises(InputError, match="method 'pdas-amg' .*use pdas"):
         solve(problem, "pdas-amg")
-    assert work.as_dict() == {}  # before any work
+    assert work.listed() == {}  # before any work
 
 
 # --- auto: the default method -------------------------------------------------------------------

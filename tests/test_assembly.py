@@ -330,13 +330,13 @@ def test_vectorised_plane_strain_stiffness_is_scikit_fems():
     from skfem import Basis, ElementVector, MeshTri, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    from signorini.fem.stiffness import plane_strain_stiffness
+    from signorini.fem.stiffness import simplex_stiffness
 
     mesh = MeshTri.init_circle(3)
     mesh = MeshTri(mesh.p * [[2.0], [0.5]], mesh.t)  # stretched: elements of many shapes
     Lambda, Mu = lame_parameters(3.0, 0.3)
     expected = asm(linear_elasticity(Lambda, Mu), Basis(mesh, ElementVector(mesh.elem())))
-    difference = abs(plane_strain_stiffness(mesh, Lambda, Mu) - expected).max()
+    difference = abs(simplex_stiffness(mesh, Lambda, Mu) - expected).max()
     assert difference <= 1e-12 * abs(expected).max()
 
 
@@ -352,7 +352,7 @@ def test_vectorised_solid_stiffness_is_scikit_fems(monkeypatch):
     Lambda, Mu = lame_parameters(2.0, 0.3)
     expected = asm(linear_elasticity(Lambda, Mu), Basis(mesh, ElementVector(mesh.elem())))
     monkeypatch.setattr(assembly, "SIMPLEX_BLOCK", 97)  # several blocks, a ragged last one
-    difference = abs(assembly.solid_stiffness(mesh, Lambda, Mu) - expected).max()
+    difference = abs(assembly.simplex_stiffness(mesh, Lambda, Mu) - expected).max()
     assert difference <= 1e-12 * abs(expected).max()
 
 

@@ -12,7 +12,7 @@ from skfem.models.elasticity import lame_parameters
 
 import signorini
 from signorini.fem.assembly import axisymmetric_elasticity
-from signorini.fem.stiffness import plane_strain_stiffness
+from signorini.fem.stiffness import simplex_stiffness
 from signorini.fem.contact_estimate import contact_term, zone_and_neighbours
 from signorini.fem.estimate import (_by_quadrature, _constant_strains, element_energies, estimate,
                                     material_units, quadrature, recover, strains)
@@ -51,7 +51,7 @@ def test_a_uniform_axisymmetric_strain_has_no_error():
 def test_element_energies_are_the_stiffness_energy():
     mesh = MeshTri.init_tensor(np.linspace(0.0, 1.0, 5), np.linspace(0.0, 1.0, 4))
     u = np.random.default_rng(0).normal(size=(mesh.p.shape[1], 2))
-    K = plane_strain_stiffness(mesh, *lame_parameters(3.0, 0.3))
+    K = simplex_stiffness(mesh, *lame_parameters(3.0, 0.3))
     assert element_energies(mesh, u, 3.0, 0.3).sum() == pytest.approx(u.ravel() @ K @ u.ravel())
 
 

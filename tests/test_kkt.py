@@ -503,3 +503,25 @@ def test_a_factorisation_of_another_matrix_is_not_used(hertz, exact):
     same.matrix = sp.csc_matrix(hertz.K, copy=True)
     cost, _ = spent(lambda: primal_dual_gap(hertz.with_data(), u, lam, [same]))
     assert cost == {"factorisations": 0, "back_solves": 1}
+
+
+def test_an_answer_with_no_factorisation_is_certified_on_one_pinned_factorisation(monkeypatch):
+    """An answer given as arrays (no factorisation from its method) with many active rows that
+    each bound one dof: the certificate factorises K once with them pinned, a back-solve a Newton
+    step and none more for the duality gap, where bordering a plain factorisation costs a
+    back-solve a row; both estimates agree."""
+    problem = signorini.at_load(build_problem("hertz-cylinder", params={"refine": 1}))
+    exact = registry.solve(problem, "pdas", tol=1e-9)
+    active = int(active_set(problem, exact).sum())
+    assert active >= kkt.PINNED_FROM
+    refuse_the_fallback(monkeypatch)
+    bare = ContactSolution("given", exact.u, exact.lam, "converged")
+    cost, pinned = spent(lambda: certificate(problem, bare))
+    assert cost == {"factorisations": 1, "back_solves": 2}
+    monkeypatch.undo()
+    monkeypatch.setattr(kkt, "PINNED_FROM", problem.m + 1)  # border a plain factorisation instead
+    bordered_cost, bordered = spent(lambda: certificate(problem, ContactSolution(
+        "given", exact.u, exact.lam, "converged")))
+    assert bordered_cost["factorisations"] == 1 and bordered_cost["back_solves"] >= active
+    assert pinned.worst()[1] < 1e-10 and bordered.worst()[1] < 1e-10
+    assert abs(pinned.force_error - bordered.force_error) < 1e-10

@@ -18,7 +18,7 @@ from signorini.errors import InputError
 from signorini.fem.assembly import assemble, axisymmetric_elasticity
 from signorini.references.pressure import contact_profile, radial_distance
 from signorini.scenes import build_problem
-from signorini.fem.model import FlatObstacle, FlatObstacle3D, SceneModel
+from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.solvers.registry import solve
 
 VALIDATION = Path(__file__).resolve().parents[1] / "validation"
@@ -119,7 +119,7 @@ def test_three_d_patch_test_uniaxial_stress():
         mesh=mesh, E=E, nu=nu,
         dirichlet=[(0, np.nonzero(np.abs(x) < tol)[0], 0.0), (1, np.nonzero(np.abs(y) < tol)[0], 0.0),
                    (2, top, -delta)],
-        contact_nodes=bottom, contact_facets=facets[on_bottom], obstacle=FlatObstacle3D(0.0),
+        contact_nodes=bottom, contact_facets=facets[on_bottom], obstacle=FlatObstacle(0.0),
         load_dofs=(2, top), length_scale=H, force_multiplicity=4.0, params={"E": E, "nu": nu})
     problem = assemble(model)
     assert problem.N.shape[1] == problem.n and problem.contact_points.shape[1] == 3

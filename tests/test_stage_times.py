@@ -6,7 +6,7 @@ import time
 
 import signorini
 from signorini.api import solve_summary
-from signorini.numerics.stages import STAGES, stage_key
+from signorini.result import STAGES, stage_key
 
 
 def test_the_stages_sum_to_the_wall_time_of_a_solve_and_its_record():

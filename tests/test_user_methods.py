@@ -199,6 +199,19 @@ def test_solve_time_limit_gives_the_same_answer_as_in_process(capsys, user_file)
     np.testing.assert_allclose(a["contact"]["force"], b["contact"]["force"], rtol=1e-12)
 
 
+def test_solve_time_limit_matches_a_target_load_once_in_the_worker(capsys, user_file):
+    """The worker builds the scene and solves it as signorini.solve does, load control included,
+    and says the push it matched: the command does not match the load again before it."""
+    assert main(["solve", "hertz-cylinder", "--method", "pdas", "--time-limit", "60",
+                 "--json", "a.json"]) == 0
+    assert main(["solve", "hertz-cylinder", "--method", "pdas", "--json", "b.json"]) == 0
+    capsys.readouterr()
+    a, b = (json.loads((user_file.parent / name).read_text()) for name in ("a.json", "b.json"))
+    assert "load matched by" in a["message"] and a["time"]["load_control_s"] == 0
+    assert a["status"] == b["status"] == "converged"
+    np.testing.assert_allclose(a["contact"]["force"], b["contact"]["force"], rtol=1e-12)
+
+
 @pytest.mark.parametrize("argv", [
     ["solve", "block", "--time-limit", "0"],
     ["solve", "block", "--time-limit", "-3"],

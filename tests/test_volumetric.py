@@ -8,7 +8,7 @@ from skfem.models.elasticity import lame_parameters
 
 import signorini
 from signorini.errors import InputError
-from signorini.fem.stiffness import plane_strain_stiffness, solid_stiffness
+from signorini.fem.stiffness import simplex_stiffness
 from signorini.fem.volumetric import (NODAL_FROM_NU, averaging, nodal_volumetric_strain, resolve,
                                       simplex_gradients, volumetric_stiffness)
 
@@ -39,8 +39,8 @@ def test_a_uniform_strain_is_averaged_to_itself(kind, axisymmetric):
 def test_averaging_keeps_the_energy_of_a_uniform_strain_and_symmetry():
     mesh = _mesh("tri")
     Lambda, Mu = lame_parameters(2.0, 0.45)
-    plain = plane_strain_stiffness(mesh, Lambda, Mu)
-    nodal = plane_strain_stiffness(mesh, 0.0, Mu) + volumetric_stiffness(mesh, Lambda)
+    plain = simplex_stiffness(mesh, Lambda, Mu)
+    nodal = simplex_stiffness(mesh, 0.0, Mu) + volumetric_stiffness(mesh, Lambda)
     assert abs(nodal - nodal.T).max() < 1e-12 * abs(nodal).max()
     u = (np.array([[0.3, 0.1], [0.1, -0.2]]) @ mesh.p).T.ravel()  # the patch test's field
     assert u @ nodal @ u == pytest.approx(u @ plain @ u, rel=1e-12)
@@ -51,8 +51,8 @@ def test_averaging_keeps_the_energy_of_a_uniform_strain_and_symmetry():
     tet = _mesh("tet")
     Lambda, Mu = lame_parameters(1.0, 0.3)
     w = (np.diag([0.1, 0.2, -0.3]) @ tet.p).T.ravel()
-    both = solid_stiffness(tet, 0.0, Mu) + volumetric_stiffness(tet, Lambda)
-    assert w @ both @ w == pytest.approx(w @ solid_stiffness(tet, Lambda, Mu) @ w, rel=1e-12)
+    both = simplex_stiffness(tet, 0.0, Mu) + volumetric_stiffness(tet, Lambda)
+    assert w @ both @ w == pytest.approx(w @ simplex_stiffness(tet, Lambda, Mu) @ w, rel=1e-12)
     assert sp.issparse(both)
 
 

@@ -1,5 +1,5 @@
 """Write the generated blocks of the docs pages (results, performance, accuracy, estimate, peer,
-convergence, derivatives, mesher) from the committed artefacts they quote; the README itself carries none.
+convergence, derivatives, mesher, certificate) from the committed artefacts they quote; the README itself carries none.
 
     .venv/bin/python tools/readme.py          # after `signorini validate --out docs/validation`,
                                               # `signorini stability --out docs`, ...
@@ -19,6 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy  # noqa: E402  (tools/accuracy.py: the accuracy study's tables)
 import amg_bench  # noqa: E402  (tools/amg_bench.py: 3D at scale, docs/amg)
 import budget  # noqa: E402  (tools/budget.py: the 10⁶-dof command against one factorisation)
+import certificate_pinning  # noqa: E402  (tools/certificate_pinning.py: a certificate with no factorisation)
 import derivatives as derivative_cost  # noqa: E402  (tools/derivatives.py: a derivative against the solve)
 import estimate as estimate_study  # noqa: E402  (tools/estimate.py: the estimate's effectivity)
 import finite_sphere  # noqa: E402  (tools/finite_sphere.py: the finite sphere against Hertz)
@@ -45,8 +46,9 @@ DERIVATIVES = ROOT / "docs" / "derivatives.md"
 MESHER = ROOT / "docs" / "mesher.md"
 TWO_BODIES = ROOT / "docs" / "two-bodies.md"
 ONE_DOOR = ROOT / "docs" / "one-door.md"
+CERTIFICATE = ROOT / "docs" / "certificate.md"
 DOCUMENTS = (RESULTS, PERFORMANCE, ACCURACY, ESTIMATE, PEER, CONVERGENCE, DERIVATIVES, MESHER,
-             TWO_BODIES, ONE_DOOR)
+             TWO_BODIES, ONE_DOOR, CERTIFICATE)
 #: the contact half-width of each convergence study's scene at its defaults (h / a in the tables)
 STUDY_A = {"hertz-cylinder": 0.05, "hertz-sphere": 0.05, "reverse-hertz": 0.02, "punch": 1.0}
 STUDY_COLUMNS = {"p0_rel": "p₀ error", "a_rel": "a error", "pressure_l2_rel": "pressure L2 error",
@@ -180,6 +182,8 @@ def blocks(document: Path = RESULTS) -> dict[str, str]:
         runs = ROOT / "docs" / "one-door"
         return {"one-door-compare": snapshot.compare_table(runs / "old.npz", runs / "new.npz"),
                 "one-door-speed": snapshot.speed_table(json.loads((runs / "speed.json").read_text()))}
+    if document == CERTIFICATE:
+        return {"certificate-pinning": certificate_pinning.table(certificate_pinning.load())}
     raise ValueError(f"no generated blocks for {document}")
 
 

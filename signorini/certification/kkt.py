@@ -12,13 +12,13 @@ right-hand sides, cost one.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
-from scipy.sparse.linalg import lobpcg
 
 from signorini.errors import InputError
+from signorini.numerics.active_set import PinnedFactor, selection_dofs
+from signorini.numerics.arrays import indefinite
 from signorini.certification.inverse import ForwardError, forward_error, pinned_rows, primal_dual_gap
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -179,11 +179,16 @@ class Remembering:
 
 
 class Offers:
-    """The factorisations on offer to one certificate — the method's, then the problem's cached
-    one — each wrapped once in :class:`Remembering`."""
+    """The factorisations on offer to one certificate — the method's, one the certificate made
+    (:meth:`add`), then the problem's cached one — each wrapped once in :class:`Remembering`."""
 
     def __init__(self, problem: ContactProblem, solution: ContactSolution):
-        self.problem, self.solution, self.wrapped = problem, solution, {}
+        self.problem, self.solution, self.wrapped, self.own = problem, solution, {}, None
+
+    def add(self, factor) -> Remembering:
+        """``factor``, made by the certificate itself, on offer from now on."""
+        self.own = factor
+        return self.wrap(factor)
 
     def wrap(self, factor) -> Remembering:
         if id(factor) not in self.wrapped:
@@ -191,7 +196,7 @@ class Offers:
         return self.wrapped[id(factor)][1]
 
     def __call__(self) -> list[Remembering]:
-        return [self.wrap(f) for f in (self.solution.factor, self.problem.cached_factor)
+        return [self.wrap(f) for f in (self.solution.factor, self.own, self.problem.cached_factor)
                 if f is not None]
 
 
@@ -227,30 +232,6 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
             cert = replace(cert, duality_gap=float("inf"))
     solution._certificate = (key, cert)
     return cert
-
-
-#: K is indefinite when an eigenvalue lies below this fraction of its largest diagonal entry
-NEGATIVE_CURVATURE = 1e-10
-#: up to this many dofs the lowest eigenvalue of K is found densely, beyond it is bounded above
-#: by LOBPCG's Rayleigh quotient after at most :data:`CURVATURE_STEPS` iterations
-DENSE_EIGEN_DOFS = 500
-CURVATURE_STEPS = 50
-
-
-def indefinite(K) -> bool:
-    """Whether ``K`` has a negative eigenvalue (below ``−NEGATIVE_CURVATURE · max|Kᵢᵢ|``): then
-    ``½uᵀKu − fᵀu`` has no minimum and a KKT point is no answer. Exact up to
-    :data:`DENSE_EIGEN_DOFS` dofs; beyond, a Rayleigh quotient below the bound proves it (one
-    above says nothing: False)."""
-    scale = float(np.max(np.abs(K.diagonal()), initial=0.0)) or 1.0
-    if K.shape[0] <= DENSE_EIGEN_DOFS:
-        lowest = np.linalg.eigvalsh(K.toarray())[0]
-    else:
-        start = np.random.default_rng(0).standard_normal((K.shape[0], 1))
-        with warnings.catch_warnings():  # an unconverged quotient still bounds the lowest above
-            warnings.simplefilter("ignore")
-            lowest = lobpcg(K, start, largest=False, maxiter=CURVATURE_STEPS, tol=1e-8)[0][0]
-    return bool(lowest < -NEGATIVE_CURVATURE * scale)
 
 
 def _certificate(problem: ContactProblem, solution: ContactSolution,
@@ -296,17 +277,31 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
     problem's cached one, else a factorisation of K — the one the duality gap
     makes anyway — unless the problem says it does not factorise for certificates
     (:attr:`ContactProblem.factorises_for_certificates`: big and not on a 2D mesh), where the
-    duality gap uses CG and the forward error is not estimated.
+    duality gap uses CG and the forward error is not estimated. Where only plain factorisations
+    without their Delassus operator are on offer and :data:`PINNED_FROM` or more active rows each
+    bound one dof, K is factorised with them pinned instead (the duality gap then takes it too).
     """
     offers, active = offers or Offers(problem, solution), active_set(problem, solution)
     offered = [f for f in offers() if f.pinned is not None  # or the saddle point of this system
                or (getattr(f, "on", None) and f.on(problem.K, problem.N, active))]
-    if not offered and problem.factorises_for_certificates:
+    plain = all(f.pinned is not None and not f.pinned[0].size  # no pinned dof, no Delassus operator
+                and getattr(f, "delassus", None) is None for f in offered)
+    dofs = selection_dofs(problem.N) if plain and active.sum() >= PINNED_FROM else None
+    if dofs is not None and problem.factorises_for_certificates:
+        offered = [offers.add(PinnedFactor(problem.K, dofs[active]))]
+    elif not offered and problem.factorises_for_certificates:
         offered = [offers.wrap(problem.factor())]
     if not offered:
         return ForwardError.unknown()
     return forward_error(problem.K, problem.f, problem.N, problem.d, solution.u, solution.lam,
                          active, offered[0], scale, Ku)
+
+
+#: from this many active rows, each bounding one dof, a certificate offered no factorisation but
+#: a plain one of K factorises K with those dofs pinned (a back-solve a Newton step) instead of
+#: bordering the plain one (a back-solve a row): one factorisation costs a few dozen back-solves,
+#: and pinning was the faster at every size measured, from 35 rows (docs/certificate.md)
+PINNED_FROM = 32
 
 
 #: what the certificate says when it cannot vouch for the contact force, by the error's name
@@ -383,7 +378,7 @@ def active_set(problem: ContactProblem, solution: ContactSolution,
     return classify(problem, solution, weak_tol) == ACTIVE
 
 
-__all__ = ["ACTIVE", "CURVATURE_STEPS", "DENSE_EIGEN_DOFS", "NEGATIVE_CURVATURE", "FORCE_FLOOR", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "WEAK", "WEAK_TOL",
+__all__ = ["ACTIVE", "FORCE_FLOOR", "PINNED_FROM", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "WEAK", "WEAK_TOL",
            "Certificate", "Offers", "REMEMBERED_SOLVES", "Remembering", "active_set", "certificate",
            "classify", "force_scale",
-           "gap_scale", "indefinite", "shortfall"]
+           "gap_scale", "shortfall"]

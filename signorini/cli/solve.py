@@ -14,14 +14,14 @@ from signorini.solvers.options import DEFAULT_TOL, guess_value
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from signorini.api import Result, at_load, solve, solve_adaptive, solve_summary  # per command
+    from signorini.api import Result, solve, solve_adaptive, solve_summary  # per command
     from signorini.scenes import build_problem  # per command (start-up)
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
     from signorini.certification.kkt import certificate  # per command (start-up)
     from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
     from signorini.solvers import user  # per command (start-up)
-    from signorini.numerics.stages import timed  # per command (start-up)
+    from signorini.numerics.factor import timed  # per command (start-up)
 
     # the process's start-up (interpreter, imports, parsing), when this command is the process
     startup = process_seconds() if getattr(args, "process", False) else None
@@ -81,15 +81,18 @@ def cmd_solve(args: argparse.Namespace) -> int:
             else:  # in a worker process that is stopped after the limit (signorini.studies.worker)
                 from signorini.studies.runner import solve_within  # per command (start-up)
 
-                seconds: dict[str, float] = {}
-                with timed(seconds, "load control"):
-                    problem = at_load(problem)  # the worker builds it again, matched the same way
+                # the worker builds the problem again and solves it as signorini.solve does (load
+                # control with the scene's predictions, then the method), and says the push matched
                 spec = {"kind": "stored", "path": os.path.abspath(args.scene)} if from_file else \
                     {"kind": "scene", "scene": args.scene, "params": params,
                      "nondimensionalise": not args.raw_units}
+                seconds: dict[str, float] = {}
                 with timed(seconds, "method"):  # the worker's whole run, its start-up included
-                    solution = solve_within(problem, spec, args.method, time_limit, tol=tol,
-                                            max_iter=max_iter, options=request.options)
+                    solution = solve_within(problem, {**spec, "matched": False}, args.method,
+                                            time_limit, tol=tol, max_iter=max_iter,
+                                            options=request.options)
+                if problem.model.pending and "push" in solution.extras:
+                    problem = problem.pushed(float(solution.extras["push"]))
                 with timed(seconds, "certificate"):
                     judged = certificate(problem, solution)
                 solution.seconds = {**solution.seconds, **seconds}

@@ -19,5 +19,5 @@ import lazy_loader
 
 __getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submodules=["estimate"], submod_attrs={
     "assembly": ["assemble"], "checks": ["check_model"], "contact_estimate": ["PressureEstimate"],
-    "estimate": ["ErrorEstimate"], "model": ["CutLoad", "FlatObstacle", "FlatObstacle3D", "SceneModel"],
+    "estimate": ["ErrorEstimate"], "model": ["CutLoad", "FlatObstacle", "SceneModel"],
     "obstacles": ["Circle", "FlatPunch", "HalfPlane", "Obstacle", "SignedDistance"]})

@@ -44,21 +44,11 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 from signorini.errors import InputError
 from signorini.fem.model import SceneModel
 from signorini.fem.stiffness import simplex_stiffness
-from signorini.fem.topology import moved
+from signorini.fem.topology import moved, outward_normals
 from signorini.fem.volumetric import volumetric_stiffness
 from signorini.problem.contact import ContactProblem, Model, Push, Scales, Watch
 
 log = logging.getLogger(__name__)
-
-
-def boundary_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """Lumped weights ``wᵢ = ∫_Γ φᵢ ds`` of ``nodes`` over the boundary ``facets`` (2D)."""
-    ends = mesh.facets[:, facets]
-    lengths = np.linalg.norm(mesh.p[:, ends[0]] - mesh.p[:, ends[1]], axis=0)
-    per_node = np.zeros(mesh.p.shape[1])
-    np.add.at(per_node, ends[0], 0.5 * lengths)
-    np.add.at(per_node, ends[1], 0.5 * lengths)
-    return per_node[nodes]
 
 
 def axisymmetric_elasticity(Lambda: float = 1.0, Mu: float = 1.0) -> BilinearForm:
@@ -87,25 +77,30 @@ def axisymmetric_elasticity(Lambda: float = 1.0, Mu: float = 1.0) -> BilinearFor
     return weakform
 
 
+def segment_weights(points: np.ndarray, ends: np.ndarray, radial: bool = False) -> np.ndarray:
+    """Lumped weights ``∫ φᵢ ds`` of the ``points`` (2, k) over the segments ``ends`` (2, e):
+    ``ℓ/2`` to each end of a segment of length ℓ, or (``radial``: ``∫ φᵢ r ds``, r the first
+    coordinate) ``ℓ (2 rᵢ + rⱼ)/6``."""
+    lengths = np.linalg.norm(points[:, ends[0]] - points[:, ends[1]], axis=0)
+    r0, r1 = points[0, ends]
+    shares = ((lengths * (2 * r0 + r1) / 6, lengths * (2 * r1 + r0) / 6) if radial
+              else (0.5 * lengths, 0.5 * lengths))
+    per_node = np.zeros(points.shape[1])
+    for end, share in zip(ends, shares):
+        np.add.at(per_node, end, share)
+    return per_node
+
+
 def contact_weights(mesh: Any, facets: np.ndarray, nodes: np.ndarray,
                     axisymmetric: bool = False) -> np.ndarray:
     """Lumped weights ``wᵢ = ∫_Γ φᵢ ds`` (``∫_Γ φᵢ r ds`` when axisymmetric) of ``nodes``.
 
-    In closed form per boundary facet: on 2D meshes per edge of length ℓ
-    ``ℓ/2`` to each end, or ``ℓ (2 rᵢ + rⱼ)/6`` with the radius r; in 3D per
-    triangle of area A ``A/3`` to each corner (scikit-fem's facet quadrature
-    gives the same to round-off, 25 times slower at 1M dofs).
+    In closed form per boundary facet: on 2D meshes per edge (:func:`segment_weights`), in 3D
+    per triangle of area A ``A/3`` to each corner (scikit-fem's facet quadrature gives the same
+    to round-off, 25 times slower at 1M dofs).
     """
     if mesh.p.shape[0] == 2:
-        if not axisymmetric:
-            return boundary_weights(mesh, facets, nodes)
-        ends = mesh.facets[:, facets]
-        (r0, r1), lengths = mesh.p[0, ends], np.linalg.norm(np.diff(mesh.p[:, ends], axis=1)[:, 0],
-                                                             axis=0)
-        per_node = np.zeros(mesh.p.shape[1])
-        np.add.at(per_node, ends[0], lengths * (2 * r0 + r1) / 6)
-        np.add.at(per_node, ends[1], lengths * (2 * r1 + r0) / 6)
-        return per_node[nodes]
+        return segment_weights(mesh.p, mesh.facets[:, facets], axisymmetric)[nodes]
     corners = mesh.facets[:, facets]  # (3, k)
     edges = mesh.p[:, corners[1:]] - mesh.p[:, corners[:1]]  # (3, 2, k)
     area = 0.5 * np.linalg.norm(np.cross(edges[:, 0], edges[:, 1], axis=0), axis=0)
@@ -284,28 +279,22 @@ def cut_traction(model: SceneModel, mesh: Any, dof_table: np.ndarray,
     if cut is None:
         return None, 0.0
     weights = contact_weights(mesh, cut.facets, cut.nodes, bool(model.axisymmetric))
-    area = float(weights.sum())
-    if not area > 0:
+    if not weights.sum() > 0:
         raise InputError("the loaded cut has no area: check the scene's cut facets")
-    f_load = np.zeros(dof_table.size)
-    dofs = dof_table[cut.component, cut.nodes]
-    f_load[dofs] = -weights / (model.force_multiplicity * area)
+    return cut_forces(weights, dof_table[cut.component, cut.nodes], -1.0, model.force_multiplicity,
+                      load_dofs, dof_table.size)
+
+
+def cut_forces(weights: np.ndarray, dofs: np.ndarray, direction: float, multiplicity: float,
+               load_dofs: np.ndarray, size: int) -> tuple[np.ndarray, float]:
+    """Nodal forces (``size`` dofs) of a uniform traction along ``direction`` (±1) on a cut whose
+    nodes have the lumped weights ``weights`` and the ``dofs`` along it, per unit load of the
+    full body (``multiplicity`` copies of the model), and the part of that load the reactions
+    of ``load_dofs`` do not see: the traction on the cut's other nodes."""
+    f_load = np.zeros(size)
+    f_load[dofs] = direction * weights / (multiplicity * weights.sum())
     others = ~np.isin(dofs, load_dofs)
-    return f_load, float(-model.force_multiplicity * f_load[dofs[others]].sum())
-
-
-def _facing_normals(mesh: Any, facets: np.ndarray) -> np.ndarray:
-    """Outward unit normals (dim, k) of boundary ``facets`` (edges in 2D, triangles in 3D)."""
-    p = mesh.p
-    ends = mesh.facets[:, facets]
-    if p.shape[0] == 2:
-        tangent = p[:, ends[1]] - p[:, ends[0]]
-        normal = np.array([tangent[1], -tangent[0]])
-    else:
-        normal = np.cross(p[:, ends[1]] - p[:, ends[0]], p[:, ends[2]] - p[:, ends[0]], axis=0)
-    inside = p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
-    outward = np.sign(np.einsum("ij,ij->j", normal, p[:, ends].mean(axis=1) - inside))
-    return normal * outward / np.linalg.norm(normal, axis=0)
+    return f_load, float(multiplicity * direction * f_load[dofs[others]].sum())
 
 
 def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch | None:
@@ -336,7 +325,7 @@ def boundary_watch(model: SceneModel, dof_table: np.ndarray, U: float) -> Watch 
     mixed = is_candidate[ends].any(axis=0) & ~is_candidate[ends].all(axis=0)
     edge_nodes = np.array([], dtype=int)
     if mixed.any():
-        outward = _facing_normals(mesh, facets[mixed])
+        outward = outward_normals(mesh, facets[mixed])
         towards, _ = obstacle.normals_and_gaps(mesh.p[:, ends[:, mixed]].mean(axis=1).T)
         facing = np.einsum("ij,ji->i", np.asarray(towards, dtype=float), outward) > 0.1
         edge_nodes = np.unique(ends[:, mixed][:, facing])
@@ -367,6 +356,6 @@ def _push(lifted, scale: float, f_load: np.ndarray | None, offset_load: float,
                 resultant=resultant, delta=delta, P=P)
 
 
-__all__ = ["boundary_weights", "axisymmetric_elasticity", "contact_weights", "stiffness_form",
+__all__ = ["axisymmetric_elasticity", "contact_weights", "cut_forces", "segment_weights", "stiffness_form",
            "stiffness", "lame_stiffness", "nodal_dofs", "force_exponent", "displacement_scale",
            "assemble", "cut_traction", "boundary_watch"]

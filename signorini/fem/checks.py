@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.fem.topology import packed_keys, sort_order, sorted_columns, with_topology
+from signorini.fem.topology import outward_normals, packed_keys, sort_order, sorted_columns
 
 #: an element whose measure is at most this times its longest edge to the dimension is degenerate
 DEGENERATE = 1e-12
@@ -234,21 +234,6 @@ def _check_facets(t: np.ndarray, orientation: np.ndarray, count: int, what: str,
                          "the mesh is folded there (an inverted element); remesh it or move its nodes")
 
 
-def _outward_normals(mesh: Any, facets: np.ndarray) -> np.ndarray:
-    """Unit normals (facets, dim) of boundary ``facets`` pointing out of the body."""
-    mesh = with_topology(mesh)
-    p = mesh.p
-    corners = p[:, mesh.facets[:, facets]]  # (dim, facet nodes, facets)
-    if p.shape[0] == 2:
-        edge = corners[:, 1] - corners[:, 0]
-        normal = np.vstack([edge[1], -edge[0]])
-    else:
-        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0], axis=0)
-    inside = p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
-    normal *= np.where(np.einsum("ij,ij->j", normal, corners.mean(axis=1) - inside) < 0, -1.0, 1.0)
-    return (normal / np.linalg.norm(normal, axis=0)).T
-
-
 def check_obstacle_outside(model: Any) -> None:
     """InputError when the obstacle starts inside the undeformed body (see the module)."""
     nodes = np.asarray(model.contact_nodes)
@@ -271,7 +256,7 @@ def check_obstacle_outside(model: Any) -> None:
     if facets.size == 0:
         return
     outward = np.zeros_like(model.mesh.p.T)
-    facet_normals = _outward_normals(model.mesh, facets)
+    facet_normals = outward_normals(model.mesh, facets).T
     for row in model.mesh.facets[:, facets]:
         np.add.at(outward, row, facet_normals)
     along = np.einsum("ij,ij->i", normals, outward[nodes])

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.fem.topology import facets_on
+from signorini.fem.topology import facets_on, outward_normals
 from signorini.certification.kkt import active_set
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -128,8 +128,7 @@ class PressureEstimate:
     are both zero — the contact zone's edge lies between the last node in
     contact and the first free one — and what the recovered stress carries
     there is the recovery's smearing of the edge, not an error of the
-    pressure (counted, it made the estimate 3.1 times the true error on
-    Hertz's cylinder: docs/estimate.md). ``nodes`` are the candidates' mesh
+    pressure (counted, it overstates the error: docs/estimate.md). ``nodes`` are the candidates' mesh
     nodes, ``active`` those in contact, ``indicators`` their shares
     ``w (p_h − p*)²`` of the numerator (zero where not counted).
     """
@@ -155,10 +154,7 @@ def boundary_normals(mesh: Any, nodes: np.ndarray) -> np.ndarray:
     """(2, len(nodes)): the body's outward unit normal at ``nodes``, from the boundary edges
     joining two of them (a corner's other edges, e.g. on a symmetry axis, do not count)."""
     facets, ends, _ = candidate_edges(mesh, nodes)
-    along = mesh.p[:, ends[1]] - mesh.p[:, ends[0]]
-    normal = np.array([along[1], -along[0]])
-    inside = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
-    normal *= np.where(np.sum(normal * (mesh.p[:, ends[0]] - inside), axis=0) < 0, -1.0, 1.0)
+    normal = outward_normals(mesh, facets, unit=False)  # as long as its edge: a longer one weighs more
     summed = np.zeros((2, mesh.p.shape[1]))
     for end in ends:
         np.add.at(summed.T, end, normal.T)

@@ -228,8 +228,7 @@ def _by_quadrature(problem: ContactProblem, mesh: Any, u: np.ndarray, Lambda: fl
     if problem.model.volumetric == "nodal":
         # K's λ-part sees the volumetric strain averaged at the nodes, θ̄: a continuous P1 field
         # that is already ZZ's recovery of tr ε_h. Recovered once more (θ*), it smooths the
-        # one-sided averages of the boundary nodes: on the default Hertz meshes at ν = 0.45 the
-        # pressure estimate from θ* is 1.2–1.5 × the distance to Hertz's pressure, from θ̄ 2.6–3.2 ×
+        # one-sided averages of the boundary nodes, which overstate the error (docs/estimate.md)
         theta_bar = nodal_volumetric_strain(mesh, u, axisymmetric)
         theta_points = np.einsum("ke,kq->eq", theta_bar[mesh.t], rule.bary)
         theta = nodal_recovery(mesh, theta_points[None], rule)[0]

@@ -26,10 +26,6 @@ class FlatObstacle:
         return normals, points[:, -1] - self.height
 
 
-#: the flat under a 3D body (the name its scenes use)
-FlatObstacle3D = FlatObstacle
-
-
 @dataclass(frozen=True)
 class CutLoad:
     """The load applied as a uniform traction on a cut of the body (as Hertz's theory loads it).
@@ -101,4 +97,4 @@ class SceneModel:
         return resolve(self.volumetric_choice, self.nu, self.mesh.p.shape[0])
 
 
-__all__ = ["FlatObstacle", "CutLoad", "SceneModel", "FlatObstacle3D"]
+__all__ = ["FlatObstacle", "CutLoad", "SceneModel"]

@@ -44,7 +44,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.errors import InputError
-from signorini.fem.topology import with_topology
+from signorini.fem.assembly import segment_weights
+from signorini.fem.topology import outward_normals, with_topology
 
 log = logging.getLogger(__name__)
 
@@ -87,28 +88,13 @@ class Face:
         nodes = _along(ends)
         local = np.searchsorted(np.sort(nodes), ends)
         local = np.argsort(nodes)[local]
-        tangent = mesh.p[:, ends[1]] - mesh.p[:, ends[0]]
-        normal = np.array([tangent[1], -tangent[0]])
-        inside = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
-        outward = np.sign(np.einsum("ij,ij->j", normal, mesh.p[:, ends].mean(axis=1) - inside))
         return cls(nodes=nodes, points=mesh.p[:, nodes], segments=local.reshape(ends.shape),
-                   normals=normal * outward / np.linalg.norm(normal, axis=0))
-
-    @property
-    def lengths(self) -> np.ndarray:
-        """The segments' lengths (e,)."""
-        ends = self.points[:, self.segments]
-        return np.linalg.norm(ends[:, 1] - ends[:, 0], axis=0)
+                   normals=outward_normals(mesh, facets))
 
     def weights(self, radial: bool = False) -> np.ndarray:
-        """Lumped weights ``∫ φₛ ds`` of the face's nodes (k,): half of each segment to each end;
-        ``radial``: ``∫ φₛ r ds`` (an axisymmetric face, r = x), ``ℓ (2 rₛ + rₒ)/6``."""
-        if not radial:
-            return np.bincount(self.segments.ravel(), np.tile(0.5 * self.lengths, 2),
-                               minlength=self.nodes.size)
-        r = self.points[0, self.segments]  # (2, e)
-        share = self.lengths * (2.0 * r + r[::-1]) / 6.0
-        return np.bincount(self.segments.ravel(), share.ravel(), minlength=self.nodes.size)
+        """Lumped weights ``∫ φₛ ds`` of the face's nodes (k,), or ``∫ φₛ r ds`` when ``radial``
+        (an axisymmetric face, r = x): :func:`~signorini.fem.assembly.segment_weights`."""
+        return segment_weights(self.points, self.segments, radial)
 
 
 def _along(ends: np.ndarray) -> np.ndarray:

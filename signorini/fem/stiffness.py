@@ -269,12 +269,5 @@ def _csr_from_blocks(dim: int, nodes: int, indptr: np.ndarray, indices: np.ndarr
     return K
 
 
-#: the stiffness of a triangle mesh in plane strain, per unit thickness
-plane_strain_stiffness = simplex_stiffness
-#: the stiffness of a tetrahedral mesh
-solid_stiffness = simplex_stiffness
-
-
 __all__ = ["triangle_gradients", "corner_coordinates", "tetrahedron_gradients",
-           "barycentric_gradients", "node_pairs", "mesh_edges", "hoop_terms", "simplex_stiffness",
-           "plane_strain_stiffness", "solid_stiffness"]
+           "barycentric_gradients", "node_pairs", "mesh_edges", "hoop_terms", "simplex_stiffness"]

@@ -39,6 +39,12 @@ def packed_keys(nodes: np.ndarray, count: int) -> np.ndarray | None:
     return key
 
 
+def edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
+    """One integer per undirected edge ``(first[k], second[k])`` of a mesh of ``n`` nodes."""
+    low, high = np.minimum(first, second), np.maximum(first, second)
+    return low.astype(np.int64) * n + high
+
+
 def sort_order(keys: np.ndarray, bound: int) -> np.ndarray:
     """``np.argsort(keys, kind="stable")`` of non-negative integer ``keys`` below ``bound``.
 
@@ -148,6 +154,22 @@ def moved(mesh: Any, p: np.ndarray) -> Any:
     return new
 
 
+def outward_normals(mesh: Any, facets: np.ndarray, unit: bool = True) -> np.ndarray:
+    """The normals (dim, k) of the boundary ``facets`` (edges in 2D, triangles in 3D) pointing
+    out of the body: of unit length, or (``unit=False``) as long as the edge (twice the
+    triangle's area)."""
+    mesh = with_topology(mesh)
+    p, ends = mesh.p, mesh.facets[:, facets]
+    if p.shape[0] == 2:
+        tangent = p[:, ends[1]] - p[:, ends[0]]
+        normal = np.array([tangent[1], -tangent[0]])
+    else:
+        normal = np.cross(p[:, ends[1]] - p[:, ends[0]], p[:, ends[2]] - p[:, ends[0]], axis=0)
+    inside = p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1)
+    normal = normal * np.sign(np.einsum("ij,ij->j", normal, p[:, ends].mean(axis=1) - inside))
+    return normal / np.linalg.norm(normal, axis=0) if unit else normal
+
+
 def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
     """The boundary facets whose ends are all among ``nodes`` (triangles or tetrahedra)."""
     boundary = with_topology(mesh).boundary_facets()
@@ -155,5 +177,5 @@ def facets_on(mesh: Any, nodes: np.ndarray) -> np.ndarray:
     return boundary[inside]
 
 
-__all__ = ["packed_keys", "distinct_entities", "sort_order", "sorted_columns", "facet_topology",
-           "with_edges", "with_topology", "moved", "facets_on", "TOPOLOGY"]
+__all__ = ["packed_keys", "edge_keys", "distinct_entities", "sort_order", "sorted_columns", "facet_topology",
+           "with_edges", "with_topology", "moved", "facets_on", "outward_normals", "TOPOLOGY"]

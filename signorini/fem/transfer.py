@@ -16,21 +16,19 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.fem.obstacles import ScaledQuery
-from signorini.fem.topology import facets_on
+from signorini.fem.topology import edge_keys, facets_on
 
 
-def edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
-    """One integer per undirected edge ``(first[k], second[k])`` of a mesh of ``n`` nodes."""
-    low, high = np.minimum(first, second), np.maximum(first, second)
-    return low.astype(np.int64) * n + high
-
-
-def uniform_parents(t: np.ndarray, n: int) -> np.ndarray:
-    """(2, edges) parents of the nodes uniform refinement adds: edge k in sorted key order
-    becomes node ``n + k`` (as :func:`signorini.scenes.meshing.refine_uniformly` numbers them)."""
-    pairs = [(i, j) for i in range(t.shape[0]) for j in range(i + 1, t.shape[0])]
-    edges = np.unique(np.concatenate([edge_keys(t[i], t[j], n) for i, j in pairs]))
-    return np.array([edges // n, edges % n])
+def split_uniformly(t: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """One uniform refinement of the triangles ``t`` over ``n`` nodes: the parents (2, edges) of
+    the nodes it adds, edge k in sorted key order becoming node ``n + k``, and the triangles
+    (children at the edge midpoints), from one sort of integer edge keys."""
+    keys = np.concatenate([edge_keys(t[i], t[j], n) for i, j in ((0, 1), (1, 2), (2, 0))])
+    edges, inverse = np.unique(keys, return_inverse=True)
+    m01, m12, m20 = n + inverse.reshape(3, -1)  # midpoint of edges 01, 12, 20 of each triangle
+    return np.array([edges // n, edges % n]), np.hstack([
+        np.vstack([t[0], m01, m20]), np.vstack([t[1], m12, m01]),
+        np.vstack([t[2], m20, m12]), np.vstack([m01, m12, m20])])
 
 
 def prolongation(n_old: int, parents: np.ndarray) -> sp.csr_matrix:
@@ -47,21 +45,11 @@ def uniform_prolongation(t: np.ndarray, n: int, times: int = 1) -> sp.csr_matrix
     """The prolongation of ``times`` uniform refinements of the triangles ``t`` over ``n`` nodes."""
     P = sp.identity(n, format="csr")
     for _ in range(times):
-        parents = uniform_parents(t, n)
+        parents, t = split_uniformly(t, n)
         step = prolongation(n, parents)
         P = step @ P
-        t = _split(t, n, parents)
         n = step.shape[0]
     return P
-
-
-def _split(t: np.ndarray, n: int, parents: np.ndarray) -> np.ndarray:
-    """The triangles of one uniform refinement (children at the edge midpoints)."""
-    keys = edge_keys(parents[0], parents[1], n)
-    mid = [n + np.searchsorted(keys, edge_keys(t[i], t[j], n)) for i, j in ((0, 1), (1, 2), (2, 0))]
-    m01, m12, m20 = mid
-    return np.hstack([np.vstack([t[0], m01, m20]), np.vstack([t[1], m12, m01]),
-                      np.vstack([t[2], m20, m12]), np.vstack([m01, m12, m20])])
 
 
 # --- a scene's model carried onto a refinement of its mesh --------------------------------------
@@ -163,5 +151,5 @@ def with_candidates(model: Any, extra: np.ndarray, in_contact: np.ndarray | None
     return replace(model, **changes)
 
 
-__all__ = ["edge_keys", "uniform_parents", "prolongation", "uniform_prolongation",
+__all__ = ["split_uniformly", "prolongation", "uniform_prolongation",
            "boundary_children", "extend_nodes", "refined_model", "with_candidates"]

@@ -29,7 +29,7 @@ from skfem.models.elasticity import lame_parameters
 from signorini.references.analytic import contact_modulus
 from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
-from signorini.fem.assembly import lame_stiffness, nodal_dofs
+from signorini.fem.assembly import contact_weights, cut_forces, lame_stiffness, nodal_dofs
 from signorini.fem.mortar import Face, couple
 from signorini.fem.topology import moved
 from signorini.fem.volumetric import resolve
@@ -37,7 +37,7 @@ from signorini.problem.contact import ContactProblem, Model, Push, Scales
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Body", "TwoBodyModel", "assemble_two_bodies", "series_modulus"]
+__all__ = ["Body", "TwoBodyModel", "series_modulus"]
 
 
 @dataclass(frozen=True)
@@ -90,113 +90,6 @@ def _check_held(body: Body, which: str) -> None:
                          "or a pushed top and one roller on a side)")
 
 
-def assemble_two_bodies(slave: Body, master: Body, discretisation: str = "mortar", *,
-                        length_scale: float, force_multiplicity: float = 1.0,
-                        reference: ReferenceData | None = None, params: dict[str, Any] | None = None,
-                        target_load: float | None = None, predicted: Any = None,
-                        direction: np.ndarray | None = None, axisymmetric: bool = False,
-                        nondimensionalise: bool = True) -> ContactProblem:
-    """The contact QP of two bodies: ``K = diag(K¹, K²)``, f, N, d, weights, points, scales.
-
-    Body 1 (``slave``) carries the rows: one per slave node the master face
-    reaches, scaled to nodal forces (:meth:`~signorini.fem.mortar.Coupling.scaled`);
-    ``weights`` are ``∫ φₛ ds`` and ``contact_points`` the slave nodes. Units
-    as :func:`signorini.fem.assembly.assemble` makes them: lengths by
-    ``length_scale``, displacements by the largest prescribed one, stresses
-    by the pair's contact modulus E* (:func:`series_modulus`).
-
-    ``target_load`` (the full pair, scene units) leaves the problem pending:
-    load control scales the prescribed push until the contact resultant along
-    y is that load; ``predicted(points)`` says which slave nodes (physical
-    coordinates, (k, 2)) the scene expects in contact, where load control starts.
-    ``direction`` fixes the rows' normal (the slave's outward unit normal, e.g.
-    the common normal at the first point of contact, along which Hertz's
-    theory measures the gap); None: each master segment's normal.
-    ``axisymmetric``: both meshes in the meridian half-plane (r, z), K and
-    the rows' integrals per radian (weight r), forces in units of E*·U·L.
-    """
-    start = time.perf_counter()
-    _check_held(slave, "slave")
-    _check_held(master, "master")
-    L = length_scale if nondimensionalise else 1.0
-    stress = series_modulus(slave.E, slave.nu, master.E, master.nu) if nondimensionalise else 1.0
-    values = [abs(v) for body in (slave, master) for _, nodes, v in body.dirichlet if len(nodes)]
-    U = (max(values, default=0.0) or length_scale) if nondimensionalise else 1.0
-    first = slave.mesh.p.shape[1]
-    k = 1 if axisymmetric else 0  # force = E*·U·L^k, weight = L^(k+1)
-    mesh = MeshTri(np.hstack([slave.mesh.p, master.mesh.p]) / L,
-                   np.hstack([slave.mesh.t, master.mesh.t + first]))
-    dof_table = nodal_dofs(mesh)
-    K_full = sp.block_diag([body.stiffness(moved(body.mesh, body.mesh.p / L), stress,
-                                           axisymmetric) for body in (slave, master)], format="csr")
-    n_full = K_full.shape[0]
-
-    prescribed = np.zeros(n_full)
-    is_free = np.ones(n_full, dtype=bool)
-    for offset, body in ((0, slave), (first, master)):
-        for component, nodes, value in body.dirichlet:
-            dofs = dof_table[component, np.asarray(nodes, dtype=int) + offset]
-            prescribed[dofs] = value / U
-            is_free[dofs] = False
-    free, fixed = np.flatnonzero(is_free), np.flatnonzero(~is_free)
-
-    slave_face = Face.of(slave.mesh, slave.contact_facets)
-    master_face = Face.of(master.mesh, master.contact_facets)
-    coupling = couple(slave_face, master_face, discretisation, direction, axisymmetric).scaled()
-    N_full = coupling.rows(dof_table[:, slave_face.nodes], dof_table[:, master_face.nodes + first],
-                           n_full)
-    load_dofs = np.concatenate([dof_table[1, slave.load_nodes],
-                                dof_table[1, master.load_nodes + first]]).astype(int)
-    load_full = -force_multiplicity * np.asarray(K_full[load_dofs].sum(axis=0)).ravel()
-
-    K_free = K_full[free]
-    K_II, K_ID = K_free[:, free], K_free[:, fixed]
-    u_D = prescribed[fixed]
-    f1 = -(K_ID @ u_D)
-    d0 = coupling.gap / U
-    d1 = -(N_full[:, fixed] @ u_D)
-    offset1 = float(load_full[fixed] @ u_D)
-    target = None if target_load is None else target_load / (stress * U * L ** k)
-    f_load, offset_load = _cut_traction((slave, master), (0, first), L, dof_table, load_dofs,
-                                        force_multiplicity, axisymmetric)
-    if f_load is not None and target is None:
-        raise InputError("a load applied on a cut needs a target load: give P (or a_over_R)")
-    load = 0.0 if f_load is None else target
-    f = f1 + (0.0 if f_load is None else load * f_load[free])
-    offset = offset1 + load * offset_load
-    pushed = [-v for body in (slave, master) for c, nodes, v in body.dirichlet
-              if c == 1 and np.isin(nodes, body.load_nodes).any()]
-    points = mesh.p[:, slave_face.nodes[coupling.slave]].T
-    # each row's share of the resultant along y: the y-part of its slave normal, reversed
-    resultant = -np.asarray(N_full[:, dof_table[1, slave_face.nodes]].sum(axis=1)).ravel()
-    push = Push(f1=f1, d0=d0, d1=d1, offset1=offset1, scale=1.0,
-                f_load=None if f_load is None else f_load[free], offset_load=offset_load,
-                load=load, target=target,
-                resultant=None if np.all(resultant == 1.0) else resultant,
-                delta=max(pushed) if pushed else None, P=target_load)
-    record = Model(
-        mesh=mesh, free_dofs=free, prescribed=prescribed, load_row=load_full[free],
-        load_offset=offset, E=float(slave.E), nu=float(slave.nu),
-        volumetric=resolve(slave.volumetric, slave.nu), axisymmetric=axisymmetric,
-        reference=reference, materials=tuple((body.mesh.t.shape[1], float(body.E), float(body.nu),
-                                              resolve(body.volumetric, body.nu))
-                                             for body in (slave, master)),
-        params=dict(params or {}, discretisation=discretisation), push=push,
-        predicted_contact=None if predicted is None else np.asarray(predicted(points * L)),
-        pending=target is not None)
-    problem = ContactProblem(
-        K=K_II, f=f, N=N_full[:, free].tocsr(), d=d0 + d1,
-        weights=coupling.weights / L ** (k + 1),
-        contact_points=points,
-        force_multiplicity=force_multiplicity,
-        scales=Scales(length=L, displacement=U, force=stress * U * L ** k, weight=L ** (k + 1)),
-        model=record)
-    record.assemble_s = time.perf_counter() - start
-    log.info("assembled two bodies: %d free dofs, %d %s rows in %.2f s", problem.n, problem.m,
-             discretisation, record.assemble_s)
-    return problem
-
-
 def _cut_traction(bodies: tuple[Body, Body], offsets: tuple[int, int], L: float,
                   dof_table: np.ndarray, load_dofs: np.ndarray, multiplicity: float,
                   axisymmetric: bool = False) -> tuple[np.ndarray | None, float]:
@@ -207,26 +100,28 @@ def _cut_traction(bodies: tuple[Body, Body], offsets: tuple[int, int], L: float,
     area per radian when ``axisymmetric``); its
     consistent nodal forces are the lumped weights times it (exact for P1).
     """
-    f_load = np.zeros(dof_table.size)
-    offset_load, loaded = 0.0, False
+    f_load, offset_load, loaded = np.zeros(dof_table.size), 0.0, False
     for body, first in zip(bodies, offsets):
         if body.traction is None:
             continue
         facets, direction = body.traction
-        cut = Face.of(moved(body.mesh, body.mesh.p / L), facets)
-        weights = cut.weights(axisymmetric)
-        dofs = dof_table[1, cut.nodes + first]
-        f_load[dofs] = direction * weights / (multiplicity * weights.sum())
+        mesh = moved(body.mesh, body.mesh.p / L)
+        nodes = np.unique(mesh.facets[:, facets])
+        forces, offset = cut_forces(contact_weights(mesh, facets, nodes, axisymmetric),
+                                    dof_table[1, nodes + first], direction, multiplicity,
+                                    load_dofs, dof_table.size)
+        f_load += forces
         loaded = True
         if len(body.load_nodes):  # the traction on the loaded body's other nodes
-            offset_load += multiplicity * direction * f_load[dofs[~np.isin(dofs, load_dofs)]].sum()
+            offset_load += offset
     return (f_load if loaded else None), offset_load
 
 
 @dataclass(frozen=True)
 class TwoBodyModel:
-    """A two-body scene in physical units, ready for :func:`assemble_two_bodies`: what a
-    two-body scene family's ``build`` returns (a one-body family returns a SceneModel)."""
+    """A two-body scene in physical units (``slave`` on ``master``), assembled into one QP by
+    :meth:`assemble`: what a two-body scene family's ``build`` returns (a one-body family returns
+    a SceneModel)."""
 
     slave: Body
     master: Body
@@ -241,11 +136,105 @@ class TwoBodyModel:
     axisymmetric: bool = False
 
     def assemble(self, nondimensionalise: bool = True) -> ContactProblem:
-        """The model's contact QP (:func:`assemble_two_bodies`)."""
-        return assemble_two_bodies(self.slave, self.master, self.discretisation,
-                                   length_scale=self.length_scale,
-                                   force_multiplicity=self.force_multiplicity,
-                                   reference=self.reference, params=self.params,
-                                   target_load=self.target_load, predicted=self.predicted,
-                                   direction=self.direction, axisymmetric=self.axisymmetric,
-                                   nondimensionalise=nondimensionalise)
+        """The contact QP of the two bodies: ``K = diag(K¹, K²)``, f, N, d, weights, points, scales.
+
+        The slave carries the rows: one per slave node the master face
+        reaches, scaled to nodal forces (:meth:`~signorini.fem.mortar.Coupling.scaled`);
+        ``weights`` are ``∫ φₛ ds`` and ``contact_points`` the slave nodes. Units
+        as :func:`signorini.fem.assembly.assemble` makes them: lengths by
+        ``length_scale``, displacements by the largest prescribed one, stresses
+        by the pair's contact modulus E* (:func:`series_modulus`).
+
+        ``target_load`` (the full pair, scene units) leaves the problem pending:
+        load control scales the prescribed push until the contact resultant along
+        y is that load; ``predicted(points)`` says which slave nodes (physical
+        coordinates, (k, 2)) the scene expects in contact, where load control starts.
+        ``direction`` fixes the rows' normal (the slave's outward unit normal, e.g.
+        the common normal at the first point of contact, along which Hertz's
+        theory measures the gap); None: each master segment's normal.
+        ``axisymmetric``: both meshes in the meridian half-plane (r, z), K and
+        the rows' integrals per radian (weight r), forces in units of E*·U·L.
+        """
+        start = time.perf_counter()
+        slave, master, discretisation = self.slave, self.master, self.discretisation
+        length_scale, force_multiplicity = self.length_scale, self.force_multiplicity
+        axisymmetric, target_load, predicted = self.axisymmetric, self.target_load, self.predicted
+        _check_held(slave, "slave")
+        _check_held(master, "master")
+        L = length_scale if nondimensionalise else 1.0
+        stress = series_modulus(slave.E, slave.nu, master.E, master.nu) if nondimensionalise else 1.0
+        values = [abs(v) for body in (slave, master) for _, nodes, v in body.dirichlet if len(nodes)]
+        U = (max(values, default=0.0) or length_scale) if nondimensionalise else 1.0
+        first = slave.mesh.p.shape[1]
+        k = 1 if axisymmetric else 0  # force = E*·U·L^k, weight = L^(k+1)
+        mesh = MeshTri(np.hstack([slave.mesh.p, master.mesh.p]) / L,
+                       np.hstack([slave.mesh.t, master.mesh.t + first]))
+        dof_table = nodal_dofs(mesh)
+        K_full = sp.block_diag([body.stiffness(moved(body.mesh, body.mesh.p / L), stress,
+                                               axisymmetric) for body in (slave, master)], format="csr")
+        n_full = K_full.shape[0]
+
+        prescribed = np.zeros(n_full)
+        is_free = np.ones(n_full, dtype=bool)
+        for offset, body in ((0, slave), (first, master)):
+            for component, nodes, value in body.dirichlet:
+                dofs = dof_table[component, np.asarray(nodes, dtype=int) + offset]
+                prescribed[dofs] = value / U
+                is_free[dofs] = False
+        free, fixed = np.flatnonzero(is_free), np.flatnonzero(~is_free)
+
+        slave_face = Face.of(slave.mesh, slave.contact_facets)
+        master_face = Face.of(master.mesh, master.contact_facets)
+        coupling = couple(slave_face, master_face, discretisation, self.direction, axisymmetric).scaled()
+        N_full = coupling.rows(dof_table[:, slave_face.nodes], dof_table[:, master_face.nodes + first],
+                               n_full)
+        load_dofs = np.concatenate([dof_table[1, slave.load_nodes],
+                                    dof_table[1, master.load_nodes + first]]).astype(int)
+        load_full = -force_multiplicity * np.asarray(K_full[load_dofs].sum(axis=0)).ravel()
+
+        K_free = K_full[free]
+        K_II, K_ID = K_free[:, free], K_free[:, fixed]
+        u_D = prescribed[fixed]
+        f1 = -(K_ID @ u_D)
+        d0 = coupling.gap / U
+        d1 = -(N_full[:, fixed] @ u_D)
+        offset1 = float(load_full[fixed] @ u_D)
+        target = None if target_load is None else target_load / (stress * U * L ** k)
+        f_load, offset_load = _cut_traction((slave, master), (0, first), L, dof_table, load_dofs,
+                                            force_multiplicity, axisymmetric)
+        if f_load is not None and target is None:
+            raise InputError("a load applied on a cut needs a target load: give P (or a_over_R)")
+        load = 0.0 if f_load is None else target
+        f = f1 + (0.0 if f_load is None else load * f_load[free])
+        offset = offset1 + load * offset_load
+        pushed = [-v for body in (slave, master) for c, nodes, v in body.dirichlet
+                  if c == 1 and np.isin(nodes, body.load_nodes).any()]
+        points = mesh.p[:, slave_face.nodes[coupling.slave]].T
+        # each row's share of the resultant along y: the y-part of its slave normal, reversed
+        resultant = -np.asarray(N_full[:, dof_table[1, slave_face.nodes]].sum(axis=1)).ravel()
+        push = Push(f1=f1, d0=d0, d1=d1, offset1=offset1, scale=1.0,
+                    f_load=None if f_load is None else f_load[free], offset_load=offset_load,
+                    load=load, target=target,
+                    resultant=None if np.all(resultant == 1.0) else resultant,
+                    delta=max(pushed) if pushed else None, P=target_load)
+        record = Model(
+            mesh=mesh, free_dofs=free, prescribed=prescribed, load_row=load_full[free],
+            load_offset=offset, E=float(slave.E), nu=float(slave.nu),
+            volumetric=resolve(slave.volumetric, slave.nu), axisymmetric=axisymmetric,
+            reference=self.reference,
+            materials=tuple((body.mesh.t.shape[1], float(body.E), float(body.nu),
+                             resolve(body.volumetric, body.nu)) for body in (slave, master)),
+            params=dict(self.params, discretisation=discretisation), push=push,
+            predicted_contact=None if predicted is None else np.asarray(predicted(points * L)),
+            pending=target is not None)
+        problem = ContactProblem(
+            K=K_II, f=f, N=N_full[:, free].tocsr(), d=d0 + d1,
+            weights=coupling.weights / L ** (k + 1),
+            contact_points=points,
+            force_multiplicity=force_multiplicity,
+            scales=Scales(length=L, displacement=U, force=stress * U * L ** k, weight=L ** (k + 1)),
+            model=record)
+        record.assemble_s = time.perf_counter() - start
+        log.info("assembled two bodies: %d free dofs, %d %s rows in %.2f s", problem.n, problem.m,
+                 discretisation, record.assemble_s)
+        return problem

@@ -3,11 +3,10 @@
 Plain P1 elements integrate ``λ (tr ε)²`` element by element. Each element
 then carries its own incompressibility constraint, and as ν → ½ (λ/μ → ∞)
 those constraints outnumber what the displacement can satisfy: the mesh
-locks, the body turns too stiff and Hertz's p₀ drifts by 0.2 % at ν = 0.45
-and by several percent at ν = 0.499 on the cylinder's default mesh
-(docs/accuracy.md). Averaging the volumetric strain over the elements around
-each node leaves one constraint per node — fewer than the two or three
-displacement dofs of that node — and the locking goes.
+locks, the body turns too stiff and Hertz's p₀ drifts away (docs/accuracy.md,
+§4). Averaging the volumetric strain over the elements around each node leaves
+one constraint per node — fewer than the two or three displacement dofs of
+that node — and the locking goes.
 
 With P1 basis functions φₙ and ``tr ε = ∂ₓuₓ + ∂ᵧuᵧ (+ ∂_z u_z, or + u_r / r
 axisymmetric)``, the nodal volumetric strain is
@@ -41,18 +40,17 @@ from signorini.fem.stiffness import barycentric_gradients
 #: the scenes' parameter ``volumetric``: element by element (plain P1), averaged at the nodes, or
 #: ``auto``: averaged from :data:`NODAL_FROM_NU` on
 CHOICES = ("auto", "element", "nodal")
-#: ``auto`` averages at the nodes from this Poisson's ratio on, in 2D and axisymmetric models.
-#: Below it both give Hertz's cylinder and sphere within 0.04 % of each other on the default
-#: meshes (docs/accuracy.md) and plain P1's K has 2.7 times fewer nonzeros; at ν = 0.4 the
-#: sphere's p₀ is 0.10 % off with plain P1 and 0.03 % with the average.
+#: ``auto`` averages at the nodes from this Poisson's ratio on, in 2D and axisymmetric models:
+#: below it the two agree on the Hertz scenes and plain P1's K has fewer nonzeros
+#: (docs/accuracy.md, §4).
 NODAL_FROM_NU = 0.4
 
 
 def resolve(choice: str, nu: float, dim: int = 2) -> str:
     """``element`` or ``nodal``: what ``choice`` (one of :data:`CHOICES`) means at Poisson's ratio
     ν on a mesh of dimension ``dim``. ``auto`` keeps plain P1 on tetrahedra: there the average's
-    K has 5.2 times the nonzeros (185 a dof against 36 on hertz-sphere-3d), more than the 3D
-    size guards and methods were measured for; ``volumetric=nodal`` asks for it explicitly."""
+    K has 5.2 times the nonzeros, more than the 3D size guards and methods were measured for;
+    ``volumetric=nodal`` asks for it explicitly."""
     if choice == "auto":
         return "nodal" if nu >= NODAL_FROM_NU and dim == 2 else "element"
     return choice

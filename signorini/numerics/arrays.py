@@ -8,11 +8,13 @@ into NaN, or a sparse matrix into zeros).
 from __future__ import annotations
 
 import math
+import warnings
 from numbers import Real
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.linalg import lobpcg
 
 from signorini.errors import InputError
 
@@ -164,5 +166,30 @@ def points_argument(value: Any, N: sp.csr_matrix) -> np.ndarray:
     return points
 
 
+#: K is indefinite when an eigenvalue lies below this fraction of its largest diagonal entry
+NEGATIVE_CURVATURE = 1e-10
+#: up to this many dofs the lowest eigenvalue of K is found densely, beyond it is bounded above
+#: by LOBPCG's Rayleigh quotient after at most :data:`CURVATURE_STEPS` iterations
+DENSE_EIGEN_DOFS = 500
+CURVATURE_STEPS = 50
+
+
+def indefinite(K) -> bool:
+    """Whether ``K`` has a negative eigenvalue (below ``−NEGATIVE_CURVATURE · max|Kᵢᵢ|``): then
+    ``½uᵀKu − fᵀu`` has no minimum and a KKT point is no answer. Exact up to
+    :data:`DENSE_EIGEN_DOFS` dofs; beyond, a Rayleigh quotient below the bound proves it (one
+    above says nothing: False)."""
+    scale = float(np.max(np.abs(K.diagonal()), initial=0.0)) or 1.0
+    if K.shape[0] <= DENSE_EIGEN_DOFS:
+        lowest = np.linalg.eigvalsh(K.toarray())[0]
+    else:
+        start = np.random.default_rng(0).standard_normal((K.shape[0], 1))
+        with warnings.catch_warnings():  # an unconverged quotient still bounds the lowest above
+            warnings.simplefilter("ignore")
+            lowest = lobpcg(K, start, largest=False, maxiter=CURVATURE_STEPS, tol=1e-8)[0][0]
+    return bool(lowest < -NEGATIVE_CURVATURE * scale)
+
+
 __all__ = ["sparse_argument", "symmetric_argument", "vector_argument", "flag_argument",
-           "finite_real", "multiplicity_argument", "dimension_of", "points_argument"]
+           "finite_real", "multiplicity_argument", "dimension_of", "points_argument",
+           "CURVATURE_STEPS", "DENSE_EIGEN_DOFS", "NEGATIVE_CURVATURE", "indefinite"]

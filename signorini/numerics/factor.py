@@ -18,7 +18,8 @@ method's factorisation of the same K.
 
 Work as data: each factorisation and back-solve (and, elsewhere in the numerics, each multigrid
 hierarchy, CG iteration and load-control step) is counted (:func:`count`) into every
-:class:`Work` record open in the current context, which a stage opens with :func:`counting`.
+:class:`Work` record open in the current context, which a stage opens with :func:`counting`;
+:func:`timed` adds a stage's wall time to ``solution.seconds``.
 The open records live in a :class:`contextvars.ContextVar` (per thread and per task): two
 solves side by side never see each other's work, and outside any ``counting`` block nothing is
 kept. Tests count work instead of timing it.
@@ -30,9 +31,10 @@ import importlib.util
 import logging
 import os
 import sys
+import time
 from contextlib import contextmanager
 from contextvars import ContextVar
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Iterator
 
 import numpy as np
@@ -43,6 +45,7 @@ from signorini.errors import BackendNotInstalled, InputError, install_hint
 
 log = logging.getLogger(__name__)
 
+
 @dataclass
 class Work:
     """The work of one stage: every count starts at zero."""
@@ -52,10 +55,6 @@ class Work:
     hierarchies: int = 0
     cg_iterations: int = 0
     load_steps: int = 0
-
-    def as_dict(self) -> dict[str, int]:
-        """The counts that are not zero, by name."""
-        return {name: value for name, value in asdict(self).items() if value}
 
     def listed(self, steps: int | None = None) -> dict[str, int]:
         """The stage as ``solution.work`` lists it: its ``steps`` (given, else load control's
@@ -94,6 +93,16 @@ def count_solves(b: np.ndarray) -> np.ndarray:
     b = np.asarray(b, dtype=float)
     count("back_solves", 1 if b.ndim == 1 else b.shape[1])
     return b
+
+
+@contextmanager
+def timed(seconds: dict[str, float], stage: str) -> Iterator[None]:
+    """Add the wall time of the block to ``seconds[stage]`` (seconds, :func:`time.perf_counter`)."""
+    start = time.perf_counter()
+    try:
+        yield
+    finally:
+        seconds[stage] = seconds.get(stage, 0.0) + time.perf_counter() - start
 
 
 BACKENDS = ("pardiso", "cholmod", "superlu")
@@ -380,4 +389,4 @@ __all__ = ["available_backends", "resolve_backend", "Factor", "cholmod_analysis"
            "cholmod_numeric", "CholmodFactor", "FactorTooLarge", "gigabytes_from",
            "factor_memory_limit", "pardiso_factor_bytes", "upper_csr", "PardisoFactor",
            "factorize", "BACKENDS", "EXTRAS", "PARDISO_OVER_CHOLMOD_FROM", "FACTOR_MEMORY_VARIABLE",
-           "Work", "count", "count_solves", "counting"]
+           "Work", "count", "count_solves", "counting", "timed"]

@@ -134,7 +134,7 @@ class ContactSolution:
     #: load-control steps, factorisations, back-solves, CG iterations
     work: dict[str, dict[str, int]] = field(default_factory=dict)
     #: the wall time of every stage that ran, by stage ("load control", "method",
-    #: "certificate"), in seconds (:func:`signorini.numerics.stages.timed`)
+    #: "certificate"), in seconds (:func:`signorini.numerics.factor.timed`)
     seconds: dict[str, float] = field(default_factory=dict)
     __repr__ = short_repr
 

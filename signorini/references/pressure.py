@@ -85,6 +85,10 @@ class HertzComparison:
         return {**asdict(self), "a_rel": self.a_rel, "p0_rel": self.p0_rel}
 
 
+#: the comparison of an answer that carries no load: nothing to compare
+_NO_CONTACT = HertzComparison(0.0, *[float("nan")] * 6)
+
+
 def compare_hertz(problem: ContactProblem, solution: ContactSolution) -> HertzComparison:
     """Compare ``solution`` of a Hertz cylinder scene with Hertz's solution."""
     profile = contact_profile(problem, solution)
@@ -94,8 +98,7 @@ def compare_hertz(problem: ContactProblem, solution: ContactSolution) -> HertzCo
 def _against_cylinder(problem: ContactProblem, profile: ContactProfile, P: float) -> HertzComparison:
     """A 2D contact profile (sorted by x) against Hertz's cylinder carrying the load P."""
     if not P > 0:
-        nan = float("nan")
-        return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
+        return _NO_CONTACT
     scene = problem.model.reference  # what the scene hands its reference
     a_ref = hertz_cylinder_half_width(P, scene.R, scene.E_star)
     p0_ref = hertz_cylinder_peak(P, a_ref)
@@ -201,8 +204,7 @@ def compare_hertz_sphere(problem: ContactProblem, solution: ContactSolution) -> 
     scene = problem.model.reference  # what the scene hands its reference
     P = profile.total_force
     if not P > 0:
-        nan = float("nan")
-        return HertzComparison(0.0, nan, nan, nan, nan, nan, nan)
+        return _NO_CONTACT
     a_ref = hertz_sphere_radius(P, scene.R, scene.E_star)
     p0_ref = hertz_sphere_peak(P, a_ref)
     rho = radial_distance(problem.contact_points) * problem.scales.length
@@ -210,18 +212,16 @@ def compare_hertz_sphere(problem: ContactProblem, solution: ContactSolution) -> 
     def reference(r: np.ndarray) -> np.ndarray:
         return hertz_pressure(r, a_ref, p0_ref)
 
+    p0_nodal = float(profile.pressure[np.argmin(rho)])
     if problem.contact_points.shape[1] == 2:
         order = np.argsort(rho)
         a = contact_half_width(sub_profile(profile, order, rho[order]))
         l2 = _l2_relative_disc(rho, profile.pressure, reference)
-    else:
+        p0, a_fit = hertz_fit(rho, profile.pressure, profile.active)
+    else:  # a fit through the scattered p² of an unstructured surface is biased: the nodal peak
         a = float(np.mean([contact_half_width(line)
                            for line in symmetry_plane_profiles(problem, solution)]))
         l2 = _l2_relative_surface(problem, profile.pressure, reference)
-    p0_nodal = float(profile.pressure[np.argmin(rho)])
-    if problem.contact_points.shape[1] == 2:
-        p0, a_fit = hertz_fit(rho, profile.pressure, profile.active)
-    else:  # a fit through the scattered p² of an unstructured surface is biased (+3.3 % here)
         p0, a_fit = p0_nodal, a
     return HertzComparison(
         a=a_fit, a_ref=a_ref, p0=p0, p0_ref=p0_ref,

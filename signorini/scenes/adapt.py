@@ -40,7 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from signorini.errors import InputError, docs_page
-from signorini.numerics.stages import timed
+from signorini.numerics.factor import timed
 from signorini.fem.assembly import assemble
 from signorini.fem.estimate import ErrorEstimate, estimate
 from signorini.fem.transfer import refined_model, with_candidates

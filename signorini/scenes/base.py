@@ -244,16 +244,19 @@ def chosen_load(p: dict[str, Any], given: set[str],
 
 
 def hertz_load(p: dict[str, Any], given: set[str], R: float, E_star: float, half_width: Callable,
-               load: Callable, check_delta: bool = True) -> tuple[float | None, float | None, float]:
+               load: Callable, check_delta: bool = True,
+               graded_by_delta: bool = False) -> tuple[float | None, float | None, float]:
     """``(target P or None, prescribed δ or None, a/R the mesh is graded for)`` of a Hertz scene,
     with Hertz's ``half_width(P, R, E*)`` and its inverse ``load(a, R, E*)``: one of ``P``,
     ``a_over_R`` (the default) or ``delta`` sets the load, refused where a/R leaves
-    :data:`A_OVER_R_RANGE` (δ as ``a ~ √(δ R)``, up to Hertz's logarithm in 2D)."""
+    :data:`A_OVER_R_RANGE` (δ as ``a ~ √(δ R)``, up to Hertz's logarithm in 2D). A prescribed δ
+    grades the mesh for ``a_over_R``, or for ``√(δ/R)`` when ``graded_by_delta``."""
     chosen = chosen_load(p, given)
     if "delta" in chosen:
-        if check_delta:
-            checked_ratio(math.sqrt(p["delta"] / R), "delta", p["delta"])
-        return None, p["delta"], p["a_over_R"]
+        ratio = math.sqrt(p["delta"] / R)
+        if check_delta or graded_by_delta:
+            ratio = checked_ratio(ratio, "delta", p["delta"])
+        return None, p["delta"], ratio if graded_by_delta else p["a_over_R"]
     if "P" in chosen:
         return p["P"], None, checked_ratio(half_width(p["P"], R, E_star) / R, "P", p["P"])
     return load(p["a_over_R"] * R, R, E_star), None, p["a_over_R"]

@@ -29,7 +29,7 @@ from skfem import MeshTri
 from signorini.references.analytic import contact_modulus
 from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
-from signorini.fem.assembly import assemble, boundary_weights
+from signorini.fem.assembly import assemble, contact_weights
 from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.fem.obstacles import ScaledQuery
 from signorini.fem.topology import facets_on
@@ -202,7 +202,7 @@ def force_controlled_problem(pressure: float = 0.01, params: dict[str, Any] | No
     force = E * U  # plane strain: forces per unit thickness in units of E·U
     facets = problem.model.mesh.boundary_facets()
     on_top = np.all(np.isin(problem.model.mesh.facets[:, facets], top), axis=0)
-    weights = boundary_weights(problem.model.mesh, facets[on_top], top) * L  # physical lengths
+    weights = contact_weights(problem.model.mesh, facets[on_top], top) * L  # physical lengths
     load = np.zeros(basis.N)
     load[basis.nodal_dofs[1, top]] = -p["pressure"] * weights / force
     problem = problem.with_data(

@@ -15,7 +15,8 @@ contact candidates. The default mesh is on the accuracy-time front of docs/meshe
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Callable
 
 from signorini.references.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.fem.model import FlatObstacle, SceneModel
@@ -39,7 +40,7 @@ from signorini.scenes.base import (
     refinements,
     two_refinements_coarser,
 )
-from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
+from signorini.scenes.meshing import cut_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
 from signorini.scenes.size import SizeModel
 
 #: the analytic reference (signorini.references.catalogue) this family's problems compare with
@@ -66,41 +67,58 @@ PARAMS = (
 )
 
 
-def _load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
-    """``(target P or None, prescribed δ or None, a/R the mesh is graded for)``
-    (:func:`~signorini.scenes.base.hertz_load`)."""
-    return hertz_load(p, given, p["R"], contact_modulus(p["E"], p["nu"]), hertz_cylinder_half_width,
-                      hertz_cylinder_load)
+@dataclass(frozen=True)
+class HertzDisc:
+    """One elastic body of revolution or cylinder on a rigid flat, modelled as a quarter disc
+    graded to the contact: what differs between them is Hertz's ``half_width(P, R, E*)`` and its
+    inverse ``load(a, R, E*)``, the reference, the copies ``multiplicity`` of the model in the
+    whole body, whether it is axisymmetric and whether a prescribed δ grades the mesh for
+    ``√(δ/R)`` (else for ``a_over_R``)."""
+
+    reference: str
+    half_width: Callable[[float, float, float], float]
+    load: Callable[[float, float, float], float]
+    multiplicity: float
+    axisymmetric: bool = False
+    graded_by_delta: bool = False
+
+    def loads(self, p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
+        """``(target P or None, prescribed δ or None, a/R the mesh is graded for)``
+        (:func:`~signorini.scenes.base.hertz_load`)."""
+        return hertz_load(p, given, p["R"], contact_modulus(p["E"], p["nu"]), self.half_width,
+                          self.load, graded_by_delta=self.graded_by_delta)
+
+    def graded_ratio(self, p: dict[str, Any]) -> float:
+        """The a/R the mesh is graded for: the load's (``P``, ``delta`` or ``a_over_R``)."""
+        return self.loads(p, {k for k in ("P", "delta") if p.get(k) is not None})[2]
+
+    def build(self, p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
+        """The quarter-disc model in physical units (the meridian plane (r, z) when axisymmetric)."""
+        R = p["R"]
+        target, delta, a_est = self.loads(p, set() if given is None else given)
+        if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
+            disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
+        else:
+            disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
+                                       p["candidates"], mesher=p["mesher"])
+        delta_nominal = delta if delta is not None else a_est ** 2 * R
+        pushed, cut_load = cut_loading(disc.top, disc.centre, disc.top_facets, p["loading"], target)
+        return SceneModel(
+            mesh=disc.mesh, E=p["E"], nu=p["nu"],
+            dirichlet=[(0, disc.axis, 0.0), (1, pushed, -delta_nominal)],
+            contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
+            obstacle=FlatObstacle(0.0),
+            load_dofs=(1, pushed), length_scale=R, force_multiplicity=self.multiplicity,
+            target_load=target, **hertz_record(p, self.reference, target, a_est, delta_nominal),
+            axisymmetric=self.axisymmetric, cut_load=cut_load,
+            candidate_remedy=CANDIDATE_REMEDY.format(**p),
+            predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
 
 
-def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
-    """The quarter-disc model of Hertz's cylinder in physical units."""
-    R = p["R"]
-    target, delta, a_est = _load_choice(p, set() if given is None else given)
-    if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
-        disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
-    else:
-        disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
-                                   p["candidates"], mesher=p["mesher"])
-    delta_nominal = delta if delta is not None else a_est ** 2 * R
-    pushed, cut_load = disc_loading(disc, p["loading"], target)
-    return SceneModel(
-        mesh=disc.mesh, E=p["E"], nu=p["nu"],
-        dirichlet=[(0, disc.axis, 0.0), (1, pushed, -delta_nominal)],
-        contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
-        obstacle=FlatObstacle(0.0),
-        load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0,
-        target_load=target, **hertz_record(p, REFERENCE, target, a_est, delta_nominal),
-        cut_load=cut_load,
-        candidate_remedy=CANDIDATE_REMEDY.format(**p),
-        predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
-
-
-def graded_ratio(p: dict[str, Any]) -> float:
-    """The a/R the mesh is graded for: the target load's, else ``a_over_R``."""
-    if p.get("P") is None or p.get("delta") is not None:
-        return p["a_over_R"]
-    return hertz_cylinder_half_width(p["P"], p["R"], contact_modulus(p["E"], p["nu"])) / p["R"]
+#: one cylinder: Hertz's plane-strain formulas, the quarter twice in the whole cylinder
+CYLINDER = HertzDisc(REFERENCE, hertz_cylinder_half_width, hertz_cylinder_load, 2.0)
+build = CYLINDER.build
+graded_ratio = CYLINDER.graded_ratio
 
 
 #: the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
@@ -116,18 +134,17 @@ VALIDATION = (
          same_as="hertz-cylinder"),
 )
 
-#: adaptive refinement starts from the relaxed mesh: its pressure estimate is within a factor 2
-#: of the true error there, and 3-6 on Triangle's meshes, which would refine past the target
-#: (docs/estimate.md)
+#: adaptive refinement starts from the relaxed mesh: on Triangle's its pressure estimate
+#: overstates the error more and would refine past the target (docs/estimate.md)
 ADAPTIVE_START = {"mesher": "relaxed", "n_contact": 40, "grading": 0.15}
 
 FAMILY = SceneFamily(
     name="hertz-cylinder",
     summary="elastic cylinder on a rigid flat, plane strain, quarter model graded to the contact",
-    params=PARAMS, build=build, loads=_load_choice, reference=REFERENCE, size_model=SIZE,
+    params=PARAMS, build=build, loads=CYLINDER.loads, reference=REFERENCE, size_model=SIZE,
     coarse=two_refinements_coarser, snap=quarter_disc_snap, validation=VALIDATION,
     convergence_start={"n_contact": 15, "grading": 0.6},
     adaptive_start=ADAPTIVE_START)
 
 
-__all__ = ["build", "graded_ratio", "PARAMS", "SIZE", "FAMILY"]
+__all__ = ["CYLINDER", "HertzDisc", "build", "graded_ratio", "PARAMS", "SIZE", "FAMILY"]

@@ -10,29 +10,20 @@ by a uniform δ (u_z = −δ, u_r free), adjusted until the contact force equals
 the target load. Forces are assembled per radian and the model's
 ``force_multiplicity`` is 2π, so reported loads are those of the whole sphere.
 The mesh is graded towards the first point of contact; only the arc nodes
-with ``r ≤ candidates · a`` are contact candidates. Default mesh (``n_contact=48``,
-``grading=0.15``, Triangle: 5,421 dofs): the fastest solve in process among the
-meshes that hold the sphere within 0.1 % of Hertz at ν = 0.3 and 0.45 and 0.15 %
-at ν = 0.499 (docs/mesher.md). A finite sphere is not Hertz's half-space: the
-converged model's a and p₀ differ from Hertz's in proportion to a/R, most at
-ν = 0; at a/R = 0.05 and ν = 0.3 a finer mesh moves p₀ away from Hertz's, not
-towards it, and within 0.05 % of Hertz the sphere needs a/R ≤ 0.0025
-(docs/accuracy.md §3).
+with ``r ≤ candidates · a`` are contact candidates. The default mesh is on the
+accuracy-time front of docs/mesher.md. A finite sphere is not Hertz's half-space:
+the converged model's a and p₀ differ from Hertz's in proportion to a/R, most at
+ν = 0, and a finer mesh need not bring them nearer (docs/accuracy.md §3).
 
 Hertz (Johnson 1985, §4.2): ``a = (3PR/(4E*))^(1/3)``, ``p₀ = 3P/(2πa²)``.
 """
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
-from signorini.references.analytic import contact_modulus, hertz_sphere_load, hertz_sphere_radius
-from signorini.errors import InputError
-from signorini.fem.model import FlatObstacle, SceneModel
+from signorini.references.analytic import hertz_sphere_load, hertz_sphere_radius
 from signorini.scenes.base import (
-    CANDIDATE_REMEDY,
     LOADING,
     MESHER,
     VOLUMETRIC,
@@ -40,16 +31,17 @@ from signorini.scenes.base import (
     Param,
     SceneFamily,
     at_least,
-    checked_ratio,
+    candidates,
     contact_ratio,
-    grading_check,
-    hertz_record,
+    grading,
     length,
     poisson_ratio,
     positive,
+    refinements,
     two_refinements_coarser,
 )
-from signorini.scenes.meshing import disc_loading, graded_quarter_disc, quarter_disc_on, quarter_disc_snap
+from signorini.scenes.hertz_cylinder import HertzDisc
+from signorini.scenes.meshing import quarter_disc_snap
 from signorini.scenes.size import SizeModel
 
 COMMON_PARAMS = (
@@ -67,73 +59,31 @@ COMMON_PARAMS = (
 PARAMS = COMMON_PARAMS + (
     Param("n_contact", 48, "elements across the contact radius (mesh fineness)", kind=int,
           check=at_least(4)),
-    Param("grading", 0.15, "growth of the element size with distance from the contact zone",
-          check=grading_check),
-    Param("candidates", 2.0, "contact candidates extend to this multiple of the contact radius",
-          check=at_least(1.2)),
-    Param("refine", 0, "uniform refinements of the graded mesh (each quadruples the dofs)",
-          kind=int, check=lambda k: None if 0 <= k <= 6 else "in 0..6"),
+    grading(0.15),
+    candidates("contact radius"),
+    refinements(),
     LOADING,
     MESHER,
 )
 
-
-def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float]:
-    """The target load P (None when δ is prescribed) and the estimated a/R.
-
-    One of ``P``, ``a_over_R`` (the default) or ``delta`` sets the load; with
-    ``delta`` the estimate of a/R is Hertz's ``√(δ/R)`` from ``δ = a²/R``.
-    """
-    chosen = {name for name in given & {"P", "a_over_R", "delta"} if p[name] is not None}
-    if len(chosen) > 1:
-        raise InputError(f"scene parameters {' and '.join(sorted(chosen))} both set the load: "
-                         "give only one of P, a_over_R, delta")
-    R, E_star = p["R"], contact_modulus(p["E"], p["nu"])
-    if "delta" in chosen:
-        return None, checked_ratio(float(np.sqrt(p["delta"] / R)), "delta", p["delta"])
-    if "P" in chosen:
-        return p["P"], checked_ratio(hertz_sphere_radius(p["P"], R, E_star) / R, "P", p["P"])
-    return hertz_sphere_load(p["a_over_R"] * R, R, E_star), p["a_over_R"]
-
-
 #: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "hertz-3d"
 
-def build(p: dict[str, Any], given: set[str] | None = None, mesh: Any = None) -> SceneModel:
-    """The axisymmetric model of Hertz's sphere in physical units (meridian plane (r, z))."""
-    given = set() if given is None else given
-    R = p["R"]
-    target, a_est = load_choice(p, given)
-    if mesh is not None:  # the scene on a given mesh (adaptive refinement: signorini.scenes.adapt)
-        disc = quarter_disc_on(mesh, R, a_est, p["candidates"])
-    else:
-        disc = graded_quarter_disc(R, a_est, p["n_contact"], p["grading"], p["refine"],
-                                   p["candidates"], mesher=p["mesher"])
-    delta_nominal = p["delta"] if target is None else a_est ** 2 * R
-    pushed, cut_load = disc_loading(disc, p["loading"], target)
-    return SceneModel(
-        mesh=disc.mesh, E=p["E"], nu=p["nu"],
-        dirichlet=[(0, disc.axis, 0.0), (1, pushed, -delta_nominal)],
-        contact_nodes=disc.candidates, contact_facets=disc.contact_facets,
-        obstacle=FlatObstacle(0.0),
-        load_dofs=(1, pushed), length_scale=R, force_multiplicity=2.0 * np.pi,
-        target_load=target, **hertz_record(p, REFERENCE, target, a_est, delta_nominal),
-        axisymmetric=True, cut_load=cut_load, candidate_remedy=CANDIDATE_REMEDY.format(**p),
-        predicted_contact=disc.mesh.p[0, disc.candidates] < a_est * R)
-
-
-def graded_ratio(p: dict[str, Any]) -> float:
-    """The a/R a sphere's mesh is graded for: the load's (``P``, ``delta`` or ``a_over_R``)."""
-    return load_choice(p, {k for k in ("P", "delta") if p.get(k) is not None})[1]
+#: one sphere: Hertz's formulas, per radian (2π in the whole sphere); a push δ grades the mesh
+#: for Hertz's ``a = √(δR)``
+SPHERE = HertzDisc(REFERENCE, hertz_sphere_radius, hertz_sphere_load, 2.0 * np.pi,
+                   axisymmetric=True, graded_by_delta=True)
+load_choice = SPHERE.loads
+build = SPHERE.build
+graded_ratio = SPHERE.graded_ratio
 
 
 #: the default mesh's dofs and how they grow, fitted to the meshes built (docs/calibration.md)
 SIZE = SizeModel(6824, 60, 0.15, 0.05, uniform=5.2, alpha=0.65, beta=1.15, far_field=100.0,
                  margin=1.13, ratio=graded_ratio)
 
-#: adaptive refinement starts from the relaxed mesh: its pressure estimate is within a factor 2
-#: of the true error there, and 3-6 on Triangle's meshes, which would refine past the target
-#: (docs/estimate.md)
+#: adaptive refinement starts from the relaxed mesh: on Triangle's its pressure estimate
+#: overstates the error more and would refine past the target (docs/estimate.md)
 ADAPTIVE_START = {"mesher": "relaxed", "n_contact": 60, "grading": 0.15}
 
 FAMILY = SceneFamily(
@@ -146,4 +96,4 @@ FAMILY = SceneFamily(
     adaptive_start=ADAPTIVE_START)
 
 
-__all__ = ["load_choice", "build", "graded_ratio", "COMMON_PARAMS", "SIZE", "FAMILY"]
+__all__ = ["SPHERE", "load_choice", "build", "graded_ratio", "COMMON_PARAMS", "REFERENCE", "SIZE", "FAMILY"]

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from signorini.fem.model import CutLoad, FlatObstacle3D, SceneModel
+from signorini.fem.model import FlatObstacle, SceneModel
 from signorini.fem.topology import facets_on, moved, with_edges
 from signorini.scenes.base import (
     CANDIDATE_REMEDY,
@@ -39,10 +39,10 @@ from signorini.scenes.base import (
     refinements,
     two_refinements_coarser,
 )
-from signorini.scenes.hertz_sphere import COMMON_PARAMS, graded_ratio, load_choice
+from signorini.scenes.hertz_sphere import COMMON_PARAMS, REFERENCE, graded_ratio, load_choice
 from signorini.scenes.ball_octant import (coarse_ball_octant, curved_boundary_facets, distance_to_disc,
                                          on_ball_octant_surface, snap_to_sphere)
-from signorini.scenes.meshing import refine_simplices_to_size
+from signorini.scenes.meshing import cut_loading, refine_simplices_to_size
 
 PARAMS = COMMON_PARAMS + (
     Param("n_contact", 10, "elements across the contact radius (mesh fineness)", kind=int,
@@ -57,13 +57,10 @@ PARAMS = COMMON_PARAMS + (
 MAX_SIZE = 0.3
 
 
-#: the analytic reference (signorini.references.catalogue) this family's problems compare with
-REFERENCE = "hertz-3d"
-
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     """The quarter model of Hertz's sphere in physical units (z vertical, contact at the origin)."""
     R = p["R"]
-    target, a_est = load_choice(p, set() if given is None else given)
+    target, _, a_est = load_choice(p, set() if given is None else given)
     h_contact = a_est / p["n_contact"]
 
     def target_size(points: np.ndarray) -> np.ndarray:
@@ -85,10 +82,8 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
     tol = 1e-12 * R
     delta_nominal = p["delta"] if target is None else a_est ** 2 * R
     top = np.nonzero(np.abs(z - R) < tol)[0]
-    pushed, cut_load = top, None
-    if p["loading"] == "traction" and target is not None:  # as the disc scenes (CutLoad)
-        pushed = np.array([top[np.argmin(rho[top])]])
-        cut_load = CutLoad(component=2, nodes=top, facets=facets_on(mesh, top))
+    pushed, cut_load = cut_loading(top, top[np.argmin(rho[top])], facets_on(mesh, top), p["loading"],
+                                   target, component=2)
     candidates = candidates[np.lexsort((x[candidates], rho[candidates]))]
     return SceneModel(
         mesh=mesh, E=p["E"], nu=p["nu"],
@@ -96,7 +91,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:
                    (1, np.nonzero(np.abs(y) < tol)[0], 0.0),
                    (2, pushed, -delta_nominal)],
         contact_nodes=candidates, contact_facets=curved,
-        obstacle=FlatObstacle3D(0.0),
+        obstacle=FlatObstacle(0.0),
         load_dofs=(2, pushed), length_scale=R, force_multiplicity=4.0,
         target_load=target, **hertz_record(p, REFERENCE, target, a_est, delta_nominal),
         cut_load=cut_load, predicted_contact=rho[candidates] < a_est * R,

@@ -25,16 +25,16 @@ rigid flat is the limit E2 → ∞, R2 → ∞.
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from signorini.references.analytic import hertz_cylinder_half_width, hertz_cylinder_load
 from signorini.problem.model import ReferenceData
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus
 from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Case, Param, SceneFamily, SizeEstimate,
                                    contact_ratio, hertz_load, length, one_of, positive)
+from signorini.scenes.hertz_cylinder import CYLINDER, HertzDisc
 from signorini.scenes.hertz_cylinder import PARAMS as CYLINDER_PARAMS
 from signorini.scenes.hertz_cylinder import SIZE as ONE_DISC
 from signorini.scenes.meshing import GradedDisc, graded_quarter_disc
@@ -108,29 +108,26 @@ def body(disc: GradedDisc, E: float, nu: float, push: float, volumetric: str, up
 
 @dataclasses.dataclass(frozen=True)
 class HertzPair:
-    """Two elastic bodies of revolution or cylinders, each a quarter disc meshed on its own: what
-    differs between them is Hertz's ``half_width(P, R*, E*)`` and its inverse ``load(a, R*, E*)``,
-    the contact size ``pushed(δ, R*)`` a prescribed push grades the mesh for, one body's size
-    model ``one_body``, the reference, the copies ``multiplicity`` of the model in the pair and
-    whether it is axisymmetric."""
+    """Two elastic bodies of revolution or cylinders, each a quarter disc meshed on its own, of
+    the kind of the one-body model ``one`` (Hertz's formulas with R* and E*, the reference, the
+    copies of the model in the pair, axisymmetric or not, what a prescribed push grades the mesh
+    for); ``one_body`` is one body's size model."""
 
-    reference: str
-    half_width: Callable[[float, float, float], float]
-    load: Callable[[float, float, float], float]
-    pushed: Callable[[dict[str, Any], float, float], float]
+    one: HertzDisc
     one_body: SizeEstimate
-    multiplicity: float
-    axisymmetric: bool = False
 
     def loads(self, p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
         """The target load P (None: a prescribed push), the push δ (None: matched to P) and a/R*."""
-        return hertz_load(p, given, pair_radius(p), pair_modulus(p), self.half_width, self.load,
-                          check_delta=False)
+        return hertz_load(p, given, pair_radius(p), pair_modulus(p), self.one.half_width,
+                          self.one.load, check_delta=False)
 
     def contact_size(self, p: dict[str, Any], target: float | None, delta: float | None) -> float:
-        """The contact half-width (radius) the discs are graded for."""
+        """The contact half-width (radius) the discs are graded for: Hertz's at the target load, or
+        for a push δ ``√(δ R*)`` or ``a_over_R · R*`` (as the one-body model grades)."""
         R = pair_radius(p)
-        return self.half_width(target, R, pair_modulus(p)) if target is not None else self.pushed(p, delta, R)
+        if target is not None:
+            return self.one.half_width(target, R, pair_modulus(p))
+        return float(np.sqrt(delta * R)) if self.one.graded_by_delta else p["a_over_R"] * R
 
     def build(self, p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
         """The two quarter discs in physical units: upper (slave) on lower (master)."""
@@ -145,11 +142,11 @@ class HertzPair:
         return TwoBodyModel(
             slave=body(upper, p["E1"], p["nu1"], delta_nominal, p["volumetric"], True, traction),
             master=body(lower, p["E2"], p["nu2"], 0.0, p["volumetric"], False, traction),
-            discretisation=p["discretisation"], length_scale=R, force_multiplicity=self.multiplicity,
-            reference=ReferenceData(self.reference, E_star=E_star, R=R), params=params,
+            discretisation=p["discretisation"], length_scale=R, force_multiplicity=self.one.multiplicity,
+            reference=ReferenceData(self.one.reference, E_star=E_star, R=R), params=params,
             target_load=target, predicted=lambda points: points[:, 0] < a,
             direction=np.array([0.0, -1.0]) if p["normal"] == "vertical" else None,
-            axisymmetric=self.axisymmetric)
+            axisymmetric=self.one.axisymmetric)
 
     def mesh_dofs(self, p: dict[str, Any]) -> float:
         """The dofs of the two graded discs: one body's size model for each."""
@@ -165,15 +162,14 @@ class HertzPair:
         method of the suite, the dense ones too."""
         return SceneFamily(
             name=name, summary=summary, params=params, build=self.build, loads=self.loads,
-            reference=self.reference, size_model=CountedSize(self.mesh_dofs),
+            reference=self.one.reference, size_model=CountedSize(self.mesh_dofs),
             convergence_start=convergence_start,
             validation=(Case(name, name, {"E2": 3.0, "nu2": 0.2, "R2": 2.0, "n_contact": 16,
                                           "grading": 0.4}),))
 
 
 #: two cylinders: Hertz's plane-strain formulas (``hertz-2d``); a push grades for ``a_over_R``
-CYLINDERS = HertzPair("hertz-2d", hertz_cylinder_half_width, hertz_cylinder_load,
-                      lambda p, delta, R: p["a_over_R"] * R, ONE_DISC, 2.0)
+CYLINDERS = HertzPair(CYLINDER, ONE_DISC)
 
 FAMILY = CYLINDERS.family(
     "hertz-two-cylinders",

@@ -20,11 +20,9 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
-
-from signorini.references.analytic import hertz_sphere_load, hertz_sphere_radius
 from signorini.scenes import hertz_two_cylinders as cylinders
 from signorini.scenes.hertz_sphere import SIZE as ONE_SPHERE
+from signorini.scenes.hertz_sphere import SPHERE
 
 __all__ = ["FAMILY", "SPHERES_PAIR"]
 
@@ -39,9 +37,7 @@ PARAMS = tuple(dataclasses.replace(param, **SPHERES.get(param.name, {}))
                for param in cylinders.PARAMS)
 
 #: two spheres: Hertz's formulas (``hertz-3d``), per radian; a push δ grades for ``a = √(δ R*)``
-SPHERES_PAIR = cylinders.HertzPair("hertz-3d", hertz_sphere_radius, hertz_sphere_load,
-                                   lambda p, delta, R: float(np.sqrt(delta * R)), ONE_SPHERE,
-                                   2.0 * np.pi, axisymmetric=True)
+SPHERES_PAIR = cylinders.HertzPair(SPHERE, ONE_SPHERE)
 
 FAMILY = SPHERES_PAIR.family(
     "hertz-two-spheres",

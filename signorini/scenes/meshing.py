@@ -23,7 +23,8 @@ import numpy as np
 from skfem import Mesh, MeshTri
 
 from signorini.fem.model import CutLoad
-from signorini.fem.topology import facets_on, moved, with_topology
+from signorini.fem.topology import edge_keys, facets_on, moved, with_topology
+from signorini.fem.transfer import split_uniformly
 from signorini.scenes.relax import relax
 from signorini.scenes.triangulated import triangle_size, triangulated_quarter_disc
 
@@ -177,14 +178,15 @@ class GradedDisc:
         return int(np.intersect1d(self.axis, self.top)[0])
 
 
-def disc_loading(disc: GradedDisc, loading: str, target: float | None):
-    """The pushed nodes and the cut load of a disc: the whole top cut, or its centre and a traction.
-
-    With a prescribed displacement (no ``target``) the cut is always pushed flat.
+def cut_loading(top: np.ndarray, centre: int, top_facets: np.ndarray, loading: str,
+                target: float | None, component: int = 1):
+    """The pushed nodes and the cut load of a Hertz scene whose cut through the centre has the
+    nodes ``top`` and the ``top_facets``: the whole cut, or its ``centre`` node and a traction
+    along ``component``. With a prescribed displacement (no ``target``) the cut is pushed flat.
     """
     if loading == "displacement" or target is None:
-        return disc.top, None
-    return np.array([disc.centre]), CutLoad(component=1, nodes=disc.top, facets=disc.top_facets)
+        return top, None
+    return np.array([centre]), CutLoad(component=component, nodes=top, facets=top_facets)
 
 
 def quarter_disc_distance(p: np.ndarray) -> np.ndarray:
@@ -250,18 +252,9 @@ def graded_unit_disc(a_over_R: float, n_contact: int, grading: float,
     if mesher == "relaxed":
         corners = [int(np.argmin(np.hypot(mesh.p[0] - x, mesh.p[1] - y))) for x, y in ((0, 0), (0, 1), (1, 1))]
         mesh = relax(mesh.p, quarter_disc_distance, target_size, corners, snap_quarter_disc)
-    arc = on_circle_arc(mesh, (0.0, 1.0), 1.0)
-    ends = np.nonzero((np.hypot(*mesh.p) < 1e-12)  # the first point of contact, the top corner
-                      | (np.hypot(mesh.p[0] - 1.0, mesh.p[1] - 1.0) < 1e-12))[0]
-    chain = np.union1d(arc, ends)
-    chain = chain[np.argsort(np.arctan2(mesh.p[1, chain] - 1.0, mesh.p[0, chain]))]  # from the bottom
+    chain = arc_chain(mesh, 1.0)
     mesh.p.flags.writeable = mesh.t.flags.writeable = chain.flags.writeable = False
     return mesh.p, mesh.t, chain
-
-
-def _edge_keys(first: np.ndarray, second: np.ndarray, n: int) -> np.ndarray:
-    low, high = np.minimum(first, second), np.maximum(first, second)
-    return low.astype(np.int64) * n + high
 
 
 def refine_uniformly(p: np.ndarray, t: np.ndarray,
@@ -270,33 +263,38 @@ def refine_uniformly(p: np.ndarray, t: np.ndarray,
     node indices) gains its segments' midpoints in order.
 
     The same mesh as scikit-fem's ``refined()`` up to node numbering, built from integer edge
-    keys (one 1D sort) rather than a sort of index pairs: several times faster on 10⁶ nodes.
+    keys (one 1D sort, :func:`~signorini.fem.transfer.split_uniformly`) rather than a sort of
+    index pairs: several times faster on 10⁶ nodes.
     """
     n = p.shape[1]
-    corners = [(0, 1), (1, 2), (2, 0)]
-    keys = np.concatenate([_edge_keys(t[i], t[j], n) for i, j in corners])
-    edges, inverse = np.unique(keys, return_inverse=True)
-    middle = n + inverse.reshape(3, -1)  # midpoint of edges 01, 12, 20 of each triangle
-    p_new = np.hstack([p, 0.5 * (p[:, edges // n] + p[:, edges % n])])
-    m01, m12, m20 = middle
-    t_new = np.hstack([np.vstack([t[0], m01, m20]), np.vstack([t[1], m12, m01]),
-                       np.vstack([t[2], m20, m12]), np.vstack([m01, m12, m20])])
-    segment = np.searchsorted(edges, _edge_keys(chain[:-1], chain[1:], n))
+    parents, children = split_uniformly(t, n)
+    segment = np.searchsorted(edge_keys(parents[0], parents[1], n),
+                              edge_keys(chain[:-1], chain[1:], n))
     chain_new = np.empty(2 * len(chain) - 1, dtype=np.int64)
     chain_new[0::2], chain_new[1::2] = chain, n + segment
-    return p_new, t_new, chain_new
+    return np.hstack([p, 0.5 * (p[:, parents[0]] + p[:, parents[1]])]), children, chain_new
 
 
 def facet_indices(mesh: MeshTri, first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """scikit-fem's facet index of each edge ``(first[k], second[k])`` of ``mesh``."""
     n = mesh.p.shape[1]
-    keys = _edge_keys(mesh.facets[0], mesh.facets[1], n)
+    keys = edge_keys(mesh.facets[0], mesh.facets[1], n)
     order = np.argsort(keys)
-    wanted = _edge_keys(np.asarray(first), np.asarray(second), n)
+    wanted = edge_keys(np.asarray(first), np.asarray(second), n)
     found = order[np.searchsorted(keys, wanted, sorter=order)]
     if not np.array_equal(keys[found], wanted):
         raise ValueError("an edge of the chain is not an edge of the mesh")
     return found
+
+
+def arc_chain(mesh: MeshTri, R: float) -> np.ndarray:
+    """The nodes of the arc of the quarter disc of radius R below (0, R), with its two ends (the
+    first point of contact and the top corner), in order from the bottom."""
+    x, y = mesh.p
+    arc = on_circle_arc(mesh, (0.0, R), R, tol=1e-9 * R)
+    ends = np.nonzero((np.hypot(x, y) < 1e-9 * R) | (np.hypot(x - R, y - R) < 1e-9 * R))[0]
+    chain = np.union1d(arc, ends)
+    return chain[np.argsort(np.arctan2(y[chain] - R, x[chain]))]
 
 
 def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
@@ -309,10 +307,7 @@ def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
     """
     mesh = with_topology(mesh)
     x, y = mesh.p
-    arc = on_circle_arc(mesh, (0.0, R), R, tol=1e-9 * R)
-    ends = np.nonzero((np.hypot(x, y) < 1e-9 * R) | (np.hypot(x - R, y - R) < 1e-9 * R))[0]
-    chain = np.union1d(arc, ends)
-    chain = chain[np.argsort(np.arctan2(y[chain] - R, x[chain]))]
+    chain = arc_chain(mesh, R)
     candidates = chain[(x[chain] <= candidate_extent * a_over_R * R * (1 + 1e-9))
                        & (y[chain] < R * (1 - 1e-12))]
     top = np.nonzero(np.abs(y - R) < 1e-12 * R)[0]
@@ -324,6 +319,6 @@ def quarter_disc_on(mesh: MeshTri, R: float, a_over_R: float,
 
 __all__ = ["refine_to_size", "distance_to_segment", "coarse_quarter_disc", "on_circle_arc",
            "snap_to_circle", "quarter_disc_snap", "longest_simplex_edges",
-           "refine_simplices_to_size", "GradedDisc", "disc_loading", "quarter_disc_distance",
+           "refine_simplices_to_size", "GradedDisc", "cut_loading", "quarter_disc_distance",
            "snap_quarter_disc", "graded_quarter_disc", "graded_unit_disc", "refine_uniformly",
-           "facet_indices", "quarter_disc_on", "MAX_TRIANGLES", "MESHERS", "MAX_ELEMENTS"]
+           "facet_indices", "arc_chain", "quarter_disc_on", "MAX_TRIANGLES", "MESHERS", "MAX_ELEMENTS"]

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from signorini.references.analytic import contact_modulus, hertz_cylinder_half_width, hertz_cylinder_load
+from signorini.references.analytic import contact_modulus
 from signorini.problem.model import ReferenceData
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle
@@ -35,13 +35,13 @@ from signorini.scenes.base import (
     candidates,
     contact_ratio,
     grading,
-    hertz_load,
     length,
     poisson_ratio,
     positive,
     refinements,
     two_refinements_coarser,
 )
+from signorini.scenes.hertz_cylinder import CYLINDER
 from signorini.scenes.punch import block_on_obstacle
 from signorini.scenes.size import SizeModel
 
@@ -72,11 +72,8 @@ PARAMS = (
 )
 
 
-def load_choice(p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
-    """``(target P or None, prescribed δ or None, estimated a/R)``
-    (:func:`~signorini.scenes.base.hertz_load`)."""
-    return hertz_load(p, given, p["R"], contact_modulus(p["E"], p["nu"]), hertz_cylinder_half_width,
-                      hertz_cylinder_load)
+#: ``(target P or None, prescribed δ or None, estimated a/R)``: Hertz's cylinder's
+load_choice = CYLINDER.loads
 
 
 def build(p: dict[str, Any], given: set[str] | None = None) -> SceneModel:

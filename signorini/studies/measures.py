@@ -128,14 +128,14 @@ def answer_record(solution: ContactSolution) -> dict[str, Any]:
 
 
 def answer_from(record: dict[str, Any]) -> ContactSolution:
-    """The answer :func:`answer_record` wrote (None entries, non-finite in JSON, become NaN)."""
+    """The answer :func:`answer_record` wrote (None entries, non-finite in JSON, become NaN), with
+    the push it was solved at in ``extras["push"]`` when the record names one."""
+    extras = {key: record[key] for key in ("traceback", "push") if record.get(key)}
     return ContactSolution(method=record["method"], u=np.array(record["u"], dtype=float),
                            lam=np.array(record["lam"], dtype=float), status=record["status"],
                            message=record["message"], iterations=record["iterations"],
                            build_time=record["build_time"], solve_time=record["solve_time"],
-                           claimed_status=record["claimed_status"],
-                           extras={"traceback": record["traceback"]} if record.get("traceback")
-                           else {})
+                           claimed_status=record["claimed_status"], extras=extras)
 
 
 def forward_error(problem: ContactProblem, reference: ContactSolution,

@@ -75,7 +75,8 @@ def _force_controlled(spec: dict[str, Any]) -> ContactProblem:
 PROBLEM_KINDS: dict[str, Callable[[dict[str, Any]], ContactProblem]] = {
     "scene": _scene, "force-controlled": _force_controlled,
     "ill-posed": lambda spec: ill_posed_problem(spec["case"], params=spec.get("params", {})),
-    "stored": lambda spec: at_load(read_problem(spec["path"]), coarse_problem),
+    "stored": lambda spec: (at_load(read_problem(spec["path"]), coarse_problem)
+                            if spec.get("matched", True) else read_problem(spec["path"])),
 }
 
 
@@ -85,8 +86,10 @@ def build_spec(spec: dict[str, Any]) -> ContactProblem:
     ``{"kind": "scene", "scene", "params", "nondimensionalise", "matched"}``,
     ``{"kind": "force-controlled", "params", "pressure", "regularisation"}``,
     ``{"kind": "ill-posed", "case", "params"}`` (see :func:`ill_posed_problem`) or
-    ``{"kind": "stored", "path"}`` (a problem file: :meth:`ContactProblem.save`'s, plain
-    ``.npz`` or Matrix Market, :mod:`signorini.problem.files`).
+    ``{"kind": "stored", "path", "matched"}`` (a problem file: :meth:`ContactProblem.save`'s,
+    plain ``.npz`` or Matrix Market, :mod:`signorini.problem.files`). A scene's or a stored
+    problem's target load is matched once here unless ``"matched"`` is false (then each method
+    solves it as :func:`signorini.solve` does).
     """
     kind = spec["kind"]
     if kind not in PROBLEM_KINDS:

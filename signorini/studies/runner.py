@@ -306,8 +306,9 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
         row["forward_error"] = forward_error(problem, reference, solution)
     if "lam" in task.measure:
         row["lam"] = solution.lam.tolist()
-    if "answer" in task.measure:
-        row["answer"] = answer_record(solution)
+    if "answer" in task.measure:  # with the push it was solved at, when the model has one
+        push = problem.model.push
+        row["answer"] = {**answer_record(solution), **({} if push is None else {"push": push.scale})}
 
 
 # --- running many tasks: in this process or in a worker with a time limit ------------------------
