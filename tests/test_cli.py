@@ -180,12 +180,25 @@ def test_run_skips_the_teardown_only_as_the_one_process(monkeypatch):
     monkeypatch.delitem(sys.modules, "mpi4py", raising=False)  # no MPI loaded in this process
     app.run(["methods"])
     assert ended == [0] and handlers == [True]  # the exit handlers ran, then the process ended
-    # with MPI loaded (under mpirun, one rank or more) MPI is finalised by the usual exit
-    monkeypatch.setitem(sys.modules, "mpi4py", types.ModuleType("mpi4py"))
+    # with MPI loaded by a process alone, PETSc and then MPI are finalised here, and the
+    # teardown skipped as before
+    finalised = []
+    petsc, mpi = types.ModuleType("petsc4py.PETSc"), types.ModuleType("mpi4py.MPI")
+    petsc.Sys = types.SimpleNamespace(isFinalized=lambda: bool(finalised))
+    petsc._finalize = lambda: finalised.append("PETSc")
+    mpi.Is_initialized, mpi.Is_finalized = lambda: True, lambda: "MPI" in finalised
+    mpi.Finalize = lambda: finalised.append("MPI")
+    for name, module in (("mpi4py", types.ModuleType("mpi4py")), ("mpi4py.MPI", mpi),
+                         ("petsc4py.PETSc", petsc)):
+        monkeypatch.setitem(sys.modules, name, module)
     monkeypatch.setattr(app, "main", lambda argv, process: 0)
+    app.run(["methods"])
+    assert finalised == ["PETSc", "MPI"] and ended == [0, 0]
+    # under mpirun (one rank or more) MPI is finalised by the usual exit, which mpirun waits for
+    monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")
     with pytest.raises(SystemExit) as stopped:
         app.run(["methods"])
-    assert stopped.value.code == 0 and ended == [0]
+    assert stopped.value.code == 0 and ended == [0, 0] and finalised == ["PETSc", "MPI"]
 
 
 def test_the_process_keeps_the_memory_it_frees():

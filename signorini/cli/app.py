@@ -95,12 +95,12 @@ def run(argv: Sequence[str] | None = None) -> NoReturn:
     Once the command is done (outputs written, workers stopped), what is buffered is flushed
     and the exit handlers run; then the process ends without the interpreter's teardown,
     which frees every object one by one (at 10⁶ dofs, gigabytes of arrays and a
-    factorisation). When MPI was loaded (under ``mpirun`` or not), or when the output cannot be
-    flushed, it exits as usual.
+    factorisation). When MPI was loaded by a process ``mpirun`` started, or when the output
+    cannot be flushed, it exits as usual; a process alone finalises PETSc and MPI first.
     """
     keep_freed_memory()
     code = main(argv, process=True)
-    if "mpi4py" in sys.modules:  # MPI is finalised by the usual exit (mpirun waits for it)
+    if "mpi4py" in sys.modules and not _finalised_alone():  # MPI finalised by the usual exit
         sys.exit(code)
     try:
         for stream in (sys.stdout, sys.stderr):
@@ -110,6 +110,24 @@ def run(argv: Sequence[str] | None = None) -> NoReturn:
         sys.exit(code)
     atexit._run_exitfuncs()  # logging's flush and whatever a library registered
     os._exit(code)
+
+
+def _finalised_alone() -> bool:
+    """Whether PETSc and MPI, when loaded, are finalised here: only in a process that is the
+    whole MPI world (not started by ``mpirun``, which waits for the usual exit)."""
+    from signorini.solvers import cluster  # per command (start-up)
+
+    if cluster.launched_size() > 1:
+        return False
+    PETSc, MPI = sys.modules.get("petsc4py.PETSc"), sys.modules.get("mpi4py.MPI")
+    try:
+        if PETSc is not None and not PETSc.Sys.isFinalized():
+            PETSc._finalize()
+        if MPI is not None and MPI.Is_initialized() and not MPI.Is_finalized():
+            MPI.Finalize()
+    except Exception:  # noqa: BLE001 - the usual exit finalises what is left
+        return False
+    return True
 
 
 #: glibc's ``mallopt`` parameters (malloc.h): the most blocks served by ``mmap``, and the free
