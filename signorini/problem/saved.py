@@ -49,8 +49,9 @@ def save(problem: Any, path: str | os.PathLike) -> None:
         pu = disc.push
         if pu is not None:
             arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
-            if pu.f_load is not None:
-                arrays.update(push_f_load=pu.f_load)
+            optional = {"push_f_load": pu.f_load, "push_resultant": pu.resultant,
+                        "predicted_contact": disc.predicted_contact}
+            arrays.update({name: value for name, value in optional.items() if value is not None})
         meta["discretisation"] = {
             "load_offset": disc.load_offset, "E": disc.E, "nu": disc.nu,
             "volumetric": disc.volumetric, "axisymmetric": disc.axisymmetric,
@@ -107,7 +108,8 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
             reference=_reference_data(about["reference"]), params=about["params"], push=push,
             pending=about["push"] is not None and about["push"]["pending"],
             assemble_s=about["assemble_s"],
-            materials=tuple(tuple(m) for m in about.get("materials", ())))
+            materials=tuple(tuple(m) for m in about.get("materials", ())),
+            predicted_contact=z["predicted_contact"] if "predicted_contact" in z else None)
     K = symmetric_argument(sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]),
                                          shape=(n, n)))
     problem = problem_type(
