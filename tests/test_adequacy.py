@@ -28,6 +28,20 @@ def test_a_push_beyond_the_candidates_is_model_inadequate():
     assert max(result.certificate.as_dict().values()) < 1e-9
 
 
+def test_a_saved_problem_keeps_its_watch_and_is_judged_inadequate_from_its_file(tmp_path):
+    """The boundary beyond the candidates is stored with the problem: solved from its file, an
+    outgrown contact is model_inadequate there too, by the command line as by the API."""
+    problem = signorini.build_problem("hertz-cylinder", params={"delta": 0.02, **SMALL})
+    problem.save(tmp_path / "p.npz")
+    saved = signorini.ContactProblem.load(tmp_path / "p.npz")
+    assert saved.model.watch is not None
+    np.testing.assert_array_equal(saved.model.watch.rows.toarray(), problem.model.watch.rows.toarray())
+    assert signorini.solve(saved).status == "model_inadequate"
+    with contextlib.redirect_stdout(io.StringIO()) as out:
+        code = main(["solve", str(tmp_path / "p.npz"), "--json", str(tmp_path / "r.json")])
+    assert code == 1 and "model_inadequate" in out.getvalue()
+
+
 def test_more_candidates_make_the_same_push_adequate():
     result = signorini.solve("hertz-cylinder", params={"delta": 0.02, "candidates": 4.0, **SMALL})
     assert result.converged, result.message
