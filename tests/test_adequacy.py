@@ -28,6 +28,34 @@ def test_a_push_beyond_the_candidates_is_model_inadequate():
     assert max(result.certificate.as_dict().values()) < 1e-9
 
 
+def test_a_saved_problem_keeps_its_watch_and_is_judged_inadequate_from_its_file(tmp_path):
+    """The boundary beyond the candidates is stored with the problem: solved from its file, an
+    outgrown contact is model_inadequate there too, by the command line as by the API."""
+    problem = signorini.build_problem("hertz-cylinder", params={"delta": 0.02, **SMALL})
+    problem.save(tmp_path / "p.npz")
+    saved = signorini.ContactProblem.load(tmp_path / "p.npz")
+    assert saved.model.watch is not None
+    np.testing.assert_array_equal(saved.model.watch.rows.toarray(), problem.model.watch.rows.toarray())
+    assert signorini.solve(saved).status == "model_inadequate"
+    with contextlib.redirect_stdout(io.StringIO()) as out:
+        code = main(["solve", str(tmp_path / "p.npz"), "--json", str(tmp_path / "r.json")])
+    assert code == 1 and "model_inadequate" in out.getvalue()
+
+
+def test_two_bodies_whose_contact_reaches_the_slave_faces_end_are_model_inadequate():
+    """A push that brings every slave candidate into contact, the last one where the slave's
+    boundary goes on facing the other cylinder: the zone may go on beyond the face, so the exact
+    answer of the QP is model_inadequate; the default load stays converged, and the patch test's
+    face, which ends at the blocks' sides, has no such candidate."""
+    pushed = signorini.solve("hertz-two-cylinders", params={"delta": 0.02, "n_contact": 8})
+    assert pushed.status == "model_inadequate" and pushed.claimed_status == "converged"
+    assert "raise the scene parameter candidates" in pushed.message
+    assert max(pushed.certificate.as_dict().values()) < 1e-9  # the QP's answer is exact
+    default = signorini.solve("hertz-two-cylinders", params={"n_contact": 8})
+    assert default.converged and default.problem.model.watch.edge.size == 1
+    assert signorini.solve("two-block-patch").problem.model.watch.edge.size == 0
+
+
 def test_more_candidates_make_the_same_push_adequate():
     result = signorini.solve("hertz-cylinder", params={"delta": 0.02, "candidates": 4.0, **SMALL})
     assert result.converged, result.message

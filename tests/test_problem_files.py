@@ -118,6 +118,22 @@ def test_a_saved_scene_with_a_pending_load_is_matched_when_solved(tmp_path, caps
     assert abs(record["total_force"] / direct.total_force - 1) < 1e-8
 
 
+@pytest.mark.parametrize("scene", ["reverse-hertz", "hertz-cylinder"])
+def test_a_saved_scene_keeps_its_load_resultant_and_its_predicted_contact(scene, tmp_path):
+    """What load control reads is stored: the resultant's weights of a curved obstacle (the load
+    matched is the resultant along the push, not Σλ) and the contact the scene predicts (load
+    control starts from it): the saved problem is matched as the scene is, in as many steps."""
+    problem = signorini.build_problem(scene)
+    problem.save(tmp_path / "p.npz")
+    saved = signorini.ContactProblem.load(tmp_path / "p.npz")
+    for kept, given in ((saved.model.push.resultant, problem.model.push.resultant),
+                        (saved.model.predicted_contact, problem.model.predicted_contact)):
+        assert (kept is None) == (given is None) and (given is None or np.array_equal(kept, given))
+    direct, again = signorini.solve(problem, "pdas"), signorini.solve(saved, "pdas")
+    assert np.array_equal(direct.solution.lam, again.solution.lam)
+    assert direct.solution.work["load_control"] == again.solution.work["load_control"]
+
+
 @pytest.mark.parametrize("write", [write_coo, write_matrix_market, write_saved],
                          ids=["coo", "matrix_market", "saved"])
 def test_crosscheck_takes_a_problem_file(block, tmp_path, capsys, write):

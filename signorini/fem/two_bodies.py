@@ -31,9 +31,9 @@ from signorini.problem.model import ReferenceData
 from signorini.errors import InputError
 from signorini.fem.assembly import contact_weights, cut_forces, lame_stiffness, nodal_dofs
 from signorini.fem.mortar import Face, couple
-from signorini.fem.topology import moved
+from signorini.fem.topology import moved, outward_normals, with_topology
 from signorini.fem.volumetric import resolve
-from signorini.problem.contact import ContactProblem, Model, Push, Scales
+from signorini.problem.contact import ContactProblem, Model, Push, Scales, Watch
 
 log = logging.getLogger(__name__)
 
@@ -69,6 +69,26 @@ class Body:
         Lambda, Mu = lame_parameters(self.E / stress, self.nu)
         return lame_stiffness(mesh, Lambda, Mu, axisymmetric=axisymmetric,
                               volumetric=resolve(self.volumetric, self.nu))
+
+
+#: what to change when the slave's outermost candidate is in contact
+EDGE_REMEDY = "raise the scene parameter candidates (the slave's contact face) or lower the load"
+#: a boundary facet beyond the contact face faces the other body when its outward normal is within
+#: 60° of the face's mean outward normal
+FACING = 0.5
+
+
+def _edge_rows(slave: Body, row_nodes: np.ndarray) -> np.ndarray:
+    """The rows whose slave node ends the contact face where the slave's boundary goes on facing
+    the other body (beyond the candidates, unseen by the QP): in contact, the zone may go on
+    beyond them (:mod:`signorini.certification.adequacy`). A face that ends at a side turned
+    away (a block's corner, a symmetry plane) has none."""
+    mesh = with_topology(slave.mesh)
+    beyond = np.setdiff1d(mesh.boundary_facets(), slave.contact_facets)
+    facing = outward_normals(mesh, slave.contact_facets).mean(axis=1)
+    facing /= np.linalg.norm(facing)
+    turned = facing @ outward_normals(mesh, beyond) > FACING
+    return np.flatnonzero(np.isin(row_nodes, mesh.facets[:, beyond[turned]]))
 
 
 def series_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
@@ -226,6 +246,8 @@ class TwoBodyModel:
                              resolve(body.volumetric, body.nu)) for body in (slave, master)),
             params=dict(self.params, discretisation=discretisation), push=push,
             predicted_contact=None if predicted is None else np.asarray(predicted(points * L)),
+            watch=Watch(sp.csr_matrix((0, n_full)), np.zeros(0), _edge_rows(
+                slave, slave_face.nodes[coupling.slave]), np.zeros(0), EDGE_REMEDY),
             pending=target is not None)
         problem = ContactProblem(
             K=K_II, f=f, N=N_full[:, free].tocsr(), d=d0 + d1,

@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from signorini.problem.model import Model, Push, ReferenceData
+from signorini.problem.model import Model, Push, ReferenceData, Watch
 from signorini.errors import InputError
 from signorini.files import atomic_write_bytes
-from signorini.numerics.arrays import symmetric_argument
+from signorini.numerics.arrays import sparse_argument, symmetric_argument
 from signorini.paths import check_input_file
 from signorini.problem.scales import Scales
 
@@ -49,14 +49,25 @@ def save(problem: Any, path: str | os.PathLike) -> None:
         pu = disc.push
         if pu is not None:
             arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
-            if pu.f_load is not None:
-                arrays.update(push_f_load=pu.f_load)
+            optional = {"push_f_load": pu.f_load, "push_resultant": pu.resultant,
+                        "predicted_contact": disc.predicted_contact}
+            arrays.update({name: value for name, value in optional.items() if value is not None})
+        watch = disc.watch
+        if watch is not None:  # the boundary beyond the candidates: the model's adequacy is judged
+            rows = sp.csr_matrix(watch.rows)
+            arrays.update(watch_data=rows.data, watch_indices=rows.indices, watch_indptr=rows.indptr,
+                          watch_gaps=watch.gaps, watch_edge=watch.edge,
+                          watch_candidate_gaps=watch.candidate_gaps)
+            if watch.nodes is not None:
+                arrays.update(watch_nodes=watch.nodes)
         meta["discretisation"] = {
             "load_offset": disc.load_offset, "E": disc.E, "nu": disc.nu,
             "volumetric": disc.volumetric, "axisymmetric": disc.axisymmetric,
             "reference": None if disc.reference is None else dataclasses.asdict(disc.reference),
             "params": disc.params, "assemble_s": disc.assemble_s,
             "materials": [list(m) for m in disc.materials],
+            "watch": None if disc.watch is None else {"remedy": disc.watch.remedy,
+                                                      "columns": disc.watch.rows.shape[1]},
             "push": None if pu is None else {"offset1": pu.offset1, "scale": pu.scale,
                                              "offset_load": pu.offset_load, "load": pu.load,
                                              "target": pu.target, "pending": disc.pending,
@@ -107,7 +118,9 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
             reference=_reference_data(about["reference"]), params=about["params"], push=push,
             pending=about["push"] is not None and about["push"]["pending"],
             assemble_s=about["assemble_s"],
-            materials=tuple(tuple(m) for m in about.get("materials", ())))
+            materials=tuple(tuple(m) for m in about.get("materials", ())),
+            predicted_contact=z["predicted_contact"] if "predicted_contact" in z else None,
+            watch=_watch(z, about.get("watch"), z["prescribed"].size))
     K = symmetric_argument(sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]),
                                          shape=(n, n)))
     problem = problem_type(
@@ -133,6 +146,19 @@ def in_given_units(problem: Any) -> Any:
         d=problem.d * s.displacement, scales=Scales(),
         weights=None if problem.weights is None else problem.weights * s.weight,
         contact_points=problem.contact_points * s.length)
+
+
+def _watch(z: Any, stored: dict[str, Any] | None, dofs: int) -> Watch | None:
+    """The boundary beyond the candidates :func:`save` stored (None when the model had none),
+    its rows checked before SciPy's C code reads them; ValueError when they do not fit."""
+    if stored is None:
+        return None
+    rows = sparse_argument(sp.csr_matrix((z["watch_data"], z["watch_indices"], z["watch_indptr"]),
+                                         shape=(z["watch_gaps"].size, stored["columns"])), "watch")
+    if rows.shape[1] != dofs:
+        raise ValueError(f"its watch has {rows.shape[1]} columns and its model {dofs} dofs")
+    return Watch(rows, z["watch_gaps"], z["watch_edge"], z["watch_candidate_gaps"],
+                 stored["remedy"], z["watch_nodes"] if "watch_nodes" in z else None)
 
 
 def _reference_data(stored: Any) -> ReferenceData | None:
