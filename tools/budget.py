@@ -4,17 +4,13 @@
     .venv/bin/python tools/budget.py --3d       # also the 3D sphere at 350k and 10^6 dofs (~6 more min)
     .venv/bin/python tools/budget.py --parts 3d-1m   # one case's in-process parts, printed only
 
-2D: the 10⁶-dof cylinder command, whole process (start to exit, ``/usr/bin/time -v`` for its
-peak memory), the fastest of ``--repeat`` runs, and the same command with ``--method nested``
-(time and memory against the default's); then, in one process, its parts: the model
-built (meshing and assembly), the solve through the API, the certificate and the estimate, and
-the same K factorised by PARDISO (SPD, the package's settings) and solved once, which no
-method can do without; that factorisation is also timed in a process of its own between the
-whole commands (the reference the command is held to). Each stage of the command's own record (its JSON ``time``) is reported
-against its budget (:data:`BUDGETS_2D`, shares of that factorisation); in 3D against
-:data:`BUDGETS_3D`, shares of the method's own time. 3D: the command's whole process, at 350k and at 10⁶ dofs, and at 10⁶ its
-parts in one process: the model built, the solve through the API, the estimate, the certificate
-alone, and the one multigrid solve of K no method without a factorisation can avoid
+2D: the 10⁶-dof cylinder command in whole processes (``/usr/bin/time -v`` for the peak memory;
+the fastest of ``--repeat``), with ``--method nested`` interleaved, and PARDISO's factorisation
+and one solve of its K in a process of its own between them (the reference); then its parts in
+one process (:func:`in_process`). Each stage of a command's record (its JSON ``time``) is held to
+its budget: :data:`BUDGETS_2D`, shares of that factorisation; in 3D :data:`BUDGETS_3D`, shares of
+the method's own time. 3D: the sphere's command at 350k and 10⁶ dofs, and at 10⁶ its parts in
+one process with the one multigrid solve of K no method without a factorisation can avoid
 (:func:`in_process_amg`).
 docs/speed.md quotes the JSON (tests/test_readme_numbers.py holds it).
 """
@@ -127,13 +123,19 @@ def factorised(scene: str, params: dict) -> dict:
     import numpy as np
 
     from signorini.cli.app import keep_freed_memory
-    from signorini.numerics.factor import PardisoFactor
     from signorini.scenes.build import build_problem
 
     keep_freed_memory()  # as the command's process does: the same allocator for both
     problem = build_problem(scene, params)
     K, f = problem.K, np.asarray(problem.f, dtype=float)
     del problem
+    return pardiso_parts(K, f)
+
+
+def pardiso_parts(K, f) -> dict:
+    """``K`` factorised by PARDISO with the package's settings, then solved once for ``f``, timed."""
+    from signorini.numerics.factor import PardisoFactor
+
     start = time.perf_counter()
     factor = PardisoFactor(K)
     parts = {"pardiso_factorise_s": time.perf_counter() - start}
@@ -165,13 +167,13 @@ def built_and_solved(scene: str, params: dict, solved_by: str | None = None, **o
 
 
 def in_process(scene: str, params: dict) -> dict:
-    """The command's parts in one process: the model built (mesh and assembly), the whole solve
-    through the API (which judges the answer), the estimate, the certificate once more alone
-    (with the method's kept factorisation), and K factorised by PARDISO and solved once."""
+    """The command's parts in one process: built, solved through the API, its estimate and
+    certificate again, load control alone (work counted), K factorised by PARDISO, solved once."""
     import numpy as np
 
     import signorini
-    from signorini.numerics.factor import PardisoFactor
+    from signorini import load_control
+    from signorini.scenes.build import build_problem
 
     parts, result = built_and_solved(scene, params, keep_factor=True)
     start = time.perf_counter()  # a copy of the answer: the judged one keeps its certificate
@@ -179,12 +181,12 @@ def in_process(scene: str, params: dict) -> dict:
     parts["certificate_s"] = time.perf_counter() - start
     K, f = result.problem.K, np.asarray(result.problem.f, dtype=float)
     del result
+    problem = build_problem(scene, params)
     start = time.perf_counter()
-    factor = PardisoFactor(K)
-    parts["pardiso_factorise_s"] = time.perf_counter() - start
-    factor.solve(f)
-    parts["pardiso_factorise_and_solve_s"] = time.perf_counter() - start
-    return parts
+    matched = load_control.match(problem, load_control.predicted_zone(problem))
+    parts.update(load_control_s=time.perf_counter() - start, load_control_work=matched.work)
+    del matched, problem
+    return {**parts, **pardiso_parts(K, f)}
 
 
 def in_process_amg(scene: str, params: dict) -> dict:
@@ -262,6 +264,8 @@ def table(record: dict) -> str:
                  ("the certificate, once more alone (the method's factorisation)",
                   "certificate_s"),
                  ("the error estimate", "estimate_s"),
+                 *((("load control alone: K factorised around the predicted zone, the push found",
+                     "load_control_s"),) if "load_control_s" in parts else ()),
                  ("PARDISO: factorise K", "pardiso_factorise_s"),
                  ("PARDISO: factorise K and solve once", "pardiso_factorise_and_solve_s"))),
              "", f"Each stage of the command's own record (its JSON `time`: {accounted(command)}; "
