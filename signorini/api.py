@@ -160,6 +160,10 @@ def certificate(problem: ContactProblem, solution: ContactSolution | None = None
     """
     if not isinstance(problem, ContactProblem):
         raise InputError(f"certificate: problem must be a ContactProblem, got {type(problem).__name__}")
+    if problem.model.pending:  # its QP is at a nominal push, not the load an answer is for
+        raise InputError("certificate: this problem's target load is not matched yet, so its QP "
+                         "is at a nominal push: certify against the problem solved "
+                         "(result.problem) or signorini.at_load(problem)")
     arrays = u is not None or force is not None
     if arrays and solution is not None:
         raise InputError("certificate: give either a solution or the arrays u= and force=, not both")

@@ -525,3 +525,19 @@ def test_an_answer_with_no_factorisation_is_certified_on_one_pinned_factorisatio
     assert bordered_cost["factorisations"] == 1 and bordered_cost["back_solves"] >= active
     assert pinned.worst()[1] < 1e-10 and bordered.worst()[1] < 1e-10
     assert abs(pinned.force_error - bordered.force_error) < 1e-10
+
+
+def test_a_kkt_point_of_an_indefinite_k_of_ones_own_is_not_certified_with_many_active_rows():
+    """K of one's own with negative curvature on forty dofs, each bounded by an active row: a
+    pinned factorisation would see only the positive rest, so the certificate factorises K
+    plainly, finds it indefinite, and no claim of convergence stands."""
+    n, m = 80, 40
+    diagonal = np.full(n, 2.0)
+    diagonal[:m] = -1.0
+    problem = ContactProblem.from_qp(sp.diags(diagonal).tocsr(), np.zeros(n),
+                                     sp.eye(m, n).tocsr(), np.full(m, 0.1))
+    u = np.where(np.arange(n) < m, 0.1, 0.0)
+    assert m >= kkt.PINNED_FROM
+    result = signorini.solve(problem, lambda problem, tol=None, max_iter=None: (u, np.full(m, 0.1)))
+    assert result.status == "inaccurate" and np.isinf(result.certificate.duality_gap)
+    assert "not positive semidefinite" in result.message

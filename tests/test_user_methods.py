@@ -344,3 +344,20 @@ def test_what_a_method_wrote_is_shown_when_it_fails_in_a_study(tmp_path, method_
     found = _command(tmp_path, "validate", "--case", "block", "--method",
                      f"{method_folder / 'debugged.py'}:crashes", "--out", str(tmp_path / "out"))
     assert "mine: starting on" in found.stderr and "a word on stderr" in found.stderr, found.stderr
+
+
+def test_solve_time_limit_takes_the_workers_certificate(capsys, user_file):
+    """The worker certified its answer on the same arrays; the command reads that certificate
+    (infinite residuals included) instead of factorising K again."""
+    from signorini.numerics.factor import counting
+
+    with counting() as work:
+        assert main(["solve", "block", "--method", "pdas", "--time-limit", "60", "--json",
+                     "a.json"]) == 0
+    assert work.factorisations == 0  # every factorisation was the worker's
+    assert main(["solve", "block", "--method", "pdas", "--json", "b.json"]) == 0
+    capsys.readouterr()
+    a, b = (json.loads((user_file.parent / name).read_text()) for name in ("a.json", "b.json"))
+    assert a["kkt"].keys() == b["kkt"].keys() and "certificate" not in a["extras"]
+    for name, value in b["kkt"].items():
+        assert value == a["kkt"][name] or abs(value - a["kkt"][name]) < 1e-12

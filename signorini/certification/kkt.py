@@ -279,14 +279,18 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
     (:attr:`ContactProblem.factorises_for_certificates`: big and not on a 2D mesh), where the
     duality gap uses CG and the forward error is not estimated. Where only plain factorisations
     without their Delassus operator are on offer and :data:`PINNED_FROM` or more active rows each
-    bound one dof, K is factorised with them pinned instead (the duality gap then takes it too).
+    bound one dof, a model's K (an elastic stiffness, never indefinite) is factorised with them
+    pinned instead (the duality gap then takes it too).
     """
     offers, active = offers or Offers(problem, solution), active_set(problem, solution)
     offered = [f for f in offers() if f.pinned is not None  # or the saddle point of this system
                or (getattr(f, "on", None) and f.on(problem.K, problem.N, active))]
     plain = all(f.pinned is not None and not f.pinned[0].size  # no pinned dof, no Delassus operator
                 and getattr(f, "delassus", None) is None for f in offered)
-    dofs = selection_dofs(problem.N) if plain and active.sum() >= PINNED_FROM else None
+    # a K of one's own may be indefinite, which a plain factorisation finds and a pinned one can
+    # miss (the negative curvature on the pinned dofs): only a model's K, positive by its making
+    made = not problem.model.empty
+    dofs = selection_dofs(problem.N) if made and plain and active.sum() >= PINNED_FROM else None
     if dofs is not None and problem.factorises_for_certificates:
         offered = [offers.add(PinnedFactor(problem.K, dofs[active]))]
     elif not offered and problem.factorises_for_certificates:

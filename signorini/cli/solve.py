@@ -17,7 +17,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from signorini.api import Result, solve, solve_adaptive, solve_summary  # per command
     from signorini.scenes import build_problem  # per command (start-up)
     from signorini.files import STDOUT, all_or_none, check_outputs, to_json  # per command (start-up)
-    from signorini.certification.kkt import certificate  # per command (start-up)
+    from signorini.certification.kkt import Certificate, certificate  # per command (start-up)
     from signorini.problem.files import is_problem_file  # per command (start-up)
     from signorini.solvers.registry import check_request, get_method  # per command (start-up)
     from signorini.solvers import user  # per command (start-up)
@@ -93,8 +93,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
                                             options=request.options)
                 if problem.model.pending and "push" in solution.extras:
                     problem = problem.pushed(float(solution.extras["push"]))
-                with timed(seconds, "certificate"):
-                    judged = certificate(problem, solution)
+                with timed(seconds, "certificate"):  # the worker's, on the same arrays
+                    given = solution.extras.pop("certificate", None)
+                    judged = certificate(problem, solution) if given is None else Certificate(**given)
                 solution.seconds = {**solution.seconds, **seconds}
                 result = Result(problem, solution, judged)
     if startup is not None:

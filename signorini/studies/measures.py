@@ -129,8 +129,12 @@ def answer_record(solution: ContactSolution) -> dict[str, Any]:
 
 def answer_from(record: dict[str, Any]) -> ContactSolution:
     """The answer :func:`answer_record` wrote (None entries, non-finite in JSON, become NaN), with
-    the push it was solved at in ``extras["push"]`` when the record names one."""
+    the push it was solved at in ``extras["push"]`` and its certificate's fields in
+    ``extras["certificate"]`` when the record names them (a non-finite one written as text)."""
     extras = {key: record[key] for key in ("traceback", "push") if record.get(key)}
+    if record.get("certificate"):
+        extras["certificate"] = {name: value if isinstance(value, int) else float(value)
+                                 for name, value in record["certificate"].items()}
     return ContactSolution(method=record["method"], u=np.array(record["u"], dtype=float),
                            lam=np.array(record["lam"], dtype=float), status=record["status"],
                            message=record["message"], iterations=record["iterations"],

@@ -29,6 +29,7 @@ restarted and the study goes on. A ``fresh`` task gets a process of its own
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import os
@@ -306,9 +307,11 @@ def measure_answer(problem: ContactProblem, task: Task, row: Row, solution: Cont
         row["forward_error"] = forward_error(problem, reference, solution)
     if "lam" in task.measure:
         row["lam"] = solution.lam.tolist()
-    if "answer" in task.measure:  # with the push it was solved at, when the model has one
+    if "answer" in task.measure:  # with the push it was solved at, and its certificate
         push = problem.model.push
-        row["answer"] = {**answer_record(solution), **({} if push is None else {"push": push.scale})}
+        row["answer"] = {**answer_record(solution), **({} if push is None else {"push": push.scale}),
+                         "certificate": {name: value if np.isfinite(value) else str(value)
+                                         for name, value in dataclasses.asdict(cert).items()}}
 
 
 # --- running many tasks: in this process or in a worker with a time limit ------------------------
