@@ -289,8 +289,8 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
                 and getattr(f, "delassus", None) is None for f in offered)
     # a K of one's own may be indefinite, which a plain factorisation finds and a pinned one can
     # miss (the negative curvature on the pinned dofs): only a model's K, positive by its making
-    made = not problem.model.empty
-    dofs = selection_dofs(problem.N) if made and plain and active.sum() >= PINNED_FROM else None
+    many = plain and active.sum() >= PINNED_FROM and not problem.model.empty
+    dofs = selection_dofs(problem.N) if many else None
     if dofs is not None and problem.factorises_for_certificates:
         offered = [offers.add(PinnedFactor(problem.K, dofs[active]))]
     elif not offered and problem.factorises_for_certificates:
