@@ -50,3 +50,17 @@ def test_a_finding_the_atlas_no_longer_shows_stops_the_tool():
             row["message"] = "diverged: λ grew by 1e6"  # "growth is never seen" is then false
     with pytest.raises(stability.StaleFinding, match="two-step cycle"):
         stability.tables(grown)
+
+
+def test_the_one_door_reading_quotes_the_committed_speed_run():
+    """Every ratio the reading under the speed table quotes is one the committed run gives."""
+    import re
+
+    text = readme_tool.ONE_DOOR.read_text(encoding="utf-8")
+    table = readme_tool.blocks(readme_tool.ONE_DOOR)["one-door-speed"]
+    reading = text[text.index("**Reading (the committed run"):]
+    reading = reading.split("\n\n")[0].split(").**", 1)[1]  # the command's own numbers left out
+    quoted = re.findall(r"\b\d\.\d\d\b", reading)
+    assert len(quoted) >= 8
+    for number in quoted:
+        assert number in table, f"docs/one-door.md's reading quotes {number}, which its run lacks"

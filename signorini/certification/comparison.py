@@ -13,7 +13,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.certification.inverse import Counted, newton_system
-from signorini.certification.kkt import WEAK, WEAK_TOL, classify
+from signorini.certification.kkt import WEAK, WEAK_TOL, classify, inf_norm
 from signorini.problem.contact import ContactProblem, ContactSolution
 
 
@@ -41,7 +41,7 @@ class Comparison:
 def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
         return float("inf")
-    return _norm(a - b) / (max(_norm(a), _norm(b)) or 1.0)
+    return inf_norm(a - b) / (max(inf_norm(a), inf_norm(b)) or 1.0)
 
 
 def compare(problem: ContactProblem, first: ContactSolution, second: ContactSolution,
@@ -56,19 +56,14 @@ def compare(problem: ContactProblem, first: ContactSolution, second: ContactSolu
     return Comparison(u_rel, lam_rel, misclassified, int(np.sum(weak)))
 
 
-
-def _norm(x: np.ndarray) -> float:
-    return float(np.max(np.abs(x))) if x.size else 0.0
-
-
 def refined_on_active_set(K: sp.spmatrix, f: np.ndarray, N: sp.csr_matrix, d: np.ndarray,
                           u: np.ndarray, lam: np.ndarray, active: np.ndarray, factor,
                           steps: int = 30) -> tuple[np.ndarray, np.ndarray]:
     """``(u*, λ*)`` on ``active`` by iterative refinement with residuals in ``np.longdouble``.
 
     The corrections come from ``factor`` in double precision (as in
-    :func:`~signorini.certification.inverse.forward_error`); the residuals and the sums are long double (80-bit
-    on x86: 11 more bits), so the refinement converges below double's round-off
+    :func:`~signorini.certification.inverse.forward_error`); the residuals and the sums are long
+    double (80-bit on x86: 11 more bits), so the refinement converges below double's round-off
     wherever ``κ(M) ε_double < 1``. A reference for tests and studies, not for the
     certificate (each step is a long-double product with K).
     """

@@ -34,7 +34,8 @@ FORCE_FLOOR = 1e-5
 FORCE_ROUNDOFF = 1e-13
 
 
-def _inf_norm(x: np.ndarray) -> float:
+def inf_norm(x: np.ndarray) -> float:
+    """``‖x‖∞`` (0 for an empty x)."""
     return float(np.max(np.abs(x))) if x.size else 0.0
 
 
@@ -52,7 +53,7 @@ def force_scale(problem: ContactProblem, lam: np.ndarray, u: np.ndarray | None =
     that does not reach the contact (see :data:`FORCE_ROUNDOFF`). ``Nu``, when the caller
     has it, is ``N u`` (not formed again).
     """
-    norm, load = _inf_norm(lam), _inf_norm(problem.f)
+    norm, load = inf_norm(lam), inf_norm(problem.f)
     if u is not None and lam.size and norm > FORCE_ROUNDOFF * load and np.all(np.isfinite(u)):
         Nu = problem.N @ u if Nu is None else Nu
         top = int(np.argmax(np.abs(lam)))
@@ -69,7 +70,7 @@ def gap_scale(problem: ContactProblem, u: np.ndarray, Nu: np.ndarray | None = No
     nor start apart (a block resting on the flat: ``d = 0``, ``Nu = 0``).
     """
     Nu = problem.N @ u if Nu is None else Nu
-    return _positive(max(_inf_norm(Nu), _inf_norm(problem.d), _inf_norm(u)))
+    return _positive(max(inf_norm(Nu), inf_norm(problem.d), inf_norm(u)))
 
 
 @dataclass(frozen=True)
@@ -244,14 +245,14 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     scale_gap = gap_scale(problem, u)
     NT_lam = problem.N.T @ lam
     lam_norm = force_scale(problem, lam, u)
-    floor = lam_norm if lam_norm > _inf_norm(lam) else 0.0
+    floor = lam_norm if lam_norm > inf_norm(lam) else 0.0
     primal = max(float(np.max(violation, initial=0.0)), 0.0) / scale_gap
     Ku = problem.K @ u
     residual = Ku - problem.f + NT_lam
-    stationarity = _inf_norm(residual) / _positive(max(_inf_norm(NT_lam), floor))
+    stationarity = inf_norm(residual) / _positive(max(inf_norm(NT_lam), floor))
     dual_sign = max(float(np.max(-lam, initial=0.0)), 0.0) / lam_norm + 0.0
-    complementarity = _inf_norm((lam / lam_norm) * (violation / scale_gap))
-    natural = _inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))
+    complementarity = inf_norm((lam / lam_norm) * (violation / scale_gap))
+    natural = inf_norm(np.minimum(lam / lam_norm, -violation / scale_gap))
     gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:
         offers = Offers(problem, solution)
@@ -289,9 +290,10 @@ def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
                 and getattr(f, "delassus", None) is None for f in offered)
     # a K of one's own may be indefinite, which a plain factorisation finds and a pinned one can
     # miss (the negative curvature on the pinned dofs): only a model's K, positive by its making
-    many = plain and active.sum() >= PINNED_FROM and not problem.model.empty
+    many = plain and problem.factorises_for_certificates and active.sum() >= PINNED_FROM \
+        and not problem.model.empty
     dofs = selection_dofs(problem.N) if many else None
-    if dofs is not None and problem.factorises_for_certificates:
+    if dofs is not None:
         offered = [offers.add(PinnedFactor(problem.K, dofs[active]))]
     elif not offered and problem.factorises_for_certificates:
         offered = [offers.wrap(problem.factor())]
@@ -385,4 +387,4 @@ def active_set(problem: ContactProblem, solution: ContactSolution,
 __all__ = ["ACTIVE", "FORCE_FLOOR", "PINNED_FROM", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "WEAK", "WEAK_TOL",
            "Certificate", "Offers", "REMEMBERED_SOLVES", "Remembering", "active_set", "certificate",
            "classify", "force_scale",
-           "gap_scale", "shortfall"]
+           "gap_scale", "inf_norm", "shortfall"]

@@ -91,10 +91,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
                     solution = solve_within(problem, {**spec, "matched": False}, args.method,
                                             time_limit, tol=tol, max_iter=max_iter,
                                             options=request.options)
-                if problem.model.pending and "push" in solution.extras:
-                    problem = problem.pushed(float(solution.extras["push"]))
+                push, given = (solution.extras.pop(said, None) for said in ("push", "certificate"))
+                if problem.model.pending and push is not None:
+                    problem = problem.pushed(float(push))
                 with timed(seconds, "certificate"):  # the worker's, on the same arrays
-                    given = solution.extras.pop("certificate", None)
                     judged = certificate(problem, solution) if given is None else Certificate(**given)
                 solution.seconds = {**solution.seconds, **seconds}
                 result = Result(problem, solution, judged)

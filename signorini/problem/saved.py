@@ -49,9 +49,10 @@ def save(problem: Any, path: str | os.PathLike) -> None:
         pu = disc.push
         if pu is not None:
             arrays.update(push_f1=pu.f1, push_d0=pu.d0, push_d1=pu.d1)
-            optional = {"push_f_load": pu.f_load, "push_resultant": pu.resultant,
-                        "predicted_contact": disc.predicted_contact}
+            optional = {"push_f_load": pu.f_load, "push_resultant": pu.resultant}
             arrays.update({name: value for name, value in optional.items() if value is not None})
+        if disc.predicted_contact is not None:  # where load control starts
+            arrays.update(predicted_contact=disc.predicted_contact)
         watch = disc.watch
         if watch is not None:  # the boundary beyond the candidates: the model's adequacy is judged
             rows = sp.csr_matrix(watch.rows)
