@@ -25,7 +25,7 @@ from signorini.cli import main
 
 ROOT = os.path.dirname(signorini.__file__)
 #: package files a solve enters: a scene with a target load, and a QP given as arrays
-SCENE_FILES = 28
+SCENE_FILES = 27
 QP_FILES = 10
 
 

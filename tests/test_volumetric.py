@@ -9,8 +9,9 @@ from skfem.models.elasticity import lame_parameters
 import signorini
 from signorini.errors import InputError
 from signorini.fem.stiffness import simplex_stiffness
-from signorini.fem.volumetric import (NODAL_FROM_NU, averaging, nodal_volumetric_strain, resolve,
-                                      simplex_gradients, volumetric_stiffness)
+from signorini.fem.model import NODAL_FROM_NU, resolve
+from signorini.fem.volumetric import (averaging, nodal_volumetric_strain, simplex_gradients,
+                                      volumetric_stiffness)
 
 
 def _mesh(kind):

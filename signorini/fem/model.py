@@ -9,7 +9,24 @@ import numpy as np
 
 from signorini.problem.model import ReferenceData
 from signorini.fem.checks import check_model
-from signorini.fem.volumetric import resolve
+
+#: the scenes' parameter ``volumetric``: element by element (plain P1), averaged at the nodes, or
+#: ``auto``: averaged from :data:`NODAL_FROM_NU` on
+CHOICES = ("auto", "element", "nodal")
+#: ``auto`` averages at the nodes from this Poisson's ratio on, in 2D and axisymmetric models:
+#: below it the two agree on the Hertz scenes and plain P1's K has fewer nonzeros
+#: (docs/accuracy.md, §4; the average: :mod:`signorini.fem.volumetric`).
+NODAL_FROM_NU = 0.4
+
+
+def resolve(choice: str, nu: float, dim: int = 2) -> str:
+    """``element`` or ``nodal``: what ``choice`` (one of :data:`CHOICES`) means at Poisson's ratio
+    ν on a mesh of dimension ``dim``. ``auto`` keeps plain P1 on tetrahedra: there the average's
+    K has 5.2 times the nonzeros, more than the 3D size guards and methods were measured for;
+    ``volumetric=nodal`` asks for it explicitly."""
+    if choice == "auto":
+        return "nodal" if nu >= NODAL_FROM_NU and dim == 2 else "element"
+    return choice
 
 
 @dataclass
@@ -97,4 +114,4 @@ class SceneModel:
         return resolve(self.volumetric_choice, self.nu, self.mesh.p.shape[0])
 
 
-__all__ = ["FlatObstacle", "CutLoad", "SceneModel"]
+__all__ = ["CHOICES", "NODAL_FROM_NU", "resolve", "FlatObstacle", "CutLoad", "SceneModel"]

@@ -32,7 +32,7 @@ from signorini.errors import InputError
 from signorini.fem.assembly import contact_weights, cut_forces, lame_stiffness, nodal_dofs
 from signorini.fem.mortar import Face, couple
 from signorini.fem.topology import moved, outward_normals, with_topology
-from signorini.fem.volumetric import resolve
+from signorini.fem.model import resolve
 from signorini.problem.contact import ContactProblem, Model, Push, Scales, Watch
 
 log = logging.getLogger(__name__)

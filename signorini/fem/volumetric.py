@@ -37,24 +37,6 @@ import scipy.sparse as sp
 
 from signorini.fem.stiffness import barycentric_gradients
 
-#: the scenes' parameter ``volumetric``: element by element (plain P1), averaged at the nodes, or
-#: ``auto``: averaged from :data:`NODAL_FROM_NU` on
-CHOICES = ("auto", "element", "nodal")
-#: ``auto`` averages at the nodes from this Poisson's ratio on, in 2D and axisymmetric models:
-#: below it the two agree on the Hertz scenes and plain P1's K has fewer nonzeros
-#: (docs/accuracy.md, §4).
-NODAL_FROM_NU = 0.4
-
-
-def resolve(choice: str, nu: float, dim: int = 2) -> str:
-    """``element`` or ``nodal``: what ``choice`` (one of :data:`CHOICES`) means at Poisson's ratio
-    ν on a mesh of dimension ``dim``. ``auto`` keeps plain P1 on tetrahedra: there the average's
-    K has 5.2 times the nonzeros, more than the 3D size guards and methods were measured for;
-    ``volumetric=nodal`` asks for it explicitly."""
-    if choice == "auto":
-        return "nodal" if nu >= NODAL_FROM_NU and dim == 2 else "element"
-    return choice
-
 
 def simplex_gradients(mesh: Any) -> tuple[np.ndarray, np.ndarray]:
     """Gradients (elements, d + 1, dim) of every simplex's barycentric coordinates, and ``|det J|``
@@ -107,5 +89,4 @@ def nodal_volumetric_strain(mesh: Any, u: np.ndarray, axisymmetric: bool = False
     return G @ np.asarray(u, dtype=float).ravel() / np.where(volumes > 0, volumes, 1.0)
 
 
-__all__ = ["resolve", "simplex_gradients", "averaging", "volumetric_stiffness",
-           "nodal_volumetric_strain", "CHOICES", "NODAL_FROM_NU"]
+__all__ = ["simplex_gradients", "averaging", "volumetric_stiffness", "nodal_volumetric_strain"]

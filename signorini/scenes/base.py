@@ -22,7 +22,7 @@ from signorini.problem.model import ReferenceData
 from signorini.errors import InputError, docs_page
 from signorini.fem.checks import LENGTH_RANGE
 from signorini.fem.model import SceneModel
-from signorini.fem.volumetric import CHOICES
+from signorini.fem.model import CHOICES
 from signorini.scenes.meshing import MESHERS
 
 __all__ = ["A_OVER_R_RANGE", "CANDIDATE_REMEDY", "Case", "GRADING_RANGE", "HALF", "LOADING",

@@ -40,7 +40,7 @@ from signorini.errors import InputError
 from signorini.fem.checks import check_mesh
 from signorini.fem.model import SceneModel
 from signorini.fem.obstacles import Circle, FlatPunch, HalfPlane, ScaledQuery
-from signorini.fem.volumetric import CHOICES
+from signorini.fem.model import CHOICES
 from signorini.paths import check_input_file
 from signorini.scenes.base import length, poisson_ratio
 from signorini.scenes.scene_toml import SceneFileContext

@@ -32,7 +32,7 @@ from typing import Any, Callable, Protocol
 import numpy as np
 
 from signorini.errors import InputError
-from signorini.fem.volumetric import resolve
+from signorini.fem.model import resolve
 from signorini.numerics.factor import gigabytes_from
 from signorini.scenes.meshing import MAX_ELEMENTS, MAX_TRIANGLES
 from signorini.scenes.registry import SCENES, FamilyField
