@@ -164,6 +164,8 @@ def certificate(problem: ContactProblem, solution: ContactSolution | None = None
         raise InputError("certificate: this problem's target load is not matched yet, so its QP "
                          "is at a nominal push: certify against the problem solved "
                          "(result.problem) or signorini.at_load(problem)")
+    if not isinstance(duality_gap, bool):
+        raise InputError(f"certificate: duality_gap must be True or False, got {duality_gap!r}")
     arrays = u is not None or force is not None
     if arrays and solution is not None:
         raise InputError("certificate: give either a solution or the arrays u= and force=, not both")

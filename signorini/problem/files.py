@@ -34,6 +34,7 @@ import scipy.sparse as sp
 from signorini.errors import InputError, docs_page
 from signorini.files import check_input_file
 from signorini.problem.contact import ContactProblem
+from signorini.problem.saved import declared_sizes
 
 __all__ = ["MATRIX_MARKET_NAMES", "PLAIN_KEYS", "is_problem_file", "problem_file_paths",
            "read_problem"]
@@ -91,7 +92,7 @@ def read_problem(name: str | os.PathLike) -> ContactProblem:
                              f"of Matrix Market files ({FORMATS})")
         arrays = _npz(path)
         if "meta" in arrays:  # written by ContactProblem.save
-            return _saved(path)
+            return ContactProblem.load(path)  # its reader names the field at fault
         return _from_arrays(path, arrays, path.stem)
     except InputError as exc:
         text = str(exc)
@@ -125,7 +126,7 @@ def _npz(path: Path) -> dict[str, np.ndarray]:
                          f"numpy.savez ({FORMATS})")
     try:
         with np.load(path, allow_pickle=False) as stored:
-            declared = _check_declared_sizes(path, stored.zip)
+            declared = declared_sizes(str(path), stored.zip)
             sizes = {key: stored[key] for key in ("K_shape", "N_shape")  # a few numbers each
                      if key in stored.files and math.prod(declared.get(key, ())) <= 3}
             _check_declared_fit(declared, sizes)
@@ -177,36 +178,6 @@ def _check_shape(key: str, shape: tuple[int, ...], expected: tuple[int, int]) ->
         raise InputError(f"{key}_shape declares {' × '.join(map(str, shape))}, but {sizes} "
                          f"{expected[1]}: {key} must be {expected[0]} × {expected[1]}; fix "
                          f"{key}_shape (or the vectors)")
-
-
-def _check_declared_sizes(path: Path, archive: zipfile.ZipFile) -> dict[str, tuple[int, ...]]:
-    """The shape each array's header declares, by name; InputError for an array whose header
-    declares more bytes than its member of the archive holds (read before it is allocated)."""
-    declared = {}
-    for info in archive.infolist():
-        with archive.open(info) as member:
-            try:
-                fmt = np.lib.format
-                header = fmt.read_array_header_1_0 if fmt.read_magic(member) == (1, 0) else \
-                    fmt.read_array_header_2_0
-                shape, _, dtype = header(member)
-            except ValueError:
-                continue  # not an array: np.load says so
-        if dtype.itemsize * math.prod(shape) > info.file_size:
-            raise InputError(f"problem file {str(path)!r}: {info.filename.removesuffix('.npy')!r} "
-                             f"declares shape {shape} ({dtype}), more than the {info.file_size} "
-                             "bytes stored: write it again with numpy.savez")
-        declared[info.filename.removesuffix(".npy")] = shape
-    return declared
-
-
-def _saved(path: Path) -> ContactProblem:
-    try:
-        return ContactProblem.load(path)
-    except (KeyError, ValueError, TypeError) as exc:
-        raise InputError(f"problem file {str(path)!r} looks written by ContactProblem.save but "
-                         f"cannot be read back ({type(exc).__name__}: {exc}): save it again with "
-                         "the installed version") from None
 
 
 def _matrix_market(folder: Path) -> dict[str, Any]:

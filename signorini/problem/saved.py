@@ -11,6 +11,7 @@ import dataclasses
 import io
 import json
 import logging
+import math
 import os
 import zipfile
 from typing import Any
@@ -27,7 +28,7 @@ from signorini.problem.scales import Scales
 
 log = logging.getLogger(__name__)
 
-__all__ = ["in_given_units", "load", "save"]
+__all__ = ["declared_sizes", "in_given_units", "load", "save"]
 
 
 def save(problem: Any, path: str | os.PathLike) -> None:
@@ -87,13 +88,56 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
     if not zipfile.is_zipfile(path):  # np.load would try it as a pickle
         raise InputError(f"problem file {os.fspath(path)!r} is not an archive ContactProblem.save "
                          "wrote: give the path it wrote")
-    z = np.load(path, allow_pickle=False)
-    meta = json.loads(bytes(z["meta"]).decode())
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            declared_sizes(os.fspath(path), z.zip)  # before an array of a declared size is made
+            return _read(z, problem_type)
+    except InputError as exc:
+        text = str(exc)
+        if text.startswith("problem file"):
+            raise
+        raise InputError(f"problem file {os.fspath(path)!r}: {text}: save the problem again "
+                         "with ContactProblem.save") from None
+    except (KeyError, ValueError, TypeError, EOFError, OSError,
+            zipfile.BadZipFile) as exc:
+        raise InputError(f"problem file {os.fspath(path)!r} is not what ContactProblem.save "
+                         f"writes ({type(exc).__name__}: {exc}): save the problem again") from None
+
+
+def declared_sizes(path: str, archive: zipfile.ZipFile) -> dict[str, tuple[int, ...]]:
+    """The shape each array's header declares, by name; InputError for an array whose header
+    declares more bytes than its member of the archive holds (read before it is allocated)."""
+    declared = {}
+    for info in archive.infolist():
+        with archive.open(info) as member:
+            try:
+                fmt = np.lib.format
+                header = fmt.read_array_header_1_0 if fmt.read_magic(member) == (1, 0) else \
+                    fmt.read_array_header_2_0
+                shape, _, dtype = header(member)
+            except ValueError:
+                continue  # not an array: np.load says so
+        if dtype.itemsize * math.prod(shape) > info.file_size:
+            raise InputError(f"problem file {path!r}: {info.filename.removesuffix('.npy')!r} "
+                             f"declares shape {shape} ({dtype}), more than the {info.file_size} "
+                             "bytes stored: write it again with numpy.savez")
+        declared[info.filename.removesuffix(".npy")] = shape
+    return declared
+
+
+def _read(z: Any, problem_type: type) -> Any:
+    """The problem in the open archive ``z``, its arrays and meta checked first (:func:`_fits`)."""
+    if "meta" not in z.files:
+        raise InputError("it holds no 'meta'")
+    try:
+        meta = json.loads(bytes(z["meta"]).decode())
+    except (ValueError, RecursionError) as exc:  # not UTF-8, not JSON, nested past the stack
+        raise InputError(f"its meta is not the JSON object ContactProblem.save writes "
+                         f"({type(exc).__name__})") from None
     if not isinstance(meta, dict):
-        raise InputError(f"problem file {os.fspath(path)!r}: its meta holds a JSON "
-                         f"{type(meta).__name__}, not the object ContactProblem.save writes: "
-                         "save the problem again")
-    n, m = (int(v) for v in z["shape"])
+        raise InputError(f"its meta holds a JSON {type(meta).__name__}, not the object "
+                         "ContactProblem.save writes")
+    n, m = _fits(z, meta)
     model = None
     about = meta.get("discretisation")
     if about is not None:
@@ -122,10 +166,13 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
             materials=tuple(tuple(m) for m in about.get("materials", ())),
             predicted_contact=z["predicted_contact"] if "predicted_contact" in z else None,
             watch=_watch(z, about.get("watch"), z["prescribed"].size))
-    K = symmetric_argument(sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]),
-                                         shape=(n, n)))
+    K = symmetric_argument(sparse_argument(
+        sp.csr_matrix((z["K_data"], z["K_indices"], z["K_indptr"]), shape=(n, n)),
+        "K (K_data, K_indices, K_indptr)"))
+    N = sparse_argument(sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
+                        "N (N_data, N_indices, N_indptr)")
     problem = problem_type(
-        K=K, f=z["f"], N=sp.csr_matrix((z["N_data"], z["N_indices"], z["N_indptr"]), shape=(m, n)),
+        K=K, f=z["f"], N=N,
         d=z["d"], weights=z["weights"] if z["weights"].size else None,
         contact_points=z["contact_points"], force_multiplicity=meta["force_multiplicity"],
         scales=Scales(**meta["scales"]), name=meta["scene"], model=model)
@@ -147,6 +194,98 @@ def in_given_units(problem: Any) -> Any:
         d=problem.d * s.displacement, scales=Scales(),
         weights=None if problem.weights is None else problem.weights * s.weight,
         contact_points=problem.contact_points * s.length)
+
+
+#: the arrays :func:`save` writes, by name: their kind (NumPy's letters) and shape, in terms of
+#: n unknowns, m candidates, D the model's dofs (``prescribed``), P mesh points; -1: any size
+#: (every float array finite but the contact points, unknown (NaN) for a QP given as arrays)
+_ARRAYS = {
+    "shape": ("iu", (2,)), "K_data": ("f", (-1,)), "K_indices": ("iu", (-1,)),
+    "K_indptr": ("iu", ("n+1",)), "N_data": ("f", (-1,)), "N_indices": ("iu", (-1,)),
+    "N_indptr": ("iu", ("m+1",)), "f": ("f", ("n",)), "d": ("f", ("m",)),
+    "weights": ("f", ("m|0",)), "contact_points": ("f", ("m", -1)), "free_dofs": ("iu", ("n",)),
+    "prescribed": ("f", ("D",)), "load_row": ("f", ("n|0",)), "mesh_p": ("f", (-1, "P")),
+    "mesh_t": ("iu", (-1, -1)), "push_f1": ("f", ("n",)), "push_d0": ("f", ("m",)),
+    "push_d1": ("f", ("m",)), "push_f_load": ("f", ("n",)), "push_resultant": ("f", ("m",)),
+    "predicted_contact": ("b", ("m",)), "watch_data": ("f", (-1,)), "watch_indices": ("iu", (-1,)),
+    "watch_indptr": ("iu", (-1,)), "watch_gaps": ("f", (-1,)), "watch_edge": ("iu", (-1,)),
+    "watch_candidate_gaps": ("f", ("m|0",)), "watch_nodes": ("iu", (-1,)), "meta": ("u", (-1,))}
+_KINDS = {"f": "floats", "iu": "integers", "b": "booleans", "u": "bytes"}
+#: the numbers of the meta record (a scale, a material constant, the push's record)
+_NUMBERS = {"scales": ("length", "displacement", "force", "weight"),
+            "discretisation": ("load_offset", "E", "nu", "assemble_s"),
+            "push": ("offset1", "scale", "offset_load", "load", "target", "delta", "P")}
+
+
+def _fits(z: Any, meta: dict[str, Any]) -> tuple[int, int]:
+    """``(n, m)`` when every stored array and number is of the kind and size :func:`save`
+    writes (checked before any is used, so that nothing of a declared size is built first);
+    InputError naming the first that is not."""
+    if not isinstance(meta.get("scene"), str):
+        raise InputError("meta 'scene' is not a name")
+    about = meta.get("discretisation")
+    records = {"scales": meta.get("scales"), "discretisation": about,
+               "push": about.get("push") if isinstance(about, dict) else None}
+    for record, names in _NUMBERS.items():
+        values = records[record]
+        if values is None and record != "scales":
+            continue
+        if not isinstance(values, dict):
+            raise InputError(f"meta {record!r} is not a record")
+        for name in names:
+            value = values.get(name)
+            if not (value is None and record == "push" and name in ("target", "delta", "P")) and \
+                    not (isinstance(value, (int, float)) and np.isfinite(value)):
+                raise InputError(f"meta {record}.{name} is {value!r}, not a finite number")
+        if record == "scales" and min(values[name] for name in names) <= 0:
+            raise InputError("meta 'scales' holds a scale that is not positive")
+    multiplicity = meta.get("force_multiplicity")
+    if not (isinstance(multiplicity, (int, float)) and np.isfinite(multiplicity) and multiplicity > 0):
+        raise InputError(f"meta force_multiplicity is {multiplicity!r}, not a positive number")
+    if isinstance(about, dict) and not isinstance(about.get("params"), dict):
+        raise InputError("meta discretisation.params is not a record")
+    required = ["shape", "meta", "f", "d", "weights", "contact_points",
+                *(f"{key}_{part}" for key in "KN" for part in ("data", "indices", "indptr"))]
+    if isinstance(about, dict):
+        required += ["free_dofs", "prescribed", "load_row"]
+        required += ["push_f1", "push_d0", "push_d1"] if records["push"] is not None else []
+        required += [f"watch_{part}" for part in ("data", "indices", "indptr", "gaps", "edge",
+                                                  "candidate_gaps")] if about.get("watch") else []
+    missing = [name for name in required if name not in z.files]
+    if missing:
+        raise InputError(f"it holds no {missing[0]!r}")
+    shape = z["shape"]
+    if shape.dtype.kind not in "iu" or shape.shape != (2,) or min(shape) < 0:
+        raise InputError(f"'shape' is {shape.tolist()}, not the two sizes n and m")
+    sizes = {"n": int(shape[0]), "m": int(shape[1]), "n+1": int(shape[0]) + 1,
+             "m+1": int(shape[1]) + 1, "0": 0, "D": z["prescribed"].size if "prescribed" in z.files
+             else -1, "P": z["mesh_p"].shape[-1] if "mesh_p" in z.files else -1}
+    for name in z.files:
+        kinds, expected = _ARRAYS.get(name, ("", ()))
+        if not kinds:
+            raise InputError(f"{name!r} is not an array ContactProblem.save writes")
+        array = z[name]
+        if array.dtype.kind not in kinds or array.ndim != len(expected):
+            raise InputError(f"{name!r} is a {array.dtype} array of shape {array.shape}, not "
+                             f"{len(expected)}-D {_KINDS[kinds]}")
+        for axis, size in zip(array.shape, expected):
+            allowed = {size} if isinstance(size, int) else {sizes[p] for p in size.split("|")}
+            if size != -1 and axis not in allowed:
+                raise InputError(f"{name!r} has shape {array.shape}, not the size {size} = "
+                                 f"{sizes[size.split('|')[0]]} that 'shape' and the other "
+                                 "arrays give")
+        if kinds == "f" and name != "contact_points" and not np.all(np.isfinite(array)):
+            raise InputError(f"{name!r} holds NaN or inf")
+    limits = {"free_dofs": sizes["D"], "mesh_t": sizes["P"]}
+    for name, limit in limits.items():
+        if name in z.files and z[name].size and not 0 <= z[name].min() <= z[name].max() < limit:
+            raise InputError(f"{name!r} indexes outside 0..{limit - 1}")
+    if "mesh_t" in z.files and z["mesh_t"].shape[0] != z["mesh_p"].shape[0] + 1:
+        raise InputError(f"'mesh_t' has {z['mesh_t'].shape[0]} corners per element, not "
+                         f"{z['mesh_p'].shape[0] + 1} (a simplex in {z['mesh_p'].shape[0]}D)")
+    if records["push"] is not None and not isinstance(records["push"].get("pending"), bool):
+        raise InputError("meta push.pending is not true or false")
+    return sizes["n"], sizes["m"]
 
 
 def _watch(z: Any, stored: dict[str, Any] | None, dofs: int) -> Watch | None:

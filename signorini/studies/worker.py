@@ -183,8 +183,8 @@ class Worker:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     return self._lost(task, "timeout")
-                ready, _, _ = select.select([fd], [], [], None if remaining == float("inf")
-                                            else remaining)
+                # at most a day per wait: select takes no timeout past the platform's time_t
+                ready, _, _ = select.select([fd], [], [], min(remaining, 86400.0))
                 if not ready:
                     continue
                 chunk = os.read(fd, 1 << 16)
