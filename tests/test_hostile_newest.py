@@ -148,3 +148,26 @@ def test_the_certificate_refuses_a_duality_gap_flag_that_is_not_true_or_false():
     with pytest.raises(InputError, match="duality_gap"):
         signorini.certificate(qp, result.solution, duality_gap="no")
     assert signorini.certificate(qp, result.solution, duality_gap=False).passed(1e-8)
+
+
+#: a row with the columns of the benchmark and dofs that are no number
+FOREIGN_ROW = (b"scene,size,dofs,candidates,method,ranks,tolerance,status,claimed_status,iterations,"
+               b"build_s,solve_s,time_s,factor_s,ratio_to_factor,kkt_worst,lam_rel,misclassified,"
+               b"p0_rel,a_rel,message\nhertz-cylinder,refine0,abc,58,pdas,1,high,converged,"
+               b"converged,1,0.1,0.1,0.1,0.1,1,1e-10,0,0,0,0,\n")
+
+
+@pytest.mark.parametrize("content, report_only", [
+    (b"a,b\n1,2\n", True), (b"a,b\n1,2\n", False), (b"\xff\xfe\x00not text", True),
+    (b"\xff\xfe\x00not text", False), (FOREIGN_ROW, True)],
+    ids=["foreign columns, report", "foreign columns, runs", "not text, report", "not text, runs",
+         "a row bench did not write"])
+def test_a_benchmark_csv_bench_did_not_write_is_refused_and_kept(tmp_path, capsys, content,
+                                                                 report_only):
+    (tmp_path / "bench.csv").write_bytes(content)
+    argv = ["bench", "--out", str(tmp_path), "--sizes", "0", "--method", "pdas"]
+    assert main(argv + (["--report-only"] if report_only else [])) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "bench.csv" in err and "Traceback" not in err
+    assert (tmp_path / "bench.csv").read_bytes() == content
+    assert not (tmp_path / "bench.md").exists()

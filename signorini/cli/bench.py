@@ -113,6 +113,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.report_only and not csv_path.is_file():
         raise InputError(f"--report-only: there is no {csv_path}: run the benchmark into --out "
                          f"{args.out or 'bench-report'} first (without --report-only)")
+    if csv_path.exists():  # read before a run is appended to it or a report made of it
+        check_csv(csv_path)
     # a method that is named must be installed, as for 'solve --method'
     chosen = [check_request(m)[0] for m in args.method] if args.method else \
         [m for m in methods(installed_only=True) if not m.dense and m.family != "user"]
@@ -150,9 +152,36 @@ def cmd_bench(args: argparse.Namespace) -> int:
     given = [a for a in sys.argv[2:] if a != "--report-only"]  # the command that made the CSV
     command = "signorini bench " + " ".join(given) if given else "signorini bench"
     with all_or_none():  # the report and its figures, or none of them
-        report = write_report(csv_path, command)
+        try:
+            report = write_report(csv_path, command)
+        except InputError:
+            raise
+        except (KeyError, ValueError, TypeError) as exc:  # a row bench did not write
+            raise InputError(f"{csv_path} holds a row the benchmark did not write ({type(exc).__name__}"
+                             f": {exc}): fix or remove the row, or run into another --out") from None
     print(f"report: {report}")
     return 0
+
+
+def check_csv(path: Path) -> None:
+    """InputError unless ``path`` is a regular UTF-8 file whose header names the benchmark's
+    columns (a CSV the benchmark wrote)."""
+    import csv  # per command (start-up)
+
+    from signorini.paths import check_input_file  # per command (start-up)
+    from signorini.studies.bench import COLUMNS  # per command (start-up)
+
+    check_input_file(str(path), "the benchmark's CSV", "remove it, or give another --out")
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            header = next(csv.reader(handle), [])
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{path} is not a CSV the benchmark wrote ({exc}): remove it, or give "
+                         "another --out") from None
+    missing = [column for column in COLUMNS if column not in header and column != "ranks"]
+    if missing:
+        raise InputError(f"{path} is not a CSV the benchmark wrote (no column {missing[0]!r}): "
+                         "remove it, or give another --out")
 
 
 def add_parsers(sub) -> None:
@@ -197,4 +226,4 @@ def add_parsers(sub) -> None:
     bench.set_defaults(run=cmd_bench)
 
 
-__all__ = ["cmd_bench", "add_parsers"]
+__all__ = ["check_csv", "cmd_bench", "add_parsers"]
