@@ -72,6 +72,11 @@ ATTACKS = [
     ("a multiplicity as text", {}, ("top", "force_multiplicity", "two"), "force_multiplicity"),
     ("a target as text", {}, ("push", "target", "x"), "target"),
     ("params as a list", {}, ("disc", "params", [1]), "params"),
+    ("nu of one half", {}, ("disc", "nu", 0.5), "nu"),
+    ("E as true", {}, ("disc", "E", True), "E"),
+    ("materials as text", {}, ("disc", "materials", ["ab"]), "materials"),
+    ("a push of zero", {}, ("push", "scale", 0), "scale"),
+    ("pending without a target", {}, ("push", "target", None), "target"),
     ("meta nested past recursion", dict(meta=np.frombuffer(b"[" * 10**5 + b"]" * 10**5,
                                                            dtype=np.uint8)), None, "meta"),
 ]

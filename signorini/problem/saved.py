@@ -235,15 +235,16 @@ def _fits(z: Any, meta: dict[str, Any]) -> tuple[int, int]:
         for name in names:
             value = values.get(name)
             if not (value is None and record == "push" and name in ("target", "delta", "P")) and \
-                    not (isinstance(value, (int, float)) and np.isfinite(value)):
+                    not (isinstance(value, (int, float)) and not isinstance(value, bool)
+                         and np.isfinite(value)):
                 raise InputError(f"meta {record}.{name} is {value!r}, not a finite number")
         if record == "scales" and min(values[name] for name in names) <= 0:
             raise InputError("meta 'scales' holds a scale that is not positive")
     multiplicity = meta.get("force_multiplicity")
     if not (isinstance(multiplicity, (int, float)) and np.isfinite(multiplicity) and multiplicity > 0):
         raise InputError(f"meta force_multiplicity is {multiplicity!r}, not a positive number")
-    if isinstance(about, dict) and not isinstance(about.get("params"), dict):
-        raise InputError("meta discretisation.params is not a record")
+    if isinstance(about, dict):
+        _model_record(about, records["push"])
     required = ["shape", "meta", "f", "d", "weights", "contact_points",
                 *(f"{key}_{part}" for key in "KN" for part in ("data", "indices", "indptr"))]
     if isinstance(about, dict):
@@ -286,6 +287,25 @@ def _fits(z: Any, meta: dict[str, Any]) -> tuple[int, int]:
     if records["push"] is not None and not isinstance(records["push"].get("pending"), bool):
         raise InputError("meta push.pending is not true or false")
     return sizes["n"], sizes["m"]
+
+
+def _model_record(about: dict[str, Any], push: dict[str, Any] | None) -> None:
+    """InputError naming the first entry of the model's meta record that no model holds."""
+    if not isinstance(about.get("params"), dict):
+        raise InputError("meta discretisation.params is not a record")
+    if not isinstance(about.get("axisymmetric"), bool):
+        raise InputError("meta discretisation.axisymmetric is not true or false")
+    if not (about["E"] > 0 and -1 < about["nu"] < 0.5):
+        raise InputError(f"meta discretisation holds E = {about['E']!r} and nu = {about['nu']!r}: "
+                         "E must be positive and nu in (-1, 0.5)")
+    materials = about.get("materials", [])
+    if not isinstance(materials, list) or any(not isinstance(m, list) or len(m) != 4
+                                              for m in materials):
+        raise InputError("meta discretisation.materials is not a list of 4-entry records")
+    if push is not None and not push["scale"] > 0:
+        raise InputError(f"meta push.scale is {push['scale']!r}, not a positive push")
+    if push is not None and push.get("pending") and push.get("target") is None:
+        raise InputError("meta push is pending without a target load to match")
 
 
 def _watch(z: Any, stored: dict[str, Any] | None, dofs: int) -> Watch | None:
