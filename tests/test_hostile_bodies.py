@@ -1,0 +1,79 @@
+"""Two bodies and the certificate, attacked as a hostile user would.
+
+"converged" must mean right for the model and the model adequate: a QP with no minimum is never
+converged, whichever factorisation the method hands the certificate; a perturbed or wrongly
+signed answer of a two-body problem is never certified.
+"""
+
+import numpy as np
+import pytest
+
+import signorini
+from signorini import ContactProblem
+
+#: a coarse pair of unlike cylinders: small, non-matching faces, every part of the two-body path
+PAIR = {"n_contact": 8, "grading": 0.6, "mesher": "triangle", "E2": 3.0, "R2": 2.0}
+
+
+def saddle_qp():
+    """K = diag(1, −1): ½uᵀKu − fᵀu falls without bound as u₁ → −∞, yet both rows are active at
+    the KKT point (0.5, 1), so a factorisation with both dofs pinned succeeds."""
+    return ContactProblem.from_qp(np.diag([1.0, -1.0]), [1.0, 0.0], np.eye(2), [0.5, 1.0])
+
+
+@pytest.mark.parametrize("method", ["qp-clarabel", "cvxpy"])
+def test_an_indefinite_qp_is_not_converged_through_a_polished_answer(method):
+    pytest.importorskip("clarabel", reason="the polished backends need Clarabel")
+    result = signorini.solve(saddle_qp(), method)
+    assert result.status != "converged"
+    assert np.isinf(result.certificate.duality_gap)
+    assert "positive semidefinite" in result.message
+
+
+def test_an_indefinite_qp_is_not_certified_on_a_pinned_factorisation():
+    from signorini.numerics.active_set import PinnedFactor
+    from signorini.problem.contact import ContactSolution
+    from signorini.certification.kkt import certificate
+    problem = saddle_qp()
+    answer = ContactSolution(method="given", u=np.array([0.5, 1.0]), lam=np.array([0.5, 1.0]),
+                             status="converged", factor=PinnedFactor(problem.K, np.array([0, 1])))
+    cert = certificate(problem, answer)
+    assert not cert.passed(1e-8) and np.isinf(cert.duality_gap)
+
+
+def test_a_singular_qp_held_by_its_contact_keeps_its_verdict():
+    """K = [[1, −1], [−1, 1]] leaves a rigid mode that the active row holds: the answer is unique,
+    and a singular K that is not indefinite keeps the other residuals' verdict."""
+    problem = ContactProblem.from_qp(np.array([[1.0, -1.0], [-1.0, 1.0]]), [0.0, 1.0],
+                                     [[0.0, 1.0]], [1.0])
+    cert = signorini.certificate(problem, u=np.array([1.0, 1.0]), force=np.array([1.0]))
+    assert cert.passed(1e-8)
+
+
+@pytest.fixture(scope="module")
+def pair():
+    return signorini.solve("hertz-two-cylinders", "pdas", params=PAIR, tol=1e-12)
+
+
+def test_the_pair_is_certified_as_solved(pair):
+    assert pair.status == "converged"
+    assert signorini.certificate(pair.problem, u=pair.u, force=pair.force).passed(1e-10)
+
+
+@pytest.mark.parametrize("attack", ["u", "force", "sign", "inactive"])
+def test_a_spoiled_answer_of_two_bodies_is_not_certified(pair, attack):
+    rng = np.random.default_rng(3)
+    u, force = pair.u.copy(), pair.force.copy()
+    if attack == "u":
+        u += 1e-6 * np.abs(u).max() * rng.standard_normal(u.size)
+    elif attack == "force":
+        force *= 1 + 1e-6 * rng.standard_normal(force.size)
+    elif attack == "sign":
+        force = -force
+    else:
+        force[~pair.active] = 1e-7 * force.max()
+    cert = signorini.certificate(pair.problem, u=u, force=force)
+    assert not cert.passed(1e-8)
+    if attack in ("force", "inactive"):  # the forward error sees the force it was given
+        true = np.abs(force - pair.force).max() / np.abs(force).max()
+        assert cert.force_error >= 0.5 * true
