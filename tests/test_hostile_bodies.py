@@ -77,3 +77,19 @@ def test_a_spoiled_answer_of_two_bodies_is_not_certified(pair, attack):
     if attack in ("force", "inactive"):  # the forward error sees the force it was given
         true = np.abs(force - pair.force).max() / np.abs(force).max()
         assert cert.force_error >= 0.5 * true
+
+
+def test_contact_that_reaches_the_last_row_short_of_the_slave_face_is_not_converged():
+    """A flat upper cylinder on a thin lower one: the slave face (three half-widths) reaches past
+    the lower cylinder, so its outer candidates have no row. Pushed five times harder than the
+    target, the contact reaches the last row: the zone may go on where the QP has no rows."""
+    params = {"n_contact": 8, "grading": 0.6, "mesher": "triangle", "R1": 100.0, "R2": 0.1,
+              "candidates": 3.0, "a_over_R": 0.5}
+    problem = signorini.build_problem("hertz-two-cylinders", params=params)
+    matched = signorini.solve(problem, "pdas")
+    assert matched.status == "converged"  # the contact ends inside the rows
+    push = matched.problem.model.push
+    pushed = signorini.solve(problem.pushed(5 * push.scale, load=5 * push.load), "pdas")
+    last = np.argmax(pushed.problem.contact_points[:, 0])
+    assert pushed.active[last]
+    assert pushed.status == "model_inadequate", pushed.message
