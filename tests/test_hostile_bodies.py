@@ -93,3 +93,10 @@ def test_contact_that_reaches_the_last_row_short_of_the_slave_face_is_not_conver
     last = np.argmax(pushed.problem.contact_points[:, 0])
     assert pushed.active[last]
     assert pushed.status == "model_inadequate", pushed.message
+
+
+def test_a_mesh_ratio_that_leaves_the_slave_face_no_element_is_refused():
+    """round(0.04 · 10) = 0 elements: refused, not silently raised to one (the record would say
+    0.04 while the mesh had 0.1)."""
+    with pytest.raises(signorini.errors.InputError, match="mesh_ratio"):
+        signorini.build_problem("two-block-patch", params={"mesh_ratio": 0.04})
