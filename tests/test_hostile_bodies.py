@@ -100,3 +100,29 @@ def test_a_mesh_ratio_that_leaves_the_slave_face_no_element_is_refused():
     0.04 while the mesh had 0.1)."""
     with pytest.raises(signorini.errors.InputError, match="mesh_ratio"):
         signorini.build_problem("two-block-patch", params={"mesh_ratio": 0.04})
+
+
+def grid_laplacian(side):
+    """The 5-point Laplacian on a side × side grid (SPD, side² dofs)."""
+    import scipy.sparse as sp
+    T = sp.diags([-np.ones(side - 1), 2 * np.ones(side), -np.ones(side - 1)], [-1, 0, 1])
+    return (sp.kron(T, sp.eye(side)) + sp.kron(sp.eye(side), T)).tocsr()
+
+
+def test_a_slightly_indefinite_qp_beyond_dense_eigenvalues_is_not_converged():
+    """900 dofs (past dense eigenvalues): the Laplacian shifted so that its lowest eigenvalue is
+    −10⁻⁶ of the lowest positive one's size, −5·10⁻⁸ of its diagonal, far above round-off. A
+    Rayleigh quotient does not reach it in a few dozen steps; the QP still has no minimum."""
+    pytest.importorskip("sksparse.cholmod", reason="the shifted factorisation is CHOLMOD's")
+    from scipy.sparse.linalg import eigsh
+    import scipy.sparse as sp
+    L = grid_laplacian(30)
+    lowest = eigsh(L, k=1, sigma=0, which="LM")[0][0]
+    K = (L - (1 + 1e-5) * lowest * sp.eye(L.shape[0])).tocsr()
+    rows = np.arange(40)
+    N = sp.csr_matrix((np.ones(rows.size), (rows, rows)), shape=(rows.size, K.shape[0]))
+    f = np.zeros(K.shape[0])
+    f[rows] = 1.0
+    result = signorini.solve(ContactProblem.from_qp(K, f, N, np.zeros(rows.size)), "qp-osqp")
+    assert result.status != "converged", result.message
+    assert np.isinf(result.certificate.duality_gap)

@@ -18,7 +18,7 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.numerics.active_set import PinnedFactor, selection_dofs
-from signorini.numerics.arrays import indefinite
+from signorini.certification.curvature import indefinite
 from signorini.certification.inverse import ForwardError, forward_error, pinned_rows, primal_dual_gap
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -253,7 +253,7 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:
         offers = Offers(problem, solution)
-        if _no_minimum(problem, offers):
+        if _no_minimum(problem, offers()):
             raise np.linalg.LinAlgError("K is indefinite")
         forward = _forward(problem, solution, lam_norm, offers, Ku)
         energy = float(0.5 * u @ Ku - problem.f @ u)
@@ -269,13 +269,13 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
                        forward.force, forward.displacement, forward.floor, forward.back_solves)
 
 
-def _no_minimum(problem: ContactProblem, offers: Offers) -> bool:
+def _no_minimum(problem: ContactProblem, offered: list) -> bool:
     """A K of one's own (no mesh) that is indefinite, unless a plain factorisation of it is on
     offer: one pinned on the active dofs, or of the active set's saddle point, succeeds when the
     negative curvature is pinned. K is factorised plainly (kept on the problem); when that fails,
     :func:`indefinite` says whether the QP has no minimum (a singular K held by its contact has)."""
     if problem.model.mesh is not None or not problem.factorises_for_certificates \
-            or any(f.pinned is not None and not f.pinned[0].size for f in offers()):
+            or any(f.pinned is not None and not f.pinned[0].size for f in offered):
         return False
     try:
         problem.factor()
