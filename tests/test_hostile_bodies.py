@@ -126,3 +126,13 @@ def test_a_slightly_indefinite_qp_beyond_dense_eigenvalues_is_not_converged():
     result = signorini.solve(ContactProblem.from_qp(K, f, N, np.zeros(rows.size)), "qp-osqp")
     assert result.status != "converged", result.message
     assert np.isinf(result.certificate.duality_gap)
+
+
+@pytest.mark.parametrize("nu1, nu2", [(0.3, 0.49), (0.49, 0.3)])
+def test_either_body_of_a_pair_that_locks_is_warned_of(nu1, nu2):
+    """Plain P1 with ν = 0.49 locks whichever body has it: the master's material is warned of as
+    the slave's is."""
+    from signorini.certification.adequacy import warnings
+    problem = signorini.build_problem("hertz-two-cylinders", params={
+        **PAIR, "E2": 1.0, "R2": 1.0, "nu1": nu1, "nu2": nu2, "volumetric": "element"})
+    assert any("ν = 0.49" in said for said in warnings(problem))
