@@ -136,3 +136,10 @@ def test_either_body_of_a_pair_that_locks_is_warned_of(nu1, nu2):
     problem = signorini.build_problem("hertz-two-cylinders", params={
         **PAIR, "E2": 1.0, "R2": 1.0, "nu1": nu1, "nu2": nu2, "volumetric": "element"})
     assert any("ν = 0.49" in said for said in warnings(problem))
+
+
+def test_a_push_too_small_for_the_sphere_pairs_graded_mesh_is_refused():
+    """hertz-two-spheres grades its meshes for √(δ R*): δ = 1e-300 asked Triangle for a mesh
+    graded to 1e-150 R and crashed the process. Refused in one line, as hertz-sphere refuses it."""
+    with pytest.raises(signorini.errors.InputError, match="delta"):
+        signorini.build_problem("hertz-two-spheres", params={"delta": 1e-300, "n_contact": 8})

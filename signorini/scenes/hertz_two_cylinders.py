@@ -117,9 +117,10 @@ class HertzPair:
     one_body: SizeEstimate
 
     def loads(self, p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
-        """The target load P (None: a prescribed push), the push δ (None: matched to P) and a/R*."""
+        """The target load P (None: a prescribed push), the push δ (None: matched to P) and a/R*;
+        a push that grades the mesh (spheres: ``√(δ R*)``) is checked as it is for one body."""
         return hertz_load(p, given, pair_radius(p), pair_modulus(p), self.one.half_width,
-                          self.one.load, check_delta=False)
+                          self.one.load, check_delta=False, graded_by_delta=self.one.graded_by_delta)
 
     def contact_size(self, p: dict[str, Any], target: float | None, delta: float | None) -> float:
         """The contact half-width (radius) the discs are graded for: Hertz's at the target load, or
