@@ -143,3 +143,11 @@ def test_a_push_too_small_for_the_sphere_pairs_graded_mesh_is_refused():
     graded to 1e-150 R and crashed the process. Refused in one line, as hertz-sphere refuses it."""
     with pytest.raises(signorini.errors.InputError, match="delta"):
         signorini.build_problem("hertz-two-spheres", params={"delta": 1e-300, "n_contact": 8})
+
+
+def test_a_push_too_small_for_double_precision_is_refused_on_cylinders_too():
+    """δ = 1e-300 on two cylinders: the gaps, divided by δ, left even the first point of contact
+    open, and the answer was converged with nothing in contact while the bodies were pushed
+    together."""
+    with pytest.raises(signorini.errors.InputError, match="delta"):
+        signorini.build_problem("hertz-two-cylinders", params={"delta": 1e-300, **PAIR})
