@@ -171,3 +171,17 @@ def test_dual_mortar_rows_of_a_slave_face_the_master_covers_in_part_hold():
     assert result.certificate.passed(1e-8)
     assert result.status == "model_inadequate"
     assert np.all(result.force >= 0)
+
+
+@pytest.mark.parametrize("spoil", ["force", "u"])
+def test_an_answer_edited_in_place_is_judged_again(spoil):
+    """The certificate kept on a solution was returned for the same arrays whatever their values:
+    an answer scaled in place by 1 % still passed."""
+    result = signorini.solve("two-block-patch", "pdas")
+    solution = result.solution
+    assert signorini.certificate(result.problem, solution).passed(1e-8)
+    if spoil == "force":
+        solution.lam *= 1.01
+    else:
+        solution.u[:] = 0.0
+    assert not signorini.certificate(result.problem, solution).passed(1e-8)

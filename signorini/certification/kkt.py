@@ -206,7 +206,7 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
 
     ``duality_gap=False`` leaves out what needs K⁻¹: the duality gap and the forward error (NaN
     too when K cannot be factorised; the gap ``inf`` when K is indefinite). The result is kept on
-    the solution (for these arrays, problem and options): judging then reporting costs one.
+    the solution (for these arrays and values, problem and options): judging then reporting costs one.
     """
     if not isinstance(problem, ContactProblem):
         raise InputError(f"certificate: problem must be a ContactProblem, got {type(problem).__name__}")
@@ -217,9 +217,10 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
         raise InputError(f"certificate: solution.u must have {problem.n} entries and solution.lam "
                          f"{problem.m}, got {np.shape(solution.u)} and {np.shape(solution.lam)}")
     key = (id(problem), id(solution.u), id(solution.lam), duality_gap)
-    kept = getattr(solution, "_certificate", None)
-    if kept is not None and kept[0] == key:
-        return kept[1]
+    kept = getattr(solution, "_certificate", None)  # and the values: arrays edited are judged again
+    arrays = (solution.u, solution.lam)
+    if kept is not None and kept[0] == key and all(map(np.array_equal, kept[1], arrays)):
+        return kept[2]
     try:
         with np.errstate(all="ignore"):  # an answer beyond double precision: inf residuals say so
             cert = _certificate(problem, solution, duality_gap)
@@ -228,7 +229,7 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
             cert = _certificate(problem, solution, False)
         if np.isfinite(cert.primal) and indefinite(problem.K):  # no minimum: no answer to certify
             cert = replace(cert, duality_gap=float("inf"))
-    solution._certificate = (key, cert)
+    solution._certificate = (key, tuple(map(np.array, arrays)), cert)
     return cert
 
 
