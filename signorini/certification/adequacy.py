@@ -90,8 +90,11 @@ def warnings(problem: ContactProblem, solution: ContactSolution | None = None) -
                     "width and peak pressure cannot be fitted): refine the mesh at the contact "
                     "or raise the load")
     model = problem.model
-    if model.nu > LOCKING_NU and model.volumetric == "element":
-        said.append(f"ν = {model.nu:g} > {LOCKING_NU:g}: P1 triangles lock, the pressure can be several "
+    bodies = [(nu, volumetric) for _, _, nu, volumetric in model.materials] or \
+        [(model.nu, model.volumetric)]  # each body of a pair its own
+    locking = max((nu for nu, volumetric in bodies if volumetric == "element"), default=0.0)
+    if locking > LOCKING_NU:
+        said.append(f"ν = {locking:g} > {LOCKING_NU:g}: P1 triangles lock, the pressure can be several "
                     f"percent off ({docs_page('accuracy')}); set the scene parameter volumetric=nodal "
                     "(the volumetric strain averaged at the nodes: no locking)")
     watch = model.watch

@@ -18,7 +18,7 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.numerics.active_set import PinnedFactor, selection_dofs
-from signorini.numerics.arrays import indefinite
+from signorini.certification.curvature import indefinite
 from signorini.certification.inverse import ForwardError, forward_error, pinned_rows, primal_dual_gap
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -154,11 +154,10 @@ class Remembering:
     """A factorisation offered to one certificate, which remembers what it was asked.
 
     The forward error's first Newton step and the duality gap can solve the same system with
-    opposite right-hand sides (the method's pinned set is the active set and λ is zero off
-    it): a solve is linear and exactly odd in floating point, so a right-hand side that is
-    minus one already solved gets minus that answer instead of a second solve — the numbers
-    a second solve gives. Its pinned rows (:func:`~signorini.certification.inverse.pinned_rows`) are found once.
-    """
+    opposite right-hand sides (the method's pinned set is the active set, λ zero off it): a
+    solve is exactly odd in floating point, so minus a right-hand side already solved gets minus
+    its answer, the numbers a second solve gives. Its pinned rows (:func:`pinned_rows`) are
+    found once."""
 
     def __init__(self, problem: ContactProblem, factor):
         self.factor, self.solved = factor, []
@@ -205,11 +204,9 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
                 duality_gap: bool = True) -> Certificate:
     """Relative KKT residuals of ``solution`` for ``problem`` (see :class:`Certificate`).
 
-    ``duality_gap=False`` leaves out what needs K⁻¹: the duality gap and the
-    forward error (left out too, NaN, when K cannot be factorised).
-
-    The result is kept on the solution (for these same arrays, problem and
-    options): judging a solution and then reporting it costs one evaluation.
+    ``duality_gap=False`` leaves out what needs K⁻¹: the duality gap and the forward error (NaN
+    too when K cannot be factorised; the gap ``inf`` when K is indefinite). The result is kept on
+    the solution (for these arrays and values, problem and options): judging then reporting costs one.
     """
     if not isinstance(problem, ContactProblem):
         raise InputError(f"certificate: problem must be a ContactProblem, got {type(problem).__name__}")
@@ -220,9 +217,10 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
         raise InputError(f"certificate: solution.u must have {problem.n} entries and solution.lam "
                          f"{problem.m}, got {np.shape(solution.u)} and {np.shape(solution.lam)}")
     key = (id(problem), id(solution.u), id(solution.lam), duality_gap)
-    kept = getattr(solution, "_certificate", None)
-    if kept is not None and kept[0] == key:
-        return kept[1]
+    kept = getattr(solution, "_certificate", None)  # and the values: arrays edited are judged again
+    arrays = (solution.u, solution.lam)
+    if kept is not None and kept[0] == key and all(map(np.array_equal, kept[1], arrays)):
+        return kept[2]
     try:
         with np.errstate(all="ignore"):  # an answer beyond double precision: inf residuals say so
             cert = _certificate(problem, solution, duality_gap)
@@ -231,7 +229,7 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
             cert = _certificate(problem, solution, False)
         if np.isfinite(cert.primal) and indefinite(problem.K):  # no minimum: no answer to certify
             cert = replace(cert, duality_gap=float("inf"))
-    solution._certificate = (key, cert)
+    solution._certificate = (key, tuple(map(np.array, arrays)), cert)
     return cert
 
 
@@ -256,6 +254,8 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:
         offers = Offers(problem, solution)
+        if _no_minimum(problem, offers()):
+            raise np.linalg.LinAlgError("K is indefinite")
         forward = _forward(problem, solution, lam_norm, offers, Ku)
         energy = float(0.5 * u @ Ku - problem.f @ u)
         absolute = primal_dual_gap(problem, u, lam, offers(), Ku)
@@ -270,28 +270,39 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
                        forward.force, forward.displacement, forward.floor, forward.back_solves)
 
 
+def _no_minimum(problem: ContactProblem, offered: list) -> bool:
+    """A K of one's own (no mesh) that is indefinite, unless a plain factorisation of it is on
+    offer: one pinned on the active dofs, or of the active set's saddle point, succeeds when the
+    negative curvature is pinned. K is factorised plainly (kept on the problem); when that fails,
+    :func:`indefinite` says whether the QP has no minimum (a singular K held by its contact has)."""
+    if problem.model.mesh is not None or not problem.factorises_for_certificates \
+            or any(f.pinned is not None and not f.pinned[0].size for f in offered):
+        return False
+    try:
+        problem.factor()
+    except np.linalg.LinAlgError:
+        return indefinite(problem.K)
+    return False
+
+
 def _forward(problem: ContactProblem, solution: ContactSolution, scale: float,
              offers: Offers | None = None, Ku: np.ndarray | None = None) -> ForwardError:
     """The forward error on the certificate's active set, by the first usable factorisation.
 
-    The method's (its pinned set checked as for the duality gap), else the
-    problem's cached one, else a factorisation of K — the one the duality gap
-    makes anyway — unless the problem says it does not factorise for certificates
-    (:attr:`ContactProblem.factorises_for_certificates`: big and not on a 2D mesh), where the
-    duality gap uses CG and the forward error is not estimated. Where only plain factorisations
-    without their Delassus operator are on offer and :data:`PINNED_FROM` or more active rows each
-    bound one dof, a model's K (an elastic stiffness, never indefinite) is factorised with them
-    pinned instead (the duality gap then takes it too).
+    The method's (its pinned set checked as for the duality gap), else the problem's cached one,
+    else a factorisation of K — the one the duality gap makes anyway — unless the problem does not
+    factorise for certificates (:attr:`ContactProblem.factorises_for_certificates`): then the
+    gap uses CG and the forward error is not estimated. Where only plain factorisations without
+    their Delassus operator are on offer and :data:`PINNED_FROM` or more active rows each bound
+    one dof, a model's K is factorised with them pinned instead (the duality gap takes it too).
     """
     offers, active = offers or Offers(problem, solution), active_set(problem, solution)
     offered = [f for f in offers() if f.pinned is not None  # or the saddle point of this system
                or (getattr(f, "on", None) and f.on(problem.K, problem.N, active))]
     plain = all(f.pinned is not None and not f.pinned[0].size  # no pinned dof, no Delassus operator
                 and getattr(f, "delassus", None) is None for f in offered)
-    # a K of one's own may be indefinite, which a plain factorisation finds and a pinned one can
-    # miss (the negative curvature on the pinned dofs): only a model's K, positive by its making
     many = plain and problem.factorises_for_certificates and active.sum() >= PINNED_FROM \
-        and not problem.model.empty
+        and not problem.model.empty  # a K of one's own may be indefinite where it is pinned
     dofs = selection_dofs(problem.N) if many else None
     if dofs is not None:
         offered = [offers.add(PinnedFactor(problem.K, dofs[active]))]
@@ -384,7 +395,6 @@ def active_set(problem: ContactProblem, solution: ContactSolution,
     return classify(problem, solution, weak_tol) == ACTIVE
 
 
-__all__ = ["ACTIVE", "FORCE_FLOOR", "PINNED_FROM", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "WEAK", "WEAK_TOL",
-           "Certificate", "Offers", "REMEMBERED_SOLVES", "Remembering", "active_set", "certificate",
-           "classify", "force_scale",
-           "gap_scale", "inf_norm", "shortfall"]
+__all__ = ["ACTIVE", "FORCE_FLOOR", "FORCE_ROUNDOFF", "FORCE_SHORTFALL", "INACTIVE", "PINNED_FROM",
+           "REMEMBERED_SOLVES", "WEAK", "WEAK_TOL", "Certificate", "Offers", "Remembering",
+           "active_set", "certificate", "classify", "force_scale", "gap_scale", "inf_norm", "shortfall"]

@@ -239,6 +239,25 @@ def _dual(r0, r1, radial: bool) -> np.ndarray:
     return mass.sum(axis=-1)[..., None] * np.linalg.inv(mass)
 
 
+def _covered_dual(slave: Face, s: np.ndarray, lo: np.ndarray, hi: np.ndarray, phi_s: np.ndarray,
+                  dw: np.ndarray, radial: bool) -> np.ndarray:
+    """The dual coefficients A (e¹, 2, 2) of each slave segment, biorthogonal on the part of it
+    the master covers: :func:`_dual` on a segment the pieces ``s`` (slave coordinates lo to hi)
+    cover whole; on one they cover in part, ``A = D M꜀⁻¹`` with M꜀ the mass matrix of the
+    covered part (of the pieces' points ``phi_s`` and weights ``dw``), so that D stays diagonal
+    and positive, ``∫ φₛ`` over the cover. The whole segment's basis there has ``∫ ψₛ φₛ`` of
+    either sign (zero when half covered): the row, divided by it, would turn or blow up."""
+    ends_r = slave.points[0, slave.segments]  # (2, e¹)
+    A = _dual(ends_r[0], ends_r[1], radial)
+    partial = np.bincount(s, hi - lo, minlength=A.shape[0]) < 1.0 - END_TOLERANCE
+    partial &= np.bincount(s, minlength=A.shape[0]) > 0
+    if partial.any():
+        mass = np.zeros_like(A)
+        np.add.at(mass, s, np.einsum("ipq,jpq,pq->pij", phi_s, phi_s, dw))
+        A[partial] = mass[partial].sum(axis=-1)[..., None] * np.linalg.inv(mass[partial])
+    return A
+
+
 #: at most this many (slave, master) segment pairs are projected at once
 PAIRS_AT_ONCE = 1 << 20
 
@@ -298,8 +317,7 @@ def mortar(slave: Face, master: Face, basis: str = "dual",
     if basis == "standard":
         psi = phi_s
     else:
-        ends_r = slave.points[0, slave.segments]  # (2, e¹)
-        psi = np.einsum("pik,kpq->ipq", _dual(ends_r[0], ends_r[1], radial)[s], phi_s)
+        psi = np.einsum("pik,kpq->ipq", _covered_dual(slave, s, lo, hi, phi_s, dw, radial)[s], phi_s)
     y0, y1 = master.points[:, master.segments[0, m]], master.points[:, master.segments[1, m]]
     across = y0[..., None] + xi * (y1 - y0)[..., None] - (x0 + eta * t)  # (2, p, q)
     normal = (-master.normals[:, m] if direction is None  # (2, p): as node-to-segment

@@ -79,12 +79,13 @@ FACING = 0.5
 
 
 def _edge_rows(slave: Body, row_nodes: np.ndarray) -> np.ndarray:
-    """The rows whose slave node ends the contact face where the slave's boundary goes on facing
-    the other body (beyond the candidates, unseen by the QP): in contact, the zone may go on
-    beyond them (:mod:`signorini.certification.adequacy`). A face that ends at a side turned
-    away (a block's corner, a symmetry plane) has none."""
+    """The rows whose slave node ends the rows where the slave's boundary goes on facing the
+    other body (beyond the candidates, or on candidates the master face does not reach: unseen by
+    the QP): in contact, the zone may go on beyond them (:mod:`signorini.certification.adequacy`).
+    A face that ends at a side turned away (a block's corner, a symmetry plane) has none."""
     mesh = with_topology(slave.mesh)
-    beyond = np.setdiff1d(mesh.boundary_facets(), slave.contact_facets)
+    facets = mesh.boundary_facets()
+    beyond = facets[~np.isin(mesh.facets[:, facets], row_nodes).all(axis=0)]
     facing = outward_normals(mesh, slave.contact_facets).mean(axis=1)
     facing /= np.linalg.norm(facing)
     turned = facing @ outward_normals(mesh, beyond) > FACING

@@ -32,8 +32,9 @@ import numpy as np
 from signorini.problem.model import ReferenceData
 from signorini.fem.topology import facets_on
 from signorini.fem.two_bodies import Body, TwoBodyModel, series_modulus
-from signorini.scenes.base import (LOADING, MESHER, VOLUMETRIC, Case, Param, SceneFamily, SizeEstimate,
-                                   contact_ratio, hertz_load, length, one_of, positive)
+from signorini.scenes.base import (A_OVER_R_RANGE, LOADING, MESHER, VOLUMETRIC, Case, Param,
+                                   SceneFamily, SizeEstimate, checked_ratio, contact_ratio,
+                                   hertz_load, length, one_of, positive)
 from signorini.scenes.hertz_cylinder import CYLINDER, HertzDisc
 from signorini.scenes.hertz_cylinder import PARAMS as CYLINDER_PARAMS
 from signorini.scenes.hertz_cylinder import SIZE as ONE_DISC
@@ -117,9 +118,14 @@ class HertzPair:
     one_body: SizeEstimate
 
     def loads(self, p: dict[str, Any], given: set[str]) -> tuple[float | None, float | None, float]:
-        """The target load P (None: a prescribed push), the push δ (None: matched to P) and a/R*."""
-        return hertz_load(p, given, pair_radius(p), pair_modulus(p), self.one.half_width,
-                          self.one.load, check_delta=False)
+        """The target load P (None: a prescribed push), the push δ (None: matched to P) and a/R*;
+        a push that grades the mesh (spheres: ``√(δ R*)``) is checked as it is for one body, and
+        any push refused below it: the initial gaps, divided by δ, would lose the contact."""
+        loads = hertz_load(p, given, pair_radius(p), pair_modulus(p), self.one.half_width,
+                           self.one.load, check_delta=False, graded_by_delta=self.one.graded_by_delta)
+        if loads[1] is not None and np.sqrt(loads[1] / pair_radius(p)) < A_OVER_R_RANGE[0]:
+            checked_ratio(float(np.sqrt(loads[1] / pair_radius(p))), "delta", loads[1])
+        return loads
 
     def contact_size(self, p: dict[str, Any], target: float | None, delta: float | None) -> float:
         """The contact half-width (radius) the discs are graded for: Hertz's at the target load, or

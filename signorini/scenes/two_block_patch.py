@@ -41,7 +41,7 @@ from signorini.scenes.base import (VOLUMETRIC, Case, Param, SceneFamily, at_leas
                                    poisson_ratio, positive)
 from signorini.scenes.size import CountedSize
 
-__all__ = ["DISCRETISATION", "FAMILY", "compliance", "materials", "patch_pressure"]
+__all__ = ["DISCRETISATION", "FAMILY", "compliance", "materials", "patch_pressure", "slave_elements"]
 
 #: the analytic reference (signorini.references.catalogue) this family's problems compare with
 REFERENCE = "uniform"
@@ -100,6 +100,16 @@ def patch_pressure(p: dict[str, Any]) -> float:
     return _load_choice(p, set())[1] / compliance(p)
 
 
+def slave_elements(p: dict[str, Any]) -> int:
+    """The upper (slave) face's elements, ``round(mesh_ratio · nx)``; refused below one."""
+    count = round(p["mesh_ratio"] * p["nx"])
+    if count < 1:
+        raise InputError(f"scene parameter mesh_ratio={p['mesh_ratio']:g} gives the upper face "
+                         f"round(mesh_ratio · nx) = 0 elements with nx={p['nx']}: raise "
+                         f"mesh_ratio above {0.5 / p['nx']:g} or raise nx")
+    return count
+
+
 def _block(width: float, bottom: float, top: float, nx: int, ny: int) -> MeshTri:
     return MeshTri.init_tensor(np.linspace(0.0, width, nx + 1), np.linspace(bottom, top, ny + 1))
 
@@ -114,7 +124,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
     _, delta = _load_choice(p, set() if given is None else given)
     W, H1, H2 = p["W"], p["H1"], p["H2"]
     scale = max(W, H1, H2)
-    upper_nx = max(1, round(p["mesh_ratio"] * p["nx"]))
+    upper_nx = slave_elements(p)
     lower, upper = _block(W, -H1, 0.0, p["nx"], p["ny"]), _block(W, 0.0, H2, upper_nx, p["ny"])
     lower_face, upper_face = _on(lower, 1, 0.0, scale), _on(upper, 1, 0.0, scale)
     top = _on(upper, 1, H2, scale)
@@ -134,8 +144,7 @@ def build(p: dict[str, Any], given: set[str] | None = None) -> TwoBodyModel:
 
 def mesh_dofs(p: dict[str, Any]) -> float:
     """The dofs of the two structured meshes: two per node of each grid."""
-    upper_nx = max(1, round(p["mesh_ratio"] * p["nx"]))
-    return 2.0 * (p["nx"] + 1 + upper_nx + 1) * (p["ny"] + 1)
+    return 2.0 * (p["nx"] + 1 + slave_elements(p) + 1) * (p["ny"] + 1)
 
 
 FAMILY = SceneFamily(
