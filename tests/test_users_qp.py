@@ -50,8 +50,10 @@ def test_the_problem_holds_the_arrays_given(kind):
         assert sp.isspmatrix_csr(held[0]) and sp.isspmatrix_csr(held[2])
     result = signorini.solve(problem, "pdas")
     assert result.converged  # and in the user's units: their own KKT conditions hold
-    # the certificate took the method's factorisation of its scaled view, made no other
-    assert problem.cached_factor is None and result.certificate.back_solves > 0
+    # the certificate solved with the method's factorisation of its scaled view, and factorised
+    # the user's K itself, unpinned and in the user's units: a K of one's own may have no minimum
+    assert result.certificate.back_solves > 0
+    assert problem.cached_factor is not None and problem.cached_factor.matrix is problem.K
     assert np.max(np.abs(K @ result.u - F + N.T @ result.force)) <= 1e-9 * np.max(np.abs(F))
     assert np.all(N @ result.u <= D + 1e-12)
 
