@@ -75,7 +75,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from signorini.scenes import get_scene  # as above
     from signorini.scenes.size import check_size  # as above
     from signorini.solvers.registry import check_request, methods  # as above
-    from signorini.studies.bench import TOLERANCES, Run, run_benchmark, write_report  # as above
+    from signorini.studies.bench import (TOLERANCES, Run, check_csv, run_benchmark,  # as above
+                                          write_report)
 
     if args.problem is not None:  # a problem file is one size, solved as stored
         given = [flag for flag, on in (("--scene", args.scene), ("--sizes", args.sizes),
@@ -163,27 +164,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
-def check_csv(path: Path) -> None:
-    """InputError unless ``path`` is a regular UTF-8 file whose header names the benchmark's
-    columns (a CSV the benchmark wrote)."""
-    import csv  # per command (start-up)
-
-    from signorini.paths import check_input_file  # per command (start-up)
-    from signorini.studies.bench import COLUMNS  # per command (start-up)
-
-    check_input_file(str(path), "the benchmark's CSV", "remove it, or give another --out")
-    try:
-        with open(path, newline="", encoding="utf-8") as handle:
-            header = next(csv.reader(handle), [])
-    except (UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"{path} is not a CSV the benchmark wrote ({exc}): remove it, or give "
-                         "another --out") from None
-    missing = [column for column in COLUMNS if column not in header and column != "ranks"]
-    if missing:
-        raise InputError(f"{path} is not a CSV the benchmark wrote (no column {missing[0]!r}): "
-                         "remove it, or give another --out")
-
-
 def add_parsers(sub) -> None:
     """Register ``bench``."""
     bench = add_command(
@@ -226,4 +206,4 @@ def add_parsers(sub) -> None:
     bench.set_defaults(run=cmd_bench)
 
 
-__all__ = ["check_csv", "cmd_bench", "add_parsers"]
+__all__ = ["cmd_bench", "add_parsers"]

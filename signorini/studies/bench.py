@@ -34,6 +34,7 @@ from signorini.errors import InputError
 from signorini.files import all_or_none, atomic_write_text, save_figure, writable_directory
 from signorini.output import plots
 from signorini.output.report import status_claimed, provenance, provenance_lines
+from signorini.paths import check_input_file
 from signorini.reprs import markdown_table
 from signorini.scenes import build_problem
 from signorini.studies.runner import Row, Task, run_tasks
@@ -184,6 +185,22 @@ def run_benchmark(runs: Iterable[Run], out: Path, time_limit: float = 600.0,
     return csv_path
 
 
+def check_csv(path: Path) -> None:
+    """InputError unless ``path`` is a regular UTF-8 file whose header names the benchmark's
+    columns (a CSV the benchmark wrote)."""
+    check_input_file(str(path), "the benchmark's CSV", "remove it, or give another --out")
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            header = next(csv.reader(handle), [])
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{path} is not a CSV the benchmark wrote ({exc}): remove it, or give "
+                         "another --out") from None
+    missing = [column for column in COLUMNS if column not in header and column != "ranks"]
+    if missing:
+        raise InputError(f"{path} is not a CSV the benchmark wrote (no column {missing[0]!r}): "
+                         "remove it, or give another --out")
+
+
 # --- metrics and report ----------------------------------------------------------------------
 
 def read_rows(path: Path) -> list[dict[str, Any]]:
@@ -278,6 +295,6 @@ def write_report(csv_path: Path, command: str) -> Path:
     return path
 
 
-__all__ = ["Run", "reference_policy", "task_of", "bench_row", "done_keys", "append_row",
+__all__ = ["Run", "check_csv", "reference_policy", "task_of", "bench_row", "done_keys", "append_row",
            "problem_file", "stored_size", "run_benchmark", "read_rows", "shifted_geometric_mean",
            "summary", "write_report", "TOLERANCES"]
