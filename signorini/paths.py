@@ -58,12 +58,13 @@ def _probe(folder: Path, flag: str, path: Any) -> None:
     os.unlink(name)
 
 
-def check_output_file(path: str | os.PathLike, flag: str) -> str:
+def check_output_file(path: str | os.PathLike, flag: str, coming: tuple[str, ...] = ()) -> str:
     """The absolute path of a file output (``-`` for standard output), or InputError naming ``flag``.
 
-    The folder must exist and take new files, the path must not be a folder,
-    the name must fit the file system's limit and an existing file must be
-    writable; checked before any work.
+    The folder must exist and take new files, or be one of ``coming`` (absolute paths of output
+    folders the command creates, checked already); the path must not be a folder, the name
+    must fit the file system's limit and an existing file must be writable; checked before any
+    work.
     """
     if str(path) == "":
         raise _refuse(flag, path, "is empty", f"give a file name, e.g. {flag} {_EXAMPLES.get(flag, 'result')}")
@@ -80,6 +81,8 @@ def check_output_file(path: str | os.PathLike, flag: str) -> str:
             raise _refuse(flag, path, "is not writable", "choose a writable path")
         return os.path.abspath(path)
     if not target.parent.is_dir():
+        if os.path.abspath(target.parent) in coming:  # the command makes the folder first
+            return os.path.abspath(path)
         raise _refuse(flag, path, f"cannot be written: the folder {str(target.parent)!r} does not exist",
                       "create it or choose another path")
     try:
@@ -150,10 +153,12 @@ def check_outputs(files: Mapping[str, str | None] = {}, folders: Mapping[str, st
     (``/dev/null``) may take several.
     """
     given = {**files, **folders}
-    out = {flag: None if path is None else check_output_file(path, flag)
+    made = {flag: None if path is None else check_output_folder(path, flag)
+            for flag, path in folders.items()}
+    coming = tuple(path for path in made.values() if path is not None and not os.path.isdir(path))
+    out = {flag: None if path is None else check_output_file(path, flag, coming)
            for flag, path in files.items()}
-    out.update({flag: None if path is None else check_output_folder(path, flag)
-                for flag, path in folders.items()})
+    out.update(made)
     named = [(flag, path) for flag, path in out.items() if path is not None]
     for i, (flag, path) in enumerate(named):
         for other, there in named[:i]:

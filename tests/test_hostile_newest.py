@@ -176,3 +176,26 @@ def test_a_benchmark_csv_bench_did_not_write_is_refused_and_kept(tmp_path, capsy
     assert len(err.strip().splitlines()) == 1 and "bench.csv" in err and "Traceback" not in err
     assert (tmp_path / "bench.csv").read_bytes() == content
     assert not (tmp_path / "bench.md").exists()
+
+
+def test_a_load_far_beyond_hertz_is_refused_in_a_short_line():
+    """A huge P names the a/R it gives in a few digits, not a 150-digit fixed-point number."""
+    problem = build_problem("hertz-cylinder", {"n_contact": 8})
+    with pytest.raises(InputError) as raised:
+        signorini.with_load(problem, P=1e300)
+    message = str(raised.value)
+    assert "a/R = 1.08e+150 > 0.5" in message and len(message) < 200
+
+
+def test_a_junit_file_may_go_into_the_report_folder_validate_creates(tmp_path, capsys):
+    """``--junit`` inside the ``--out`` folder that does not exist yet: the command makes the
+    folder, so the path is taken, and the JUnit file is written beside the report."""
+    out = tmp_path / "new"
+    argv = ["validate", "--out", str(out), "--junit", str(out / "checks.xml"), "--method", "pdas",
+            "--case", "block"]
+    assert main(argv) == 0, capsys.readouterr().err
+    assert (out / "report.md").is_file() and "<testsuites" in (out / "checks.xml").read_text()
+    assert main(["validate", "--out", str(tmp_path / "other"), "--junit",
+                 str(tmp_path / "elsewhere" / "checks.xml"), "--method", "pdas", "--case",
+                 "block"]) == 2  # a folder no output makes is still refused
+    assert "does not exist" in capsys.readouterr().err

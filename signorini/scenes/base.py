@@ -224,7 +224,7 @@ def checked_ratio(a_over_R: float, name: str, value: float) -> float:
     """``a_over_R`` that the load parameter ``name=value`` gives, refused outside :data:`A_OVER_R_RANGE`."""
     lo, hi = A_OVER_R_RANGE
     if not a_over_R <= hi:
-        raise InputError(f"scene parameter {name}={value:g} gives a/R = {a_over_R:.2f} > {hi:g}: "
+        raise InputError(f"scene parameter {name}={value:g} gives a/R = {a_over_R:.3g} > {hi:g}: "
                          f"Hertz's half-space theory needs a/R small; lower {name}")
     if not a_over_R >= lo:
         raise InputError(f"scene parameter {name}={value:g} gives a/R = {a_over_R:.2g} < {lo:g}: "
