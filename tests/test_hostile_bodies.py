@@ -41,6 +41,21 @@ def test_an_indefinite_qp_is_not_certified_on_a_pinned_factorisation():
     assert not cert.passed(1e-8) and np.isinf(cert.duality_gap)
 
 
+def test_a_qp_with_no_minimum_is_judged_indefinite_once(monkeypatch):
+    """The certificate that finds no minimum says so to its own fallback: the eigenvalue check
+    (and, past the dense size, a shifted factorisation) runs once, not once more on the way out."""
+    from signorini.certification import kkt
+    from signorini.numerics.active_set import PinnedFactor
+    from signorini.problem.contact import ContactSolution
+    calls = []
+    monkeypatch.setattr(kkt, "indefinite", lambda K: calls.append(K) or True)
+    problem = saddle_qp()
+    answer = ContactSolution(method="given", u=np.array([0.5, 1.0]), lam=np.array([0.5, 1.0]),
+                             status="converged", factor=PinnedFactor(problem.K, np.array([0, 1])))
+    assert np.isinf(kkt.certificate(problem, answer).duality_gap)
+    assert len(calls) == 1
+
+
 def test_a_singular_qp_held_by_its_contact_keeps_its_verdict():
     """K = [[1, −1], [−1, 1]] leaves a rigid mode that the active row holds: the answer is unique,
     and a singular K that is not indefinite keeps the other residuals' verdict."""

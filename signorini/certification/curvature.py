@@ -11,7 +11,11 @@ from signorini.numerics.arrays import DENSE_EIGEN_DOFS, NEGATIVE_CURVATURE
 from signorini.numerics.arrays import indefinite as negative_quotient
 from signorini.numerics.factor import available_backends, factorize
 
-__all__ = ["indefinite"]
+__all__ = ["NoMinimum", "indefinite"]
+
+
+class NoMinimum(np.linalg.LinAlgError):
+    """K has a negative eigenvalue (:func:`indefinite` said so): the QP has no minimum."""
 
 
 def indefinite(K) -> bool:

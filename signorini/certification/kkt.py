@@ -18,7 +18,7 @@ import numpy as np
 
 from signorini.errors import InputError
 from signorini.numerics.active_set import PinnedFactor, selection_dofs
-from signorini.certification.curvature import indefinite
+from signorini.certification.curvature import NoMinimum, indefinite
 from signorini.certification.inverse import ForwardError, forward_error, pinned_rows, primal_dual_gap
 from signorini.problem.contact import ContactProblem, ContactSolution
 
@@ -224,10 +224,10 @@ def certificate(problem: ContactProblem, solution: ContactSolution,
     try:
         with np.errstate(all="ignore"):  # an answer beyond double precision: inf residuals say so
             cert = _certificate(problem, solution, duality_gap)
-    except np.linalg.LinAlgError:  # K singular or indefinite: no dual function, no Newton step
+    except np.linalg.LinAlgError as exc:  # K singular or indefinite: no dual, no Newton step
         with np.errstate(all="ignore"):
             cert = _certificate(problem, solution, False)
-        if np.isfinite(cert.primal) and indefinite(problem.K):  # no minimum: no answer to certify
+        if np.isfinite(cert.primal) and (isinstance(exc, NoMinimum) or indefinite(problem.K)):
             cert = replace(cert, duality_gap=float("inf"))
     solution._certificate = (key, tuple(map(np.array, arrays)), cert)
     return cert
@@ -254,8 +254,8 @@ def _certificate(problem: ContactProblem, solution: ContactSolution,
     gap, forward = float("nan"), ForwardError.unknown()
     if duality_gap:
         offers = Offers(problem, solution)
-        if _no_minimum(problem, offers()):
-            raise np.linalg.LinAlgError("K is indefinite")
+        if _no_minimum(problem, offers()):  # no minimum: no answer to certify
+            raise NoMinimum("K is indefinite")
         forward = _forward(problem, solution, lam_norm, offers, Ku)
         energy = float(0.5 * u @ Ku - problem.f @ u)
         absolute = primal_dual_gap(problem, u, lam, offers(), Ku)

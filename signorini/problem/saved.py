@@ -91,7 +91,8 @@ def load(path: str | os.PathLike, problem_type: type) -> Any:
     try:
         with np.load(path, allow_pickle=False) as z:
             declared_sizes(os.fspath(path), z.zip)  # before an array of a declared size is made
-            return _read(z, problem_type)
+            arrays = {name: z[name] for name in z}  # each read from the archive once
+        return _read(arrays, problem_type)
     except InputError as exc:
         text = str(exc)
         if text.startswith("problem file"):
@@ -125,9 +126,10 @@ def declared_sizes(path: str, archive: zipfile.ZipFile) -> dict[str, tuple[int, 
     return declared
 
 
-def _read(z: Any, problem_type: type) -> Any:
-    """The problem in the open archive ``z``, its arrays and meta checked first (:func:`_fits`)."""
-    if "meta" not in z.files:
+def _read(z: dict[str, np.ndarray], problem_type: type) -> Any:
+    """The problem in the arrays ``z`` read from the archive, its arrays and meta checked first
+    (:func:`_fits`)."""
+    if "meta" not in z:
         raise InputError("it holds no 'meta'")
     try:
         meta = json.loads(bytes(z["meta"]).decode())
@@ -217,7 +219,7 @@ _NUMBERS = {"scales": ("length", "displacement", "force", "weight"),
             "push": ("offset1", "scale", "offset_load", "load", "target", "delta", "P")}
 
 
-def _fits(z: Any, meta: dict[str, Any]) -> tuple[int, int]:
+def _fits(z: dict[str, np.ndarray], meta: dict[str, Any]) -> tuple[int, int]:
     """``(n, m)`` when every stored array and number is of the kind and size :func:`save`
     writes (checked before any is used, so that nothing of a declared size is built first);
     InputError naming the first that is not."""
@@ -252,16 +254,16 @@ def _fits(z: Any, meta: dict[str, Any]) -> tuple[int, int]:
         required += ["push_f1", "push_d0", "push_d1"] if records["push"] is not None else []
         required += [f"watch_{part}" for part in ("data", "indices", "indptr", "gaps", "edge",
                                                   "candidate_gaps")] if about.get("watch") else []
-    missing = [name for name in required if name not in z.files]
+    missing = [name for name in required if name not in z]
     if missing:
         raise InputError(f"it holds no {missing[0]!r}")
     shape = z["shape"]
     if shape.dtype.kind not in "iu" or shape.shape != (2,) or min(shape) < 0:
         raise InputError(f"'shape' is {shape.tolist()}, not the two sizes n and m")
     sizes = {"n": int(shape[0]), "m": int(shape[1]), "n+1": int(shape[0]) + 1,
-             "m+1": int(shape[1]) + 1, "0": 0, "D": z["prescribed"].size if "prescribed" in z.files
-             else -1, "P": z["mesh_p"].shape[-1] if "mesh_p" in z.files else -1}
-    for name in z.files:
+             "m+1": int(shape[1]) + 1, "0": 0, "D": z["prescribed"].size if "prescribed" in z
+             else -1, "P": z["mesh_p"].shape[-1] if "mesh_p" in z else -1}
+    for name in z:
         kinds, expected = _ARRAYS.get(name, ("", ()))
         if not kinds:
             raise InputError(f"{name!r} is not an array ContactProblem.save writes")
@@ -279,9 +281,9 @@ def _fits(z: Any, meta: dict[str, Any]) -> tuple[int, int]:
             raise InputError(f"{name!r} holds NaN or inf")
     limits = {"free_dofs": sizes["D"], "mesh_t": sizes["P"]}
     for name, limit in limits.items():
-        if name in z.files and z[name].size and not 0 <= z[name].min() <= z[name].max() < limit:
+        if name in z and z[name].size and not 0 <= z[name].min() <= z[name].max() < limit:
             raise InputError(f"{name!r} indexes outside 0..{limit - 1}")
-    if "mesh_t" in z.files and z["mesh_t"].shape[0] != z["mesh_p"].shape[0] + 1:
+    if "mesh_t" in z and z["mesh_t"].shape[0] != z["mesh_p"].shape[0] + 1:
         raise InputError(f"'mesh_t' has {z['mesh_t'].shape[0]} corners per element, not "
                          f"{z['mesh_p'].shape[0] + 1} (a simplex in {z['mesh_p'].shape[0]}D)")
     if records["push"] is not None and not isinstance(records["push"].get("pending"), bool):
@@ -308,7 +310,7 @@ def _model_record(about: dict[str, Any], push: dict[str, Any] | None) -> None:
         raise InputError("meta push is pending without a target load to match")
 
 
-def _watch(z: Any, stored: dict[str, Any] | None, dofs: int) -> Watch | None:
+def _watch(z: dict[str, np.ndarray], stored: dict[str, Any] | None, dofs: int) -> Watch | None:
     """The boundary beyond the candidates :func:`save` stored (None when the model had none),
     its rows checked before SciPy's C code reads them; ValueError when they do not fit."""
     if stored is None:

@@ -123,8 +123,9 @@ class HertzPair:
         any push refused below it: the initial gaps, divided by δ, would lose the contact."""
         loads = hertz_load(p, given, pair_radius(p), pair_modulus(p), self.one.half_width,
                            self.one.load, check_delta=False, graded_by_delta=self.one.graded_by_delta)
-        if loads[1] is not None and np.sqrt(loads[1] / pair_radius(p)) < A_OVER_R_RANGE[0]:
-            checked_ratio(float(np.sqrt(loads[1] / pair_radius(p))), "delta", loads[1])
+        ratio = None if loads[1] is None else float(np.sqrt(loads[1] / pair_radius(p)))
+        if ratio is not None and ratio < A_OVER_R_RANGE[0]:  # a large push is judged, not refused
+            checked_ratio(ratio, "delta", loads[1])
         return loads
 
     def contact_size(self, p: dict[str, Any], target: float | None, delta: float | None) -> float:
